@@ -1,0 +1,54 @@
+"""Compiled march of a contact law over a prescribed history."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._jit import specialize
+
+__all__ = ["march"]
+
+
+def _march_template(params, s0, x, N, T, kT, code, s_final):  # pragma: no cover - compiled
+    """March ``STEP`` over samples ``x[i], N[i]``, committing after each."""
+    a = s0.copy()
+    b = np.empty_like(s0)
+    for i in range(x.shape[0]):
+        t_, k_, c_ = STEP(params, a, b, x[i], N[i])  # noqa: F821 - bound by specialize
+        T[i] = t_
+        kT[i] = k_
+        code[i] = c_
+        a, b = b, a
+    s_final[:] = a
+
+
+def march(law, x, N, state=None):
+    """Force history of ``law`` for displacement and normal-load samples.
+
+    Parameters
+    ----------
+    law : ContactLaw
+        Any registered contact law.
+    x : ndarray
+        Tangential displacement samples, m.
+    N : ndarray
+        Normal-load samples, N (same length).
+    state : ndarray, optional
+        Committed state to start from; default the law's virgin state at
+        ``x[0], N[0]``.
+
+    Returns
+    -------
+    T, kT, code, state : ndarray, ndarray, ndarray(int8), ndarray
+        Force (N), tangent (N/m), motion state per sample, final state.
+    """
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    N = np.ascontiguousarray(N, dtype=np.float64)
+    s0 = law.initial_state(float(x[0]), float(N[0])) if state is None else np.array(state, dtype=np.float64)
+    n = x.shape[0]
+    T = np.empty(n)
+    kT = np.empty(n)
+    code = np.empty(n, dtype=np.int8)
+    s_final = np.empty_like(s0)
+    specialize(_march_template, STEP=law.step)(law.params, s0, x, N, T, kT, code, s_final)
+    return T, kT, code, s_final

@@ -1,0 +1,9 @@
+"""Paper figures, one compute + plot pair per figure, registered by name.
+
+Modules in this package register their figures on import; :func:`figure_names`
+imports them all.
+"""
+
+from ._registry import FIGURES, Figure, figure_names, make_figure, register_figure
+
+__all__ = ["FIGURES", "Figure", "figure_names", "make_figure", "register_figure"]

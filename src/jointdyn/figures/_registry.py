@@ -1,0 +1,90 @@
+"""Figure registry: compute data, save it, plot from the saved data.
+
+A figure is registered by name with two functions:
+
+``compute() -> dict[str, pandas.DataFrame]``
+    the numbers, as named tables;
+``plot(tables, out_dir) -> list[Path]``
+    draws PNG (and SVG) files from the tables as read back from CSV.
+
+:func:`make_figure` runs compute, writes ``<name>_<table>.csv`` atomically,
+reads them back and calls plot, so every picture is reproducible from the
+data beside it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import pandas as pd
+
+from .._io import atomic_path
+
+__all__ = ["Figure", "register_figure", "figure_names", "make_figure", "FIGURES"]
+
+FIGURES: dict[str, "Figure"] = {}
+
+
+@dataclass(frozen=True)
+class Figure:
+    name: str
+    title: str
+    compute: Callable[[], dict]
+    plot: Callable[[dict, Path], list]
+    order: int = 100
+
+
+def register_figure(name: str, title: str, order: int = 100):
+    """Decorator for a ``compute`` function; its ``.plot`` attribute is set by
+    ``@<compute>.plotter``."""
+
+    def deco(compute):
+        holder = {}
+
+        def plotter(plot):
+            FIGURES[name] = Figure(name=name, title=title, compute=compute, plot=plot, order=order)
+            holder["plot"] = plot
+            return plot
+
+        compute.plotter = plotter
+        return compute
+
+    return deco
+
+
+def figure_names() -> list[str]:
+    _load_all()
+    return [f.name for f in sorted(FIGURES.values(), key=lambda f: (f.order, f.name))]
+
+
+def _load_all() -> None:
+    import importlib
+    import pkgutil
+
+    from . import __path__ as pkg_path
+
+    for info in pkgutil.iter_modules(pkg_path):
+        if not info.name.startswith("_"):
+            importlib.import_module(f"{__package__}.{info.name}")
+
+
+def make_figure(name: str, out_dir) -> list[Path]:
+    """Compute, save and plot one registered figure; returns written paths."""
+    _load_all()
+    if name not in FIGURES:
+        raise ValueError(f"figure must be one of {', '.join(figure_names())}; got {name!r}")
+    fig = FIGURES[name]
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    tables = fig.compute()
+    written = []
+    for key, df in tables.items():
+        path = out / f"{name}_{key}.csv"
+        with atomic_path(path) as tmp:
+            df.to_csv(tmp, index=False)
+        written.append(path)
+    saved = {key: pd.read_csv(out / f"{name}_{key}.csv") for key in tables}
+    written += [Path(p) for p in fig.plot(saved, out)]
+    return written

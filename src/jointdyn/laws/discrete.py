@@ -1,0 +1,206 @@
+"""Discrete Iwan model: n parallel Jenkins elements (MODEL.md section 5).
+
+The ground truth of jointdyn: exact for any history (Masing memory is
+automatic) and any normal-load variation. ``n = 1`` is a single Jenkins
+element whose slip force follows the normal load (Yang-Menq contact).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from .. import _validate as V
+from .._jit import jit
+from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, register
+
+__all__ = ["DiscreteIwan", "Jenkins", "discrete_step", "discrete_step_jvp"]
+
+# params layout: [kt, fy, n_ref, n, f_1 ... f_n]  (f_i: total slip force of
+# element i at the reference load, i.e. element limit = alpha * f_i / n)
+# state layout:  [x_prev, p_1 ... p_n]            (p_i: element force, N)
+_P_HEAD = 4
+_S_HEAD = 1
+
+
+@jit
+def _discrete_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
+    # Derivative arguments are all arrays or all None (pruned at compile time).
+    kt = params[0]
+    n_ref = params[2]
+    n = int(params[3])
+    alpha = N / n_ref
+    nd = 0
+    if dx is not None:
+        nd = dx.shape[0]
+    s_new[0] = x
+    if ds_new is not None:
+        for j in range(nd):
+            ds_new[0, j] = dx[j]
+            dT[j] = 0.0
+    if alpha <= 0.0:
+        for i in range(n):
+            s_new[_S_HEAD + i] = 0.0
+        if ds_new is not None:
+            for i in range(n):
+                for j in range(nd):
+                    ds_new[_S_HEAD + i, j] = 0.0
+        return 0.0, 0.0, SEPARATION
+    ke = kt / n
+    inc = ke * (x - s_old[0])
+    scale = alpha / n
+    T = 0.0
+    nstick = 0
+    for i in range(n):
+        lim = scale * params[_P_HEAD + i]
+        p = s_old[_S_HEAD + i] + inc
+        stick = True
+        if p > lim:
+            p = lim
+            stick = False
+        elif p < -lim:
+            p = -lim
+            stick = False
+        s_new[_S_HEAD + i] = p
+        T += p
+        nstick += stick
+        if ds_new is not None:
+            r = _S_HEAD + i
+            if stick:
+                for j in range(nd):
+                    dp = ds_old[r, j] + ke * (dx[j] - ds_old[0, j])
+                    ds_new[r, j] = dp
+                    dT[j] += dp
+            else:
+                c = (1.0 if p > 0.0 else -1.0) * params[_P_HEAD + i] / (n * n_ref)
+                for j in range(nd):
+                    dp = c * dN[j]
+                    ds_new[r, j] = dp
+                    dT[j] += dp
+    code = MACROSLIP if nstick == 0 else STICK_SLIP
+    return T, ke * nstick, code
+
+
+@jit
+def discrete_step(params, s_old, s_new, x, N):
+    """Trial step of n Jenkins elements with load-scaled slip forces.
+
+    Implements MODEL.md section 5: for each element, trial force
+    ``p_i + (kt/n) dx``, clipped to ``alpha f_i / n`` with
+    ``alpha = N / N_ref``; all ``p_i = 0`` when ``alpha <= 0``.
+
+    Parameters
+    ----------
+    params : float64[:]
+        ``[kt (N/m), fy (N), N_ref (N), n, f_1..f_n (N)]``.
+    s_old, s_new : float64[:]
+        ``[x_prev (m), p_1..p_n (N)]``; ``s_old`` is not written.
+    x : float
+        Tangential displacement, m.
+    N : float
+        Normal load, N.
+
+    Returns
+    -------
+    T : float
+        Tangential force, N.
+    kT : float
+        Tangent stiffness dT/dx, N/m (sum over sticking elements).
+    code : int
+        STICK_SLIP, MACROSLIP (every element slipping) or SEPARATION.
+    """
+    return _discrete_core(params, s_old, s_new, x, N, None, None, None, None, None)
+
+
+@jit
+def discrete_step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT):
+    """``discrete_step`` with forward-mode derivatives along ``dx.size`` directions.
+
+    A sticking element carries ``dp_i = dp_i_old + (kt/n)(dx - dx_prev)``;
+    a slipping one ``dp_i = sign(p_i) f_i dN / (n N_ref)``; separation zeroes
+    everything. ``ds_*`` rows follow the state layout.
+    """
+    return _discrete_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT)
+
+
+@dataclass(frozen=True)
+class DiscreteIwan(ContactLaw):
+    """n parallel Jenkins elements, slip forces scaled by N(t)/N_ref.
+
+    Element i has stiffness kt/n and slip force alpha(t) f_i / n, with f_i at
+    the midpoints of n equal bins of [0, 2 fy] (uniform slip density, the
+    discrete counterpart of :class:`~jointdyn.Iwan`). Exact for any history.
+
+    Parameters
+    ----------
+    kt : float
+        Total tangential stiffness, N/m.
+    mu : float
+        Friction coefficient.
+    n_ref : float
+        Reference normal load, N.
+    n : int
+        Number of Jenkins elements (>= 1). ``n = 1`` is one Jenkins element
+        with slip force mu N(t) (use :class:`Jenkins`).
+    """
+
+    n: int = 1000
+    name: ClassVar[str] = "discrete"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        object.__setattr__(self, "n", V.positive_int("n", self.n))
+
+    @property
+    def step(self):
+        return discrete_step
+
+    @property
+    def step_jvp(self):
+        return discrete_step_jvp
+
+    @property
+    def params(self) -> np.ndarray:
+        n = self.n
+        f = 2.0 * self.fy * (np.arange(n) + 0.5) / n
+        return np.concatenate(([self.kt, self.fy, self.n_ref, float(n)], f))
+
+    @property
+    def state_size(self) -> int:
+        return _S_HEAD + self.n
+
+    def initial_state(self, x0: float = 0.0, n0: float | None = None) -> np.ndarray:
+        s = np.zeros(self.state_size)
+        s[0] = x0
+        return s
+
+
+@dataclass(frozen=True)
+class Jenkins(DiscreteIwan):
+    """One Jenkins element (spring kt in series with a slider mu N(t)).
+
+    The Yang-Menq contact with the normal load prescribed; equals
+    ``DiscreteIwan(n=1)``.
+    """
+
+    n: int = 1
+    name: ClassVar[str] = "jenkins"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.n != 1:
+            raise ValueError(f"n must be 1 for a Jenkins element (allowed range [1, 1]), got {self.n}")
+
+
+def _make_discrete(*, kt, mu, n_ref, n=1000, **_):
+    return DiscreteIwan(kt=kt, mu=mu, n_ref=n_ref, n=n)
+
+
+def _make_jenkins(*, kt, mu, n_ref, **_):
+    return Jenkins(kt=kt, mu=mu, n_ref=n_ref)
+
+
+register("discrete", _make_discrete)
+register("jenkins", _make_jenkins)

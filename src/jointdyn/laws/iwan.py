@@ -1,0 +1,390 @@
+"""Closed-form Iwan model with time-varying normal load (MODEL.md sections 2-4).
+
+Uniform slip density on [0, 2 alpha fy], alpha(t) = N(t)/N_ref. The force on
+a branch that started at a reversal point (q0, G0, alpha0) is the modified
+Masing rule (paper section 2.1, normalised form; MODEL.md section 3)::
+
+    G = G0 + d c G_oa(|q - q0| / c; alpha),   c = 1 + alpha0 / alpha,
+    G_oa(u; a) = u - u^2 / (4 a)  (u < 2a),   a  (u >= 2a),
+
+with q = kt x / fy, G = T / fy and d the direction of motion, clipped to
+|G| <= alpha (macroslip). Two memory rules are offered:
+
+``memory="full"`` (default)
+    Masing's extended rules: a stack of reversal points; a branch that
+    reaches an earlier reversal point rejoins the branch that point belonged
+    to and both points are forgotten. When the clip is active every slider
+    slips, so the memory is wiped and the saturation point (q_s, alpha_s)
+    is remembered: continuing in the same direction after alpha rises, the
+    sliders re-stick and G = d alpha_s + d G_oa(|q - q_s|; alpha - alpha_s)
+    (exact for the uniform density). At constant alpha this equals the
+    discrete model (n -> inf) for ANY history.
+``memory="last"``
+    The paper's rule: only the last reversal point is kept (exact for steady
+    symmetric cycles at constant alpha, wrong for nested or growing loops);
+    branch formula and clip applied at every step. The paper writes
+    -G_oa(q0) where we use the actual force G0 at the reversal; the two
+    agree on steady cycles at constant alpha and G0 keeps T continuous.
+
+Separation (alpha <= 0): T = 0, all memory lost; the next contact starts a
+virgin curve G = G_oa(q - q_c; alpha) from the re-contact point q_c.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from .. import _validate as V
+from .. import config
+from .._jit import jit
+from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, register
+
+__all__ = ["Iwan", "iwan_step", "iwan_step_jvp", "backbone"]
+
+# params: [kt, fy, n_ref, memory (0 full, 1 last), max_depth]
+# state : [q_prev, G_prev, a_prev, dir, base, base_q, base_a, m, (q_i, G_i, a_i) * max_depth]
+#   base: 0 separated, 1 virgin (base_q = q_c), 2 saturated (base_q = q_s, base_a = alpha_s)
+_Q, _G, _A, _DIR, _BASE, _BQ, _BA, _M = 0, 1, 2, 3, 4, 5, 6, 7
+_HEAD = 8
+_SEP, _VIRGIN, _SAT = 0.0, 1.0, 2.0
+_SAT_RTOL = 1e-12
+
+
+@jit
+def _goa(u, a):
+    """Normalised backbone G_oa(u; a) for u >= 0 and its partials (d/du, d/da)."""
+    if u < 2.0 * a:
+        return u - u * u / (4.0 * a), 1.0 - u / (2.0 * a), u * u / (4.0 * a * a)
+    return a, 0.0, 1.0
+
+
+@jit
+def backbone(q, alpha):
+    """Normalised virgin curve G_oa(q; alpha), odd in q (MODEL.md eq. of section 3).
+
+    Parameters
+    ----------
+    q : float
+        Normalised displacement kt x / fy.
+    alpha : float
+        Normal-load ratio N / N_ref (> 0).
+
+    Returns
+    -------
+    float
+        G = T / fy.
+    """
+    if q >= 0.0:
+        return _goa(q, alpha)[0]
+    return -_goa(-q, alpha)[0]
+
+
+@jit
+def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
+    # The derivative arguments are either all arrays or all None; Numba
+    # prunes the ``is not None`` branches at compile time, so the plain step
+    # carries no derivative code at all.
+    kt = params[0]
+    fy = params[1]
+    n_ref = params[2]
+    last_only = params[3] != 0.0
+    max_depth = int(params[4])
+    alpha = N / n_ref
+    nd = 0
+    if dx is not None:
+        nd = dx.shape[0]
+
+    # --- separation (or no friction) ---------------------------------------
+    if alpha <= 0.0 or fy <= 0.0:
+        qs0 = kt / fy if fy > 0.0 else 0.0
+        for r in range(_HEAD):
+            s_new[r] = 0.0
+        s_new[_Q] = qs0 * x
+        s_new[_A] = alpha
+        if ds_new is not None:
+            for j in range(nd):
+                for r in range(_HEAD):
+                    ds_new[r, j] = 0.0
+                ds_new[_Q, j] = qs0 * dx[j]
+                ds_new[_A, j] = dN[j] / n_ref
+                dT[j] = 0.0
+        if alpha > 0.0:
+            s_new[_BASE] = _VIRGIN
+            return 0.0, 0.0, MACROSLIP
+        s_new[_BASE] = _SEP
+        return 0.0, 0.0, SEPARATION
+
+    qs = kt / fy  # dq = qs * dx
+    ia = 1.0 / n_ref  # dalpha = ia * dN
+    q = qs * x
+
+    # --- (re)contact: virgin curve from here --------------------------------
+    if s_old[_BASE] == _SEP:
+        for r in range(_HEAD):
+            s_new[r] = 0.0
+        s_new[_Q] = q
+        s_new[_A] = alpha
+        s_new[_BASE] = _VIRGIN
+        s_new[_BQ] = q
+        if ds_new is not None:
+            for j in range(nd):
+                for r in range(_HEAD):
+                    ds_new[r, j] = 0.0
+                ds_new[_Q, j] = qs * dx[j]
+                ds_new[_A, j] = ia * dN[j]
+                ds_new[_BQ, j] = qs * dx[j]
+                dT[j] = 0.0
+        return 0.0, kt, STICK_SLIP
+
+    # --- copy the live part of the committed state --------------------------
+    m = int(s_old[_M])
+    for r in range(_HEAD + 3 * m):
+        s_new[r] = s_old[r]
+    if ds_new is not None:
+        for r in range(_HEAD + 3 * m):
+            for j in range(nd):
+                ds_new[r, j] = ds_old[r, j]
+    q_prev = s_old[_Q]
+    d = s_old[_DIR]
+    base = s_old[_BASE]
+
+    # --- reversal detection: the previous point becomes a reversal point ---
+    if q != q_prev:
+        dnew = 1.0 if q > q_prev else -1.0
+        if d == 0.0:
+            d = dnew
+        elif dnew != d:
+            if last_only:
+                m = 0
+            elif m >= max_depth:
+                m -= 2  # forget the innermost pair (documented limitation)
+            r = _HEAD + 3 * m
+            s_new[r] = q_prev
+            s_new[r + 1] = s_old[_G]
+            s_new[r + 2] = s_old[_A]
+            if ds_new is not None:
+                for j in range(nd):
+                    ds_new[r, j] = ds_old[_Q, j]
+                    ds_new[r + 1, j] = ds_old[_G, j]
+                    ds_new[r + 2, j] = ds_old[_A, j]
+            m += 1
+            d = dnew
+
+    # --- Masing's extended rules: rejoin earlier branches ------------------
+    if not last_only:
+        while True:
+            if m >= 2:
+                if d * (q - s_new[_HEAD + 3 * (m - 2)]) >= 0.0:
+                    m -= 2
+                    continue
+            elif m == 1 and base == _VIRGIN:
+                if d * (q - (2.0 * s_new[_BQ] - s_new[_HEAD])) >= 0.0:
+                    m = 0
+                    continue
+            break
+
+    # --- force from the current branch -------------------------------------
+    # dG = cq*dq + ca*dalpha + c0q*dq_ref + c0g*dG_ref + c0a*dalpha_ref,
+    # (q_ref, G_ref, alpha_ref) being state rows ref, ref+1, ref+2
+    cq = 0.0
+    ca = 0.0
+    c0q = 0.0
+    c0g = 0.0
+    c0a = 0.0
+    ref = _BQ  # rows _BQ, _BA: base point (G row unused, c0g = 0)
+    if m == 0:
+        if base == _VIRGIN:
+            u = q - s_new[_BQ]
+            sg = 1.0 if u > 0.0 else (-1.0 if u < 0.0 else (d if d != 0.0 else 1.0))
+            g, gu, ga = _goa(sg * u, alpha)
+            G = sg * g
+            cq = gu
+            c0q = -gu
+            ca = sg * ga
+        else:  # saturated base, moving on in its direction
+            asat = s_new[_BA]
+            aeff = alpha - asat
+            if aeff > 0.0:
+                u = d * (q - s_new[_BQ])
+                if u < 0.0:
+                    u = 0.0
+                g, gu, ga = _goa(u, aeff)
+                G = d * asat + d * g
+                cq = gu
+                c0q = -gu
+                ca = d * ga
+                c0a = d - d * ga
+            else:
+                G = d * alpha
+                ca = d
+    else:
+        ref = _HEAD + 3 * (m - 1)
+        q0 = s_new[ref]
+        g0 = s_new[ref + 1]
+        a0 = s_new[ref + 2]
+        c = 1.0 + a0 / alpha
+        u = d * (q - q0) / c
+        if u < 0.0:
+            u = 0.0
+        g, gu, ga = _goa(u, alpha)
+        G = g0 + d * c * g
+        # dG = dG0 + d*dc*(g - gu*u) + gu*(dq - dq0) + d*c*ga*dalpha,
+        # dc = dalpha0/alpha - a0 dalpha/alpha^2
+        k1 = d * (g - gu * u)
+        cq = gu
+        c0q = -gu
+        c0g = 1.0
+        c0a = k1 / alpha
+        ca = -k1 * a0 / (alpha * alpha) + d * c * ga
+
+    # --- clip (macroslip) ---------------------------------------------------
+    code = STICK_SLIP
+    if G >= alpha * (1.0 - _SAT_RTOL) or G <= -alpha * (1.0 - _SAT_RTOL):
+        sg = 1.0 if G > 0.0 else -1.0
+        G = sg * alpha
+        code = MACROSLIP
+        cq = 0.0
+        c0q = 0.0
+        c0g = 0.0
+        c0a = 0.0
+        ca = sg
+        if not last_only:
+            # every slider slips: wipe the memory, remember the saturation
+            m = 0
+            base = _SAT
+            d = sg
+            s_new[_BQ] = q
+            s_new[_BA] = alpha
+            if ds_new is not None:
+                for j in range(nd):
+                    ds_new[_BQ, j] = qs * dx[j]
+                    ds_new[_BA, j] = ia * dN[j]
+
+    # --- derivatives ------------------------------------------------------
+    if ds_new is not None:
+        for j in range(nd):
+            dgj = (
+                cq * qs * dx[j]
+                + ca * ia * dN[j]
+                + c0q * ds_new[ref, j]
+                + c0g * ds_new[ref + 1, j]
+                + c0a * ds_new[ref + 2 if ref != _BQ else _BA, j]
+            )
+            dT[j] = fy * dgj
+            ds_new[_Q, j] = qs * dx[j]
+            ds_new[_G, j] = dgj
+            ds_new[_A, j] = ia * dN[j]
+
+    s_new[_Q] = q
+    s_new[_G] = G
+    s_new[_A] = alpha
+    s_new[_DIR] = d
+    s_new[_BASE] = base
+    s_new[_M] = m
+    return fy * G, kt * cq, code
+
+
+@jit
+def iwan_step(params, s_old, s_new, x, N):
+    """Trial step of the closed-form Iwan law (see module docstring).
+
+    Parameters
+    ----------
+    params : float64[:]
+        ``[kt (N/m), fy (N), N_ref (N), memory (0 full / 1 last), max_depth]``.
+    s_old, s_new : float64[:]
+        Committed (not written) and trial state, length ``8 + 3 max_depth``.
+    x : float
+        Tangential displacement, m.
+    N : float
+        Normal load, N.
+
+    Returns
+    -------
+    T : float
+        Tangential force, N (paper eq. for T-> / T<-, MODEL.md section 3).
+    kT : float
+        Tangent dT/dx at fixed N, N/m.
+    code : int
+        STICK_SLIP, MACROSLIP or SEPARATION.
+    """
+    return _iwan_core(params, s_old, s_new, x, N, None, None, None, None, None)
+
+
+@jit
+def iwan_step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT):
+    """:func:`iwan_step` with forward-mode derivatives along ``dx.size`` directions."""
+    return _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT)
+
+
+@dataclass(frozen=True)
+class Iwan(ContactLaw):
+    """Closed-form Iwan law with slip forces scaled by N(t)/N_ref.
+
+    Parameters
+    ----------
+    kt : float
+        Total tangential stiffness, N/m.
+    mu : float
+        Friction coefficient; fy = mu n_ref is the macroslip force at N_ref.
+    n_ref : float
+        Reference normal load N_ref, N.
+    memory : {"full", "last"}
+        ``"full"``: Masing's extended rules (exact at constant N for any
+        history); ``"last"``: the paper's last-reversal-only rule.
+    max_depth : int
+        Capacity of the reversal-point stack (>= 2). When full, the
+        innermost pair of reversal points is forgotten.
+    """
+
+    memory: str = "full"
+    max_depth: int = config.IWAN_MAX_DEPTH
+    name: ClassVar[str] = "iwan"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        V.choice("memory", self.memory, ("full", "last"))
+        object.__setattr__(self, "max_depth", V.positive_int("max_depth", self.max_depth, 2))
+
+    @property
+    def step(self):
+        return iwan_step
+
+    @property
+    def step_jvp(self):
+        return iwan_step_jvp
+
+    @property
+    def params(self) -> np.ndarray:
+        return np.array(
+            [self.kt, self.fy, self.n_ref, 0.0 if self.memory == "full" else 1.0, float(self.max_depth)]
+        )
+
+    @property
+    def state_size(self) -> int:
+        return _HEAD + 3 * self.max_depth
+
+    def initial_state(self, x0: float = 0.0, n0: float | None = None) -> np.ndarray:
+        s = np.zeros(self.state_size)
+        a = 1.0 if n0 is None else float(n0) / self.n_ref
+        q = self.kt * x0 / self.fy if self.fy > 0 else 0.0
+        s[_Q] = q
+        s[_A] = a
+        s[_BASE] = _VIRGIN if a > 0 else _SEP
+        s[_BQ] = q
+        return s
+
+
+def _make_iwan(*, kt, mu, n_ref, **_):
+    return Iwan(kt=kt, mu=mu, n_ref=n_ref, memory="full")
+
+
+def _make_iwan_paper(*, kt, mu, n_ref, **_):
+    return Iwan(kt=kt, mu=mu, n_ref=n_ref, memory="last")
+
+
+register("iwan", _make_iwan)
+register("iwan-paper", _make_iwan_paper)
