@@ -26,3 +26,11 @@ TEST_IWAN_VS_DISCRETE_FY = 5e-3
 TEST_REFERENCE_ATOL_FY = 1e-9
 #: energy created over a closed cycle may not exceed this fraction of fy*A
 TEST_ENERGY_CREATION_TOL = 1e-9
+
+# --- quasi-static driver and loop metrics (issue 2) ----------------------
+
+# --- time integration and steady state (issue 3) --------------------------
+
+# --- sweeps (issue 3) -----------------------------------------------------
+
+# --- harmonic balance, continuation, stability (issue 4) ------------------
