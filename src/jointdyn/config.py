@@ -28,6 +28,19 @@ TEST_REFERENCE_ATOL_FY = 1e-9
 TEST_ENERGY_CREATION_TOL = 1e-9
 
 # --- quasi-static driver and loop metrics (issue 2) ----------------------
+#: a time within this fraction of a step (harmonic grid) or of the history
+#: duration (cycle windows) is the same instant: crossing instants and cycle
+#: boundaries snap onto existing samples instead of creating tiny steps
+QS_SNAP_RTOL = 1e-9
+#: load (as a fraction of n_ref) at which a law is evaluated at a re-contact
+#: instant (N = 0 followed by N > 0), so that the virgin curve starts exactly
+#: there; the sample is reported as separated with T = 0
+QS_RECONTACT_LOAD = 1e-300
+#: test: exactness of the separation time fraction with crossings inserted
+TEST_QS_FRACTION_ATOL = 1e-9
+#: test: closed-form Iwan vs discrete (n = 1000) energy per cycle at constant
+#: N, relative (discretisation error of the ground truth is O(1/n^2))
+TEST_QS_DISCRETE_ENERGY_RTOL = 5e-3
 
 # --- time integration and steady state (issue 3) --------------------------
 
