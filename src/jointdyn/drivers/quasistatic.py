@@ -220,7 +220,7 @@ def read_history_csv(path):
 # --------------------------------------------------------------------------
 # result
 # --------------------------------------------------------------------------
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class LoopResult:
     """Response of a contact law to a prescribed history, with loop metrics.
 
