@@ -58,6 +58,16 @@ def test_harmonic_history_inserts_exact_crossings(delta):
     np.testing.assert_allclose(N[keep], N0 + 1.2 * N0 * np.sin(2 * math.pi * f * t[keep] + delta), rtol=1e-12)
 
 
+def test_harmonic_history_crossing_on_grid_point_is_not_duplicated():
+    # eta = 2, delta = 0: sin = -1/2 at phases 7 pi/6 and 11 pi/6, i.e. t = 7/12, 11/12
+    t, x, N = harmonic_history(1e-4, 1.0, N0, eta=2.0, cycles=2, steps_per_cycle=12)
+    assert t.size == 25 and np.all(np.diff(t) > 0)
+    for c in (7 / 12, 11 / 12, 19 / 12, 23 / 12):
+        i = int(np.argmin(np.abs(t - c)))
+        assert abs(t[i] - c) < 1e-15 and N[i] == 0.0
+    assert np.count_nonzero(N == 0.0) == 4
+
+
 def test_harmonic_history_no_crossings_when_in_contact():
     t, x, N = harmonic_history(1e-4, 1.0, N0, eta=0.9, delta=1.0, cycles=2, steps_per_cycle=40, x_offset=1e-4)
     assert t.size == 81 and np.all(N > 0)
