@@ -321,3 +321,30 @@ def test_read_history_csv_validates(tmp_path, text, name):
 def test_read_history_csv_missing_file(tmp_path):
     with pytest.raises(ValueError, match="existing CSV"):
         read_history_csv(tmp_path / "nope.csv")
+
+
+def _branch_microslip_fractions(r):
+    """Time fractions of stick-slip on the unloading and loading branches."""
+    sl = r.cycle_slice(-1)
+    dx = np.diff(r.x[sl])
+    dt = np.diff(r.t[sl])
+    cc = r.code[sl][1:]
+    unl, lod = dx < 0, dx > 0
+    return (
+        np.sum(dt[unl & (cc == STICK_SLIP)]) / np.sum(dt[unl]),
+        np.sum(dt[lod & (cc == STICK_SLIP)]) / np.sum(dt[lod]),
+    )
+
+
+@pytest.mark.parametrize("delta_deg, sign", [(0.0, +1), (90.0, -1)])
+def test_paper_trends_of_state_regions(delta_deg, sign):
+    """Paper section 2.2: in phase, as eta grows, the stick-slip part of the
+    unloading branch grows and that of the loading branch shrinks (macroslip
+    the other way round); out of phase (90 deg) the reverse."""
+    fr = np.array([
+        _branch_microslip_fractions(harmonic_loop(law("iwan"), 0.5e-3, eta=eta, delta=math.radians(delta_deg),
+                                                  steps_per_cycle=1000))
+        for eta in (0.0, 0.3, 0.6, 0.9)
+    ])
+    assert np.all(sign * np.diff(fr[:, 0]) > 0)  # unloading
+    assert np.all(-sign * np.diff(fr[:, 1]) > 0)  # loading
