@@ -370,7 +370,10 @@ class Iwan(ContactLaw):
     def initial_state(self, x0: float = 0.0, n0: float | None = None) -> np.ndarray:
         s = np.zeros(self.state_size)
         a = 1.0 if n0 is None else float(n0) / self.n_ref
-        q = self.kt * x0 / self.fy if self.fy > 0 else 0.0
+        # the same expression as the kernels' q = (kt/fy) x, bit for bit: a
+        # rounding difference would look like motion and, under the paper's
+        # last-reversal rule, turn the virgin curve into a reversal branch
+        q = (self.kt / self.fy) * x0 if self.fy > 0 else 0.0
         s[_Q] = q
         s[_A] = a
         s[_BASE] = _VIRGIN if a > 0 else _SEP
