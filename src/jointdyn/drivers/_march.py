@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import _validate as V
 from .._jit import specialize
 
 __all__ = ["march"]
@@ -37,14 +38,26 @@ def march(law, x, N, state=None):
         Committed state to start from; default the law's virgin state at
         ``x[0], N[0]``.
 
+    Raises
+    ------
+    ValueError
+        If ``x`` or ``N`` is empty, not 1-D or not finite, if their lengths
+        differ, or if ``state`` is not finite or not ``law.state_size`` long.
+
     Returns
     -------
     T, kT, code, state : ndarray, ndarray, ndarray(int8), ndarray
         Force (N), tangent (N/m), motion state per sample, final state.
     """
-    x = np.ascontiguousarray(x, dtype=np.float64)
-    N = np.ascontiguousarray(N, dtype=np.float64)
-    s0 = law.initial_state(float(x[0]), float(N[0])) if state is None else np.array(state, dtype=np.float64)
+    x = V.finite_array("x", x)
+    N = V.finite_array("N", N)
+    V.same_length(x=x, N=N)
+    if state is None:
+        s0 = law.initial_state(float(x[0]), float(N[0]))
+    else:
+        s0 = V.finite_array("state", state).copy()
+        if s0.shape[0] != law.state_size:
+            raise ValueError(f"state must have length law.state_size = {law.state_size}, got {s0.shape[0]}")
     n = x.shape[0]
     T = np.empty(n)
     kT = np.empty(n)
