@@ -91,9 +91,7 @@ def test_march_empty_or_2d(which):
 
 
 def test_march_bad_state():
-    with pytest.raises(ValueError, match="state must have length"):
+    with pytest.raises(ValueError, match="state must have shape"):
         march(LAW, np.zeros(3), np.ones(3), state=np.zeros(3))
-    s = LAW.initial_state()
-    s[0] = math.nan
-    with pytest.raises(ValueError, match="state must be finite"):
-        march(LAW, np.zeros(3), np.ones(3), state=s)
+    with pytest.raises(ValueError, match="state must have shape"):
+        march(LAW, np.zeros(3), np.ones(3), state=np.zeros((LAW.state_size, 1)))

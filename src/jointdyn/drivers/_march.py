@@ -42,7 +42,7 @@ def march(law, x, N, state=None):
     ------
     ValueError
         If ``x`` or ``N`` is empty, not 1-D or not finite, if their lengths
-        differ, or if ``state`` is not finite or not ``law.state_size`` long.
+        differ, or if ``state`` is not a vector of ``law.state_size``.
 
     Returns
     -------
@@ -55,9 +55,11 @@ def march(law, x, N, state=None):
     if state is None:
         s0 = law.initial_state(float(x[0]), float(N[0]))
     else:
-        s0 = V.finite_array("state", state).copy()
-        if s0.shape[0] != law.state_size:
-            raise ValueError(f"state must have length law.state_size = {law.state_size}, got {s0.shape[0]}")
+        # not checked for finiteness: rows beyond a state's live part (e.g. the
+        # unused reversal-point stack of Iwan) may hold anything
+        s0 = np.array(state, dtype=np.float64)
+        if s0.ndim != 1 or s0.shape[0] != law.state_size:
+            raise ValueError(f"state must have shape ({law.state_size},) (law.state_size), got {s0.shape}")
     n = x.shape[0]
     T = np.empty(n)
     kT = np.empty(n)
