@@ -82,7 +82,10 @@ def backbone(q, alpha):
     return -_goa(-q, alpha)[0]
 
 
-@jit
+# inline="always": inlined (Numba IR) into the two public kernels, so that
+# they are small enough for LLVM to inline into the caller's time loop; a
+# call with three arrays passed field by field cost half of the step time.
+@jit(inline="always")
 def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
     # The derivative arguments are either all arrays or all None; Numba
     # prunes the ``is not None`` branches at compile time, so the plain step
