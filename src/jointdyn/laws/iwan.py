@@ -144,8 +144,11 @@ def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
         return 0.0, kt, STICK_SLIP
 
     # --- copy the live part of the committed state --------------------------
+    # (rows _Q, _G, _A, _DIR, _BASE, _M are written at the end of the step)
     m = int(s_old[_M])
-    for r in range(_HEAD + 3 * m):
+    s_new[_BQ] = s_old[_BQ]
+    s_new[_BA] = s_old[_BA]
+    for r in range(_HEAD, _HEAD + 3 * m):
         s_new[r] = s_old[r]
     if ds_new is not None:
         for r in range(_HEAD + 3 * m):
