@@ -9,7 +9,8 @@ and random displacement and normal-load histories.
   arbitrary state it is >= -kt sum(dx^2)/8, the largest trapezoid error of an
   elastic-plastic element per step (an exact cycle integral is >= 0 by
   Ilyushin's postulate);
-* the kernels never write their committed state (``step`` and ``step_jvp``).
+* the kernels never write their committed state (``step`` and ``step_jvp``),
+  and a march split in two pieces (state handed over) equals one march.
 """
 
 import numpy as np
@@ -145,3 +146,19 @@ def test_kernels_leave_committed_state_untouched(data):
         assert out == out_j  # primal outputs of step_jvp are step's, bit for bit
         s, s_new = s_new.copy(), s
         ds, ds_new = ds_new.copy(), ds
+
+
+@settings(max_examples=30, deadline=None)
+@given(data=st.data())
+def test_march_in_pieces_equals_one_march(data):
+    """Committing is complete: marching a history in two pieces, the second
+    from the state the first returned, gives the same forces bit for bit."""
+    law = data.draw(laws())
+    x, N = data.draw(histories(law))
+    k = data.draw(st.integers(1, x.size - 1))
+    T, kT, code, s_end = march(law, x, N)
+    T1, kT1, c1, s1 = march(law, x[:k], N[:k])
+    T2, kT2, c2, s2 = march(law, x[k:], N[k:], state=s1)
+    assert np.array_equal(np.concatenate([T1, T2]), T)
+    assert np.array_equal(np.concatenate([kT1, kT2]), kT)
+    assert np.array_equal(np.concatenate([c1, c2]), code)
