@@ -41,6 +41,16 @@ TEST_QS_FRACTION_ATOL = 1e-9
 #: test: closed-form Iwan vs discrete (n = 1000) energy per cycle at constant
 #: N, relative (discretisation error of the ground truth is O(1/n^2))
 TEST_QS_DISCRETE_ENERGY_RTOL = 5e-3
+#: contact-law tests: tangent kT of compiled kernels vs plain-Python
+#: references (absolute, in units of kt)
+TEST_REFERENCE_ATOL_KT = 1e-9
+#: contact-law tests: step_jvp vs central finite differences of the march
+#: (relative to the largest derivative of the history)
+TEST_JVP_RTOL = 1e-6
+#: contact-law tests: finite-difference step, relative to the history's scale
+TEST_JVP_FD_STEP = 1e-6
+#: contact-law tests: |T| <= alpha fy (1 + this) (rounding of the clip)
+TEST_FORCE_BOUND_RTOL = 1e-12
 
 # --- time integration and steady state (issue 3) --------------------------
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import _validate as V
 from .._jit import specialize
 
 __all__ = ["march"]
@@ -37,14 +38,28 @@ def march(law, x, N, state=None):
         Committed state to start from; default the law's virgin state at
         ``x[0], N[0]``.
 
+    Raises
+    ------
+    ValueError
+        If ``x`` or ``N`` is empty, not 1-D or not finite, if their lengths
+        differ, or if ``state`` is not a vector of ``law.state_size``.
+
     Returns
     -------
     T, kT, code, state : ndarray, ndarray, ndarray(int8), ndarray
         Force (N), tangent (N/m), motion state per sample, final state.
     """
-    x = np.ascontiguousarray(x, dtype=np.float64)
-    N = np.ascontiguousarray(N, dtype=np.float64)
-    s0 = law.initial_state(float(x[0]), float(N[0])) if state is None else np.array(state, dtype=np.float64)
+    x = V.finite_array("x", x)
+    N = V.finite_array("N", N)
+    V.same_length(x=x, N=N)
+    if state is None:
+        s0 = law.initial_state(float(x[0]), float(N[0]))
+    else:
+        # not checked for finiteness: rows beyond a state's live part (e.g. the
+        # unused reversal-point stack of Iwan) may hold anything
+        s0 = np.array(state, dtype=np.float64)
+        if s0.ndim != 1 or s0.shape[0] != law.state_size:
+            raise ValueError(f"state must have shape ({law.state_size},) (law.state_size), got {s0.shape}")
     n = x.shape[0]
     T = np.empty(n)
     kT = np.empty(n)

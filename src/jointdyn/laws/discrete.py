@@ -25,9 +25,37 @@ _P_HEAD = 4
 _S_HEAD = 1
 
 
+@jit(inline="always")
+def _lane_sum(a, lo, hi):
+    """sum(a[lo:hi]) in eight interleaved partial sums, combined pairwise.
+
+    Eight independent accumulators break the add latency chain (the loop
+    is throughput-bound instead of latency-bound) without ``fastmath``;
+    the summation order is fixed, so every caller gets the same bits.
+    """
+    n8 = lo + (hi - lo) // 8 * 8
+    t0 = t1 = t2 = t3 = t4 = t5 = t6 = t7 = 0.0
+    for i in range(lo, n8, 8):
+        t0 += a[i]
+        t1 += a[i + 1]
+        t2 += a[i + 2]
+        t3 += a[i + 3]
+        t4 += a[i + 4]
+        t5 += a[i + 5]
+        t6 += a[i + 6]
+        t7 += a[i + 7]
+    t = ((t0 + t1) + (t2 + t3)) + ((t4 + t5) + (t6 + t7))
+    for i in range(n8, hi):
+        t += a[i]
+    return t
+
+
 @jit
 def _discrete_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
     # Derivative arguments are all arrays or all None (pruned at compile time).
+    # Not inlined into callers: as a function of its own, the element loop
+    # below compiles to SIMD code (AVX-512 where available); inlined into a
+    # time loop it did not vectorise.
     kt = params[0]
     n_ref = params[2]
     n = int(params[3])
@@ -51,24 +79,21 @@ def _discrete_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
     ke = kt / n
     inc = ke * (x - s_old[0])
     scale = alpha / n
-    T = 0.0
+    # element loop, branch-free so that it vectorises: trial force, clamp to
+    # +-limit with max/min, count the elements the clamp left alone (stuck)
     nstick = 0
     for i in range(n):
         lim = scale * params[_P_HEAD + i]
         p = s_old[_S_HEAD + i] + inc
-        stick = True
-        if p > lim:
-            p = lim
-            stick = False
-        elif p < -lim:
-            p = -lim
-            stick = False
-        s_new[_S_HEAD + i] = p
-        T += p
-        nstick += stick
-        if ds_new is not None:
+        pc = min(max(p, -lim), lim)
+        s_new[_S_HEAD + i] = pc
+        nstick += pc == p
+    T = _lane_sum(s_new, _S_HEAD, _S_HEAD + n)
+    if ds_new is not None:
+        for i in range(n):
             r = _S_HEAD + i
-            if stick:
+            p = s_new[r]
+            if p == s_old[r] + inc:  # stuck: same test as above, same bits
                 for j in range(nd):
                     dp = ds_old[r, j] + ke * (dx[j] - ds_old[0, j])
                     ds_new[r, j] = dp

@@ -1,0 +1,120 @@
+"""Forward-mode kernels (``step_jvp``) against central finite differences.
+
+The derivative of the force history along a perturbation of the displacement
+history and/or the normal-load history, propagated through the state by
+``step_jvp``, must equal the central difference of two marches of ``step``
+(to ``TEST_JVP_RTOL`` of the largest derivative) for histories with
+reversals, macroslip, varying load and separation, as long as no sample sits
+at a state transition (the perturbed marches must pass through the same
+motion states, which the test checks). The primal outputs of ``step_jvp``
+must be ``step``'s bit for bit.
+"""
+
+import numpy as np
+import pytest
+
+import law_histories as H
+
+from jointdyn import DiscreteIwan, Iwan, Jenkins, march
+from jointdyn import config as C
+from jointdyn._jit import specialize
+
+KT, MU, NREF = 1e5, 0.1, 100.0
+XS = 2.0 * MU * NREF / KT
+
+
+def _march_jvp_template(params, s0, ds0, x, dx, N, dN, T, kT, code, dT):  # pragma: no cover - compiled
+    a = s0.copy()
+    b = np.empty_like(s0)
+    da = ds0.copy()
+    db = np.empty_like(ds0)
+    for i in range(x.shape[0]):
+        t_, k_, c_ = STEP_JVP(params, a, da, b, db, x[i], dx[i], N[i], dN[i], dT[i])  # noqa: F821
+        T[i] = t_
+        kT[i] = k_
+        code[i] = c_
+        a, b = b, a
+        da, db = db, da
+
+
+def march_jvp(law, x, dx, N, dN, state):
+    n, nd = dx.shape
+    T, kT, dT = np.empty(n), np.empty(n), np.empty((n, nd))
+    code = np.empty(n, dtype=np.int8)
+    ds0 = np.zeros((law.state_size, nd))
+    fn = specialize(_march_jvp_template, STEP_JVP=law.step_jvp)
+    fn(law.params, state, ds0, x, np.ascontiguousarray(dx), N, np.ascontiguousarray(dN), T, kT, code, dT)
+    return T, kT, code, dT
+
+
+LAWS = {
+    "iwan-full": Iwan(kt=KT, mu=MU, n_ref=NREF),
+    "iwan-last": Iwan(kt=KT, mu=MU, n_ref=NREF, memory="last"),
+    "discrete-7": DiscreteIwan(kt=KT, mu=MU, n_ref=NREF, n=7),
+    "jenkins": Jenkins(kt=KT, mu=MU, n_ref=NREF),
+}
+
+
+def _case(seed, eta):
+    rng = np.random.default_rng(seed)
+    x = H.random_reversals(rng, 14, 2.5 * XS, steps=(6, 30))
+    N = H.normal_history(rng, x.size, NREF, eta)
+    n = x.size
+    # three directions: displacement only, load only, both; the first sample
+    # is held (it fixes the virgin state the marches start from)
+    dx = np.zeros((n, 3))
+    dN = np.zeros((n, 3))
+    dx[1:, 0] = rng.normal(size=n - 1) * XS
+    dN[1:, 1] = rng.normal(size=n - 1) * NREF
+    dx[1:, 2] = rng.normal(size=n - 1) * XS
+    dN[1:, 2] = rng.normal(size=n - 1) * NREF
+    return x, N, dx, dN
+
+
+@pytest.mark.parametrize("name", sorted(LAWS))
+@pytest.mark.parametrize("seed,eta", [(1, 0.0), (2, 0.5), (3, 0.8), (4, 1.3), (5, 1.6)])
+def test_jvp_equals_finite_differences(name, seed, eta):
+    law = LAWS[name]
+    x, N, dx, dN = _case(seed, eta)
+    s0 = law.initial_state(x[0], N[0])
+    T, kT, code, dT = march_jvp(law, x, dx, N, dN, s0)
+    T0, kT0, code0, _ = march(law, x, N, state=s0)
+    # primal outputs of step_jvp are step's, exactly
+    np.testing.assert_array_equal(T, T0)
+    np.testing.assert_array_equal(kT, kT0)
+    np.testing.assert_array_equal(code, code0)
+    h = C.TEST_JVP_FD_STEP
+    for j in range(dx.shape[1]):
+        Tp, _, cp, _ = march(law, x + h * dx[:, j], N + h * dN[:, j], state=s0)
+        Tm, _, cm, _ = march(law, x - h * dx[:, j], N - h * dN[:, j], state=s0)
+        # the perturbed histories cross no state transition
+        np.testing.assert_array_equal(cp, code0)
+        np.testing.assert_array_equal(cm, code0)
+        fd = (Tp - Tm) / (2 * h)
+        scale = np.max(np.abs(fd))
+        assert scale > 0.0
+        np.testing.assert_allclose(dT[:, j], fd, rtol=0, atol=C.TEST_JVP_RTOL * scale)
+
+
+def test_jvp_cases_cover_every_state():
+    """Guard of the test above: its histories reach all motion states."""
+    seen = set()
+    for seed, eta in [(1, 0.0), (4, 1.3)]:
+        x, N, dx, dN = _case(seed, eta)
+        seen.update(np.unique(march(LAWS["iwan-full"], x, N)[2]).tolist())
+    assert seen == {0, 1, 2}
+
+
+def test_jvp_of_constant_load_branch_closed_form():
+    """d T / d x along a Masing branch: kT of the branch, by hand: after a
+    reversal at q0 the slope is kt (1 - (q0 - q)/(4 alpha)) (c = 2)."""
+    law = LAWS["iwan-full"]
+    x = np.concatenate([np.linspace(0, 0.8 * XS, 20), np.linspace(0.8 * XS, 0.0, 21)[1:]])
+    N = np.full(x.size, NREF)
+    dx = np.zeros((x.size, 1))
+    dx[-1, 0] = 1.0  # move only the last sample
+    dN = np.zeros_like(dx)
+    T, kT, code, dT = march_jvp(law, x, dx, N, dN, law.initial_state(0.0, NREF))
+    q0, q = 1.6, 0.0
+    assert dT[-1, 0] == pytest.approx(KT * (1 - (q0 - q) / 4.0), rel=1e-12)
+    assert kT[-1] == pytest.approx(KT * (1 - (q0 - q) / 4.0), rel=1e-12)
