@@ -110,10 +110,30 @@ class IwanRef:
         self.base = "virgin" if a > 0.0 else "separated"
         self.q_base = q  # q_c (virgin) or q_s (saturated)
         self.a_base = 0.0  # alpha_s (saturated)
+        self.g_base = 0.0  # force offset of the base curve (rejoins under varying alpha)
+
+    def _branch(self, q, alpha, d):
+        """Force and slope of the current branch (top reversal point or base)."""
+        if self.stack:
+            q0, G0, a0 = self.stack[-1]
+            c = 1.0 + a0 / alpha
+            u = max(0.0, d * (q - q0) / c)
+            g, slope = goa(u, alpha)
+            return G0 + d * c * g, slope
+        if self.base == "virgin":
+            u = q - self.q_base
+            g, slope = goa(abs(u), alpha)
+            return _sign(u) * g + self.g_base, slope
+        a_extra = alpha - self.a_base  # saturated base
+        if a_extra > 0.0:
+            g, slope = goa(max(0.0, d * (q - self.q_base)), a_extra)
+            return d * self.a_base + d * g + self.g_base, slope
+        return d * alpha + self.g_base, 0.0
 
     def _forget(self, q, alpha):
         self.stack = []
         self.direction = 0.0
+        self.g_base = 0.0
         self.q_last, self.G_last, self.a_last = q, 0.0, alpha
 
     def step(self, x, N):
@@ -147,38 +167,33 @@ class IwanRef:
                 self.direction = moving
         d = self.direction
 
-        # Masing's extended rules
+        # Masing's extended rules; a rejoin keeps T continuous by adding the
+        # difference (zero at constant alpha) to the rejoined branch
         if not self.last_only:
             while True:
                 if len(self.stack) >= 2 and d * (q - self.stack[-2][0]) >= 0.0:
+                    q_t = self.stack[-2][0]
+                    before = self._branch(q_t, alpha, d)[0]
                     del self.stack[-2:]
                 elif (
                     len(self.stack) == 1
                     and self.base == "virgin"
                     and d * (q - (2.0 * self.q_base - self.stack[0][0])) >= 0.0
                 ):
+                    q_t = 2.0 * self.q_base - self.stack[0][0]
+                    before = self._branch(q_t, alpha, d)[0]
                     self.stack = []
                 else:
                     break
+                # mismatch of the two branches at the rejoin point q_t
+                jump = before - self._branch(q_t, alpha, d)[0]
+                if self.stack:
+                    q0, G0, a0 = self.stack[-1]
+                    self.stack[-1] = (q0, G0 + jump, a0)
+                else:
+                    self.g_base += jump
 
-        # current branch
-        if self.stack:
-            q0, G0, a0 = self.stack[-1]
-            c = 1.0 + a0 / alpha
-            u = max(0.0, d * (q - q0) / c)
-            g, slope = goa(u, alpha)
-            G = G0 + d * c * g
-        elif self.base == "virgin":
-            u = q - self.q_base
-            g, slope = goa(abs(u), alpha)
-            G = _sign(u) * g
-        else:  # saturated
-            a_extra = alpha - self.a_base
-            if a_extra > 0.0:
-                g, slope = goa(max(0.0, d * (q - self.q_base)), a_extra)
-                G = d * self.a_base + d * g
-            else:
-                G, slope = d * alpha, 0.0
+        G, slope = self._branch(q, alpha, d)
 
         code = STICK_SLIP
         if abs(G) >= alpha * (1.0 - SAT_RTOL):
@@ -187,7 +202,7 @@ class IwanRef:
             if not self.last_only:
                 self.stack = []
                 self.base = "saturated"
-                self.q_base, self.a_base = q, alpha
+                self.q_base, self.a_base, self.g_base = q, alpha, 0.0
                 self.direction = sg
 
         self.q_last, self.G_last, self.a_last = q, G, alpha

@@ -18,7 +18,11 @@ with q = kt x / fy, G = T / fy and d the direction of motion, clipped to
     is remembered: continuing in the same direction after alpha rises, the
     sliders re-stick and G = d alpha_s + d G_oa(|q - q_s|; alpha - alpha_s)
     (exact for the uniform density). At constant alpha this equals the
-    discrete model (n -> inf) for ANY history.
+    discrete model (n -> inf) for ANY history. When alpha has changed since
+    the forgotten reversal points, the rejoined branch no longer passes
+    through the current point; the difference is kept as a constant force
+    offset on the rejoined branch (on its G0, or on the base curve), which
+    is zero at constant alpha and keeps T continuous.
 ``memory="last"``
     The paper's rule: only the last reversal point is kept (exact for steady
     symmetric cycles at constant alpha, wrong for nested or growing loops);
@@ -45,10 +49,11 @@ from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, register
 __all__ = ["Iwan", "iwan_step", "iwan_step_jvp", "backbone"]
 
 # params: [kt, fy, n_ref, memory (0 full, 1 last), max_depth]
-# state : [q_prev, G_prev, a_prev, dir, base, base_q, base_a, m, (q_i, G_i, a_i) * max_depth]
-#   base: 0 separated, 1 virgin (base_q = q_c), 2 saturated (base_q = q_s, base_a = alpha_s)
-_Q, _G, _A, _DIR, _BASE, _BQ, _BA, _M = 0, 1, 2, 3, 4, 5, 6, 7
-_HEAD = 8
+# state : [q_prev, G_prev, a_prev, dir, base, base_q, base_a, m, base_G, (q_i, G_i, a_i) * max_depth]
+#   base: 0 separated, 1 virgin (base_q = q_c), 2 saturated (base_q = q_s, base_a = alpha_s);
+#   base_G: force offset of the base curve left by rejoins under varying alpha
+_Q, _G, _A, _DIR, _BASE, _BQ, _BA, _M, _BG = 0, 1, 2, 3, 4, 5, 6, 7, 8
+_HEAD = 9
 _SEP, _VIRGIN, _SAT = 0.0, 1.0, 2.0
 _SAT_RTOL = 1e-12
 
@@ -81,6 +86,53 @@ def backbone(q, alpha):
     if q >= 0.0:
         return _goa(q, alpha)[0]
     return -_goa(-q, alpha)[0]
+
+
+@jit(inline="always")
+def _branch(s, m, base, d, q, alpha):
+    """Force on the current branch and its partials.
+
+    Returns ``G, cq, ca, c0q, c0g, c0a, rq, rg, ra``: the normalised force and
+    the coefficients of dG = cq dq + ca dalpha + c0q dq_ref + c0g dG_ref +
+    c0a dalpha_ref, where the reference quantities are state rows rq, rg, ra
+    (the top reversal point (q0, G0, alpha0), or the base point with its
+    force offset).
+    """
+    if m == 0:
+        off = s[_BG]
+        if base == _VIRGIN:
+            u = q - s[_BQ]
+            sg = 1.0 if u > 0.0 else (-1.0 if u < 0.0 else (d if d != 0.0 else 1.0))
+            g, gu, ga = _goa(sg * u, alpha)
+            return sg * g + off, gu, sg * ga, -gu, 1.0, 0.0, _BQ, _BG, _BA
+        # saturated base, moving on in its direction
+        asat = s[_BA]
+        aeff = alpha - asat
+        if aeff > 0.0:
+            u = d * (q - s[_BQ])
+            if u < 0.0:
+                u = 0.0
+            g, gu, ga = _goa(u, aeff)
+            return d * asat + d * g + off, gu, d * ga, -gu, 1.0, d - d * ga, _BQ, _BG, _BA
+        return d * alpha + off, 0.0, d, 0.0, 1.0, 0.0, _BQ, _BG, _BA
+    ref = _HEAD + 3 * (m - 1)
+    q0 = s[ref]
+    g0 = s[ref + 1]
+    a0 = s[ref + 2]
+    # G = G0 + d c G_oa(v / c; alpha) with v = d (q - q0), c = 1 + a0/alpha,
+    # simplifies to G0 + d (v - v^2 / (4 S)) for v < 2 S, G0 + d S beyond,
+    # S = alpha + a0 = c alpha: one division instead of five
+    v = d * (q - q0)
+    if v < 0.0:
+        v = 0.0
+    S = alpha + a0
+    if v < 2.0 * S:
+        h = 0.5 * v / S  # = u / (2 alpha), u = v / c
+        # dG/dalpha = dG/dalpha0 = d v^2 / (4 S^2)
+        cq = 1.0 - h
+        ca = d * h * h
+        return g0 + d * (v - 0.5 * v * h), cq, ca, -cq, 1.0, ca, ref, ref + 1, ref + 2
+    return g0 + d * S, 0.0, d, 0.0, 1.0, d, ref, ref + 1, ref + 2
 
 
 # inline="always": inlined (Numba IR) into the two public kernels, so that
@@ -148,6 +200,7 @@ def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
     m = int(s_old[_M])
     s_new[_BQ] = s_old[_BQ]
     s_new[_BA] = s_old[_BA]
+    s_new[_BG] = s_old[_BG]
     for r in range(_HEAD, _HEAD + 3 * m):
         s_new[r] = s_old[r]
     if ds_new is not None:
@@ -181,78 +234,47 @@ def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
             d = dnew
 
     # --- Masing's extended rules: rejoin earlier branches ------------------
+    # At constant alpha the rejoined branch passes through the current point
+    # (exact Masing memory). When alpha has changed since its reversal point
+    # it does not, and a plain rejoin would make T jump; the mismatch of the
+    # two branches at the rejoin point qt is kept as a constant force offset
+    # on the rejoined branch (its G0, or the base offset): zero at constant
+    # alpha, and T continuous as the step shrinks.
     if not last_only:
         while True:
+            m_after = -1
+            qt = 0.0
             if m >= 2:
-                if d * (q - s_new[_HEAD + 3 * (m - 2)]) >= 0.0:
-                    m -= 2
-                    continue
+                qt = s_new[_HEAD + 3 * (m - 2)]
+                if d * (q - qt) >= 0.0:
+                    m_after = m - 2
             elif m == 1 and base == _VIRGIN:
-                if d * (q - (2.0 * s_new[_BQ] - s_new[_HEAD])) >= 0.0:
-                    m = 0
-                    continue
-            break
+                qt = 2.0 * s_new[_BQ] - s_new[_HEAD]
+                if d * (q - qt) >= 0.0:
+                    m_after = 0
+            if m_after < 0:
+                break
+            # mismatch of the two branches at the rejoin point qt
+            gb, cqb, cab, c0qb, c0gb, c0ab, rqb, rgb, rab = _branch(s_new, m, base, d, qt, alpha)
+            ga, cqa, caa, c0qa, c0ga, c0aa, rqa, rga, raa = _branch(s_new, m_after, base, d, qt, alpha)
+            rg = _BG if m_after == 0 else _HEAD + 3 * (m_after - 1) + 1
+            if ds_new is not None:
+                for j in range(nd):
+                    if m >= 2:
+                        dqj = ds_new[_HEAD + 3 * (m - 2), j]
+                    else:
+                        dqj = 2.0 * ds_new[_BQ, j] - ds_new[_HEAD, j]
+                    daj = ia * dN[j]
+                    dgb = cqb * dqj + cab * daj + c0qb * ds_new[rqb, j] + c0gb * ds_new[rgb, j] + c0ab * ds_new[rab, j]
+                    dga = cqa * dqj + caa * daj + c0qa * ds_new[rqa, j] + c0ga * ds_new[rga, j] + c0aa * ds_new[raa, j]
+                    ds_new[rg, j] += dgb - dga
+            s_new[rg] += gb - ga
+            m = m_after
 
     # --- force from the current branch -------------------------------------
     # dG = cq*dq + ca*dalpha + c0q*dq_ref + c0g*dG_ref + c0a*dalpha_ref,
-    # (q_ref, G_ref, alpha_ref) being state rows ref, ref+1, ref+2
-    cq = 0.0
-    ca = 0.0
-    c0q = 0.0
-    c0g = 0.0
-    c0a = 0.0
-    ref = _BQ  # rows _BQ, _BA: base point (G row unused, c0g = 0)
-    if m == 0:
-        if base == _VIRGIN:
-            u = q - s_new[_BQ]
-            sg = 1.0 if u > 0.0 else (-1.0 if u < 0.0 else (d if d != 0.0 else 1.0))
-            g, gu, ga = _goa(sg * u, alpha)
-            G = sg * g
-            cq = gu
-            c0q = -gu
-            ca = sg * ga
-        else:  # saturated base, moving on in its direction
-            asat = s_new[_BA]
-            aeff = alpha - asat
-            if aeff > 0.0:
-                u = d * (q - s_new[_BQ])
-                if u < 0.0:
-                    u = 0.0
-                g, gu, ga = _goa(u, aeff)
-                G = d * asat + d * g
-                cq = gu
-                c0q = -gu
-                ca = d * ga
-                c0a = d - d * ga
-            else:
-                G = d * alpha
-                ca = d
-    else:
-        ref = _HEAD + 3 * (m - 1)
-        q0 = s_new[ref]
-        g0 = s_new[ref + 1]
-        a0 = s_new[ref + 2]
-        # G = G0 + d c G_oa(v / c; alpha) with v = d (q - q0), c = 1 + a0/alpha,
-        # simplifies to G0 + d (v - v^2 / (4 S)) for v < 2 S, G0 + d S beyond,
-        # S = alpha + a0 = c alpha: one division instead of five
-        v = d * (q - q0)
-        if v < 0.0:
-            v = 0.0
-        S = alpha + a0
-        if v < 2.0 * S:
-            w = 1.0 / S
-            h = 0.5 * v * w  # = u / (2 alpha), u = v / c
-            G = g0 + d * (v - 0.5 * v * h)
-            cq = 1.0 - h
-            # dG/dalpha = dG/dalpha0 = d v^2 / (4 S^2)
-            ca = d * h * h
-        else:
-            G = g0 + d * S
-            cq = 0.0
-            ca = d
-        c0q = -cq
-        c0g = 1.0
-        c0a = ca
+    # the reference point (q_ref, G_ref, alpha_ref) being state rows rq, rg, ra
+    G, cq, ca, c0q, c0g, c0a, rq, rg, ra = _branch(s_new, m, base, d, q, alpha)
 
     # --- clip (macroslip) ---------------------------------------------------
     code = STICK_SLIP
@@ -272,10 +294,12 @@ def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
             d = sg
             s_new[_BQ] = q
             s_new[_BA] = alpha
+            s_new[_BG] = 0.0
             if ds_new is not None:
                 for j in range(nd):
                     ds_new[_BQ, j] = qs * dx[j]
                     ds_new[_BA, j] = ia * dN[j]
+                    ds_new[_BG, j] = 0.0
 
     # --- derivatives ------------------------------------------------------
     if ds_new is not None:
@@ -283,9 +307,9 @@ def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
             dgj = (
                 cq * qs * dx[j]
                 + ca * ia * dN[j]
-                + c0q * ds_new[ref, j]
-                + c0g * ds_new[ref + 1, j]
-                + c0a * ds_new[ref + 2 if ref != _BQ else _BA, j]
+                + c0q * ds_new[rq, j]
+                + c0g * ds_new[rg, j]
+                + c0a * ds_new[ra, j]
             )
             dT[j] = fy * dgj
             ds_new[_Q, j] = qs * dx[j]
@@ -313,7 +337,7 @@ def iwan_step(params, s_old, s_new, x, N):
     params : float64[:]
         ``[kt (N/m), fy (N), N_ref (N), memory (0 full / 1 last), max_depth]``.
     s_old, s_new : float64[:]
-        Committed (not written) and trial state, length ``8 + 3 max_depth``.
+        Committed (not written) and trial state, length ``9 + 3 max_depth``.
     x : float
         Tangential displacement, m.
     N : float

@@ -1,8 +1,12 @@
-"""Kernel defects found by the quasi-static driver (laws/iwan.py is not ours).
+"""Continuity of the full-memory closed form when a Masing rejoin fires
+under a varying normal load.
 
-Marked ``xfail(strict=True)``: the suite stays green while the defect is
-there, and the test turns red (XPASS) once the kernel is fixed, so the
-marker gets removed. Reported to the lead with the numbers below.
+Before the fix, the rejoin switched onto the remembered branch evaluated at
+the current alpha, and T jumped by ~5 % fy (A = 0.1 mm, eta = 0.3): at the
+turning point of a symmetric sine (mirror point of the virgin curve) and
+mid-branch for a growing amplitude, with the steady energy per cycle 30 %
+off the discrete ground truth. The kernel now keeps the mismatch at the
+rejoin point as a force offset on the rejoined branch (zero at constant N).
 """
 
 import math
@@ -38,14 +42,6 @@ def test_discrete_and_paper_rule_are_continuous():
         assert _max_excess_jump(_run(model)) < 1e-9 * FY
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="iwan (memory='full'): when a branch reaches the mirror point 2 q_c - q0 of the virgin curve "
-    "(here exactly at the turning point x = -A of a symmetric sine) the Masing rejoin switches to the "
-    "virgin curve at the current alpha, which differs from the branch value once alpha has changed: "
-    "T jumps by 0.49 N = 4.9 % fy (A = 0.1 mm, eta = 0.3, delta = 0) and the steady energy per cycle "
-    "is +30 % off the discrete ground truth",
-)
 def test_full_memory_closed_form_is_continuous_under_varying_load():
     r = _run("iwan")
     assert _max_excess_jump(r) < 1e-3 * FY
@@ -54,11 +50,6 @@ def test_full_memory_closed_form_is_continuous_under_varying_load():
     assert e_full == pytest.approx(e_disc, rel=1e-2)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="iwan (memory='full'): with a growing amplitude the rejoin fires mid-branch and T jumps by "
-    "0.51 N = 5.1 % fy in one step (x = 0.1 mm (1 + 0.05 t) sin(2 pi t), N = 100 (1 + 0.3 sin(2 pi t)))",
-)
 def test_full_memory_rejoin_is_continuous_for_growing_amplitude():
     from jointdyn.drivers import quasistatic
 
