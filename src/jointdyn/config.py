@@ -9,9 +9,6 @@ from __future__ import annotations
 # --- contact-law kernels -------------------------------------------------
 #: default depth of the reversal-point stack of the closed-form Iwan law
 IWAN_MAX_DEPTH = 64
-#: relative tolerance used to decide that a branch has reached an earlier
-#: reversal point (Masing's extended rules), relative to fy/kt
-IWAN_WIPE_RTOL = 1e-12
 
 # --- quasi-static driver --------------------------------------------------
 QS_STEPS_PER_CYCLE = 2000

@@ -13,7 +13,7 @@ __all__ = ["march"]
 def _march_template(params, s0, x, N, T, kT, code, s_final):  # pragma: no cover - compiled
     """March ``STEP`` over samples ``x[i], N[i]``, committing after each."""
     a = s0.copy()
-    b = np.empty_like(s0)
+    b = s0.copy()  # unused stack rows stay finite in the returned state
     for i in range(x.shape[0]):
         t_, k_, c_ = STEP(params, a, b, x[i], N[i])  # noqa: F821 - bound by specialize
         T[i] = t_
