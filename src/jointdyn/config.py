@@ -62,6 +62,12 @@ SS_CHUNK = 8
 SS_SHOOT_AFTER = 40
 #: steady state: Newton iterations of one shooting attempt
 SS_SHOOT_MAXIT = 12
+#: steady state: largest Newton step (relative to the amplitude) and
+#: step halvings of the line search
+SS_SHOOT_MAXSTEP = 1.0
+SS_SHOOT_HALVINGS = 8
+#: steady state: shooting attempts per run
+SS_MAX_SHOTS = 3
 #: steady state: relative finite-difference step of the monodromy matrix
 SS_SHOOT_FD = 1e-6
 #: steady state: a Floquet multiplier above 1 + this marks an unstable orbit
@@ -72,6 +78,9 @@ SS_LINEAR_ITERS = 30
 SS_GROWTH_PERIODS = 40
 #: ... with increments of the second half >= this fraction of the first
 SS_GROWTH_RATIO = 0.9
+#: ... and with the amplitude of x[response_dof] above this many fy/kt of
+#: the first contact (friction saturated: only then can friction lose)
+SS_UNBOUNDED_Q = 20.0
 
 # --- test tolerances for time integration (tests/test_dynamics.py) --------
 #: peak of the beta = 1000 response vs sqrt((k + kt)/k)
