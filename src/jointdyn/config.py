@@ -53,6 +53,9 @@ SS_ENERGY_RTOL = 1e-3
 SS_CHECK_PERIODS = 3
 #: steady state: largest period multiple p looked for
 SS_MAX_MULTIPLE = 4
+#: steady state: longer multiples (up to this) are detected and reported
+#: as "not-settled", detail "period-P", instead of running to max_periods
+SS_DETECT_MULTIPLE = 12
 #: steady state: default cap on integrated periods
 SS_MAX_PERIODS = 1500
 #: steady state: periods integrated between two checks

@@ -48,8 +48,10 @@ class SteadyState:
         ``"periodic"``, ``"not-settled"`` or ``"unbounded"``.
     detail : str
         More on the status: ``"integration"`` or ``"shooting"`` (how a
-        periodic state was reached); ``"growing"``, ``"blow-up"``;
-        ``"slowly-converging"``, ``"quasi-periodic-or-chaotic"``.
+        periodic state was reached); ``"growing"``, ``"blow-up"``
+        (unbounded); ``"period-P"`` (repeats every P > SS_MAX_MULTIPLE
+        periods), ``"slowly-converging"`` (Poincare distance still
+        shrinking at max_periods), ``"quasi-periodic-or-chaotic"``.
     period_multiple : int
         p: the response repeats every p forcing periods (0 if not periodic).
     gamma, omega : float
@@ -185,6 +187,16 @@ def _growing(h: _History, model, amp_rtol) -> bool:
     if cs and not A[-1] > config.SS_UNBOUNDED_Q * cs[0].law.fy / cs[0].law.kt:
         return False
     return True
+
+
+def _long_period(h: _History, K: int, model, amp_rtol, energy_rtol) -> int:
+    """Smallest multiple p in (SS_MAX_MULTIPLE, SS_DETECT_MULTIPLE] that repeats (0 if none)."""
+    for p in range(config.SS_MAX_MULTIPLE + 1, config.SS_DETECT_MULTIPLE + 1):
+        if h.size < K * p:
+            break
+        if _check_periodic(h, p, K, model, amp_rtol, energy_rtol) and not _one_period_decaying(h, K * p, model):
+            return p
+    return 0
 
 
 def _one_period_decaying(h: _History, m: int, model) -> bool:
@@ -508,6 +520,10 @@ def steady_state(
         if p_found:
             status = "periodic"
             detail = "shooting" if counters["shoot"] else "integration"
+            break
+        long_p = _long_period(hist, K, model, amp_rtol, energy_rtol)
+        if long_p:
+            status, detail = "not-settled", f"period-{long_p}"
             break
         growing = _growing(hist, model, amp_rtol)
         if growing and not (shooting and shots < config.SS_MAX_SHOTS):
