@@ -208,13 +208,22 @@ def _long_period(h: _History, K: int, model, amp_rtol, energy_rtol) -> int:
 
 
 def _one_period_decaying(h: _History, m: int, model) -> bool:
-    """True if the one-period mismatch of the Poincare points decays over the last m periods."""
-    Z = np.asarray(h.Z[-(m + 1):])
+    """True unless the one-period mismatch of the Poincare points has stopped decaying.
+
+    A genuine p-periodic orbit repeats its one-period mismatches exactly; a
+    slowly decaying beat that happens to be nearly commensurate with the
+    forcing (lightly damped transients) shrinks them. Compares the largest
+    mismatch over the last m periods with that over the m periods before
+    (needs 2m periods of history; undecided counts as decaying).
+    """
+    if h.size < 2 * m:
+        return True
+    Z = np.asarray(h.Z[-(2 * m + 1):])
     n = model.n
     D = np.diff(Z, axis=0)
     D[:, n:] /= max(model.w, 1e-300)
     d = np.max(np.abs(D), axis=1)
-    return d[-1] < 0.7 * d[0]
+    return d[m:].max() < config.SS_MULTIPLE_DECAY * d[:m].max()
 
 
 def _contraction(h: _History, model):
@@ -352,8 +361,18 @@ def _shoot(model: _Model, x, v, S, rdof, tol, counters):
         if best is None or rn < best[0]:
             best = (rn, z.copy(), S.copy(), rn if best is None else best[3])
         if rn <= tol:
-            converged = True
-            break
+            # the law state must be periodic too: one more period from the
+            # end state (z1, S1) has to repeat as well, else go on from there
+            z2, S2, s2 = phi(z1, S1)
+            if z2 is None:
+                break
+            if float(np.max(np.abs((z2 - z1) / D))) <= tol:
+                z, S = z1, S1
+                converged = True
+                break
+            z, S, z1, S1, s1 = z1, S1, z2, S2, s2
+            best = None
+            continue
         counters["shoot"] += 1
         Jm = np.empty((2 * n, 2 * n))
         for j in range(2 * n):
