@@ -361,18 +361,8 @@ def _shoot(model: _Model, x, v, S, rdof, tol, counters):
         if best is None or rn < best[0]:
             best = (rn, z.copy(), S.copy(), rn if best is None else best[3])
         if rn <= tol:
-            # the law state must be periodic too: one more period from the
-            # end state (z1, S1) has to repeat as well, else go on from there
-            z2, S2, s2 = phi(z1, S1)
-            if z2 is None:
-                break
-            if float(np.max(np.abs((z2 - z1) / D))) <= tol:
-                z, S = z1, S1
-                converged = True
-                break
-            z, S, z1, S1, s1 = z1, S1, z2, S2, s2
-            best = None
-            continue
+            converged = True
+            break
         counters["shoot"] += 1
         Jm = np.empty((2 * n, 2 * n))
         for j in range(2 * n):
