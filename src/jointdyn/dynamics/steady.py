@@ -439,6 +439,7 @@ def steady_state(
     response_dof: int = 0,
     keep_loop: bool = True,
     shooting: bool = True,
+    _events: bool = True,
 ) -> SteadyState:
     """Steady periodic response at frequency ratio ``gamma``, classified.
 
@@ -496,7 +497,7 @@ def steady_state(
         raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {rdof}")
     w = _omega(system, gamma)
     gamma = float(gamma)
-    model = _Model(system, w, spp)
+    model = _Model(system, w, spp, events=_events)
 
     if start is not None:
         x, v, S = _unpack_start(start, model)
