@@ -51,7 +51,9 @@ class SteadyState:
         periodic state was reached); ``"growing"``, ``"blow-up"``
         (unbounded); ``"period-P"`` (repeats every P > SS_MAX_MULTIPLE
         periods), ``"slowly-converging"`` (Poincare distance still
-        shrinking at max_periods), ``"quasi-periodic-or-chaotic"``.
+        shrinking at max_periods), ``"quasi-periodic-or-chaotic"`` (the
+        one-period mismatch stopped shrinking over SS_STALL_PERIODS periods,
+        after shooting; quasi-periodic and chaotic are not told apart).
     period_multiple : int
         p: the response repeats every p forcing periods (0 if not periodic).
     gamma, omega : float
@@ -224,6 +226,23 @@ def _one_period_decaying(h: _History, m: int, model) -> bool:
     D[:, n:] /= max(model.w, 1e-300)
     d = np.max(np.abs(D), axis=1)
     return d[m:].max() < config.SS_MULTIPLE_DECAY * d[:m].max()
+
+
+def _stalled(h: _History, model) -> bool:
+    """True when the one-period mismatch has stopped shrinking (quasi-periodic, chaotic).
+
+    Compares the largest mismatch over the last SS_STALL_PERIODS / 2 periods
+    with that over the half before.
+    """
+    m = config.SS_STALL_PERIODS // 2
+    if h.size < 2 * m:
+        return False
+    Z = np.asarray(h.Z[-(2 * m + 1):])
+    n = model.n
+    D = np.diff(Z, axis=0)
+    D[:, n:] /= max(model.w, 1e-300)
+    d = np.max(np.abs(D), axis=1)
+    return d[m:].max() >= config.SS_STALL_RATIO * d[:m].max()
 
 
 def _contraction(h: _History, model):
@@ -562,6 +581,8 @@ def steady_state(
             break
         if counters["periods"] >= maxp:
             break
+        if not can_shoot and _stalled(hist, model):
+            break
         if can_shoot:
             est = _contraction(hist, model)
             need_shoot = False
@@ -585,11 +606,10 @@ def steady_state(
     if status is None:
         # did not settle within max_periods: say why if we can
         status = "not-settled"
-        est = _contraction(hist, model)
-        if est is not None and est[0] < 0.999:
-            detail = "slowly-converging"
-        else:
+        if hist.size >= config.SS_STALL_PERIODS and _stalled(hist, model):
             detail = "quasi-periodic-or-chaotic"
+        else:
+            detail = "slowly-converging"
     last = hist.summ[-1] if hist.size else None
     last_amp = 0.5 * (last[S_XMAX] - last[S_XMIN]) if last is not None else math.nan
 
