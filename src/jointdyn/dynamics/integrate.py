@@ -352,6 +352,8 @@ def integrate(
         Samples at every accepted step end (grid points, separation and
         re-contact instants, velocity reversals of the contacts).
     """
+    if not isinstance(system, System):
+        raise ValueError(f"system must be a System, got {type(system).__name__}")
     spp = V.positive_int("steps_per_period", config.TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period, 4)
     periods = V.positive_int("periods", periods)
     w = _omega(system, gamma)

@@ -166,6 +166,9 @@ def _check_periodic(h: _History, p: int, K: int, model, amp_rtol, energy_rtol):
     etol = max(energy_rtol * max(max(abs(w) for w in ws), max(abs(e) for e in es)), amp_rtol * stored, 1e-300)
     if max(es) - min(es) > etol or max(ws) - min(ws) > etol:
         return False
+    # a periodic motion returns its stored energy: work = dissipation
+    if abs(np.mean(ws) - np.mean(es)) > etol:
+        return False
     return True
 
 
@@ -368,20 +371,28 @@ def _shoot(model: _Model, x, v, S, rdof, tol, counters):
     if z1 is None:
         return x0, v0, S0, False, floq
     converged = False
-    best = None  # (residual, z, S) of the best iterate
+    best = None  # (residual, z, S, first residual) in the fixed scale D0
+    D0 = None
     for _ in range(config.SS_SHOOT_MAXIT):
         A = 0.5 * (s1[S_XMAX] - s1[S_XMIN])
         xs = _amplitude_scale(model, max(A, np.max(np.abs(z[:n]))))
         D = np.concatenate([np.full(n, xs), np.full(n, xs * w)])
-        r = (z1 - z) / D
+        if D0 is None:
+            # residuals are compared in the scale of the first iterate, so
+            # that a step that merely inflates the amplitude (a relative
+            # residual shrinking because the scale grows: an undamped
+            # resonance) is never taken for progress
+            D0 = D
+        r = (z1 - z) / D0
         if _DEBUG:
             print("shoot r", np.max(np.abs(r)), z)
         rn = float(np.max(np.abs(r)))
         if best is None or rn < best[0]:
             best = (rn, z.copy(), S.copy(), rn if best is None else best[3])
-        if rn <= tol:
+        if float(np.max(np.abs((z1 - z) / D))) <= tol:
             converged = True
             break
+        D = D0
         counters["shoot"] += 1
         Jm = np.empty((2 * n, 2 * n))
         for j in range(2 * n):
