@@ -78,6 +78,9 @@ SS_SHOOT_MAXIT = 12
 #: step halvings of the line search
 SS_SHOOT_MAXSTEP = 1.0
 SS_SHOOT_HALVINGS = 8
+#: steady state: before shooting (section at phase 0), rebuild the law
+#: states from the last period alone (forget the transient's memory)
+SS_SHOOT_CLEAN_STATE = True
 #: steady state: shooting attempts per run
 SS_MAX_SHOTS = 3
 #: steady state: relative finite-difference step of the monodromy matrix
