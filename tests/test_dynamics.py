@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from jointdyn import config
 from jointdyn.drivers import march
@@ -161,6 +163,27 @@ def test_integrator_law_agrees_with_march(model, eta):
     T, _, code, _ = march(law, tr.x[:, 0], tr.N[:, 0])
     assert np.max(np.abs(T - tr.T[:, 0])) <= config.TEST_TI_MARCH_ATOL_FY * law.fy
     assert np.array_equal(code.astype(np.int8), tr.code[:, 0])
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    eta=st.floats(0.0, 2.5),
+    delta=st.floats(-3.0, 3.0),
+    beta=st.floats(0.3, 20.0),
+    gamma=st.floats(0.3, 2.5),
+    model=st.sampled_from(["iwan", "jenkins", "iwan-paper"]),
+)
+def test_property_law_in_integrator_equals_march(eta, delta, beta, gamma, model):
+    # for any loads, the forces recorded by the integrator are those of the
+    # law marched over the recorded displacement and normal-load samples,
+    # every sample is finite and an open contact carries no force
+    s = System.paper_damper(eta=eta, beta=beta, delta=delta, model=model)
+    tr = integrate(s, gamma, periods=3, steps_per_period=64)
+    assert tr.status == "ok" and np.all(np.isfinite(tr.x)) and np.all(np.diff(tr.t) > 0)
+    law = s.contacts[0].law
+    T = march(law, tr.x[:, 0], tr.N[:, 0])[0]
+    assert np.max(np.abs(T - tr.T[:, 0])) <= config.TEST_TI_MARCH_ATOL_FY * law.fy
+    assert np.all(np.abs(tr.T[:, 0]) <= law.fy * np.maximum(tr.N[:, 0], 0.0) / law.n_ref * (1 + 1e-9) + 1e-12)
 
 
 def test_separation_and_recontact_are_step_boundaries():
