@@ -49,6 +49,9 @@ TI_BLOWUP_FACTOR = 1e8
 SS_AMP_RTOL = 1e-4
 #: steady state: default relative tolerance on the energy per period
 SS_ENERGY_RTOL = 1e-3
+#: steady state: work of the forcing = dissipation per period to this
+#: (relative; the energy integrals carry the discretisation error)
+SS_BALANCE_RTOL = 1e-2
 #: steady state: windows (of p periods) that must agree
 SS_CHECK_PERIODS = 3
 #: steady state: largest period multiple p looked for
