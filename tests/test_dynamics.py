@@ -77,6 +77,30 @@ def test_linear_system_without_contacts():
     assert r.status == "unbounded" and math.isnan(r.amplitude_m)
 
 
+def test_two_dof_separating_contact_events_and_law():
+    # contact from DOF 1 to ground with eta = 1.5 (separation), forced DOF 0
+    law = make_law("iwan", kt=2e5, mu=0.5, n_ref=100.0)
+    Mm = np.diag([1.0, 2.0])
+    Kk = np.array([[2e5, -1e5], [-1e5, 1.5e5]])
+    c = Contact(law=law, dof=1, n0=100.0, n1=150.0, delta=0.4)
+    s = System(M=Mm, C=np.zeros((2, 2)), K=Kk, contacts=(c,), force=[20.0, 0.0])
+    gamma = 1.2
+    tr = integrate(s, gamma, periods=4)
+    w = gamma * s.w0
+    ev = HarmonicLoad(c.n0, c.n1, w, c.delta).zero_crossings(0.0, tr.t[-1])
+    assert ev.size == 8
+    for te in ev:
+        assert np.min(np.abs(tr.t - te)) <= 1e-12 * tr.t[-1]
+    T = march(law, tr.x[:, 1], tr.N[:, 0])[0]
+    assert np.max(np.abs(T - tr.T[:, 0])) <= config.TEST_TI_MARCH_ATOL_FY * law.fy
+    r = steady_state(s, gamma, response_dof=0)
+    assert r.status == "periodic"
+    diss = r.energy_contact_J + r.energy_viscous_J
+    assert diss == pytest.approx(r.work_force_J, rel=config.TEST_TI_ENERGY_RTOL)
+    rec = r.to_record()
+    assert rec["status"] == "periodic" and rec["amplitude_m"] == r.amplitude_m
+
+
 # --- the paper damper: peak, Den Hartog, energy, step size -----------------
 
 

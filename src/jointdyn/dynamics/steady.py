@@ -110,6 +110,15 @@ class SteadyState:
         """True when a periodic steady state was found."""
         return self.status == "periodic"
 
+    def to_record(self) -> dict:
+        """The scalar fields as a flat dict (one row of a sweep table)."""
+        keys = (
+            "status", "detail", "period_multiple", "gamma", "omega", "amplitude_q", "amplitude_m",
+            "offset_m", "max_abs_m", "energy_contact_J", "energy_viscous_J", "work_force_J",
+            "periods", "steps", "shooting_iterations", "floquet_max", "last_amplitude_m",
+        )  # fmt: skip
+        return {k: getattr(self, k) for k in keys}
+
 
 class _History:
     """Per-period summaries since the last jump of the state."""
