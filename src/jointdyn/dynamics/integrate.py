@@ -248,7 +248,9 @@ class _Model:
         S = np.zeros((self.nc, self.slen))
         for i, c in enumerate(self.system.contacts):
             u = x[c.dof] - (x[c.dof2] if c.dof2 >= 0 else 0.0)
-            n_at0 = c.n0 + c.n1 * math.sin(c.delta)
+            # the grid value at t = 0 (event-snapped: a re-contact at t = 0
+            # must start the virgin curve there)
+            n_at0 = self.Ngrid[0, i] if hasattr(self, "Ngrid") else c.n0 + c.n1 * math.sin(c.delta)
             s = c.law.initial_state(float(u), float(n_at0))
             S[i, : s.size] = s
         return S
