@@ -274,6 +274,14 @@ def test_sampled_loads_match_harmonic_run():
     assert np.array_equal(c2.x, a.x)
 
 
+def test_sampled_free_vibration_without_contacts():
+    s = System.sdof(m=1.0, k=100.0)
+    t = np.linspace(0.0, 10.0, 2001)
+    tr = integrate_sampled(s, t, np.zeros((t.size, 1)), None, x0=[1.0])
+    assert tr.status == "ok" and tr.t.size == t.size
+    assert np.max(np.abs(tr.x[:, 0] - np.cos(10.0 * t))) <= 1e-5
+
+
 # --- steady-state bookkeeping -----------------------------------------------
 
 
