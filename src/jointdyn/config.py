@@ -32,5 +32,14 @@ TEST_ENERGY_CREATION_TOL = 1e-9
 # --- time integration and steady state (issue 3) --------------------------
 
 # --- sweeps (issue 3) -----------------------------------------------------
+#: default CLI gamma grid START:STOP:STEP (the paper's Fig 6 range)
+SWEEP_GAMMA_DEFAULT = (0.6, 1.8, 0.01)
+#: local pool for sweep lines when no Dask client is given: "process" or
+#: "thread" (numba kernels release the GIL; see the report for the measurement)
+SWEEP_POOL = "process"
+#: status codes of a swept point (netCDF-friendly int8); index = code
+SWEEP_STATUS = ("periodic", "not-settled", "unbounded")
+#: code of a point that was not computed (never written by a finished sweep)
+SWEEP_STATUS_MISSING = -1
 
 # --- harmonic balance, continuation, stability (issue 4) ------------------
