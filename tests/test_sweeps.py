@@ -199,3 +199,55 @@ def test_status_codes_match_config():
 
     assert STATUS_CODES == {n: i for i, n in enumerate(config.SWEEP_STATUS)}
     assert status_name(-1) == "not-computed"
+
+
+# --- with the real time-domain solver -------------------------------------
+def _dyn():
+    return pytest.importorskip("jointdyn.dynamics")
+
+
+def test_linear_stuck_limit_real_solver():
+    """eta = 0, beta = 1000 (F1 = 0.05 N): the joint hardly slips, so the
+    response is the linear one with stiffness k + kt:
+    q = kt / fy * F1 / (k + kt - m w^2), w = gamma sqrt(k/m)."""
+    _dyn()
+    g = [0.8, 1.6]
+    ds = frc_sweep(g, etas=[0.0], betas=[1000.0], directions=("up",), n_workers=1, progress=False)
+    q = ds.amplitude_q.sel(eta=0.0, beta=1000.0, delta=0.0, direction="up").values
+    assert (ds.status.values == 0).all()
+    k, m, kt, fy = 3.9e5, 10.0, 3e5, 50.0
+    w = np.asarray(g) * math.sqrt(k / m)
+    q_lin = kt / fy * 0.05 / np.abs(k + kt - m * w**2)
+    np.testing.assert_allclose(q, q_lin, rtol=0.01)
+
+
+def test_real_solver_serial_equals_dask_and_resume(tmp_path):
+    """Deterministic: serial == Dask LocalCluster; an interrupted sweep
+    resumes to the identical result without recomputing finished lines."""
+    _dyn()
+    from distributed import Client, LocalCluster
+
+    g = [0.9, 1.0, 1.1]
+    kw = dict(etas=[0.5, 1.5], betas=[2.0], progress=False)
+    serial = frc_sweep(g, **kw, n_workers=1)
+    with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
+        with Client(lc) as client:
+            dist = frc_sweep(g, **kw, client=client)
+    xr.testing.assert_identical(serial, dist)
+
+    class Stop(Exception):
+        pass
+
+    def stop(spec, computed):
+        raise Stop
+
+    with pytest.raises(Stop):
+        frc_sweep(g, **kw, n_workers=1, out=tmp_path, on_line=stop)
+    calls = []
+    real = _frc._solve_line
+    import unittest.mock as um
+
+    with um.patch.object(_frc, "_solve_line", side_effect=lambda s: calls.append(s) or real(s)):
+        again = frc_sweep(g, **kw, n_workers=1, out=tmp_path)
+    assert len(calls) == 3  # 4 lines, 1 loaded
+    xr.testing.assert_identical(again, serial)
