@@ -262,7 +262,11 @@ def _iter_results(todo, client, n_workers, pool):
     else:
         import multiprocessing as mp
 
-        ex = cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=mp.get_context("spawn"))
+        # fork (Linux): workers inherit the compiled kernels and do not
+        # re-import the caller's __main__ (spawn would, breaking scripts
+        # without a main guard); spawn elsewhere
+        method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
+        ex = cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=mp.get_context(method))
     with ex:
         futs = {ex.submit(_solve_line, spec): i for i, spec in todo}
         try:
