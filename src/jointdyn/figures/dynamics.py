@@ -88,6 +88,8 @@ def _plot_fig6(tables, out_dir):
                                label=f"beta = {beta:g}" if d == "up" else None,
                                rug_y=0.02 + 0.025 * ib)
         ax.set_yscale("log")
+        lo, hi = ax.get_ylim()  # free the bottom quarter for the rug markers
+        ax.set_ylim(lo / (hi / lo) ** 0.3, hi)
         ax.set_title(f"eta = {eta:g}" + (" (separation)" if eta > 1 else ""), fontsize=10)
         ax.axvline(1.0, color="0.7", lw=0.6)
         ax.axvline(math.sqrt(1 + 3e5 / 3.9e5), color="0.7", lw=0.6, ls=":")
