@@ -1,0 +1,258 @@
+"""Stability of harmonic-balance solutions: Hill's method and a monodromy check.
+
+Hill's method
+-------------
+A perturbation ``x = x*(t) + exp(s t) p(tau)`` with ``p`` periodic,
+``p = Q(tau) P`` in the HB basis, turns the linearised equation of motion
+into the quadratic eigenvalue problem (von Groll & Ewins, J. Sound Vib. 241,
+2001; Detroux, Renson, Masset & Kerschen, CMAME 296, 2015, eq. 24)::
+
+    (s^2 Delta_2 + s Delta_1 + J_X) P = 0,
+    Delta_2 = I (x) M,   Delta_1 = 2 w (nabla (x) M) + I (x) C,
+
+with J_X the HB Jacobian dR/dX (the contact part is the AFT-derived
+derivative of the periodic force coefficients, the standard choice for
+hysteretic forces, which are not differentiable in velocity) and nabla the
+d/dtau operator on the coefficients. It is solved in first-order (companion)
+form, size 2 n (2H+1). Of those eigenvalues, the 2n Floquet exponents are
+chosen by the symmetry criterion of Lazarus & Thomas (C. R. Mecanique 338,
+2010) as refined by Guillot, Lazarus, Thomas, Vergez & Cochelin (J. Comput.
+Phys. 416, 2020): the eigenvectors of the exponents themselves are the most
+"central" ones, i.e. their energy is centred on harmonic 0; the eigenvalues
+shifted by i k w have eigenvectors shifted by k harmonics. We take the 2n
+eigenvalues whose eigenvector's harmonic centroid (in the complex
+exponential basis) is nearest to 0. The solution is unstable when one of
+them has ``Re(s) > HB_STABILITY_RTOL * w``. Floquet multipliers are
+``exp(2 pi s / w)``.
+
+Monodromy check
+---------------
+:func:`monodromy_multipliers` integrates the equations of motion over one
+period (compiled velocity-Verlet march of the same contact kernels, the
+contact state taken from the periodic HB orbit) and differentiates the
+period map by central finite differences in the 2n positions and
+velocities.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import config
+from .._jit import specialize
+from ..drivers import march
+
+__all__ = ["hill_exponents", "hill_stability", "monodromy_multipliers", "derivative_matrix"]
+
+
+def derivative_matrix(H: int) -> np.ndarray:
+    """d/dtau on the real coefficients (1, cos tau, sin tau, ..., sin H tau)."""
+    D = np.zeros((2 * H + 1, 2 * H + 1))
+    for k in range(1, H + 1):
+        D[2 * k - 1, 2 * k] = k
+        D[2 * k, 2 * k - 1] = -k
+    return D
+
+
+def _centroids(V, n, H):
+    """Harmonic centroid of the displacement part of each eigenvector."""
+    nh = 2 * H + 1
+    P = V[: n * nh].reshape(nh, n, -1)
+    num = np.zeros(V.shape[1])
+    den = np.sum(np.abs(P[0]) ** 2, axis=0)
+    for k in range(1, H + 1):
+        a = P[2 * k - 1]
+        b = P[2 * k]
+        cp = np.sum(np.abs(0.5 * (a - 1j * b)) ** 2, axis=0)
+        cm = np.sum(np.abs(0.5 * (a + 1j * b)) ** 2, axis=0)
+        num += k * (cp - cm)
+        den += cp + cm
+    return num / np.where(den > 0, den, 1.0)
+
+
+def hill_exponents(JX, M, C, w, H):
+    """All Hill eigenvalues and the 2n selected Floquet exponents.
+
+    Parameters
+    ----------
+    JX : ndarray (n(2H+1), n(2H+1))
+        HB Jacobian dR/dX (harmonic-major ordering), N/m.
+    M, C : ndarray (n, n)
+        Mass (kg) and damping (N s/m) matrices.
+    w : float
+        Angular frequency of the periodic solution, rad/s.
+    H : int
+        Number of harmonics.
+
+    Returns
+    -------
+    exponents : ndarray complex (2n,)
+        Floquet exponents s, 1/s (sorted by decreasing real part).
+    all_eigenvalues : ndarray complex (2 n (2H+1),)
+    """
+    n = M.shape[0]
+    nh = 2 * H + 1
+    N = n * nh
+    D = derivative_matrix(H)
+    Minv = np.linalg.inv(M)
+    D2i = np.kron(np.eye(nh), Minv)
+    D1 = 2.0 * w * np.kron(D, M) + np.kron(np.eye(nh), C)
+    A = np.zeros((2 * N, 2 * N))
+    A[:N, N:] = np.eye(N)
+    A[N:, :N] = -D2i @ JX
+    A[N:, N:] = -D2i @ D1
+    lam, V = np.linalg.eig(A)
+    cen = _centroids(V, n, H)
+    idx = np.argsort(np.abs(cen), kind="stable")[: 2 * n]
+    sel = lam[idx]
+    sel = sel[np.argsort(-sel.real, kind="stable")]
+    return sel, lam
+
+
+def hill_stability(JX, M, C, w, H, rtol: float = config.HB_STABILITY_RTOL):
+    """(stable, max Re(s) / w, Floquet multipliers) of a periodic HB solution.
+
+    See the module docstring for the method and references.
+    """
+    sel, _ = hill_exponents(JX, M, C, w, H)
+    growth = float(np.max(sel.real)) / w
+    mult = np.exp(sel * 2.0 * np.pi / w)
+    return growth <= rtol, growth, mult
+
+
+def _verlet_template(Minv, C, K, f, Bm, params, states, n0, n1, dl, w, x0, v0, h, nsteps, xo, vo):  # pragma: no cover - compiled
+    """Velocity-Verlet march of M x'' + C x' + K x + sum B_c T_c = f sin(w t)."""
+    n = x0.shape[0]
+    nc = Bm.shape[0]
+    x = x0.copy()
+    v = v0.copy()
+    sa = states.copy()
+    sb = states.copy()
+    Tc = np.zeros(nc)
+    a = np.zeros(n)
+    rhs = np.zeros(n)
+    # force at t = 0, committed: the perturbation of x0 loads the contact
+    for c in range(nc):
+        u = 0.0
+        for i in range(n):
+            u += Bm[c, i] * x[i]
+        N = n0[c] + n1[c] * np.sin(dl[c])
+        t_, k_, c_ = STEP(params[c], sa[c], sb[c], u, N)  # noqa: F821
+        Tc[c] = t_
+    sa, sb = sb, sa
+    for i in range(n):
+        r = 0.0 - K[i, :] @ x - C[i, :] @ v
+        for c in range(nc):
+            r -= Bm[c, i] * Tc[c]
+        rhs[i] = r
+    a[:] = Minv @ rhs
+    for step in range(nsteps):
+        t1 = (step + 1) * h
+        xn = x + h * v + 0.5 * h * h * a
+        vp = v + h * a
+        for c in range(nc):
+            u = 0.0
+            for i in range(n):
+                u += Bm[c, i] * xn[i]
+            N = n0[c] + n1[c] * np.sin(w * t1 + dl[c])
+            t_, k_, c_ = STEP(params[c], sa[c], sb[c], u, N)  # noqa: F821
+            Tc[c] = t_
+        sa, sb = sb, sa
+        for i in range(n):
+            r = f[i] * np.sin(w * t1) - K[i, :] @ xn - C[i, :] @ vp
+            for c in range(nc):
+                r -= Bm[c, i] * Tc[c]
+            rhs[i] = r
+        an = Minv @ rhs
+        v = v + 0.5 * h * (a + an)
+        x = xn
+        a = an
+    xo[:] = x
+    vo[:] = v
+    states[:, :] = sa
+
+
+def _pad_stack(rows):
+    m = max(len(r) for r in rows)
+    out = np.zeros((len(rows), m))
+    for i, r in enumerate(rows):
+        out[i, : len(r)] = r
+    return out
+
+
+def monodromy_multipliers(problem, X, p, *, steps: int = 4096, eps: float = 1e-6, warm_periods: int = 3):
+    """Floquet multipliers from finite differences of the period map.
+
+    Parameters
+    ----------
+    problem : HBProblem
+        The harmonic-balance problem (system, parameter).
+    X : ndarray
+        HB coefficients of the periodic solution.
+    p : float
+        Parameter value.
+    steps : int
+        Velocity-Verlet steps per period.
+    eps : float
+        Relative perturbation of positions (scaled by the amplitude) and
+        velocities (scaled by w times the amplitude).
+    warm_periods : int
+        Periods of the HB displacement marched through each contact law to
+        obtain the contact state at t = 0.
+
+    Returns
+    -------
+    ndarray complex (2n,)
+        Eigenvalues of the finite-difference monodromy matrix.
+    """
+    sysm = problem.system
+    n = problem.n
+    w = problem.omega(p)
+    Tper = 2.0 * np.pi / w
+    h = Tper / steps
+    w_, f, loads = problem._split(p)
+    Xm = X.reshape(problem.nh, n)
+    tau = 2.0 * np.pi * np.arange(steps) / steps
+    E = np.ones((steps, problem.nh))
+    for k in range(1, problem.H + 1):
+        E[:, 2 * k - 1] = np.cos(k * tau)
+        E[:, 2 * k] = np.sin(k * tau)
+    xs = E @ Xm  # (steps, n)
+    D = derivative_matrix(problem.H)
+    x0 = Xm[0] + Xm[1::2].sum(axis=0)
+    v0 = w * ((D @ Xm)[0] + (D @ Xm)[1::2].sum(axis=0))
+    states, params = [], []
+    for c, b, (n0, n1, dl, _) in zip(problem.contacts, problem.B, loads):
+        u = np.tile(xs @ b, warm_periods)
+        u = np.append(u, u[0])
+        tt = np.arange(u.size) * (2.0 * np.pi / steps)
+        N = n0 + n1 * np.sin(tt + dl)
+        s = march(c.law, u, N)[3]
+        states.append(s)
+        params.append(c.law.params)
+    S = _pad_stack(states)
+    Pm = _pad_stack(params)
+    Bm = np.array(problem.B) if problem.B else np.zeros((0, n))
+    n0a = np.array([l[0] for l in loads])
+    n1a = np.array([l[1] for l in loads])
+    dla = np.array([l[2] for l in loads])
+    law = problem.contacts[0].law
+    fn = specialize(_verlet_template, STEP=law.step)
+    Minv = np.linalg.inv(sysm.M)
+    amp = max(float(np.max(np.abs(xs))), 1e-12)
+
+    def pmap(z):
+        xo = np.empty(n)
+        vo = np.empty(n)
+        st = S.copy()
+        fn(Minv, sysm.C, sysm.K, f, Bm, Pm, st, n0a, n1a, dla, w, z[:n].copy(), z[n:].copy(), h, steps, xo, vo)
+        return np.concatenate((xo, vo))
+
+    z0 = np.concatenate((x0, v0))
+    scale = np.concatenate((np.full(n, amp), np.full(n, amp * w)))
+    Phi = np.empty((2 * n, 2 * n))
+    for j in range(2 * n):
+        dz = np.zeros(2 * n)
+        dz[j] = eps * scale[j]
+        Phi[:, j] = (pmap(z0 + dz) - pmap(z0 - dz)) / (2 * dz[j])
+    return np.linalg.eigvals(Phi)
