@@ -3,13 +3,15 @@ Jacobians, arc-length continuation, Hill stability, unbounded-response
 detection (see docs/harmonic-balance.md)."""
 
 from .continuation import ContinuationResult, continuation, newton
-from .frc import HBBranch, branch_dataset, continue_hb, frc_hb
+from .frc import HBBranch, HBSolution, branch_dataset, continue_hb, frc_hb, harmonic_balance
 from .problem import PARAMETERS, HBProblem
 from .stability import hill_exponents, hill_stability, monodromy_multipliers
 
 __all__ = [
     "frc_hb",
     "continue_hb",
+    "harmonic_balance",
+    "HBSolution",
     "branch_dataset",
     "HBBranch",
     "HBProblem",

@@ -45,7 +45,7 @@ from .continuation import ContinuationResult, continuation
 from .problem import PARAMETERS, HBProblem, contact_of
 from .stability import hill_stability
 
-__all__ = ["HBBranch", "continue_hb", "frc_hb", "branch_dataset"]
+__all__ = ["HBBranch", "HBSolution", "continue_hb", "frc_hb", "branch_dataset", "harmonic_balance"]
 
 
 class HBBranch:
@@ -392,3 +392,82 @@ def frc_hb(
                      parameter="gamma", harmonics=harmonics, samples=samples, ds=ds, ds_max=ds_max,
                      max_points=max_points, predictor=predictor, progress=progress)
     return branch_dataset(br, response_dof)
+
+
+class HBSolution:
+    """One harmonic-balance solution at fixed parameters.
+
+    Attributes
+    ----------
+    converged : bool
+    iterations : int
+    X : ndarray
+        Harmonic coefficients (harmonic-major), m.
+    residual_norm : float
+        max |R| at X, N.
+    amplitude_m, offset_m, max_abs_m : float
+        Half peak-to-peak, mean and max |x| of ``response_dof``, m.
+    stable : bool
+        Hill's method.
+    problem : HBProblem
+    """
+
+    def __init__(self, problem, X, converged, iterations, response_dof):
+        self.problem = problem
+        self.X = X
+        self.converged = bool(converged)
+        self.iterations = int(iterations)
+        p = problem
+        lam = p.f1_ref
+        ev = p.evaluate(X, lam)
+        self.residual_norm = float(np.max(np.abs(ev.R)))
+        self.amplitude_m, self.offset_m, self.max_abs_m = p.amplitudes(X, response_dof)
+        self.stable, self.growth, self.multipliers = hill_stability(ev.JX, p.system.M, p.system.C, p.omega(lam), p.H)
+        self.aft_info = ev.info
+
+
+def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB_HARMONICS,
+                     samples: int = config.HB_SAMPLES, guess=None, response_dof: int = 0,
+                     tol: float = config.HB_NEWTON_RTOL, max_iter: int = 50) -> HBSolution:
+    """Solve the HB equations at one frequency by damped Newton.
+
+    Parameters
+    ----------
+    system : System
+    gamma : float
+        w / w0 (> 0).
+    harmonics, samples : int
+        H >= 1 and AFT samples per period >= 2H + 2.
+    guess : ndarray, optional
+        Starting coefficients (default: the stuck-contact linear solution).
+    response_dof : int
+        DOF reported in the amplitudes.
+    tol : float
+        Tolerance on the residual scaled by max(F1, fy).
+    max_iter : int
+        Newton iterations.
+
+    Returns
+    -------
+    HBSolution
+        ``converged`` False when Newton failed (no exception).
+    """
+    from .continuation import newton
+
+    gamma = V.positive("gamma", gamma)
+    # problem with gamma as a fixed value: reuse the f1 parameterisation
+    problem = HBProblem(system, harmonics=harmonics, samples=samples, parameter="f1", gamma=gamma)
+    xs, fs, _ = _scales(problem)
+    f1 = problem.f1_ref
+
+    def residual(y, lam):
+        ev = problem.evaluate(y * xs, f1)
+        return ev.R / fs, ev.JX * (xs / fs), ev.Jp / fs
+
+    y0 = (problem.linear_guess(f1) if guess is None else V.finite_array("guess", guess)) / xs
+    if y0.size != problem.size:
+        raise ValueError(f"guess must have length {problem.size}, got {y0.size}")
+    y, ok, it = newton(residual, y0, 0.0, tol=tol, max_iter=max_iter)
+    problem.gamma_fixed = gamma
+    sol = HBSolution(problem, y * xs, ok, it, response_dof)
+    return sol

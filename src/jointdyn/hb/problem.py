@@ -95,6 +95,8 @@ class HBProblem:
             raise ValueError("system must have a positive lowest natural frequency w0 (K positive definite)")
         self.E, self.P = fourier_matrices(self.H, self.Ns)
         self.tau = 2.0 * np.pi * np.arange(self.Ns) / self.Ns
+        self._fine = {}
+        self._lin = None
         self.contacts = list(system.contacts)
         fmax = float(np.max(np.abs(system.force))) if system.force.size else 0.0
         self.f_dir = system.force / fmax if fmax > 0 else system.force.copy()
@@ -148,36 +150,34 @@ class HBProblem:
         return [n0 + n1 * np.sin(self.tau + dl) for (n0, n1, dl, _) in loads]
 
     # --- linear part --------------------------------------------------------
+    def _linear_parts(self):
+        """A(w) = A_K + w A_C + w^2 A_M (built once)."""
+        if getattr(self, "_lin", None) is None:
+            n = self.n
+            M, C, K = self.system.M, self.system.C, self.system.K
+            AK = np.kron(np.eye(self.nh), K)
+            AC = np.zeros((self.size, self.size))
+            AM = np.zeros((self.size, self.size))
+            for k in range(1, self.H + 1):
+                ic = (2 * k - 1) * n
+                is_ = 2 * k * n
+                AM[ic:ic + n, ic:ic + n] = -(k * k) * M
+                AM[is_:is_ + n, is_:is_ + n] = -(k * k) * M
+                AC[ic:ic + n, is_:is_ + n] = k * C
+                AC[is_:is_ + n, ic:ic + n] = -k * C
+            self._lin = (AK, AC, AM)
+        return self._lin
+
     def linear_matrix(self, w):
-        """Block matrix A(w) of the linear terms (size n(2H+1))."""
-        n = self.n
-        M, C, K = self.system.M, self.system.C, self.system.K
-        A = np.zeros((self.size, self.size))
-        A[:n, :n] = K
-        for k in range(1, self.H + 1):
-            ic = (2 * k - 1) * n
-            is_ = 2 * k * n
-            D = K - (k * w) ** 2 * M
-            A[ic:ic + n, ic:ic + n] = D
-            A[is_:is_ + n, is_:is_ + n] = D
-            A[ic:ic + n, is_:is_ + n] = k * w * C
-            A[is_:is_ + n, ic:ic + n] = -k * w * C
-        return A
+        """Block matrix A(w) of the linear terms (size n(2H+1)): per harmonic k
+        ``[[K - k^2 w^2 M, k w C], [-k w C, K - k^2 w^2 M]]``, K for k = 0."""
+        AK, AC, AM = self._linear_parts()
+        return AK + w * AC + (w * w) * AM
 
     def linear_matrix_dw(self, w):
         """dA/dw."""
-        n = self.n
-        M, C = self.system.M, self.system.C
-        A = np.zeros((self.size, self.size))
-        for k in range(1, self.H + 1):
-            ic = (2 * k - 1) * n
-            is_ = 2 * k * n
-            D = -2.0 * k * k * w * M
-            A[ic:ic + n, ic:ic + n] = D
-            A[is_:is_ + n, is_:is_ + n] = D
-            A[ic:ic + n, is_:is_ + n] = k * C
-            A[is_:is_ + n, ic:ic + n] = -k * C
-        return A
+        _, AC, AM = self._linear_parts()
+        return AC + (2.0 * w) * AM
 
     def forcing(self, f):
         """Coefficient vector of f sin(tau)."""
@@ -224,10 +224,17 @@ class HBProblem:
                                                       max_passes=self.max_passes,
                                                       rtol=config.HB_PERIODIC_RTOL)
             # scatter: R[h*n + i] += b_i F_h ; JX[(h,i),(g,j)] += b_i b_j dF_hg
-            R += np.kron(F, b)
-            JX += np.kron(dFdU, np.outer(b, b))
-            if dFdp is not None:
-                Jp += np.kron(dFdp, b)
+            if self.n == 1:
+                R += F * b[0]
+                JX += dFdU * (b[0] * b[0])
+                if dFdp is not None:
+                    Jp += dFdp * b[0]
+            else:
+                R += (F[:, None] * b[None, :]).ravel()
+                bb = np.outer(b, b)
+                JX += (dFdU[:, None, :, None] * bb[None, :, None, :]).reshape(self.size, self.size)
+                if dFdp is not None:
+                    Jp += (dFdp[:, None] * b[None, :]).ravel()
             Ts.append(T)
             codes.append(code)
             info[0] = max(info[0], inf[0])
@@ -238,12 +245,10 @@ class HBProblem:
     # --- post-processing ----------------------------------------------------
     def reconstruct(self, X, dof: int, points: int = 1024):
         """x_dof(tau) on a fine grid of ``points`` samples over one period, m."""
-        tau = 2.0 * np.pi * np.arange(points) / points
-        Xm = X.reshape(self.nh, self.n)[:, dof]
-        x = np.full(points, Xm[0])
-        for k in range(1, self.H + 1):
-            x += Xm[2 * k - 1] * np.cos(k * tau) + Xm[2 * k] * np.sin(k * tau)
-        return x
+        Ef = self._fine.get(points)
+        if Ef is None:
+            Ef = self._fine[points] = fourier_matrices(self.H, points)[0]
+        return Ef @ X.reshape(self.nh, self.n)[:, dof]
 
     def amplitudes(self, X, dof: int):
         """(half peak-to-peak, mean, max |x|) of x_dof(t), m."""

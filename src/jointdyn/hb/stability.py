@@ -14,16 +14,21 @@ with J_X the HB Jacobian dR/dX (the contact part is the AFT-derived
 derivative of the periodic force coefficients, the standard choice for
 hysteretic forces, which are not differentiable in velocity) and nabla the
 d/dtau operator on the coefficients. It is solved in first-order (companion)
-form, size 2 n (2H+1). Of those eigenvalues, the 2n Floquet exponents are
-chosen by the symmetry criterion of Lazarus & Thomas (C. R. Mecanique 338,
-2010) as refined by Guillot, Lazarus, Thomas, Vergez & Cochelin (J. Comput.
-Phys. 416, 2020): the eigenvectors of the exponents themselves are the most
-"central" ones, i.e. their energy is centred on harmonic 0; the eigenvalues
-shifted by i k w have eigenvectors shifted by k harmonics. We take the 2n
-eigenvalues whose eigenvector's harmonic centroid (in the complex
-exponential basis) is nearest to 0. The solution is unstable when one of
-them has ``Re(s) > HB_STABILITY_RTOL * w``. Floquet multipliers are
-``exp(2 pi s / w)``.
+form, size 2 n (2H+1). Each Floquet exponent s appears there as a family
+s + i k w (k = -H..H), of which the truncation resolves well only the
+members whose eigenvectors are centred on the low harmonics. Following
+Moore (Int. J. Numer. Meth. Eng. 62, 2005) and the comparison of Peletan,
+Baguet, Torkhani & Jacquet-Richardet (Nonlinear Dyn. 72, 2013), the 2n
+exponents are the eigenvalues with the smallest |Im s| (one representative
+per family lies in |Im s| <= w/2); ties (several real eigenvalues, whose
+real eigenvectors are all symmetric) are broken by the symmetry criterion
+of Lazarus & Thomas (C. R. Mecanique 338, 2010; Guillot et al., J. Comput.
+Phys. 416, 2020): the eigenvector's harmonic centroid, in the complex
+exponential basis, nearest to 0. The large-|Im| eigenvalues that this
+discards include the truncation artefacts at the edge of the harmonic
+range, which may have spurious positive real parts. The solution is
+unstable when a selected exponent has ``Re(s) > HB_STABILITY_RTOL * w``.
+Floquet multipliers are ``exp(2 pi s / w)``.
 
 Monodromy check
 ---------------
@@ -41,6 +46,7 @@ import numpy as np
 from .. import config
 from .._jit import specialize
 from ..drivers import march
+from ..laws import MACROSLIP, SEPARATION
 
 __all__ = ["hill_exponents", "hill_stability", "monodromy_multipliers", "derivative_matrix"]
 
@@ -103,7 +109,8 @@ def hill_exponents(JX, M, C, w, H):
     A[N:, N:] = -D2i @ D1
     lam, V = np.linalg.eig(A)
     cen = _centroids(V, n, H)
-    idx = np.argsort(np.abs(cen), kind="stable")[: 2 * n]
+    key_imag = np.round(np.abs(lam.imag) / w, 8)
+    idx = np.lexsort((np.abs(cen), key_imag))[: 2 * n]
     sel = lam[idx]
     sel = sel[np.argsort(-sel.real, kind="stable")]
     return sel, lam
@@ -120,7 +127,7 @@ def hill_stability(JX, M, C, w, H, rtol: float = config.HB_STABILITY_RTOL):
     return growth <= rtol, growth, mult
 
 
-def _verlet_template(Minv, C, K, f, Bm, params, states, n0, n1, dl, w, x0, v0, h, nsteps, xo, vo):  # pragma: no cover - compiled
+def _verlet_template(Minv, C, K, f, Bm, params, states, n0, n1, dl, w, t0, x0, v0, h, nsteps, xo, vo):  # pragma: no cover - compiled
     """Velocity-Verlet march of M x'' + C x' + K x + sum B_c T_c = f sin(w t)."""
     n = x0.shape[0]
     nc = Bm.shape[0]
@@ -136,18 +143,18 @@ def _verlet_template(Minv, C, K, f, Bm, params, states, n0, n1, dl, w, x0, v0, h
         u = 0.0
         for i in range(n):
             u += Bm[c, i] * x[i]
-        N = n0[c] + n1[c] * np.sin(dl[c])
+        N = n0[c] + n1[c] * np.sin(w * t0 + dl[c])
         t_, k_, c_ = STEP(params[c], sa[c], sb[c], u, N)  # noqa: F821
         Tc[c] = t_
     sa, sb = sb, sa
     for i in range(n):
-        r = 0.0 - K[i, :] @ x - C[i, :] @ v
+        r = f[i] * np.sin(w * t0) - K[i, :] @ x - C[i, :] @ v
         for c in range(nc):
             r -= Bm[c, i] * Tc[c]
         rhs[i] = r
     a[:] = Minv @ rhs
     for step in range(nsteps):
-        t1 = (step + 1) * h
+        t1 = t0 + (step + 1) * h
         xn = x + h * v + 0.5 * h * h * a
         vp = v + h * a
         for c in range(nc):
@@ -212,22 +219,36 @@ def monodromy_multipliers(problem, X, p, *, steps: int = 4096, eps: float = 1e-6
     h = Tper / steps
     w_, f, loads = problem._split(p)
     Xm = X.reshape(problem.nh, n)
-    tau = 2.0 * np.pi * np.arange(steps) / steps
-    E = np.ones((steps, problem.nh))
-    for k in range(1, problem.H + 1):
-        E[:, 2 * k - 1] = np.cos(k * tau)
-        E[:, 2 * k] = np.sin(k * tau)
-    xs = E @ Xm  # (steps, n)
+    # Poincare section where the contacts hold the least memory (all open,
+    # else all in macroslip): there the contact state is a function of the
+    # positions, velocities and load, so the 2n-dimensional period map is exact
+    ev = problem.evaluate(X, p)
+    codes = np.array(ev.code).reshape(len(ev.code), -1)
+    j0 = 0
+    for target in (SEPARATION, MACROSLIP):
+        hit = np.flatnonzero(np.all(codes == target, axis=0))
+        if hit.size:
+            j0 = int(hit[hit.size // 2])
+            break
+    tau0 = 2.0 * np.pi * j0 / problem.Ns
     D = derivative_matrix(problem.H)
-    x0 = Xm[0] + Xm[1::2].sum(axis=0)
-    v0 = w * ((D @ Xm)[0] + (D @ Xm)[1::2].sum(axis=0))
+
+    def basis(tau):
+        E = np.ones((tau.size, problem.nh))
+        for k in range(1, problem.H + 1):
+            E[:, 2 * k - 1] = np.cos(k * tau)
+            E[:, 2 * k] = np.sin(k * tau)
+        return E
+
+    e0 = basis(np.array([tau0]))[0]
+    x0 = e0 @ Xm
+    v0 = w * (e0 @ (D @ Xm))
+    tt = tau0 + np.arange(warm_periods * steps + 1) * (2.0 * np.pi / steps)
+    xs = basis(tt) @ Xm
     states, params = [], []
     for c, b, (n0, n1, dl, _) in zip(problem.contacts, problem.B, loads):
-        u = np.tile(xs @ b, warm_periods)
-        u = np.append(u, u[0])
-        tt = np.arange(u.size) * (2.0 * np.pi / steps)
         N = n0 + n1 * np.sin(tt + dl)
-        s = march(c.law, u, N)[3]
+        s = march(c.law, xs @ b, N)[3]
         states.append(s)
         params.append(c.law.params)
     S = _pad_stack(states)
@@ -245,7 +266,7 @@ def monodromy_multipliers(problem, X, p, *, steps: int = 4096, eps: float = 1e-6
         xo = np.empty(n)
         vo = np.empty(n)
         st = S.copy()
-        fn(Minv, sysm.C, sysm.K, f, Bm, Pm, st, n0a, n1a, dla, w, z[:n].copy(), z[n:].copy(), h, steps, xo, vo)
+        fn(Minv, sysm.C, sysm.K, f, Bm, Pm, st, n0a, n1a, dla, w, tau0 / w, z[:n].copy(), z[n:].copy(), h, steps, xo, vo)
         return np.concatenate((xo, vo))
 
     z0 = np.concatenate((x0, v0))
