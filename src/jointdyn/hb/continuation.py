@@ -16,6 +16,12 @@ Springer 2010, sec. 4.4):
   halved and retried after a failure, down to ``ds_min``;
 * a fold (turning point in lam) is where the lam component of the tangent
   changes sign; it is flagged at the first point past it;
+* a residual that jumps (a contact law with a discontinuous force, e.g.
+  the closed-form Iwan rules under a varying load) can leave no solution
+  on the arc: when the corrector fails at ``ds_min``, Newton at fixed lam
+  is tried a little further on (1e-4, 1e-3, 1e-2 of the range); if it
+  converges the branch goes on from there and the point is marked as a
+  ``gap``;
 * the branch stops when lam leaves ``[min(lam0, lam_stop), max(..)]``
   (the end point is corrected onto ``lam_stop`` exactly), after
   ``max_points``, when a ``monitor`` says so, or when the corrector fails
@@ -38,6 +44,8 @@ __all__ = ["ContinuationResult", "continuation", "newton"]
 #: below this (scaled) step a sharp turn or a long correction is a corner of
 #: a piecewise-smooth branch, not a jump to another branch
 _CORNER_DS = 2e-3
+#: bound on the jumps over discontinuities per branch
+_MAX_JUMPS = 5
 
 
 @dataclass
@@ -62,8 +70,11 @@ class ContinuationResult:
         True at the first point past a turning point in lam.
     iterations : ndarray of int (points,)
         Newton iterations of each point.
+    gap : ndarray of bool (points,)
+        True where the point was reached by a jump over a discontinuity of
+        the residual (see :func:`continuation`), not along the curve.
     counters : dict
-        ``points, residual_evaluations, steps_rejected, folds``.
+        ``points, residual_evaluations, steps_rejected, folds, jumps``.
     """
 
     status: str
@@ -73,6 +84,7 @@ class ContinuationResult:
     tangent_lam: np.ndarray
     fold: np.ndarray
     iterations: np.ndarray
+    gap: np.ndarray
     counters: dict = field(default_factory=dict)
 
 
@@ -162,6 +174,21 @@ def _tangent(Jy, Jl, t_prev):
     return t / nt
 
 
+def _jump(residual, u, t, span, sgn, tol, max_iter, cnt):
+    """Newton at fixed lam a little beyond u (over a discontinuity)."""
+    n = u.size - 1
+    d = sgn  # forward in the range: never bounce back over the same discontinuity
+    for frac in (1e-4, 1e-3, 1e-2):
+        lam = u[n] + d * frac * span
+        y0 = u[:n] + (t[:n] * ((lam - u[n]) / t[n]) if abs(t[n]) > 1e-3 else 0.0)
+        y, ok, it, (R, Jy, Jl) = _solve_damped(residual, y0, lam, None, None, tol=tol, max_iter=max_iter, cnt=cnt)
+        if ok:
+            tn = _tangent(Jy, Jl, t)
+            if tn is not None:
+                return np.concatenate((y, [lam])), tn, it
+    return None
+
+
 def continuation(
     residual: Callable,
     y0,
@@ -223,8 +250,9 @@ def continuation(
     ds = min(max(ds, ds_min), ds_max)
     sgn = 1.0 if lam_stop > lam0 else -1.0
     lo, hi = min(lam0, lam_stop), max(lam0, lam_stop)
-    cnt = {"points": 0, "residual_evaluations": 0, "steps_rejected": 0, "folds": 0}
-    Y, L, TL, FOLD, IT = [], [], [], [], []
+    cnt = {"points": 0, "residual_evaluations": 0, "steps_rejected": 0, "folds": 0, "jumps": 0}
+    Y, L, TL, FOLD, IT, GAP = [], [], [], [], [], []
+    ds_init = ds
 
     def finish(status, message):
         cnt["points"] = len(L)
@@ -237,6 +265,7 @@ def continuation(
             tangent_lam=np.array(TL),
             fold=np.array(FOLD, dtype=bool),
             iterations=np.array(IT, dtype=int),
+            gap=np.array(GAP, dtype=bool),
             counters=dict(cnt),
         )
 
@@ -252,7 +281,7 @@ def continuation(
     if t is None:
         return finish("failed", f"singular Jacobian at the start lam = {lam0:.6g}")
     u = np.concatenate((y, [lam0]))
-    Y.append(y.copy()); L.append(lam0); TL.append(t[n]); FOLD.append(False); IT.append(it)
+    Y.append(y.copy()); L.append(lam0); TL.append(t[n]); FOLD.append(False); IT.append(it); GAP.append(False)
     if progress is not None:
         progress.update(1)
     if monitor is not None:
@@ -264,6 +293,7 @@ def continuation(
         if len(L) >= max_points:
             return finish("max-points", f"stopped after {len(L)} points at lam = {u[n]:.6g}")
         accepted = False
+        gap = False
         while not accepted:
             if predictor == "secant" and u_prev is not None:
                 d = u - u_prev
@@ -289,10 +319,21 @@ def continuation(
                 cnt["steps_rejected"] += 1
                 ds *= 0.5
                 if ds < ds_min:
-                    return finish("failed", f"corrector failed at the smallest step near lam = {u[n]:.6g}")
+                    jump = None
+                    if cnt["jumps"] < _MAX_JUMPS:
+                        jump = _jump(residual, u, t, hi - lo, sgn, tol, max_iter, cnt)
+                    if jump is None:
+                        why = "" if cnt["jumps"] < _MAX_JUMPS else f" after {_MAX_JUMPS} jumps over discontinuities"
+                        return finish("failed", f"corrector failed at the smallest step near lam = {u[n]:.6g}{why}")
+                    v, t_new, it = jump
+                    cnt["jumps"] += 1
+                    ds = ds_init
+                    gap = True
+                    break
                 continue
             accepted = True
-        fold = bool(np.sign(t_new[n]) != np.sign(t[n]) and t[n] != 0.0)
+            gap = False
+        fold = bool(np.sign(t_new[n]) != np.sign(t[n]) and t[n] != 0.0) and not gap
         cnt["folds"] += fold
         lam_new = v[n]
         if lam_new > hi or lam_new < lo:
@@ -306,13 +347,14 @@ def continuation(
                 cnt["residual_evaluations"] += 1
                 te = _tangent(Jy, Jl, t)
                 Y.append(y_end); L.append(lam_end); TL.append(te[n] if te is not None else np.nan)
-                FOLD.append(fold); IT.append(it_end)
+                FOLD.append(fold); IT.append(it_end); GAP.append(False)
             where = "lam_stop" if lam_end == lam_stop else "the start of the range (the branch turned back)"
             return finish("complete", f"reached {where} lam = {lam_end:.6g}")
         u_prev = u
         u = v
         t = t_new
         Y.append(v[:n].copy()); L.append(lam_new); TL.append(t[n]); FOLD.append(fold); IT.append(it)
+        GAP.append(gap)
         if progress is not None:
             progress.update(1)
         if monitor is not None:

@@ -64,6 +64,9 @@ class HBBranch:
         0 for the branch from the start, 1 for the one continued back from
         the end after an unbounded stop.
     stable, fold : ndarray of bool
+    gap : ndarray of bool
+        Point reached by a jump over a discontinuity of the contact force
+        (do not join it to the previous point).
     growth : ndarray
         max Re(s) / w of the selected Floquet exponents.
     passes, periodic_error : ndarray
@@ -71,7 +74,7 @@ class HBBranch:
     counters : dict
     """
 
-    def __init__(self, problem, parameter, status, message, lam, X, segment, fold, counters):
+    def __init__(self, problem, parameter, status, message, lam, X, segment, fold, counters, gap=None):
         self.problem = problem
         self.parameter = parameter
         self.status = status
@@ -80,6 +83,7 @@ class HBBranch:
         self.X = X
         self.segment = segment
         self.fold = fold
+        self.gap = np.zeros(lam.size, dtype=bool) if gap is None else gap
         self.counters = counters
         n = lam.size
         self.stable = np.zeros(n, dtype=bool)
@@ -264,9 +268,13 @@ def continue_hb(
     X = np.concatenate([p.y * xs for p in parts]) if lam.size else np.empty((0, problem.size))
     seg = np.concatenate([np.full(p.lam.size, i) for i, p in enumerate(parts)]).astype(int)
     fold = np.concatenate([p.fold for p in parts]).astype(bool)
+    gap = np.concatenate([p.gap for p in parts]).astype(bool)
     counters = {k: sum(p.counters.get(k, 0) for p in parts) for k in parts[0].counters}
     counters["segments"] = len(parts)
-    return HBBranch(problem, parameter, status, message, lam, X, seg, fold, counters)
+    if counters.get("jumps", 0):
+        message += (f"; {counters['jumps']} jump(s) over discontinuities of the contact force "
+                    "(points flagged 'gap')")
+    return HBBranch(problem, parameter, status, message, lam, X, seg, fold, counters, gap)
 
 
 def _relabel_failure(res: ContinuationResult, xs, qamp):
@@ -285,7 +293,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
     Variables: ``gamma``, the parameter (if not gamma), ``amplitude_q``
     (kt X / fy of the first contact, X = half peak-to-peak of x(t) of
     ``response_dof``), ``amplitude_m`` (X, m), ``offset_m`` (mean, m),
-    ``max_abs_m`` (m), ``stable``, ``fold``, ``segment``, ``growth``
+    ``max_abs_m`` (m), ``stable``, ``fold``, ``segment``, ``gap``, ``growth``
     (max Re(s)/w of the Floquet exponents), ``harmonic_amplitude_m``
     (dims point, harmonic: sqrt(a_k^2 + b_k^2), |a_0| for k = 0).
     """
@@ -310,6 +318,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
         "stable": ("point", branch.stable),
         "fold": ("point", branch.fold),
         "segment": ("point", branch.segment),
+        "gap": ("point", branch.gap),
         "growth": ("point", branch.growth),
         "aft_passes": ("point", branch.passes),
         "harmonic_amplitude_m": (("point", "harmonic"), harm),
