@@ -30,6 +30,69 @@ TEST_ENERGY_CREATION_TOL = 1e-9
 # --- quasi-static driver and loop metrics (issue 2) ----------------------
 
 # --- time integration and steady state (issue 3) --------------------------
+#: default RK4 steps per forcing period (before events and reversal splits)
+TI_STEPS_PER_PERIOD = 256
+#: steps per period are raised so that w_max * h <= this (w_max: stiffest
+#: linear mode with every contact stuck); RK4 is stable up to ~2.8
+TI_MAX_OMEGA_H = 1.0
+#: at most this many reversal splits inside one grid step
+TI_MAX_SPLITS = 4
+#: an event closer than this fraction of a step to a grid point moves it
+TI_EVENT_MERGE = 1e-6
+#: normal load put at a re-contact instant, as a fraction of n0 (> 0 so that
+#: the committed law state is "in contact, virgin at the re-contact point")
+TI_RECONTACT_ALPHA = 1e-12
+#: a state larger than this factor times (|f|/k_min + fy/kt) is a blow-up
+TI_BLOWUP_FACTOR = 1e8
+#: steady state: default relative tolerance on the half peak-to-peak
+#: amplitude and on the period-boundary state (Poincare points)
+SS_AMP_RTOL = 1e-4
+#: steady state: default relative tolerance on the energy per period
+SS_ENERGY_RTOL = 1e-3
+#: steady state: windows (of p periods) that must agree
+SS_CHECK_PERIODS = 3
+#: steady state: largest period multiple p looked for
+SS_MAX_MULTIPLE = 4
+#: steady state: default cap on integrated periods
+SS_MAX_PERIODS = 1500
+#: steady state: periods integrated between two checks
+SS_CHUNK = 8
+#: steady state: shooting (Newton on the period map) when the estimated
+#: number of periods to converge exceeds this
+SS_SHOOT_AFTER = 40
+#: steady state: Newton iterations of one shooting attempt
+SS_SHOOT_MAXIT = 12
+#: steady state: largest Newton step (relative to the amplitude) and
+#: step halvings of the line search
+SS_SHOOT_MAXSTEP = 1.0
+SS_SHOOT_HALVINGS = 8
+#: steady state: shooting attempts per run
+SS_MAX_SHOTS = 3
+#: steady state: relative finite-difference step of the monodromy matrix
+SS_SHOOT_FD = 1e-6
+#: steady state: a Floquet multiplier above 1 + this marks an unstable orbit
+SS_FLOQUET_TOL = 1e-3
+#: steady state: describing-function iterations of the linear start
+SS_LINEAR_ITERS = 30
+#: unbounded: amplitude increasing over this many consecutive periods ...
+SS_GROWTH_PERIODS = 40
+#: ... with increments of the second half >= this fraction of the first
+SS_GROWTH_RATIO = 0.9
+#: ... and with the amplitude of x[response_dof] above this many fy/kt of
+#: the first contact (friction saturated: only then can friction lose)
+SS_UNBOUNDED_Q = 20.0
+
+# --- test tolerances for time integration (tests/test_dynamics.py) --------
+#: peak of the beta = 1000 response vs sqrt((k + kt)/k)
+TEST_TI_PEAK_GAMMA_ATOL = 0.01
+#: eta = 0 tiny forcing vs linear (k + kt) oscillator, relative
+TEST_TI_LINEAR_RTOL = 0.01
+#: energy balance W = E_contact + E_viscous at steady state, relative
+TEST_TI_ENERGY_RTOL = 0.01
+#: amplitude change when the step is halved at the default steps, relative
+TEST_TI_STEP_HALVING_RTOL = 0.005
+#: compiled law inside the integrator vs drivers.march, in units of fy
+TEST_TI_MARCH_ATOL_FY = 1e-9
 
 # --- sweeps (issue 3) -----------------------------------------------------
 

@@ -1,0 +1,578 @@
+"""Steady periodic response of a harmonically forced System, with classification.
+
+:func:`steady_state` integrates (RK4 core, ``_core.py``) until the response
+repeats with the forcing period, or with a multiple p <= 4 of it, within
+tolerances on the half peak-to-peak amplitude, the period-boundary state
+(Poincare points) and the energy per period over K windows; otherwise it
+classifies the run as ``"unbounded"`` (amplitude still growing, e.g. the Den
+Hartog case of MODEL.md section 6) or ``"not-settled"``. When the transient
+decays slowly (lightly damped cases, MODEL.md section 7) it computes the
+periodic state directly by shooting: Newton on the period map of (x, v) with
+the law state carried along, finite-difference monodromy matrix, minimum-norm
+(least-squares) steps because the offset of a partly stuck contact is
+neutral (a multiplier 1).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _validate as V
+from .. import config
+from ..drivers import march
+from ..systems import System
+from ._core import S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
+from .integrate import Restart, Trajectory, _Model, _omega
+
+__all__ = ["SteadyState", "steady_state", "STATUSES"]
+_DEBUG = False
+
+#: possible values of :attr:`SteadyState.status`
+STATUSES = ("periodic", "not-settled", "unbounded")
+
+
+@dataclass(frozen=True)
+class SteadyState:
+    """Result of :func:`steady_state`.
+
+    Every amplitude/energy field is NaN unless ``status == "periodic"``: a
+    run that did not settle is never reported as a plain number (the last
+    observed amplitude is kept in ``last_amplitude_m`` for diagnostics).
+
+    Attributes
+    ----------
+    status : str
+        ``"periodic"``, ``"not-settled"`` or ``"unbounded"``.
+    detail : str
+        More on the status: ``"integration"`` or ``"shooting"`` (how a
+        periodic state was reached); ``"growing"``, ``"blow-up"``;
+        ``"slowly-converging"``, ``"quasi-periodic-or-chaotic"``.
+    period_multiple : int
+        p: the response repeats every p forcing periods (0 if not periodic).
+    gamma, omega : float
+        Frequency ratio w / w0 and excitation frequency w (rad/s).
+    amplitude_q : float
+        kt X / fy of the first contact's law (MODEL.md section 6).
+    amplitude_m : float
+        X = half peak-to-peak of x[response_dof] over the final p periods, m.
+    offset_m : float
+        Time mean of x[response_dof] over the final p periods, m.
+    max_abs_m : float
+        max |x[response_dof]| over the final p periods, m.
+    energy_contact_J, energy_viscous_J, work_force_J : float
+        Energy dissipated by all contacts, by viscous damping, and work of
+        the forcing, per forcing period (J), averaged over the final p periods.
+    periods : int
+        Forcing periods integrated (shooting evaluations included).
+    steps : int
+        RK4 steps taken (all periods).
+    shooting_iterations : int
+        Newton iterations spent in shooting (0 if not used).
+    floquet_max : float
+        Largest |Floquet multiplier| from the last shooting Jacobian (NaN if none).
+    last_amplitude_m : float
+        Half peak-to-peak of the last integrated period, m (diagnostic; not a result).
+    restart : Restart
+        x, v and law states at the final period boundary (warm start).
+    loop : Trajectory or None
+        The final p periods, sampled at every step (if ``keep_loop``).
+    """
+
+    status: str
+    detail: str
+    period_multiple: int
+    gamma: float
+    omega: float
+    amplitude_q: float
+    amplitude_m: float
+    offset_m: float
+    max_abs_m: float
+    energy_contact_J: float
+    energy_viscous_J: float
+    work_force_J: float
+    periods: int
+    steps: int
+    shooting_iterations: int
+    floquet_max: float
+    last_amplitude_m: float
+    restart: Restart = field(repr=False)
+    loop: Trajectory | None = field(default=None, repr=False)
+
+    @property
+    def ok(self) -> bool:
+        """True when a periodic steady state was found."""
+        return self.status == "periodic"
+
+
+class _History:
+    """Per-period summaries since the last jump of the state."""
+
+    def __init__(self, z0):
+        self.Z = [np.array(z0, dtype=float)]
+        self.summ = []
+
+    def add(self, summ, zend):
+        self.summ.extend(summ)
+        self.Z.extend(zend)
+
+    @property
+    def size(self):
+        return len(self.summ)
+
+
+def _amplitude_scale(model, A):
+    floor = 1e-14 + 1e-9 * sum(c.law.fy / c.law.kt for c in model.system.contacts)
+    return max(A, floor)
+
+
+def _check_periodic(h: _History, p: int, K: int, model, amp_rtol, energy_rtol):
+    """True if the last K windows of p periods repeat within the tolerances."""
+    P = h.size
+    if P < K * p:
+        return False
+    S = np.asarray(h.summ[P - K * p:])
+    Z = np.asarray(h.Z[P - K * p:])
+    n = model.n
+    amps, es, ws = [], [], []
+    for i in range(K):
+        win = S[i * p:(i + 1) * p]
+        amps.append(0.5 * (win[:, S_XMAX].max() - win[:, S_XMIN].min()))
+        es.append(np.mean(win[:, S_EC] + win[:, S_EV]))
+        ws.append(np.mean(win[:, S_W]))
+    A = max(amps)
+    xs = _amplitude_scale(model, A)
+    if max(amps) - min(amps) > amp_rtol * xs:
+        return False
+    wscale = max(model.w, 1e-300)
+    for i in range(K):
+        dz = Z[(i + 1) * p] - Z[i * p]
+        if np.max(np.abs(dz[:n])) > amp_rtol * xs or np.max(np.abs(dz[n:])) > amp_rtol * xs * wscale:
+            return False
+    escale = max(max(abs(w) for w in ws), max(abs(e) for e in es), 1e-300)
+    if max(es) - min(es) > energy_rtol * escale or max(ws) - min(ws) > energy_rtol * escale:
+        return False
+    return True
+
+
+def _growing(h: _History, model, amp_rtol) -> bool:
+    """Amplitude increasing over the last SS_GROWTH_PERIODS periods without slowing down."""
+    G = config.SS_GROWTH_PERIODS
+    if h.size < G + 1:
+        return False
+    S = np.asarray(h.summ[-(G + 1):])
+    A = 0.5 * (S[:, S_XMAX] - S[:, S_XMIN])
+    d = np.diff(A)
+    if not np.all(d > 0):
+        return False
+    half = d.size // 2
+    if d[half:].mean() < config.SS_GROWTH_RATIO * d[:half].mean():
+        return False
+    # energy surplus (W - E_c - E_v) / W per period: stays positive and does
+    # not decay when the response is unbounded (Den Hartog: 1 - 4R/(pi F));
+    # it decays to 0 on a (slow) approach to a bounded state
+    sur = (S[1:, S_W] - S[1:, S_EC] - S[1:, S_EV]) / np.maximum(np.abs(S[1:, S_W]), 1e-300)
+    q = max(sur.size // 4, 1)
+    if not np.all(sur > 0) or sur[-q:].mean() < config.SS_GROWTH_RATIO * sur[:q].mean():
+        return False
+    if d.mean() <= amp_rtol * A[-1]:
+        return False
+    # a contact in microslip dissipates ~A^3 (faster than the work ~A of the
+    # forcing): growth can only be unbounded once the friction saturates
+    cs = model.system.contacts
+    if cs and not A[-1] > config.SS_UNBOUNDED_Q * cs[0].law.fy / cs[0].law.kt:
+        return False
+    return True
+
+
+def _one_period_decaying(h: _History, m: int, model) -> bool:
+    """True if the one-period mismatch of the Poincare points decays over the last m periods."""
+    Z = np.asarray(h.Z[-(m + 1):])
+    n = model.n
+    D = np.diff(Z, axis=0)
+    D[:, n:] /= max(model.w, 1e-300)
+    d = np.max(np.abs(D), axis=1)
+    return d[-1] < 0.7 * d[0]
+
+
+def _contraction(h: _History, model):
+    """Estimated contraction factor of the Poincare distance per period (or None)."""
+    if h.size < 6:
+        return None
+    Z = np.asarray(h.Z[-7:])
+    n = model.n
+    D = np.diff(Z, axis=0)
+    D[:, n:] /= max(model.w, 1e-300)
+    d = np.max(np.abs(D), axis=1)
+    if d[0] <= 0 or d[-1] <= 0:
+        return None
+    return (d[-1] / d[0]) ** (1.0 / (d.size - 1)), d[-1]
+
+
+def _linear_start(model: _Model):
+    """Equivalent-linearisation estimate of the periodic state at phase 0.
+
+    Solves (K - w^2 M + i w C + sum_c k_c B_c B_c^T) X = f with k_c the
+    describing function (first harmonic of T over one cycle of
+    u = Im(U e^{i w t}) with the actual N_c(t), marched with the real law),
+    started from the stuck stiffness kt and iterated with relaxation.
+    Returns x, v (m, m/s) and law states at t = 0 (law marched over the last
+    two cycles of the estimate), or None if the iteration diverges.
+    """
+    sysm = model.system
+    n, w = model.n, model.w
+    Z0 = model.K - w * w * sysm.M + 1j * w * model.C
+    f = model.fvec.astype(complex)
+    kc = np.array([c.law.kt for c in sysm.contacts], dtype=complex)
+    B = np.zeros((model.nc, n))
+    for i, c in enumerate(sysm.contacts):
+        B[i, c.dof] = 1.0
+        if c.dof2 >= 0:
+            B[i, c.dof2] = -1.0
+    ns = 64
+    th = 2 * math.pi * np.arange(2 * ns) / ns - 4 * math.pi  # two cycles ending before t = 0
+    th = np.append(th, 0.0)
+    xscale = float(np.max(np.abs(f))) / max(model.w_min_stuck**2 * float(np.min(np.diag(sysm.M))), 1e-300)
+    xscale += sum(c.law.fy / c.law.kt for c in sysm.contacts)
+    X = None
+    for it in range(config.SS_LINEAR_ITERS if model.nc else 1):
+        Z = Z0 + (B.T * kc) @ B
+        try:
+            Xn = np.linalg.solve(Z, f)
+        except np.linalg.LinAlgError:
+            return None
+        if not np.all(np.isfinite(Xn)) or np.max(np.abs(Xn)) > 1e3 * xscale:
+            return None
+        conv = X is not None and np.max(np.abs(Xn - X)) <= 1e-4 * np.max(np.abs(Xn))
+        X = Xn
+        if conv:
+            break
+        U = B @ X
+        for i, c in enumerate(sysm.contacts):
+            if abs(U[i]) == 0:
+                continue
+            u = np.imag(U[i] * np.exp(1j * th))
+            N = c.n0 + c.n1 * np.sin(th + c.delta)
+            T = march(c.law, u, N)[0]
+            sl = slice(ns, 2 * ns)
+            a = 2.0 / ns * np.sum(T[sl] * np.sin(th[sl]))
+            b = 2.0 / ns * np.sum(T[sl] * np.cos(th[sl]))
+            knew = (a + 1j * b) / U[i]
+            kc[i] = 0.5 * kc[i] + 0.5 * knew
+    x = np.imag(X).copy()
+    v = w * np.real(X).copy()
+    S = np.zeros((model.nc, model.slen))
+    U = B @ X
+    for i, c in enumerate(sysm.contacts):
+        u = np.imag(U[i] * np.exp(1j * th))
+        N = c.n0 + c.n1 * np.sin(th + c.delta)
+        s = march(c.law, u, N)[3]
+        S[i, : s.size] = s
+    return x, v, S
+
+
+def _shoot(model: _Model, x, v, S, rdof, tol, counters):
+    """Newton on the period map (x, v) -> (x, v)(t + T) with the law state carried.
+
+    The Poincare section is at phase 0, or in the middle of a separation
+    when every contact separates (law states reset there, so (x, v) is the
+    whole state and the map is exact). The finite-difference monodromy
+    perturbs (x, v) with the law state kept (a displacement perturbation
+    acts as a motion of the contact). Returns (x, v, S, converged,
+    floquet_max) at a phase-0 boundary. ``counters`` (dict) gets the
+    periods, steps and iterations spent.
+    """
+    n = model.n
+    w = model.w
+    Tp = model.period
+    floq = math.nan
+    ts = model.section_time()
+    x0, v0, S0 = x.copy(), v.copy(), S.copy()
+
+    def count(summ, done, frac=1.0):
+        counters["periods"] += done * frac
+        counters["steps"] += int(summ[:, S_STEPS].sum()) if done else 0
+
+    if ts > 0.0:
+        tg, Ng = model.segment_grid(0.0, ts)
+        summ, _, st_, done = model.run_grid(x, v, S, tg, Ng, 1, rdof)
+        count(summ, done, ts / Tp)
+        if st_ != 0:
+            return x0, v0, S0, False, floq
+        tgp, Ngp = model.segment_grid(ts, ts + Tp)
+    else:
+        tgp, Ngp = model.tgrid, model.Ngrid
+    z = np.concatenate([x, v])
+
+    def phi(zz, SS):
+        xx = zz[:n].copy()
+        vv = zz[n:].copy()
+        S2 = SS.copy()
+        summ, zend, status, done = model.run_grid(xx, vv, S2, tgp, Ngp, 1, rdof)
+        count(summ, done)
+        if status != 0 or done < 1:
+            return None, None, None
+        return np.concatenate([xx, vv]), S2, summ[0]
+
+    z1, S1, s1 = phi(z, S)
+    if z1 is None:
+        return x0, v0, S0, False, floq
+    converged = False
+    best = None  # (residual, z, S) of the best iterate
+    for _ in range(config.SS_SHOOT_MAXIT):
+        A = 0.5 * (s1[S_XMAX] - s1[S_XMIN])
+        xs = _amplitude_scale(model, max(A, np.max(np.abs(z[:n]))))
+        D = np.concatenate([np.full(n, xs), np.full(n, xs * w)])
+        r = (z1 - z) / D
+        if _DEBUG:
+            print("shoot r", np.max(np.abs(r)), z)
+        rn = float(np.max(np.abs(r)))
+        if best is None or rn < best[0]:
+            best = (rn, z.copy(), S.copy(), rn if best is None else best[3])
+        if rn <= tol:
+            converged = True
+            break
+        counters["shoot"] += 1
+        Jm = np.empty((2 * n, 2 * n))
+        for j in range(2 * n):
+            e = config.SS_SHOOT_FD * D[j]
+            zp = z.copy()
+            zp[j] += e
+            zj, _, _ = phi(zp, S)
+            if zj is None:
+                return x0, v0, S0, False, floq
+            Jm[:, j] = (zj - z1) / D / config.SS_SHOOT_FD
+        floq = float(np.max(np.abs(np.linalg.eigvals(Jm))))
+        dz = np.linalg.lstsq(Jm - np.eye(2 * n), -r, rcond=1e-8)[0]
+        # damped step: accept the first that reduces the residual
+        lam = 1.0
+        accepted = False
+        big = float(np.max(np.abs(dz)))
+        if big > config.SS_SHOOT_MAXSTEP:
+            lam = config.SS_SHOOT_MAXSTEP / big
+        for _ls in range(config.SS_SHOOT_HALVINGS):
+            zn = z + lam * dz * D
+            zn1, Sn1, sn1 = phi(zn, S1)
+            if zn1 is not None:
+                rnew = np.max(np.abs((zn1 - zn) / D))
+                if rnew < rn:
+                    accepted = True
+                    break
+            lam *= 0.5
+        if not accepted:
+            break
+        z, S, z1, S1, s1 = zn, S1, zn1, Sn1, sn1
+    if not converged:
+        # a stalled Newton (noise of the non-smooth law) may still have
+        # removed most of the transient: keep its best iterate if it gained
+        # a factor of 100; the integration that follows decides
+        if best is None or not best[0] <= 1e-2 * best[3]:
+            return x0, v0, S0, False, floq
+        z, S = best[1], best[2]
+    x = z[:n].copy()
+    v = z[n:].copy()
+    if ts > 0.0:
+        tg, Ng = model.segment_grid(ts, Tp)
+        summ, _, st_, done = model.run_grid(x, v, S, tg, Ng, 1, rdof)
+        count(summ, done, (Tp - ts) / Tp)
+        if st_ != 0:
+            return x0, v0, S0, False, floq
+    return x, v, S, True, floq
+
+
+def _unpack_start(start, model):
+    if isinstance(start, SteadyState):
+        start = start.restart
+    if not isinstance(start, Restart):
+        raise ValueError(f"start must be None, a SteadyState or a Restart, got {type(start).__name__}")
+    x = np.array(start.x, dtype=float)
+    v = np.array(start.v, dtype=float)
+    S = np.array(start.states, dtype=float, ndmin=2)
+    if x.shape != (model.n,) or v.shape != (model.n,) or S.shape != (model.nc, model.slen):
+        raise ValueError("start does not belong to this system (shapes of x, v or law states differ)")
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(v))):
+        raise ValueError("start must be finite (NaN/inf in its x or v)")
+    return x, v, np.ascontiguousarray(S)
+
+
+def steady_state(
+    system: System,
+    gamma: float,
+    *,
+    steps_per_period: int | None = None,
+    start=None,
+    amp_rtol: float | None = None,
+    energy_rtol: float | None = None,
+    check_periods: int | None = None,
+    max_periods: int | None = None,
+    response_dof: int = 0,
+    keep_loop: bool = True,
+    shooting: bool = True,
+) -> SteadyState:
+    """Steady periodic response at frequency ratio ``gamma``, classified.
+
+    Integrates M x'' + C x' + K x = f sin(w t) - sum_c B_c T_c(u_c, N_c(t))
+    (MODEL.md section 6), w = gamma w0, until the response repeats with the
+    forcing period or a multiple p <= ``config.SS_MAX_MULTIPLE``: over the
+    last ``check_periods`` windows of p periods the half peak-to-peak
+    amplitude of x[response_dof] and the period-boundary state agree within
+    ``amp_rtol`` (relative to the amplitude) and the dissipated energy and
+    the work of the forcing per period within ``energy_rtol``. Slowly
+    decaying transients are skipped by shooting (Newton on the period map).
+
+    Parameters
+    ----------
+    system : System
+        The forced system.
+    gamma : float
+        w / w0 (> 0).
+    steps_per_period : int, optional
+        Base RK4 steps per forcing period (default ``config.TI_STEPS_PER_PERIOD``).
+    start : SteadyState or Restart, optional
+        Warm start (state at a period boundary, e.g. the previous sweep
+        point). Default: equivalent-linearisation estimate (stuck stiffness
+        kt refined by the law's describing function).
+    amp_rtol, energy_rtol : float, optional
+        Tolerances (defaults ``config.SS_AMP_RTOL``, ``config.SS_ENERGY_RTOL``).
+    check_periods : int, optional
+        K, windows that must agree (default ``config.SS_CHECK_PERIODS``).
+    max_periods : int, optional
+        Cap on integrated periods (default ``config.SS_MAX_PERIODS``).
+    response_dof : int
+        DOF whose amplitude is reported.
+    keep_loop : bool
+        Record the final p periods in ``loop``.
+    shooting : bool
+        Allow shooting to skip slow transients.
+
+    Returns
+    -------
+    SteadyState
+        With ``status`` "periodic", "not-settled" or "unbounded"; amplitudes
+        are NaN unless periodic.
+    """
+    if not isinstance(system, System):
+        raise ValueError(f"system must be a System, got {type(system).__name__}")
+    spp = V.positive_int(
+        "steps_per_period", config.TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period, 4
+    )
+    amp_rtol = V.positive("amp_rtol", config.SS_AMP_RTOL if amp_rtol is None else amp_rtol)
+    energy_rtol = V.positive("energy_rtol", config.SS_ENERGY_RTOL if energy_rtol is None else energy_rtol)
+    K = V.positive_int("check_periods", config.SS_CHECK_PERIODS if check_periods is None else check_periods, 2)
+    maxp = V.positive_int("max_periods", config.SS_MAX_PERIODS if max_periods is None else max_periods)
+    rdof = V.positive_int("response_dof", response_dof, 0)
+    if rdof >= system.ndof:
+        raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {rdof}")
+    w = _omega(system, gamma)
+    gamma = float(gamma)
+    model = _Model(system, w, spp)
+
+    if start is not None:
+        x, v, S = _unpack_start(start, model)
+    else:
+        est = _linear_start(model)
+        if est is None:
+            x = np.zeros(model.n)
+            v = np.zeros(model.n)
+            S = model.initial_states(x)
+        else:
+            x, v, S = est
+            S = np.ascontiguousarray(S)
+
+    counters = {"periods": 0, "steps": 0, "shoot": 0}
+    hist = _History(np.concatenate([x, v]))
+    status, detail, p_found = None, "", 0
+    shots = 0
+    floq = math.nan
+    pmax = config.SS_MAX_MULTIPLE
+    chunk = max(config.SS_CHUNK, K)
+    while True:
+        nrun = int(min(chunk, maxp - counters["periods"]))
+        if nrun <= 0:
+            break
+        summ, zend, st, done, _ = model.run_periods(x, v, S, nrun, rdof=rdof)
+        counters["periods"] += done
+        counters["steps"] += int(summ[:, S_STEPS].sum()) if done else 0
+        hist.add(summ, zend)
+        if st != 0:
+            status, detail = "unbounded", "blow-up"
+            break
+        for p in range(1, pmax + 1):
+            if _check_periodic(hist, p, K, model, amp_rtol, energy_rtol):
+                if p > 1 and _one_period_decaying(hist, K * p, model):
+                    continue  # a slowly alternating approach to a period-1 state
+                p_found = p
+                break
+        if p_found:
+            status = "periodic"
+            detail = "shooting" if counters["shoot"] else "integration"
+            break
+        growing = _growing(hist, model, amp_rtol)
+        if growing and not (shooting and shots < config.SS_MAX_SHOTS):
+            status, detail = "unbounded", "growing"
+            break
+        if counters["periods"] >= maxp:
+            break
+        if shooting and shots < config.SS_MAX_SHOTS:
+            est = _contraction(hist, model)
+            need_shoot = False
+            if est is not None:
+                rho, dlast = est
+                A = 0.5 * (hist.summ[-1][S_XMAX] - hist.summ[-1][S_XMIN])
+                target = amp_rtol * _amplitude_scale(model, A)
+                if growing:
+                    need_shoot = True
+                elif rho >= 1.0:
+                    need_shoot = hist.size >= 2 * chunk
+                elif dlast > target:
+                    need_shoot = math.log(target / dlast) / math.log(rho) > config.SS_SHOOT_AFTER
+            if need_shoot:
+                shots += 1
+                xs_, vs_, Ss_, ok, floq = _shoot(model, x.copy(), v.copy(), S.copy(), rdof, 0.1 * amp_rtol, counters)
+                if ok and not (floq > 1.0 + config.SS_FLOQUET_TOL):
+                    x, v, S = xs_, vs_, np.ascontiguousarray(Ss_)
+                    hist = _History(np.concatenate([x, v]))
+
+    if status is None:
+        # did not settle within max_periods: say why if we can
+        status = "not-settled"
+        est = _contraction(hist, model)
+        if est is not None and est[0] < 0.999:
+            detail = "slowly-converging"
+        else:
+            detail = "quasi-periodic-or-chaotic"
+    last = hist.summ[-1] if hist.size else None
+    last_amp = 0.5 * (last[S_XMAX] - last[S_XMIN]) if last is not None else math.nan
+
+    nan = math.nan
+    vals = dict(amplitude_q=nan, amplitude_m=nan, offset_m=nan, max_abs_m=nan,
+                energy_contact_J=nan, energy_viscous_J=nan, work_force_J=nan)  # fmt: skip
+    loop = None
+    if status == "periodic":
+        p = p_found
+        if keep_loop:
+            summ, zend, st, done, smp = model.run_periods(x, v, S, p, rec=True, rdof=rdof)
+            counters["periods"] += done
+            counters["steps"] += int(summ[:, S_STEPS].sum())
+            t, X, Vv, T, N, code = smp
+            loop = Trajectory(t=t, x=X, v=Vv, T=T, N=N, code=code, final=Restart(x.copy(), v.copy(), S.copy()))
+        else:
+            summ = np.asarray(hist.summ[-p:])
+        A = 0.5 * (summ[:, S_XMAX].max() - summ[:, S_XMIN].min())
+        vals["amplitude_m"] = float(A)
+        if system.contacts:
+            law = system.contacts[0].law
+            vals["amplitude_q"] = float(law.kt * A / law.fy) if law.fy > 0 else math.inf
+        vals["offset_m"] = float(summ[:, S_XMEAN].mean())
+        vals["max_abs_m"] = float(max(abs(summ[:, S_XMAX].max()), abs(summ[:, S_XMIN].min())))
+        vals["energy_contact_J"] = float(summ[:, S_EC].mean())
+        vals["energy_viscous_J"] = float(summ[:, S_EV].mean())
+        vals["work_force_J"] = float(summ[:, S_W].mean())
+    return SteadyState(
+        status=status, detail=detail, period_multiple=int(p_found), gamma=gamma, omega=w,
+        periods=int(math.ceil(counters["periods"])), steps=int(counters["steps"]),
+        shooting_iterations=int(counters["shoot"]), floquet_max=float(floq),
+        last_amplitude_m=float(last_amp), restart=Restart(x.copy(), v.copy(), S.copy()), loop=loop, **vals,
+    )  # fmt: skip
