@@ -448,7 +448,9 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
     harmonics, samples : int
         H >= 1 and AFT samples per period >= 2H + 2.
     guess : ndarray, optional
-        Starting coefficients (default: the stuck-contact linear solution).
+        Starting coefficients (default: the stuck-contact linear solution;
+        if Newton fails from it, a continuation in the forcing amplitude
+        from 1e-3 F1 to F1 at this gamma).
     response_dof : int
         DOF reported in the amplitudes.
     tol : float
@@ -477,6 +479,12 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
     if y0.size != problem.size:
         raise ValueError(f"guess must have length {problem.size}, got {y0.size}")
     y, ok, it = newton(residual, y0, 0.0, tol=tol, max_iter=max_iter)
-    problem.gamma_fixed = gamma
+    if not ok and guess is None and f1 > 0:
+        # homotopy: continue in the forcing amplitude from a weak force,
+        # where the stuck-contact linear solution is a good start
+        br = continue_hb(system, 1e-3 * f1, f1, parameter="f1", gamma=gamma, harmonics=harmonics,
+                         samples=samples, tol=tol, backward_after_unbounded=False, progress=False)
+        if br.status == "complete" and br.lam.size and br.lam[-1] == f1:
+            y, ok, it = newton(residual, br.X[-1] / xs, 0.0, tol=tol, max_iter=max_iter)
     sol = HBSolution(problem, y * xs, ok, it, response_dof)
     return sol
