@@ -95,6 +95,15 @@ TEST_TI_STEP_HALVING_RTOL = 0.005
 TEST_TI_MARCH_ATOL_FY = 1e-9
 
 # --- sweeps (issue 3) -----------------------------------------------------
+#: default CLI gamma grid START:STOP:STEP (the paper's Fig 6 range)
+SWEEP_GAMMA_DEFAULT = (0.6, 1.8, 0.01)
+#: local pool for sweep lines when no Dask client is given: "process" or
+#: "thread" (numba kernels release the GIL; see the report for the measurement)
+SWEEP_POOL = "process"
+#: status codes of a swept point (netCDF-friendly int8); index = code
+SWEEP_STATUS = ("periodic", "not-settled", "unbounded")
+#: code of a point that was not computed (never written by a finished sweep)
+SWEEP_STATUS_MISSING = -1
 
 # --- harmonic balance, continuation, stability (issue 4) ------------------
 #: bound on the periods marched per AFT evaluation (two normally suffice
