@@ -158,7 +158,7 @@ def test_unbounded_below_den_hartog_limit():
     ds = frc_hb(System.paper_damper(eta=0.01, beta=0.5, model="iwan"), 0.6, 1.6)
     assert ds.attrs["status"] == "unbounded"
     assert "gamma" in ds.attrs["message"] and "Den Hartog" in ds.attrs["message"]
-    seg = ds.segment.values
+    seg = ds.branch.values
     assert set(seg) == {0, 1}
     assert ds.gamma.values[seg == 0].max() < 1.0 < ds.gamma.values[seg == 1].min()
     # above the limit the same system is bounded

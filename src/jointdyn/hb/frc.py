@@ -293,7 +293,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
     Variables: ``gamma``, the parameter (if not gamma), ``amplitude_q``
     (kt X / fy of the first contact, X = half peak-to-peak of x(t) of
     ``response_dof``), ``amplitude_m`` (X, m), ``offset_m`` (mean, m),
-    ``max_abs_m`` (m), ``stable``, ``fold``, ``segment``, ``gap``, ``growth``
+    ``max_abs_m`` (m), ``stable``, ``fold``, ``branch`` (segment index), ``gap``, ``growth``
     (max Re(s)/w of the Floquet exponents), ``harmonic_amplitude_m``
     (dims point, harmonic: sqrt(a_k^2 + b_k^2), |a_0| for k = 0).
     """
@@ -317,7 +317,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
         "max_abs_m": ("point", mx),
         "stable": ("point", branch.stable),
         "fold": ("point", branch.fold),
-        "segment": ("point", branch.segment),
+        "branch": ("point", branch.segment),
         "gap": ("point", branch.gap),
         "growth": ("point", branch.growth),
         "aft_passes": ("point", branch.passes),
@@ -387,7 +387,7 @@ def frc_hb(
     xarray.Dataset
         Dim ``point``; variables ``gamma``, ``amplitude_q``,
         ``amplitude_m``, ``offset_m``, ``max_abs_m``, ``stable``, ``fold``
-        (and ``segment``, ``growth``, ``harmonic_amplitude_m``); attrs
+        (and ``branch``, ``gap``, ``growth``, ``harmonic_amplitude_m``); attrs
         ``status`` (``complete`` | ``unbounded`` | ``failed`` |
         ``max-points``), ``message``, ``harmonics``, ``samples`` and the
         counters.
