@@ -26,9 +26,10 @@ A branch point is declared ``unbounded`` when
   pi F1 X1 then outgrows dissipation R1 pi X1 as the amplitude grows, so
   the branch rises without bound towards gamma = 1.
 
-The branch computed up to that point is kept, and (for gamma) a second
-segment is continued from ``gamma_stop`` backwards, so the Dataset shows
-both flanks with ``attrs["status"] == "unbounded"``.
+The branch computed up to that point is kept, and a second segment is
+continued from ``stop`` backwards, so the Dataset shows both flanks with
+``attrs["status"] == "unbounded"``. The same is done after a failure of
+the corrector (status stays ``failed``, the message says where).
 """
 
 from __future__ import annotations
@@ -190,7 +191,8 @@ def continue_hb(
     tol : float
         Newton tolerance on the scaled residual (force / max(F1, fy)).
     backward_after_unbounded : bool
-        After an unbounded stop, continue a second segment from ``stop``.
+        After an unbounded (or failed) stop, continue a second segment from
+        ``stop`` backwards, so that both ends of the range are covered.
     progress : bool, optional
         Show a tqdm bar (None: only on a TTY).
 
@@ -260,7 +262,7 @@ def continue_hb(
     res = _relabel_failure(res, xs, qamp)
     parts = [res]
     status, message = res.status, res.message
-    if res.status == "unbounded" and backward_after_unbounded and max_points - res.lam.size >= 2:
+    if res.status in ("unbounded", "failed") and backward_after_unbounded and max_points - res.lam.size >= 2:
         back = _relabel_failure(run(stop, start, max_points - res.lam.size), xs, qamp)
         parts.append(back)
         message += f"; continued back from {parameter} = {stop:.6g}: {back.status} ({back.message})"
