@@ -47,7 +47,13 @@ def fourier_matrices(harmonics: int, samples: int):
 def _aft_template(params, s0, ds0, u, du, N, dN, max_passes, rtol, T, dT, code, info):  # pragma: no cover - compiled
     """March ``STEP_JVP`` over whole periods of samples until the force repeats.
 
-    ``info`` receives ``[passes, max |T_p - T_(p-1)|, converged]``.
+    Stops when two consecutive passes agree to ``rtol * max|T|`` (period 1).
+    If instead passes p and p-2 agree (the law's state alternates between
+    two cycles: a period-2 force under a period-1 displacement), the force
+    and its derivatives are the mean of the last two passes, which is the
+    exact projection of the 2T-periodic force on the T-periodic harmonics.
+    ``info`` receives ``[passes, max |T_p - T_(p-1)|, period (1, 2; 0 if
+    neither repeated within max_passes)]``.
     """
     ns = u.shape[0]
     nd = du.shape[1]
@@ -58,21 +64,27 @@ def _aft_template(params, s0, ds0, u, du, N, dN, max_passes, rtol, T, dT, code, 
     dxj = np.empty(nd)
     dNj = np.empty(nd)
     dTj = np.empty(nd)
+    T1 = np.zeros(ns)
+    T2 = np.zeros(ns)
+    dT1 = np.zeros((ns, nd))
     passes = 0
     err = np.inf
-    converged = 0.0
+    period = 0.0
     while passes < max_passes:
         err = 0.0
+        err2 = 0.0
         tmax = 0.0
         for i in range(ns):
             for d in range(nd):
                 dxj[d] = du[i, d]
                 dNj[d] = dN[i, d]
             t_, k_, c_ = STEP_JVP(params, a, da, b, db, u[i], dxj, N[i], dNj, dTj)  # noqa: F821
-            if passes > 0:
-                e = abs(t_ - T[i])
-                if e > err:
-                    err = e
+            e = abs(t_ - T1[i])
+            if e > err:
+                err = e
+            e = abs(t_ - T2[i])
+            if e > err2:
+                err2 = e
             if abs(t_) > tmax:
                 tmax = abs(t_)
             T[i] = t_
@@ -83,11 +95,23 @@ def _aft_template(params, s0, ds0, u, du, N, dN, max_passes, rtol, T, dT, code, 
             da, db = db, da
         passes += 1
         if passes >= 2 and err <= rtol * tmax:
-            converged = 1.0
+            period = 1.0
             break
+        if passes >= 4 and err2 <= rtol * tmax:
+            period = 2.0
+            for i in range(ns):
+                T[i] = 0.5 * (T[i] + T1[i])
+                for d in range(nd):
+                    dT[i, d] = 0.5 * (dT[i, d] + dT1[i, d])
+            break
+        for i in range(ns):
+            T2[i] = T1[i]
+            T1[i] = T[i]
+            for d in range(nd):
+                dT1[i, d] = dT[i, d]
     info[0] = passes
     info[1] = err
-    info[2] = converged
+    info[2] = period
 
 
 def _aft_kernel(law):
@@ -143,7 +167,9 @@ def aft_contact(law, E, P, U, Nsamp, dNsamp=None, *, max_passes=8, rtol=1e-10):
     T, code : ndarray
         Force samples (N) and motion-state codes of the last pass.
     info : ndarray
-        ``[passes, last pass difference (N), converged (0/1)]``.
+        ``[passes, last pass difference (N), period]``: period 1 (the force
+        repeated), 2 (it alternated between two cycles; the mean of the two
+        is used) or 0 (no repetition within ``max_passes``).
     """
     ns, nh = E.shape
     u = E @ U

@@ -70,8 +70,11 @@ class HBBranch:
         (do not join it to the previous point).
     growth : ndarray
         max Re(s) / w of the selected Floquet exponents.
-    passes, periodic_error : ndarray
-        AFT periods marched and last-pass force difference (N) per point.
+    passes, periodic_error, force_period : ndarray
+        AFT periods marched, last-pass force difference (N), and the period
+        of the marched force in forcing periods (1; 2 when the law's state
+        alternates between two cycles, the mean of both is then used; 0 if
+        it did not repeat within ``config.HB_MAX_PASSES``).
     counters : dict
     """
 
@@ -91,6 +94,7 @@ class HBBranch:
         self.growth = np.full(n, np.nan)
         self.passes = np.zeros(n, dtype=int)
         self.periodic_error = np.zeros(n)
+        self.force_period = np.zeros(n, dtype=int)
         sysm = problem.system
         for i in range(n):
             ev = problem.evaluate(X[i], lam[i])
@@ -99,6 +103,7 @@ class HBBranch:
             self.growth[i] = g
             self.passes[i] = int(ev.info[0])
             self.periodic_error[i] = ev.info[1]
+            self.force_period[i] = int(ev.info[2])
 
     def gamma(self):
         """gamma = w / w0 per point."""
@@ -323,6 +328,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
         "gap": ("point", branch.gap),
         "growth": ("point", branch.growth),
         "aft_passes": ("point", branch.passes),
+        "force_period": ("point", branch.force_period),
         "harmonic_amplitude_m": (("point", "harmonic"), harm),
     }
     if branch.parameter != "gamma":
@@ -344,6 +350,8 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
         folds=int(branch.fold.sum()),
         unstable_points=int((~branch.stable).sum()),
         max_aft_passes=int(branch.passes.max()) if branch.passes.size else 0,
+        force_period_2_points=int((branch.force_period == 2).sum()),
+        force_not_periodic_points=int((branch.force_period == 0).sum()),
         **{f"counter_{k}": int(v) for k, v in branch.counters.items()},
     )
     return ds

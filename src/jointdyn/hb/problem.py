@@ -239,7 +239,10 @@ class HBProblem:
             codes.append(code)
             info[0] = max(info[0], inf[0])
             info[1] = max(info[1], inf[1])
-            info[2] = min(info[2], inf[2])
+            # worst case over the contacts: 0 (not repeated) < 2 < 1
+            rank = {1.0: 2, 2.0: 1, 0.0: 0}
+            if rank[float(inf[2])] < rank[float(info[2])]:
+                info[2] = inf[2]
         return _Eval(R, JX, Jp, Ts, codes, info)
 
     # --- post-processing ----------------------------------------------------
