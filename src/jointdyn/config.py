@@ -119,7 +119,7 @@ HB_NEWTON_RTOL = 1e-9
 HB_NEWTON_MAX_ITER = 12
 #: continuation: step-length control (in the scaled unknowns), bounds
 HB_DS_MIN = 1e-6
-HB_DS_MAX = 0.25
+HB_DS_MAX = 0.1
 HB_DS_GROW = 1.6
 HB_TARGET_NEWTON_ITER = 4
 HB_MAX_POINTS = 2000

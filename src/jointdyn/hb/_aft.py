@@ -118,23 +118,35 @@ def _aft_kernel(law):
     return specialize(_aft_template, STEP_JVP=law.step_jvp)
 
 
+_DS0_CACHE: dict = {}
+
+
 def _initial_state_jacobian(law, x0, n0, dx0, dn0):
     """Virgin state at (x0, n0) and its derivative along directions.
 
-    The derivative is a central difference of ``law.initial_state`` (a
-    smooth, in practice affine, function supplied by the law), so that the
-    harmonic-balance code needs no knowledge of the state layout.
+    The derivative is a central difference of ``law.initial_state`` (the
+    virgin state is an affine function of x0 and n0 for every law of the
+    contract: it stores the displacement and the load ratio), so the
+    harmonic-balance code needs no knowledge of the state layout. It is
+    computed once per law (and side of n0 = 0) and reused.
     """
     s0 = law.initial_state(x0, n0)
-    hx = 1e-3 * max(abs(x0), law.x_slip if np.isfinite(law.x_slip) else 1.0, 1e-12)
-    hn = 1e-3 * max(abs(n0), 1.0)
-    sx = (law.initial_state(x0 + hx, n0) - law.initial_state(x0 - hx, n0)) / (2 * hx)
-    sn = (law.initial_state(x0, n0 + hn) - law.initial_state(x0, n0 - hn)) / (2 * hn)
+    key = (id(law), n0 > 0.0)
+    hit = _DS0_CACHE.get(key)
+    if hit is None or hit[0] is not law:
+        hx = 1e-3 * (law.x_slip if np.isfinite(law.x_slip) and law.x_slip > 0 else 1.0)
+        hn = 1e-3 * max(abs(n0), 1.0)
+        sx = (law.initial_state(x0 + hx, n0) - law.initial_state(x0 - hx, n0)) / (2 * hx)
+        sn = (law.initial_state(x0, n0 + hn) - law.initial_state(x0, n0 - hn)) / (2 * hn)
+        if len(_DS0_CACHE) > 256:
+            _DS0_CACHE.clear()
+        hit = _DS0_CACHE[key] = (law, sx, sn)
+    _, sx, sn = hit
     ds0 = np.outer(sx, dx0) + np.outer(sn, dn0)
     return s0, np.ascontiguousarray(ds0)
 
 
-def aft_contact(law, E, P, U, Nsamp, dNsamp=None, *, max_passes=8, rtol=1e-10):
+def aft_contact(law, E, P, U, Nsamp, dNsamp=None, *, max_passes=8, rtol=1e-10, params=None):
     """Periodic force coefficients of one contact and their Jacobians.
 
     Parameters
@@ -155,6 +167,8 @@ def aft_contact(law, E, P, U, Nsamp, dNsamp=None, *, max_passes=8, rtol=1e-10):
     rtol : float
         The periodic force is accepted when two consecutive passes differ
         by at most ``rtol * max|T|``.
+    params : ndarray, optional
+        ``law.params`` if already at hand (saves rebuilding it).
 
     Returns
     -------
@@ -190,7 +204,7 @@ def aft_contact(law, E, P, U, Nsamp, dNsamp=None, *, max_passes=8, rtol=1e-10):
     dT = np.empty((ns, nd))
     code = np.empty(ns, dtype=np.int64)
     info = np.zeros(3)
-    _aft_kernel(law)(law.params, s0, ds0, u, du, np.ascontiguousarray(Nsamp, dtype=np.float64), dN,
+    _aft_kernel(law)(law.params if params is None else params, s0, ds0, u, du, np.ascontiguousarray(Nsamp, dtype=np.float64), dN,
                      int(max_passes), float(rtol), T, dT, code, info)
     F = P @ T
     G = P @ dT

@@ -12,7 +12,8 @@ Springer 2010, sec. 4.4):
 * predictor ``u + ds t`` (tangent) or ``u + ds (u - u_prev)/|u - u_prev|``
   (secant);
 * corrector: Newton on ``R(u) = 0, t^T (u - u_pred) = 0``;
-* step length: grown after easy corrections, shrunk after hard ones,
+* step length: grown after easy corrections, shrunk after hard ones and
+  where the tangent turned by more than ~10 degrees (folds are resolved),
   halved and retried after a failure, down to ``ds_min``;
 * a fold (turning point in lam) is where the lam component of the tangent
   changes sign; it is flagged at the first point past it;
@@ -44,6 +45,8 @@ __all__ = ["ContinuationResult", "continuation", "newton"]
 #: below this (scaled) step a sharp turn or a long correction is a corner of
 #: a piecewise-smooth branch, not a jump to another branch
 _CORNER_DS = 2e-3
+#: the step is halved after a turn of the tangent by more than ~10 degrees
+_TURN_COS = 0.985
 #: bound on the jumps over discontinuities per branch
 _MAX_JUMPS = 5
 
@@ -93,7 +96,10 @@ def _solve_damped(residual, v, lam, d, u_pred, *, tol, max_iter, cnt):
 
     With ``d is None`` solves R(v, lam) = 0 for v; otherwise v holds
     (y, lam) and the constraint d^T (v - u_pred) = 0 is appended. The step
-    is halved (up to 8 times) until the merit max|residual| decreases: the
+    is halved (up to 8 times) until the merit max|residual| decreases; the
+    iteration has converged when the merit, evaluated at the new point, is
+    at most ``tol`` (the Newton step after it would be of order
+    |J^-1| tol). The
     AFT residual of stick-slip laws is only piecewise smooth, and the plain
     Newton iteration can cycle between the pieces near a corner (onset of
     slip). Returns ``(v, ok, iterations, (R, R_y, R_lam))`` with the
@@ -137,9 +143,8 @@ def _solve_damped(residual, v, lam, d, u_pred, *, tol, max_iter, cnt):
             alpha *= 0.5
         else:
             return v, False, it, (R, Jy, Jl)
-        step = alpha * float(np.max(np.abs(dv)))
         v, R, Jy, Jl, merit = w, R2, Jy2, Jl2, m2
-        if merit <= tol and step <= tol * (1.0 + float(np.max(np.abs(v)))):
+        if merit <= tol:
             return v, True, it, (R, Jy, Jl)
     return v, merit <= tol, max_iter, (R, Jy, Jl)
 
@@ -147,8 +152,8 @@ def _solve_damped(residual, v, lam, d, u_pred, *, tol, max_iter, cnt):
 def newton(residual, y, lam, *, tol, max_iter, counter=None):
     """Damped Newton's method for R(y, lam) = 0 at fixed lam.
 
-    Converged when ``|R|_inf <= tol`` and the last update
-    ``|dy|_inf <= tol * (1 + |y|_inf)``. Returns ``(y, ok, iterations)``.
+    Converged when ``|R|_inf <= tol`` at the returned point. Returns
+    ``(y, ok, iterations)``.
     """
     cnt = counter if counter is not None else {"residual_evaluations": 0}
     y, ok, it, _ = _solve_damped(residual, np.asarray(y, dtype=float), lam, None, None,
@@ -289,6 +294,7 @@ def continuation(
         if m is not None:
             return finish(*m)
     u_prev = None
+    u_prev_t = t
     while True:
         if len(L) >= max_points:
             return finish("max-points", f"stopped after {len(L)} points at lam = {u[n]:.6g}")
@@ -351,6 +357,7 @@ def continuation(
             where = "lam_stop" if lam_end == lam_stop else "the start of the range (the branch turned back)"
             return finish("complete", f"reached {where} lam = {lam_end:.6g}")
         u_prev = u
+        u_prev_t = t
         u = v
         t = t_new
         Y.append(v[:n].copy()); L.append(lam_new); TL.append(t[n]); FOLD.append(fold); IT.append(it)
@@ -361,7 +368,10 @@ def continuation(
             m = monitor(v[:n], lam_new)
             if m is not None:
                 return finish(*m)
-        if it <= config.HB_TARGET_NEWTON_ITER - 1:
+        turn = float(t @ u_prev_t) if u_prev_t is not None else 1.0
+        if turn < _TURN_COS:
+            ds = max(ds * 0.5, ds_min)  # the branch bends: resolve it (folds)
+        elif it <= config.HB_TARGET_NEWTON_ITER - 1:
             ds = min(ds * config.HB_DS_GROW, ds_max)
         elif it > config.HB_TARGET_NEWTON_ITER:
             ds = max(ds * 0.6, ds_min)

@@ -78,7 +78,8 @@ class HBBranch:
     counters : dict
     """
 
-    def __init__(self, problem, parameter, status, message, lam, X, segment, fold, counters, gap=None):
+    def __init__(self, problem, parameter, status, message, lam, X, segment, fold, counters, gap=None,
+                 evaluations=None):
         self.problem = problem
         self.parameter = parameter
         self.status = status
@@ -96,8 +97,12 @@ class HBBranch:
         self.periodic_error = np.zeros(n)
         self.force_period = np.zeros(n, dtype=int)
         sysm = problem.system
+        evaluations = {} if evaluations is None else evaluations
         for i in range(n):
-            ev = problem.evaluate(X[i], lam[i])
+            ev = evaluations.get(float(lam[i]))
+            if ev is None or not np.array_equal(ev[0], X[i]):
+                ev = (X[i], problem.evaluate(X[i], lam[i]))
+            ev = ev[1]
             st, g, _ = hill_stability(ev.JX, sysm.M, sysm.C, problem.omega(lam[i]), problem.H)
             self.stable[i] = st
             self.growth[i] = g
@@ -240,10 +245,14 @@ def continue_hb(
     def qamp(X):
         return law.kt * problem.amplitudes(X, 0)[0] / law.fy if law.fy > 0 else 0.0
 
+    evaluations = {}
+
     def monitor(y, lam_s):
         X = y * xs
         q = qamp(X)
         lam = lam_s * ls
+        if "ev" in cache:
+            evaluations[float(lam)] = (X, cache["ev"])
         if not np.isfinite(q) or q > config.HB_UNBOUNDED_Q:
             return "unbounded", f"q = kt X / fy = {q:.4g} exceeds {config.HB_UNBOUNDED_Q:g} at {parameter} = {lam:.6g}"
         ev = cache.get("ev")
@@ -281,7 +290,7 @@ def continue_hb(
     if counters.get("jumps", 0):
         message += (f"; {counters['jumps']} jump(s) over discontinuities of the contact force "
                     "(points flagged 'gap')")
-    return HBBranch(problem, parameter, status, message, lam, X, seg, fold, counters, gap)
+    return HBBranch(problem, parameter, status, message, lam, X, seg, fold, counters, gap, evaluations)
 
 
 def _relabel_failure(res: ContinuationResult, xs, qamp):

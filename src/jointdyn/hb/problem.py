@@ -97,6 +97,7 @@ class HBProblem:
         self.tau = 2.0 * np.pi * np.arange(self.Ns) / self.Ns
         self._fine = {}
         self._lin = None
+        self._params = [c.law.params for c in system.contacts]
         self.contacts = list(system.contacts)
         fmax = float(np.max(np.abs(system.force))) if system.force.size else 0.0
         self.f_dir = system.force / fmax if fmax > 0 else system.force.copy()
@@ -217,12 +218,12 @@ class HBProblem:
         Ts, codes = [], []
         info = np.zeros(3)
         info[2] = 1.0
-        for c, b, (n0, n1, dl, dn) in zip(self.contacts, self.B, loads):
+        for c, b, (n0, n1, dl, dn), prm in zip(self.contacts, self.B, loads, self._params):
             U = Xm @ b
             Nsamp = n0 + n1 * np.sin(self.tau + dl)
             F, dFdU, dFdp, T, code, inf = aft_contact(c.law, self.E, self.P, U, Nsamp, dn,
                                                       max_passes=self.max_passes,
-                                                      rtol=config.HB_PERIODIC_RTOL)
+                                                      rtol=config.HB_PERIODIC_RTOL, params=prm)
             # scatter: R[h*n + i] += b_i F_h ; JX[(h,i),(g,j)] += b_i b_j dF_hg
             if self.n == 1:
                 R += F * b[0]

@@ -76,6 +76,23 @@ def _centroids(V, n, H):
     return num / np.where(den > 0, den, 1.0)
 
 
+_PARTS: dict = {}
+
+
+def _hill_parts(M, C, H):
+    """(I (x) M^-1, [I (x) M^-1 (I (x) C), I (x) M^-1 (2 nabla (x) M)]), cached."""
+    key = (M.tobytes(), C.tobytes(), M.shape[0], H)
+    hit = _PARTS.get(key)
+    if hit is None:
+        nh = 2 * H + 1
+        D2i = np.kron(np.eye(nh), np.linalg.inv(M))
+        B1 = (D2i @ np.kron(np.eye(nh), C), D2i @ (2.0 * np.kron(derivative_matrix(H), M)))
+        if len(_PARTS) > 64:
+            _PARTS.clear()
+        hit = _PARTS[key] = (D2i, B1)
+    return hit
+
+
 def hill_exponents(JX, M, C, w, H):
     """All Hill eigenvalues and the 2n selected Floquet exponents.
 
@@ -97,21 +114,23 @@ def hill_exponents(JX, M, C, w, H):
     all_eigenvalues : ndarray complex (2 n (2H+1),)
     """
     n = M.shape[0]
-    nh = 2 * H + 1
-    N = n * nh
-    D = derivative_matrix(H)
-    Minv = np.linalg.inv(M)
-    D2i = np.kron(np.eye(nh), Minv)
-    D1 = 2.0 * w * np.kron(D, M) + np.kron(np.eye(nh), C)
+    N = n * (2 * H + 1)
+    D2iJ_pre, B1 = _hill_parts(M, C, H)
     A = np.zeros((2 * N, 2 * N))
     A[:N, N:] = np.eye(N)
-    A[N:, :N] = -D2i @ JX
-    A[N:, N:] = -D2i @ D1
-    lam, V = np.linalg.eig(A)
-    cen = _centroids(V, n, H)
+    A[N:, :N] = -(D2iJ_pre @ JX)
+    A[N:, N:] = -(B1[0] + w * B1[1])
+    lam = np.linalg.eigvals(A)
     key_imag = np.round(np.abs(lam.imag) / w, 8)
-    idx = np.lexsort((np.abs(cen), key_imag))[: 2 * n]
-    sel = lam[idx]
+    order = np.argsort(key_imag, kind="stable")
+    cut = key_imag[order[2 * n - 1]]
+    if order.size > 2 * n and key_imag[order[2 * n]] == cut:
+        # a tie at the cut: break it by the eigenvector centroid
+        lam, V = np.linalg.eig(A)
+        key_imag = np.round(np.abs(lam.imag) / w, 8)
+        cen = _centroids(V, n, H)
+        order = np.lexsort((np.abs(cen), key_imag))
+    sel = lam[order[: 2 * n]]
     sel = sel[np.argsort(-sel.real, kind="stable")]
     return sel, lam
 
