@@ -1,0 +1,207 @@
+"""Harmonic balance: oracles (describing function, finite differences, time
+integration, monodromy), folds and stability, unbounded responses, input
+validation."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from jointdyn import System, config
+from jointdyn.hb import (
+    HBProblem,
+    continuation,
+    continue_hb,
+    frc_hb,
+    harmonic_balance,
+    hill_exponents,
+    monodromy_multipliers,
+)
+from jointdyn.laws import Jenkins
+
+KT, FY, M, K, F1, ZETA = 3e5, 50.0, 10.0, 3.9e5, 20.0, 1e-3
+
+
+def _jenkins_system():
+    law = Jenkins(kt=KT, mu=0.5, n_ref=100.0)
+    return System.sdof(m=M, k=K, law=law, f1=F1, zeta=ZETA)
+
+
+def _df_amplitude(gamma):
+    """Describing-function amplitude of the Jenkins oscillator (closed form).
+
+    Equivalent stiffness and damping of a Jenkins element (spring kt, slip
+    force fy) for x = A cos(theta) (Caughey 1960): with
+    cos(theta*) = 1 - 2 fy / (kt A), k_eq = kt (theta* - sin(2 theta*)/2) / pi
+    and d_eq = 4 fy (1 - fy / (kt A)) / (pi A) for A > fy/kt; k_eq = kt,
+    d_eq = 0 below. Amplitude equation:
+    A^2 [(k + k_eq - m w^2)^2 + (c w + d_eq)^2] = F1^2.
+    """
+    w = gamma * math.sqrt(K / M)
+    c = 2 * ZETA * math.sqrt(K * M)
+
+    def res(A):
+        if A <= FY / KT:
+            keq, deq = KT, 0.0
+        else:
+            ts = math.acos(1 - 2 * FY / (KT * A))
+            keq = KT / math.pi * (ts - 0.5 * math.sin(2 * ts))
+            deq = 4 * FY / (math.pi * A) * (1 - FY / (KT * A))
+        return A * A * ((K + keq - M * w * w) ** 2 + (c * w + deq) ** 2) - F1 * F1
+
+    grid = np.geomspace(1e-7, 1e-1, 3000)
+    r = np.array([res(a) for a in grid])
+    idx = np.flatnonzero(np.sign(r[:-1]) != np.sign(r[1:]))
+    assert idx.size == 1, "the DF equation must have a single root at the test frequencies"
+    return brentq(res, grid[idx[0]], grid[idx[0] + 1], xtol=1e-18, rtol=1e-15)
+
+
+@pytest.mark.parametrize("gamma", [1.0, 1.25, 1.35, 1.42])
+def test_one_harmonic_equals_describing_function(gamma):
+    # 1024 samples per period: the AFT quadrature of the kinked Jenkins force
+    # converges as Ns^-2 (measured: 256 -> 3e-5, 1024 -> 4e-7 relative)
+    sol = harmonic_balance(_jenkins_system(), gamma, harmonics=1, samples=1024)
+    assert sol.converged
+    A = math.hypot(sol.X[1], sol.X[2])
+    assert abs(sol.X[0]) < 1e-12  # symmetric loop: no offset
+    assert abs(A - _df_amplitude(gamma)) <= config.TEST_HB_DF_RTOL * _df_amplitude(gamma)
+
+
+@pytest.mark.parametrize(
+    "model,eta,par",
+    [("iwan", 0.5, "eta"), ("jenkins", 0.5, "delta"), ("discrete", 0.3, "n0"), ("iwan", 0.5, "gamma"),
+     ("iwan-paper", 0.5, "f1")],
+)
+def test_jacobian_matches_central_differences(model, eta, par):
+    sysm = System.paper_damper(eta=eta, beta=2.0, model=model, n=20, delta=0.3, zeta=0.01)
+    g = 1.1
+    p = HBProblem(sysm, harmonics=4, samples=128, parameter=par, gamma=None if par == "gamma" else g)
+    lam = {"eta": eta, "delta": 0.3, "n0": 100.0, "gamma": g, "f1": p.f1_ref}[par]
+    X = harmonic_balance(sysm, g, harmonics=4, samples=128).X
+    ev = p.evaluate(X, lam)
+    Ja = np.c_[ev.JX, ev.Jp]
+    Jfd = np.empty_like(Ja)
+    for j in range(X.size + 1):
+        Xp, Xm, lp, lm = X.copy(), X.copy(), lam, lam
+        if j < X.size:
+            h = 1e-6 * np.abs(X).max()
+            Xp[j] += h
+            Xm[j] -= h
+        else:
+            h = 1e-6 * max(abs(lam), 1e-3)
+            lp, lm = lam + h, lam - h
+        Jfd[:, j] = (p.evaluate(Xp, lp).R - p.evaluate(Xm, lm).R) / (2 * h)
+    assert np.max(np.abs(Ja - Jfd)) <= config.TEST_HB_JACOBIAN_RTOL * np.max(np.abs(Ja))
+    assert ev.info[2] == 1.0  # the marched force repeated
+
+
+def test_hb_equals_time_integration_at_stable_points():
+    from jointdyn.dynamics import steady_state
+
+    cases = [(System.paper_damper(eta=0.01, beta=1.0, model="iwan"), 1.25),
+             (System.paper_damper(eta=0.5, beta=2.0, model="iwan"), 1.5)]
+    for sysm, g in cases:
+        sol = harmonic_balance(sysm, g, harmonics=7, samples=128)
+        assert sol.converged and sol.stable
+        ss = steady_state(sysm, g)
+        assert ss.status == "periodic"
+        assert abs(sol.amplitude_m - ss.amplitude_m) <= config.TEST_HB_VS_TIME_RTOL * ss.amplitude_m
+
+
+def test_jenkins_branch_complete_and_agrees_with_df():
+    ds = frc_hb(_jenkins_system(), 0.6, 1.8, harmonics=1, samples=1024)
+    assert ds.attrs["status"] == "complete"
+    assert ds.gamma.values[0] == 0.6 and ds.gamma.values[-1] == 1.8
+    assert ds.stable.values.all() and ds.attrs["folds"] == 0
+    for i in range(0, ds.sizes["point"], 7):
+        g = float(ds.gamma[i])
+        A = float(ds.amplitude_m[i])
+        assert abs(A - _df_amplitude(g)) <= 1e-3 * _df_amplitude(g)
+    for name in ("gamma", "amplitude_q", "amplitude_m", "offset_m", "max_abs_m", "stable", "fold"):
+        assert ds[name].dims == ("point",)
+    assert ds.attrs["harmonics"] == 1 and ds.attrs["samples"] == 1024
+
+
+def test_eta_1p5_folds_with_unstable_segment_between():
+    ds = frc_hb(System.paper_damper(eta=1.5, beta=20.0, model="iwan"), 0.8, 1.8)
+    assert ds.attrs["status"] == "complete"
+    f = np.flatnonzero(ds.fold.values)
+    assert f.size >= 2
+    between = ds.stable.values[f[0]:f[-1] + 1]
+    assert (~between).any()
+    # far from the folds the response is stable
+    assert ds.stable.values[: max(f[0] - 5, 1)].all() and ds.stable.values[f[-1] + 5:].all()
+
+
+def test_hill_agrees_with_monodromy():
+    br = continue_hb(System.paper_damper(eta=10.0, beta=2.0, model="iwan"), 0.5, 2.0)
+    f = np.flatnonzero(br.fold)
+    assert f.size >= 2
+    picks = [f[0] - 3, (f[0] + f[-1]) // 2, f[-1] + 3, br.lam.size // 4]
+    seen = set()
+    for i in picks:
+        ev = br.problem.evaluate(br.X[i], br.lam[i])
+        w = br.problem.omega(br.lam[i])
+        s, _ = hill_exponents(ev.JX, br.problem.system.M, br.problem.system.C, w, br.problem.H)
+        mu_hill = np.max(np.abs(np.exp(s * 2 * np.pi / w)))
+        mu_mono = np.max(np.abs(monodromy_multipliers(br.problem, br.X[i], br.lam[i])))
+        assert abs(mu_hill - mu_mono) < 1e-2
+        if abs(mu_mono - 1) > 2e-3:
+            assert (mu_mono > 1) == (not br.stable[i])
+        seen.add(bool(br.stable[i]))
+    assert seen == {True, False}
+
+
+def test_unbounded_below_den_hartog_limit():
+    # beta = 0.5 < pi/4, no viscous damping: no steady state near gamma = 1
+    ds = frc_hb(System.paper_damper(eta=0.01, beta=0.5, model="iwan"), 0.6, 1.6)
+    assert ds.attrs["status"] == "unbounded"
+    assert "gamma" in ds.attrs["message"] and "Den Hartog" in ds.attrs["message"]
+    seg = ds.branch.values
+    assert set(seg) == {0, 1}
+    assert ds.gamma.values[seg == 0].max() < 1.0 < ds.gamma.values[seg == 1].min()
+    # above the limit the same system is bounded
+    ok = frc_hb(System.paper_damper(eta=0.01, beta=1.0, model="iwan"), 0.6, 1.6)
+    assert ok.attrs["status"] == "complete"
+
+
+def test_generic_continuation_finds_both_folds_of_a_cubic():
+    # y^3 - y + lam = 0: folds at lam = -+2 / (3 sqrt 3)
+    def res(y, lam):
+        return np.array([y[0] ** 3 - y[0] + lam]), np.array([[3 * y[0] ** 2 - 1]]), np.array([1.0])
+
+    r = continuation(res, np.array([1.5]), -1.5, 1.5, ds=0.05, ds_max=0.1)
+    assert r.status == "complete" and r.counters["folds"] == 2
+    lam_f = np.sort(r.lam[r.fold])
+    assert np.allclose(lam_f, [-2 / (3 * math.sqrt(3)), 2 / (3 * math.sqrt(3))], atol=0.05)
+    assert np.all(np.abs(r.y[:, 0] ** 3 - r.y[:, 0] + r.lam) < 1e-8)
+
+
+def test_continuation_in_eta_matches_fixed_solutions():
+    sysm = System.paper_damper(eta=0.1, beta=2.0, model="iwan")
+    br = continue_hb(sysm, 0.1, 0.6, parameter="eta", gamma=1.4, harmonics=5, samples=128)
+    assert br.status == "complete"
+    i = br.lam.size // 2
+    ref = harmonic_balance(System.paper_damper(eta=float(br.lam[i]), beta=2.0, model="iwan"), 1.4,
+                           harmonics=5, samples=128, guess=br.X[i])
+    assert ref.converged and np.allclose(ref.X, br.X[i], rtol=0, atol=1e-9 * np.abs(ref.X).max())
+
+
+@pytest.mark.parametrize(
+    "kwargs,name",
+    [
+        (dict(harmonics=0), "harmonics"),
+        (dict(harmonics=7, samples=10), "samples"),
+        (dict(gamma_start=1.0, gamma_stop=1.0), "gamma"),
+        (dict(gamma_start=-0.5), "gamma_start"),
+        (dict(gamma_stop=float("nan")), "gamma_stop"),
+        (dict(response_dof=3), "response_dof"),
+    ],
+)
+def test_bad_input_names_the_parameter(kwargs, name):
+    args = dict(gamma_start=0.6, gamma_stop=1.8)
+    args.update(kwargs)
+    g0, g1 = args.pop("gamma_start"), args.pop("gamma_stop")
+    with pytest.raises(ValueError, match=name):
+        frc_hb(_jenkins_system(), g0, g1, **args)
