@@ -89,7 +89,7 @@ def run(quick: bool = False) -> dict:
     from jointdyn.sweeps import default_workers
     from jointdyn.systems import System
 
-    out = {}
+    out = {"load_average_before": list(os.getloadavg())}
     # warm the numba cache (compile once) so timings are steady-state speed
     steady_state(System.paper_damper(eta=0.5, beta=2.0), 1.0)
 
@@ -128,12 +128,16 @@ def run(quick: bool = False) -> dict:
         t_ref = (time.perf_counter() - t0) * periods / run_p
         rows.append(dict(eta=eta, beta=beta, gamma=gamma, status=res.status, periods=periods,
                          seconds_jointdyn=t_ours, seconds_reference=t_ref, baseline_periods_run=run_p,
-                         reference_steps=nsteps, speedup=t_ref / t_ours))
+                         reference_steps=nsteps, ms_per_period_jointdyn=1e3 * t_ours / periods,
+                         ms_per_period_reference=1e3 * t_ref / periods, speedup=t_ref / t_ours))
     out["baseline"] = rows
     out["baseline_note"] = ("reference = scipy RK45 stepped from Python, law kernel called from Python at every "
                             "RHS evaluation, law state committed at accepted steps, max step = period/"
                             f"{config.TI_STEPS_PER_PERIOD}, rtol 1e-8; time scaled from baseline_periods_run to "
                             "the periods jointdyn used for the point")
+    out["load_average_after"] = list(os.getloadavg())
+    out["load_note"] = ("the machine is shared: a 1-minute load average above the core count means other "
+                        "jobs took CPU during the timings")
     out["speedup_per_point_geomean"] = float(np.exp(np.mean([np.log(r["speedup"]) for r in rows])))
     out["speedup_target"] = 100.0
     return out

@@ -120,3 +120,14 @@ def test_hb_missing_is_a_clear_error(monkeypatch, capsys, tmp_path):
     err = capsys.readouterr().err
     assert rc == 2 and "jointdyn.hb" in err and "--method time" in err
     assert not (tmp_path / "o").exists()
+
+
+def test_scheduler_address(fake, capsys):
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, processes=False, threads_per_worker=2, dashboard_address=None) as lc:
+        rc = main(["frc", "--gamma", "0.8:0.9:0.1", "--sweep", "up", "--scheduler", lc.scheduler_address, "--json"])
+    assert rc == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["directions"]["up"]["status"] == ["periodic", "periodic"]
+    assert len(fake.calls) == 2  # ran on the cluster's in-process workers

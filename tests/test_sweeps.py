@@ -234,6 +234,8 @@ def test_real_solver_serial_equals_dask_and_resume(tmp_path):
         with Client(lc) as client:
             dist = frc_sweep(g, **kw, client=client)
     xr.testing.assert_identical(serial, dist)
+    pooled = frc_sweep(g, **kw, n_workers=2)  # local process pool (config.SWEEP_POOL)
+    xr.testing.assert_identical(serial, pooled)
 
     class Stop(Exception):
         pass
