@@ -56,6 +56,15 @@ SS_MAX_MULTIPLE = 4
 #: steady state: longer multiples (up to this) are detected and reported
 #: as "not-settled", detail "period-P", instead of running to max_periods
 SS_DETECT_MULTIPLE = 12
+#: steady state: a multiple p > 1 is accepted only when the largest
+#: one-period mismatch over the last K p periods is at least this fraction
+#: of that over the K p periods before (no decaying beat)
+SS_MULTIPLE_DECAY = 0.97
+#: steady state: after shooting, stop as "quasi-periodic-or-chaotic" when
+#: the largest one-period mismatch over the last SS_STALL_PERIODS/2 periods
+#: is >= SS_STALL_RATIO times that over the half before
+SS_STALL_PERIODS = 240
+SS_STALL_RATIO = 0.9
 #: steady state: default cap on integrated periods
 SS_MAX_PERIODS = 1500
 #: steady state: periods integrated between two checks
