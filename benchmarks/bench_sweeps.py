@@ -11,7 +11,7 @@ against a plain ``scipy.integrate.solve_ivp``-style integration.
 - ``baseline``: for a subset of points, the seconds of ``jointdyn``'s
   ``steady_state`` for that point alone (cold start, one thread) and of the
   reference integrator run over the same number of forcing periods, and
-  their ratio.
+  their ratio (best of 3 runs each; 1 in quick mode).
 
 Reference integrator: scipy's explicit Runge-Kutta (RK45, rtol 1e-8, step at
 most the period / config.TI_STEPS_PER_PERIOD like jointdyn's base step) stepped
@@ -118,14 +118,19 @@ def run(quick: bool = False) -> dict:
     rows = []
     for eta, beta, gamma in BASELINE_POINTS[: 2 if quick else None]:
         system = System.paper_damper(eta=eta, beta=beta)
-        t0 = time.perf_counter()
-        res = steady_state(system, gamma)
-        t_ours = time.perf_counter() - t0
+        reps = 1 if quick else 3  # best of reps for both, same policy
+        t_ours = math.inf
+        for _ in range(reps):
+            t0 = time.perf_counter()
+            res = steady_state(system, gamma)
+            t_ours = min(t_ours, time.perf_counter() - t0)
         periods = max(1, int(res.periods))
         run_p = min(periods, 3 if quick else BASELINE_MAX_PERIODS)
-        t0 = time.perf_counter()
-        nsteps = _reference_periods(system, gamma, run_p)
-        t_ref = (time.perf_counter() - t0) * periods / run_p
+        t_ref = math.inf
+        for _ in range(reps):
+            t0 = time.perf_counter()
+            nsteps = _reference_periods(system, gamma, run_p)
+            t_ref = min(t_ref, (time.perf_counter() - t0) * periods / run_p)
         rows.append(dict(eta=eta, beta=beta, gamma=gamma, status=res.status, periods=periods,
                          seconds_jointdyn=t_ours, seconds_reference=t_ref, baseline_periods_run=run_p,
                          reference_steps=nsteps, ms_per_period_jointdyn=1e3 * t_ours / periods,
