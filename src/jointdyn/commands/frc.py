@@ -241,7 +241,7 @@ def _plot(result, path: Path) -> None:
             amp = np.array([np.nan if v is None else v for v in r["amplitude_q"]], float)
             codes = [config.SWEEP_STATUS.index(s) for s in r["status"]]
             plot_frc_curve(ax, r["gamma"], amp, codes, color="C0" if d == "up" else "C3",
-                           linestyle=style, label=f"sweep {d}")
+                           linestyle=style, label=f"sweep {d}", rug_y=0.03 if d == "up" else 0.07)
         mark_legend(ax, fontsize=8)
     else:
         for i, br in enumerate(result["branches"]):

@@ -24,6 +24,8 @@ With ``out=DIR`` each finished line is written atomically to
 ``DIR/lines/<key>.nc`` together with the full description of the line; a
 rerun loads every line whose description matches instead of recomputing it.
 The assembled Dataset goes to ``DIR/frc.nc`` and a tidy CSV ``DIR/frc.csv``.
+The description covers the parameters, not the solver's code: delete
+``DIR/lines`` after changing the solver to recompute everything.
 """
 
 from __future__ import annotations
