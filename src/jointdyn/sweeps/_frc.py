@@ -181,14 +181,14 @@ def _solve_line(spec: LineSpec) -> dict:
     -------
     dict
         ``status`` (int8 codes), every name of :data:`VARIABLES` (float64)
-        and :data:`INT_VARIABLES` (int64), each of length ``len(gammas)``.
+        and :data:`INT_VARIABLES` (int32), each of length ``len(gammas)``.
     """
     solve = _steady_state_fn()
     system = spec.system()
     g = np.asarray(spec.gammas, dtype=float)
     m = g.size
     out = {name: np.full(m, np.nan) for name in VARIABLES}
-    out.update({name: np.zeros(m, dtype=np.int64) for name in INT_VARIABLES})
+    out.update({name: np.zeros(m, dtype=np.int32) for name in INT_VARIABLES})
     out["status"] = np.full(m, _MISSING, dtype=np.int8)
     order = range(m) if spec.direction == "up" else range(m - 1, -1, -1)
     kwargs = {"keep_loop": False}
@@ -233,7 +233,7 @@ def _read_line(path: Path, spec: LineSpec) -> dict | None:
                 return None
             return {
                 name: np.asarray(ds[name].values).astype(
-                    np.int8 if name == "status" else (np.int64 if name in INT_VARIABLES else np.float64)
+                    np.int8 if name == "status" else (np.int32 if name in INT_VARIABLES else np.float64)
                 )
                 for name in (*VARIABLES, *INT_VARIABLES, "status")
             }
@@ -446,7 +446,7 @@ def frc_sweep(
 
     shape = (len(etas), len(loads), len(deltas), len(directions), len(g))
     arrays = {name: np.full(shape, np.nan) for name in VARIABLES}
-    arrays.update({name: np.zeros(shape, dtype=np.int64) for name in INT_VARIABLES})
+    arrays.update({name: np.zeros(shape, dtype=np.int32) for name in INT_VARIABLES})
     arrays["status"] = np.full(shape, _MISSING, dtype=np.int8)
 
     line_dir = None if out is None else Path(out) / "lines"
