@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from jointdyn import config
 from jointdyn.drivers import march
@@ -73,6 +75,30 @@ def test_linear_system_without_contacts():
     # undamped linear resonance grows without bound
     r = steady_state(System.sdof(m=2.0, k=8e4, f1=3.0), 1.0, max_periods=200)
     assert r.status == "unbounded" and math.isnan(r.amplitude_m)
+
+
+def test_two_dof_separating_contact_events_and_law():
+    # contact from DOF 1 to ground with eta = 1.5 (separation), forced DOF 0
+    law = make_law("iwan", kt=2e5, mu=0.5, n_ref=100.0)
+    Mm = np.diag([1.0, 2.0])
+    Kk = np.array([[2e5, -1e5], [-1e5, 1.5e5]])
+    c = Contact(law=law, dof=1, n0=100.0, n1=150.0, delta=0.4)
+    s = System(M=Mm, C=np.zeros((2, 2)), K=Kk, contacts=(c,), force=[20.0, 0.0])
+    gamma = 1.2
+    tr = integrate(s, gamma, periods=4)
+    w = gamma * s.w0
+    ev = HarmonicLoad(c.n0, c.n1, w, c.delta).zero_crossings(0.0, tr.t[-1])
+    assert ev.size == 8
+    for te in ev:
+        assert np.min(np.abs(tr.t - te)) <= 1e-12 * tr.t[-1]
+    T = march(law, tr.x[:, 1], tr.N[:, 0])[0]
+    assert np.max(np.abs(T - tr.T[:, 0])) <= config.TEST_TI_MARCH_ATOL_FY * law.fy
+    r = steady_state(s, gamma, response_dof=0)
+    assert r.status == "periodic"
+    diss = r.energy_contact_J + r.energy_viscous_J
+    assert diss == pytest.approx(r.work_force_J, rel=config.TEST_TI_ENERGY_RTOL)
+    rec = r.to_record()
+    assert rec["status"] == "periodic" and rec["amplitude_m"] == r.amplitude_m
 
 
 # --- the paper damper: peak, Den Hartog, energy, step size -----------------
@@ -161,6 +187,27 @@ def test_integrator_law_agrees_with_march(model, eta):
     T, _, code, _ = march(law, tr.x[:, 0], tr.N[:, 0])
     assert np.max(np.abs(T - tr.T[:, 0])) <= config.TEST_TI_MARCH_ATOL_FY * law.fy
     assert np.array_equal(code.astype(np.int8), tr.code[:, 0])
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    eta=st.floats(0.0, 2.5),
+    delta=st.floats(-3.0, 3.0),
+    beta=st.floats(0.3, 20.0),
+    gamma=st.floats(0.3, 2.5),
+    model=st.sampled_from(["iwan", "jenkins", "iwan-paper"]),
+)
+def test_property_law_in_integrator_equals_march(eta, delta, beta, gamma, model):
+    # for any loads, the forces recorded by the integrator are those of the
+    # law marched over the recorded displacement and normal-load samples,
+    # every sample is finite and an open contact carries no force
+    s = System.paper_damper(eta=eta, beta=beta, delta=delta, model=model)
+    tr = integrate(s, gamma, periods=3, steps_per_period=64)
+    assert tr.status == "ok" and np.all(np.isfinite(tr.x)) and np.all(np.diff(tr.t) > 0)
+    law = s.contacts[0].law
+    T = march(law, tr.x[:, 0], tr.N[:, 0])[0]
+    assert np.max(np.abs(T - tr.T[:, 0])) <= config.TEST_TI_MARCH_ATOL_FY * law.fy
+    assert np.all(np.abs(tr.T[:, 0]) <= law.fy * np.maximum(tr.N[:, 0], 0.0) / law.n_ref * (1 + 1e-9) + 1e-12)
 
 
 def test_separation_and_recontact_are_step_boundaries():

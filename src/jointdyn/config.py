@@ -49,6 +49,9 @@ TI_BLOWUP_FACTOR = 1e8
 SS_AMP_RTOL = 1e-4
 #: steady state: default relative tolerance on the energy per period
 SS_ENERGY_RTOL = 1e-3
+#: steady state: work of the forcing = dissipation per period to this
+#: (relative; the energy integrals carry the discretisation error)
+SS_BALANCE_RTOL = 1e-2
 #: steady state: windows (of p periods) that must agree
 SS_CHECK_PERIODS = 3
 #: steady state: largest period multiple p looked for
@@ -78,6 +81,9 @@ SS_SHOOT_MAXIT = 12
 #: step halvings of the line search
 SS_SHOOT_MAXSTEP = 1.0
 SS_SHOOT_HALVINGS = 8
+#: steady state: before shooting (section at phase 0), rebuild the law
+#: states from the last period alone (forget the transient's memory)
+SS_SHOOT_CLEAN_STATE = True
 #: steady state: shooting attempts per run
 SS_MAX_SHOTS = 3
 #: steady state: relative finite-difference step of the monodromy matrix
