@@ -205,3 +205,46 @@ def test_bad_input_names_the_parameter(kwargs, name):
     g0, g1 = args.pop("gamma_start"), args.pop("gamma_stop")
     with pytest.raises(ValueError, match=name):
         frc_hb(_jenkins_system(), g0, g1, **args)
+
+
+def test_two_dof_contact_between_masses_equals_time_integration():
+    from jointdyn.dynamics import steady_state
+    from jointdyn.laws import Iwan
+    from jointdyn.systems import Contact
+
+    law = Iwan(kt=3e5, mu=0.5, n_ref=100.0)
+    M = np.diag([10.0, 5.0])
+    K = np.array([[5.9e5, -2e5], [-2e5, 2e5]])
+    s = System(M=M, C=1e-4 * K, K=K, force=[40.0, 0.0],
+               contacts=(Contact(law=law, dof=0, dof2=1, n0=100.0, n1=30.0, delta=0.4),))
+    for g in (1.0, 1.2):
+        sol = harmonic_balance(s, g, harmonics=7, samples=256)
+        ss = steady_state(s, g)
+        assert sol.converged and sol.stable and ss.status == "periodic"
+        assert abs(sol.amplitude_m - ss.amplitude_m) <= config.TEST_HB_VS_TIME_RTOL * ss.amplitude_m
+
+
+def test_fully_stuck_contact_gives_the_linear_solution():
+    # slip force far above anything the forcing can reach: the contact is a
+    # linear spring kt and HB must return the stuck linear solution exactly
+    law = Jenkins(kt=KT, mu=1e6, n_ref=100.0)
+    s = System.sdof(m=M, k=K, law=law, f1=F1, zeta=0.02)
+    for g in (0.7, 1.3, 1.6):
+        sol = harmonic_balance(s, g, harmonics=3, samples=64)
+        w = g * math.sqrt(K / M)
+        c = 2 * 0.02 * math.sqrt(K * M)
+        A = F1 / math.hypot(K + KT - M * w * w, c * w)
+        assert sol.converged and abs(sol.amplitude_m - A) <= 1e-10 * A
+
+
+def test_fig6_hb_figure_from_saved_tables(tmp_path):
+    import pandas as pd
+
+    from jointdyn.figures.hb import _plot_fig6_hb, fig6_hb_data
+
+    tables = fig6_hb_data(etas=(0.5,), betas=(2.0,), gamma=(0.8, 1.6), time_domain=False)
+    hb = tables["hb"]
+    assert {"gamma", "amplitude_q", "stable", "fold", "gap", "branch"} <= set(hb.columns)
+    hb.to_csv(tmp_path / "hb.csv", index=False)
+    paths = _plot_fig6_hb({"hb": pd.read_csv(tmp_path / "hb.csv")}, tmp_path)
+    assert all(p.exists() and p.stat().st_size > 0 for p in paths)
