@@ -178,14 +178,33 @@ def test_generic_continuation_finds_both_folds_of_a_cubic():
     assert np.all(np.abs(r.y[:, 0] ** 3 - r.y[:, 0] + r.lam) < 1e-8)
 
 
-def test_continuation_in_eta_matches_fixed_solutions():
-    sysm = System.paper_damper(eta=0.1, beta=2.0, model="iwan")
-    br = continue_hb(sysm, 0.1, 0.6, parameter="eta", gamma=1.4, harmonics=5, samples=128)
-    assert br.status == "complete"
-    i = br.lam.size // 2
-    ref = harmonic_balance(System.paper_damper(eta=float(br.lam[i]), beta=2.0, model="iwan"), 1.4,
-                           harmonics=5, samples=128, guess=br.X[i])
-    assert ref.converged and np.allclose(ref.X, br.X[i], rtol=0, atol=1e-9 * np.abs(ref.X).max())
+def _damper(eta=0.1, delta=0.0, n0=100.0, f1=25.0):
+    from jointdyn.laws import Iwan
+
+    law = Iwan(kt=3e5, mu=0.5, n_ref=100.0)
+    return System.sdof(m=10.0, k=3.9e5, law=law, f1=f1, n0=n0, eta=eta, delta=delta)
+
+
+@pytest.mark.parametrize("par,start,stop", [("eta", 0.1, 0.6), ("delta", 0.0, 1.5), ("n0", 80.0, 140.0),
+                                            ("f1", 10.0, 40.0)])
+def test_continuation_in_a_parameter_matches_fixed_solutions(par, start, stop):
+    br = continue_hb(_damper(**{par: start}), start, stop, parameter=par, gamma=1.4, harmonics=5, samples=128)
+    assert br.status == "complete" and br.lam[-1] == stop
+    for i in (br.lam.size // 3, br.lam.size - 1):
+        ref = harmonic_balance(_damper(**{par: float(br.lam[i])}), 1.4, harmonics=5, samples=128, guess=br.X[i])
+        assert ref.converged and ref.iterations <= 2
+        assert np.allclose(ref.X, br.X[i], rtol=0, atol=1e-8 * np.abs(ref.X).max())
+
+
+def test_downward_frequency_sweep_matches_upward():
+    up = frc_hb(_jenkins_system(), 0.8, 1.6, harmonics=3)
+    down = frc_hb(_jenkins_system(), 1.6, 0.8, harmonics=3)
+    assert up.attrs["status"] == down.attrs["status"] == "complete"
+    g = np.linspace(0.85, 1.55, 8)
+    iu, idn = np.argsort(up.gamma.values), np.argsort(down.gamma.values)
+    a_up = np.interp(g, up.gamma.values[iu], up.amplitude_m.values[iu])
+    a_dn = np.interp(g, down.gamma.values[idn], down.amplitude_m.values[idn])
+    assert np.allclose(a_up, a_dn, rtol=2e-2)
 
 
 @pytest.mark.parametrize(
