@@ -134,6 +134,36 @@ def test_eta_1p5_folds_with_unstable_segment_between():
     assert ds.stable.values[: max(f[0] - 5, 1)].all() and ds.stable.values[f[-1] + 5:].all()
 
 
+def test_eta_1p5_time_domain_sweeps_jump_at_the_hb_turning_points():
+    # eta = 1.5 (separation), beta = 1.5: the HB branch turns back at A and
+    # forward again at B < A; the up sweep jumps up near A, the down sweep
+    # jumps down near B, and the HB branch between them is unstable
+    from jointdyn.sweeps import frc_sweep, to_frame
+
+    ds = frc_hb(System.paper_damper(eta=1.5, beta=1.5), 1.0, 1.3, samples=512)
+    assert ds.attrs["status"] == "complete"
+    tp = np.flatnonzero(ds.turning.values)
+    assert tp.size == 2 and ds.attrs["folds"] >= 2
+    gB, gA = np.sort(ds.gamma.values[tp])
+    qA, qB = ds.amplitude_q.values[tp[0]], ds.amplitude_q.values[tp[1]]
+    assert qB > qA
+    between = (ds.point > tp[0]) & (ds.point < tp[1])
+    assert (~ds.stable.values[between.values]).any()
+    g = np.round(np.arange(1.121, 1.1290001, 0.001), 6)
+    td = to_frame(frc_sweep(g, etas=(1.5,), betas=(1.5,), directions=("up", "down"), progress=False,
+                            n_workers=1))
+    mid = 0.5 * (qA + qB)
+    up = td[(td.direction == "up") & (td.status_name == "periodic")].sort_values("gamma")
+    dn = td[(td.direction == "down") & (td.status_name == "periodic")].sort_values("gamma")
+    g_up = up.gamma[up.amplitude_q > mid].min()  # first high point sweeping up
+    g_up_low = up.gamma[up.amplitude_q < mid].max()  # last low point
+    g_dn = dn.gamma[dn.amplitude_q > mid].min()  # last high point sweeping down
+    g_dn_low = dn.gamma[dn.amplitude_q < mid].max()  # first low point
+    assert g_up_low < gA + 1e-3 and g_up > gA - 1e-3
+    assert g_dn_low < gB + 1e-3 and g_dn > gB - 1e-3
+    assert g_up > g_dn  # hysteresis: the two sweeps jump at different gammas
+
+
 def test_hill_agrees_with_monodromy():
     br = continue_hb(System.paper_damper(eta=10.0, beta=2.0, model="iwan"), 0.5, 2.0)
     f = np.flatnonzero(br.fold)
