@@ -134,6 +134,36 @@ def test_eta_1p5_folds_with_unstable_segment_between():
     assert ds.stable.values[: max(f[0] - 5, 1)].all() and ds.stable.values[f[-1] + 5:].all()
 
 
+def test_eta_1p5_time_domain_sweeps_jump_at_the_hb_turning_points():
+    # eta = 1.5 (separation), beta = 1.5: the HB branch turns back at A and
+    # forward again at B < A; the up sweep jumps up near A, the down sweep
+    # jumps down near B, and the HB branch between them is unstable
+    from jointdyn.sweeps import frc_sweep, to_frame
+
+    ds = frc_hb(System.paper_damper(eta=1.5, beta=1.5), 1.0, 1.3, samples=512)
+    assert ds.attrs["status"] == "complete"
+    tp = np.flatnonzero(ds.turning.values)
+    assert tp.size == 2 and ds.attrs["folds"] >= 2
+    gB, gA = np.sort(ds.gamma.values[tp])
+    qA, qB = ds.amplitude_q.values[tp[0]], ds.amplitude_q.values[tp[1]]
+    assert qB > qA
+    between = (ds.point > tp[0]) & (ds.point < tp[1])
+    assert (~ds.stable.values[between.values]).any()
+    g = np.round(np.arange(1.121, 1.1290001, 0.001), 6)
+    td = to_frame(frc_sweep(g, etas=(1.5,), betas=(1.5,), directions=("up", "down"), progress=False,
+                            n_workers=1))
+    mid = 0.5 * (qA + qB)
+    up = td[(td.direction == "up") & (td.status_name == "periodic")].sort_values("gamma")
+    dn = td[(td.direction == "down") & (td.status_name == "periodic")].sort_values("gamma")
+    g_up = up.gamma[up.amplitude_q > mid].min()  # first high point sweeping up
+    g_up_low = up.gamma[up.amplitude_q < mid].max()  # last low point
+    g_dn = dn.gamma[dn.amplitude_q > mid].min()  # last high point sweeping down
+    g_dn_low = dn.gamma[dn.amplitude_q < mid].max()  # first low point
+    assert g_up_low < gA + 1e-3 and g_up > gA - 1e-3
+    assert g_dn_low < gB + 1e-3 and g_dn > gB - 1e-3
+    assert g_up > g_dn  # hysteresis: the two sweeps jump at different gammas
+
+
 def test_hill_agrees_with_monodromy():
     br = continue_hb(System.paper_damper(eta=10.0, beta=2.0, model="iwan"), 0.5, 2.0)
     f = np.flatnonzero(br.fold)
@@ -178,14 +208,33 @@ def test_generic_continuation_finds_both_folds_of_a_cubic():
     assert np.all(np.abs(r.y[:, 0] ** 3 - r.y[:, 0] + r.lam) < 1e-8)
 
 
-def test_continuation_in_eta_matches_fixed_solutions():
-    sysm = System.paper_damper(eta=0.1, beta=2.0, model="iwan")
-    br = continue_hb(sysm, 0.1, 0.6, parameter="eta", gamma=1.4, harmonics=5, samples=128)
-    assert br.status == "complete"
-    i = br.lam.size // 2
-    ref = harmonic_balance(System.paper_damper(eta=float(br.lam[i]), beta=2.0, model="iwan"), 1.4,
-                           harmonics=5, samples=128, guess=br.X[i])
-    assert ref.converged and np.allclose(ref.X, br.X[i], rtol=0, atol=1e-9 * np.abs(ref.X).max())
+def _damper(eta=0.1, delta=0.0, n0=100.0, f1=25.0):
+    from jointdyn.laws import Iwan
+
+    law = Iwan(kt=3e5, mu=0.5, n_ref=100.0)
+    return System.sdof(m=10.0, k=3.9e5, law=law, f1=f1, n0=n0, eta=eta, delta=delta)
+
+
+@pytest.mark.parametrize("par,start,stop", [("eta", 0.1, 0.6), ("delta", 0.0, 1.5), ("n0", 80.0, 140.0),
+                                            ("f1", 10.0, 40.0)])
+def test_continuation_in_a_parameter_matches_fixed_solutions(par, start, stop):
+    br = continue_hb(_damper(**{par: start}), start, stop, parameter=par, gamma=1.4, harmonics=5, samples=128)
+    assert br.status == "complete" and br.lam[-1] == stop
+    for i in (br.lam.size // 3, br.lam.size - 1):
+        ref = harmonic_balance(_damper(**{par: float(br.lam[i])}), 1.4, harmonics=5, samples=128, guess=br.X[i])
+        assert ref.converged and ref.iterations <= 2
+        assert np.allclose(ref.X, br.X[i], rtol=0, atol=1e-8 * np.abs(ref.X).max())
+
+
+def test_downward_frequency_sweep_matches_upward():
+    up = frc_hb(_jenkins_system(), 0.8, 1.6, harmonics=3)
+    down = frc_hb(_jenkins_system(), 1.6, 0.8, harmonics=3)
+    assert up.attrs["status"] == down.attrs["status"] == "complete"
+    g = np.linspace(0.85, 1.55, 8)
+    iu, idn = np.argsort(up.gamma.values), np.argsort(down.gamma.values)
+    a_up = np.interp(g, up.gamma.values[iu], up.amplitude_m.values[iu])
+    a_dn = np.interp(g, down.gamma.values[idn], down.amplitude_m.values[idn])
+    assert np.allclose(a_up, a_dn, rtol=2e-2)
 
 
 @pytest.mark.parametrize(
@@ -205,3 +254,46 @@ def test_bad_input_names_the_parameter(kwargs, name):
     g0, g1 = args.pop("gamma_start"), args.pop("gamma_stop")
     with pytest.raises(ValueError, match=name):
         frc_hb(_jenkins_system(), g0, g1, **args)
+
+
+def test_two_dof_contact_between_masses_equals_time_integration():
+    from jointdyn.dynamics import steady_state
+    from jointdyn.laws import Iwan
+    from jointdyn.systems import Contact
+
+    law = Iwan(kt=3e5, mu=0.5, n_ref=100.0)
+    M = np.diag([10.0, 5.0])
+    K = np.array([[5.9e5, -2e5], [-2e5, 2e5]])
+    s = System(M=M, C=1e-4 * K, K=K, force=[40.0, 0.0],
+               contacts=(Contact(law=law, dof=0, dof2=1, n0=100.0, n1=30.0, delta=0.4),))
+    for g in (1.0, 1.2):
+        sol = harmonic_balance(s, g, harmonics=7, samples=256)
+        ss = steady_state(s, g)
+        assert sol.converged and sol.stable and ss.status == "periodic"
+        assert abs(sol.amplitude_m - ss.amplitude_m) <= config.TEST_HB_VS_TIME_RTOL * ss.amplitude_m
+
+
+def test_fully_stuck_contact_gives_the_linear_solution():
+    # slip force far above anything the forcing can reach: the contact is a
+    # linear spring kt and HB must return the stuck linear solution exactly
+    law = Jenkins(kt=KT, mu=1e6, n_ref=100.0)
+    s = System.sdof(m=M, k=K, law=law, f1=F1, zeta=0.02)
+    for g in (0.7, 1.3, 1.6):
+        sol = harmonic_balance(s, g, harmonics=3, samples=64)
+        w = g * math.sqrt(K / M)
+        c = 2 * 0.02 * math.sqrt(K * M)
+        A = F1 / math.hypot(K + KT - M * w * w, c * w)
+        assert sol.converged and abs(sol.amplitude_m - A) <= 1e-10 * A
+
+
+def test_fig6_hb_figure_from_saved_tables(tmp_path):
+    import pandas as pd
+
+    from jointdyn.figures.hb import _plot_fig6_hb, fig6_hb_data
+
+    tables = fig6_hb_data(etas=(0.5,), betas=(2.0,), gamma=(0.8, 1.6), time_domain=False)
+    hb = tables["hb"]
+    assert {"gamma", "amplitude_q", "stable", "fold", "gap", "branch"} <= set(hb.columns)
+    hb.to_csv(tmp_path / "hb.csv", index=False)
+    paths = _plot_fig6_hb({"hb": pd.read_csv(tmp_path / "hb.csv")}, tmp_path)
+    assert all(p.exists() and p.stat().st_size > 0 for p in paths)

@@ -154,3 +154,5 @@ HB_STABILITY_RTOL = 1e-6
 TEST_HB_JACOBIAN_RTOL = 1e-6
 TEST_HB_DF_RTOL = 1e-4
 TEST_HB_VS_TIME_RTOL = 1e-2
+#: turning points of a branch (secant): dead band as a fraction of the range
+HB_TURNING_BAND = 5e-4

@@ -40,7 +40,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 
-__all__ = ["ContinuationResult", "continuation", "newton"]
+__all__ = ["ContinuationResult", "continuation", "newton", "turning_points"]
 
 #: below this (scaled) step a sharp turn or a long correction is a corner of
 #: a piecewise-smooth branch, not a jump to another branch
@@ -177,6 +177,37 @@ def _tangent(Jy, Jl, t_prev):
     if not np.isfinite(nt) or nt == 0:
         return None
     return t / nt
+
+
+def turning_points(lam, gap=None, band: float = 0.0):
+    """Indices where lam is extremal along a branch (secant turning points).
+
+    A reversal counts only once lam has come back from the running extreme
+    by more than ``band`` (dead band: jitter of the points of a
+    piecewise-smooth branch is ignored). Points reached by a jump
+    (``gap``) restart the search.
+    """
+    lam = np.asarray(lam, dtype=float)
+    gap = np.zeros(lam.size, dtype=bool) if gap is None else np.asarray(gap, dtype=bool)
+    out = []
+    i_ext = 0
+    direction = 0
+    for i in range(1, lam.size):
+        if gap[i]:
+            i_ext, direction = i, 0
+            continue
+        if direction == 0:
+            if abs(lam[i] - lam[i_ext]) > band:
+                direction = 1 if lam[i] > lam[i_ext] else -1
+                i_ext = i
+            continue
+        if direction * (lam[i] - lam[i_ext]) >= 0:
+            i_ext = i
+        elif abs(lam[i] - lam[i_ext]) > band:
+            out.append(i_ext)
+            direction = -direction
+            i_ext = i
+    return np.array(out, dtype=int)
 
 
 def _jump(residual, u, t, span, sgn, tol, max_iter, cnt):

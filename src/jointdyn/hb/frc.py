@@ -303,13 +303,31 @@ def _relabel_failure(res: ContinuationResult, xs, qamp):
     return res
 
 
+def _turning_mask(branch):
+    from .continuation import turning_points
+
+    m = np.zeros(branch.lam.size, dtype=bool)
+    span = float(np.ptp(branch.lam)) if branch.lam.size else 0.0
+    for sgm in np.unique(branch.segment):
+        idx = np.flatnonzero(branch.segment == sgm)
+        tp = turning_points(branch.lam[idx], branch.gap[idx], band=config.HB_TURNING_BAND * span)
+        m[idx[tp]] = True
+    return m
+
+
 def branch_dataset(branch: HBBranch, response_dof: int = 0):
     """xarray Dataset of a branch (dim ``point``).
 
     Variables: ``gamma``, the parameter (if not gamma), ``amplitude_q``
     (kt X / fy of the first contact, X = half peak-to-peak of x(t) of
     ``response_dof``), ``amplitude_m`` (X, m), ``offset_m`` (mean, m),
-    ``max_abs_m`` (m), ``stable``, ``fold``, ``branch`` (segment index), ``gap``, ``growth``
+    ``max_abs_m`` (m), ``stable``, ``fold`` (sign change of the parameter
+    component of the Jacobian tangent: consistent with Hill's method, where
+    a real Floquet multiplier crosses 1), ``turning`` (points where the
+    parameter is extremal along the computed branch, the secant turning
+    points, with a dead band of ``config.HB_TURNING_BAND`` of the range;
+    on a piecewise-smooth branch they can differ from ``fold``),
+    ``branch`` (segment index), ``gap``, ``growth``
     (max Re(s)/w of the Floquet exponents), ``harmonic_amplitude_m``
     (dims point, harmonic: sqrt(a_k^2 + b_k^2), |a_0| for k = 0).
     """
@@ -333,6 +351,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
         "max_abs_m": ("point", mx),
         "stable": ("point", branch.stable),
         "fold": ("point", branch.fold),
+        "turning": ("point", _turning_mask(branch)),
         "branch": ("point", branch.segment),
         "gap": ("point", branch.gap),
         "growth": ("point", branch.growth),
@@ -357,6 +376,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
         response_dof=response_dof,
         points=int(branch.lam.size),
         folds=int(branch.fold.sum()),
+        turning_points=int(_turning_mask(branch).sum()),
         unstable_points=int((~branch.stable).sum()),
         max_aft_passes=int(branch.passes.max()) if branch.passes.size else 0,
         force_period_2_points=int((branch.force_period == 2).sum()),

@@ -254,10 +254,34 @@ class HBProblem:
             Ef = self._fine[points] = fourier_matrices(self.H, points)[0]
         return Ef @ X.reshape(self.nh, self.n)[:, dof]
 
+    def _extremum(self, c, tau):
+        """Refine a grid extremum of sum_k c_k Q_k(tau) by Newton on x'(tau) = 0."""
+        k = np.arange(1, self.H + 1)
+        a, b = c[1::2], c[2::2]
+        for _ in range(4):
+            s_, co = np.sin(k * tau), np.cos(k * tau)
+            d1 = np.sum(k * (-a * s_ + b * co))
+            d2 = np.sum(k * k * (-a * co - b * s_))
+            if d2 == 0.0:
+                break
+            step = d1 / d2
+            if abs(step) > 2.0 * np.pi / 1024:
+                break
+            tau -= step
+        return c[0] + np.sum(a * np.cos(k * tau) + b * np.sin(k * tau))
+
     def amplitudes(self, X, dof: int):
-        """(half peak-to-peak, mean, max |x|) of x_dof(t), m."""
+        """(half peak-to-peak, mean, max |x|) of x_dof(t), m.
+
+        Extrema located on 1024 samples per period and refined by Newton's
+        method on the derivative of the Fourier series.
+        """
         x = self.reconstruct(X, dof)
-        return 0.5 * (x.max() - x.min()), float(X.reshape(self.nh, self.n)[0, dof]), float(np.abs(x).max())
+        c = X.reshape(self.nh, self.n)[:, dof]
+        tau = 2.0 * np.pi / x.size
+        hi = max(self._extremum(c, tau * int(np.argmax(x))), float(x.max()))
+        lo = min(self._extremum(c, tau * int(np.argmin(x))), float(x.min()))
+        return 0.5 * (hi - lo), float(c[0]), max(abs(hi), abs(lo))
 
     def first_harmonic_amplitude(self, X, dof: int) -> float:
         """sqrt(a_1^2 + b_1^2) of DOF ``dof``, m."""
