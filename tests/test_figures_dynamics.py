@@ -55,8 +55,8 @@ def test_plotters_write_files(tmp_path):
                     rows.append(dict(eta=eta, beta=beta, direction=d, gamma=g, amplitude_q=1.0 + i,
                                      status=[0, 2, 1][i]))
     paths = F._plot_fig6({"curves": pd.DataFrame(rows)}, tmp_path)
-    energy = pd.DataFrame(dict(eta=[0.5, 0.5, 1.5], delta=[0.0, 90.0, 0.0], energy_contact_J=[1.0, 2.0, 3.0],
-                               status=[0, 0, 2]))
+    energy = pd.DataFrame(dict(eta=[0.5, 0.5, 1.5], beta=[1.0, 1.0, 1.0], gamma=[0.8, 0.8, 0.8],
+                               delta=[0.0, 90.0, 0.0], energy_contact_J=[1.0, 2.0, 3.0], status=[0, 0, 2]))
     paths += F._plot_energy({"energy": energy}, tmp_path)
     for p in paths:
         assert p.stat().st_size > 1000

@@ -42,6 +42,8 @@ FIG8_BETA = 1.0
 FIG8_GAMMA = 0.8
 FIG8_DELTAS = (0.0, 45.0, 90.0, 135.0, 180.0)
 ENERGY_DELTAS = tuple(float(d) for d in range(0, 181, 15))
+ENERGY_BETAS = (1.0, 5.0)
+ENERGY_GAMMAS = (0.8, 1.2, 1.6)
 
 
 def _gamma_grid(spec):
@@ -271,7 +273,8 @@ def _plot_fig8(tables, out_dir):
 def energy_delta():
     from ..sweeps import frc_sweep, to_frame
 
-    ds = frc_sweep([FIG8_GAMMA], etas=FIG8_ETAS, betas=[FIG8_BETA], deltas=ENERGY_DELTAS, directions=("up",))
+    ds = frc_sweep(list(ENERGY_GAMMAS), etas=FIG8_ETAS, betas=ENERGY_BETAS, deltas=ENERGY_DELTAS,
+                   directions=("up",))
     df = to_frame(ds)
     return {"energy": df[["eta", "beta", "delta", "gamma", "energy_contact_J", "work_force_J", "amplitude_q",
                           "offset_m", "status", "status_name"]]}
@@ -285,20 +288,31 @@ def _plot_energy(tables, out_dir):
     import matplotlib.pyplot as plt
 
     df = tables["energy"]
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    for i, eta in enumerate(sorted(df.eta.unique())):
-        sub = df[df.eta == eta].sort_values("delta")
-        ok = sub.status == 0
-        ax.plot(sub.delta[ok], sub.energy_contact_J[ok], "o-", color=f"C{i}",
-                label=f"eta = {eta:g} ({'separation' if eta > 1 else 'contact'})")
-        if (~ok).any():
-            ax.plot(sub.delta[~ok], np.zeros((~ok).sum()), "x", color=f"C{i}", label="no steady state")
-    ax.set_xlabel("delta (deg)")
-    ax.set_ylabel("energy dissipated per cycle (J)")
-    ax.set_title(f"Contact dissipation vs normal-load phase (beta = {FIG8_BETA:g}, gamma = {FIG8_GAMMA:g})",
-                 fontsize=9)
-    ax.set_xticks(range(0, 181, 30))
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    etas = sorted(df.eta.unique())
+    fig, axes = plt.subplots(1, len(etas), figsize=(5.2 * len(etas), 4.2), squeeze=False)
+    styles = ["-", "--", ":", "-."]
+    for ax, eta in zip(axes[0], etas):
+        sub_eta = df[df.eta == eta]
+        betas = sorted(sub_eta.beta.unique())
+        gammas = sorted(sub_eta.gamma.unique())
+        for ib, beta in enumerate(betas):
+            for ig, gamma in enumerate(gammas):
+                sub = sub_eta[(sub_eta.beta == beta) & (sub_eta.gamma == gamma)].sort_values("delta")
+                ok = sub.status == 0
+                color = f"C{ig}"
+                ax.plot(sub.delta, np.where(ok, sub.energy_contact_J, np.nan), marker="o", ms=3, ls=styles[ib % 4],
+                        color=color,
+                        label=f"beta = {beta:g}, gamma = {gamma:g}")
+                if (~ok).any():
+                    ax.plot(sub.delta[~ok], np.full((~ok).sum(), 0.03), "x", color=color,
+                            transform=ax.get_xaxis_transform())
+        ax.set_yscale("log")
+        ax.set_xlabel("delta (deg)")
+        ax.set_ylabel("energy dissipated by the contact per cycle (J)")
+        ax.set_title(f"eta = {eta:g} ({'separation' if eta > 1 else 'contact'}); x: no steady state", fontsize=9)
+        ax.set_xticks(range(0, 181, 30))
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+    fig.suptitle("Contact dissipation per cycle vs the phase delta of the normal load (forced damper)", fontsize=9)
     fig.tight_layout()
     return _save(fig, out_dir, "energy_delta")
