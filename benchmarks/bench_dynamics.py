@@ -1,125 +1,67 @@
-"""Forced-response speed: the full Fig 6 data set and a per-point comparison
-against a plain ``scipy.integrate.solve_ivp``-style integration.
+"""Steady-state sweep speed of jointdyn.dynamics (issue 3).
 
-``run(quick)`` returns
-
-- ``fig6_seconds``: wall time of the Fig 6 sweep (4 eta x 6 beta x gamma grid,
-  up and down) on all local cores; ``quick`` uses a reduced gamma grid and
-  says so (``grid``);
-- ``seconds_per_point``: mean steady-state point cost (wall time x workers /
-  points, i.e. CPU-seconds per point) of that sweep;
-- ``baseline``: for a subset of points, the seconds of ``jointdyn``'s
-  ``steady_state`` for that point alone (cold start, one thread) and of the
-  reference integrator run over the same number of forcing periods, and
-  their ratio.
-
-Reference integrator: scipy's explicit Runge-Kutta (RK45, rtol 1e-8) stepped
-from Python; every right-hand-side evaluation calls the contact law's
-compiled trial kernel from Python (``law.step`` from the committed state),
-and the law's state is committed after every accepted step -- the textbook
-way of putting a hysteretic law into an ODE solver. It does not locate
-separation instants (an honest but lighter baseline than jointdyn's solver).
-When the point needs many periods the reference runs at most
-``BASELINE_MAX_PERIODS`` of them and its time is scaled to the same count
-(``baseline_periods_run`` says how many ran).
+For representative paper-damper cases, a sweep of gamma up and down with warm
+starts (the way sweeps use ``steady_state``): seconds per point, periods and
+RK4 steps per point. Reference measured in the same run: ``drivers.march`` of
+the same law over as many samples as the sweep made law evaluations (four
+per RK4 step), so ``ratio_vs_march`` is the integrator's cost per law
+evaluation relative to a bare compiled law loop.
 """
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
 
-BASELINE_MAX_PERIODS = 20
-BASELINE_POINTS = (  # (eta, beta, gamma)
-    (0.5, 2.0, 0.9),
-    (0.5, 2.0, 1.2),
-    (1.5, 5.0, 1.1),
-    (0.01, 10.0, 1.5),
-)
 
-
-def _reference_periods(system, gamma, periods):
-    """Integrate ``periods`` forcing periods with scipy RK45 + Python law calls."""
-    from scipy.integrate import RK45
-
-    c = system.contacts[0]
-    law = c.law
-    step = law.step
-    params = law.params
-    m = float(system.M[0, 0])
-    k = float(system.K[0, 0])
-    cv = float(system.C[0, 0])
-    f1 = float(system.force[0])
-    w = gamma * system.w0
-    s_old = law.initial_state(0.0, c.n0 + c.n1 * math.sin(c.delta))
-    s_new = np.empty_like(s_old)
-
-    def rhs(t, y):
-        N = c.n0 + c.n1 * math.sin(w * t + c.delta)
-        T, _, _ = step(params, s_old, s_new, y[0], N)
-        return np.array([y[1], (f1 * math.sin(w * t) - k * y[0] - cv * y[1] - T) / m])
-
-    t_end = periods * 2.0 * math.pi / w
-    solver = RK45(rhs, 0.0, np.zeros(2), t_end, rtol=1e-8, atol=1e-12, max_step=(2 * math.pi / w) / 50)
-    nsteps = 0
-    while solver.status == "running":
-        solver.step()
-        nsteps += 1
-        # commit the law at the accepted point
-        N = c.n0 + c.n1 * math.sin(w * solver.t + c.delta)
-        step(params, s_old, s_new, solver.y[0], N)
-        s_old[:] = s_new
-    return nsteps
-
-
-def run(quick: bool = False) -> dict:
-    import os
-
+def _sweep(system, gammas):
     from jointdyn.dynamics import steady_state
-    from jointdyn.figures.dynamics import FIG6_BETAS, FIG6_ETAS, FIG6_GAMMA, fig6_data
-    from jointdyn.sweeps import default_workers
+
+    per, steps, status = [], [], {}
+    t0 = time.perf_counter()
+    for direction in (gammas, gammas[::-1]):
+        prev = None
+        for g in direction:
+            r = steady_state(system, float(g), start=prev, keep_loop=False)
+            prev = r if r.ok else None
+            per.append(r.periods)
+            steps.append(r.steps)
+            key = r.status if r.ok else f"{r.status}:{r.detail}"
+            status[key] = status.get(key, 0) + 1
+    dt = time.perf_counter() - t0
+    return dt, np.array(per), np.array(steps), status
+
+
+def run(quick: bool) -> dict:
+    from jointdyn.drivers import march
+    from jointdyn.dynamics import steady_state
     from jointdyn.systems import System
 
-    out = {}
-    # warm the numba cache (compile once) so timings are steady-state speed
-    steady_state(System.paper_damper(eta=0.5, beta=2.0), 1.0)
-
-    start, stop, step_ = FIG6_GAMMA
-    if quick:
-        step_ = 0.05
-    gammas = np.round(start + step_ * np.arange(int(round((stop - start) / step_)) + 1), 12)
-    workers = default_workers()
-    t0 = time.perf_counter()
-    df = fig6_data(gammas=gammas, progress=False)
-    wall = time.perf_counter() - t0
-    npts = len(df)
-    out["grid"] = (f"{'REDUCED (quick) ' if quick else ''}{len(FIG6_ETAS)} eta x {len(FIG6_BETAS)} beta x "
-                   f"{len(gammas)} gamma x 2 directions = {npts} points")
-    out["fig6_seconds"] = wall
-    out["fig6_target_seconds"] = 60.0
-    out["workers"] = workers
-    out["cpu_count"] = os.cpu_count()
-    out["seconds_per_point"] = wall * workers / npts
-    out["status_counts"] = {str(k): int(v) for k, v in df.status_name.value_counts().items()}
-    out["mean_periods_per_point"] = float(df.periods.mean())
-
-    rows = []
-    for eta, beta, gamma in BASELINE_POINTS[: 2 if quick else None]:
-        system = System.paper_damper(eta=eta, beta=beta)
+    ng = 20 if quick else 100
+    gammas = np.linspace(0.5, 2.0, ng)
+    cases = [("eta0.5_beta2", dict(eta=0.5, beta=2.0)), ("eta1.5_beta2", dict(eta=1.5, beta=2.0)),
+             ("eta0.5_beta1000", dict(eta=0.5, beta=1000.0))]  # fmt: skip
+    out = {"gammas_per_direction": ng}
+    for name, kw in cases:
+        s = System.paper_damper(**kw)
+        steady_state(s, 1.0, max_periods=10)  # compile / load the cache
+        dt, per, steps, status = _sweep(s, gammas)
+        npts = 2 * ng
+        law = s.contacts[0].law
+        nev = int(4 * steps.sum())
+        x = 1e-4 * np.sin(np.linspace(0.0, 2 * np.pi * steps.sum() / 256, nev))
+        N = np.full(nev, law.n_ref)
         t0 = time.perf_counter()
-        res = steady_state(system, gamma)
-        t_ours = time.perf_counter() - t0
-        periods = max(1, int(res.periods))
-        run_p = min(periods, 3 if quick else BASELINE_MAX_PERIODS)
-        t0 = time.perf_counter()
-        nsteps = _reference_periods(system, gamma, run_p)
-        t_ref = (time.perf_counter() - t0) * periods / run_p
-        rows.append(dict(eta=eta, beta=beta, gamma=gamma, status=res.status, periods=periods,
-                         seconds_jointdyn=t_ours, seconds_reference=t_ref, baseline_periods_run=run_p,
-                         reference_steps=nsteps, speedup=t_ref / t_ours))
-    out["baseline"] = rows
-    out["speedup_per_point_geomean"] = float(np.exp(np.mean([np.log(r["speedup"]) for r in rows])))
-    out["speedup_target"] = 100.0
+        march(law, x, N)
+        tref = time.perf_counter() - t0
+        out[name] = {
+            "seconds_per_point": dt / npts,
+            "periods_per_point_mean": float(per.mean()),
+            "periods_per_point_max": int(per.max()),
+            "steps_per_point_mean": float(steps.mean()),
+            "status_counts": status,
+            "march_reference_seconds": tref,
+            "ratio_vs_march": dt / tref,
+        }
     return out

@@ -92,3 +92,42 @@ def test_beta_and_f1_exclusive(capsys):
         main(["frc", "--beta", "1", "--f1", "3"])
     assert e.value.code == 2
     assert "not allowed with" in capsys.readouterr().err
+
+
+def test_hb_json_and_files(capsys, tmp_path):
+    pytest.importorskip("jointdyn.hb")
+    rc = main(["frc", "--method", "hb", "--gamma", "1.1:1.3:0.1", "--eta", "0.5", "--beta", "2",
+               "--harmonics", "7", "--samples", "128", "--json", "--out", str(tmp_path)])
+    assert rc == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["method"] == "hb" and out["status"] == "complete"
+    br = out["branches"]
+    assert len(br) >= 1
+    g = [x for b in br for x in b["gamma"]]
+    assert min(g) == pytest.approx(1.1) and max(g) == pytest.approx(1.3)
+    for b in br:
+        assert len(b["stable"]) == len(b["gamma"]) == len(b["amplitude_q"])
+        assert all(isinstance(i, int) and 0 <= i < len(b["gamma"]) for i in b["folds"])
+    for name in ("frc.nc", "frc.csv", "frc.png"):
+        assert (tmp_path / name).stat().st_size > 0
+
+
+def test_hb_missing_is_a_clear_error(monkeypatch, capsys, tmp_path):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "jointdyn.hb", None)  # import fails as if not installed
+    rc = main(["frc", "--method", "hb", "--gamma", "1.1:1.3:0.1", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "jointdyn.hb" in err and "--method time" in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_scheduler_address(fake, capsys):
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, processes=False, threads_per_worker=2, dashboard_address=None) as lc:
+        rc = main(["frc", "--gamma", "0.8:0.9:0.1", "--sweep", "up", "--scheduler", lc.scheduler_address, "--json"])
+    assert rc == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["directions"]["up"]["status"] == ["periodic", "periodic"]
+    assert len(fake.calls) == 2  # ran on the cluster's in-process workers

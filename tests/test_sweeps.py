@@ -234,6 +234,8 @@ def test_real_solver_serial_equals_dask_and_resume(tmp_path):
         with Client(lc) as client:
             dist = frc_sweep(g, **kw, client=client)
     xr.testing.assert_identical(serial, dist)
+    pooled = frc_sweep(g, **kw, n_workers=2)  # local process pool (config.SWEEP_POOL)
+    xr.testing.assert_identical(serial, pooled)
 
     class Stop(Exception):
         pass
@@ -251,3 +253,15 @@ def test_real_solver_serial_equals_dask_and_resume(tmp_path):
         again = frc_sweep(g, **kw, n_workers=1, out=tmp_path)
     assert len(calls) == 3  # 4 lines, 1 loaded
     xr.testing.assert_identical(again, serial)
+
+
+def test_energy_balance_real_solver():
+    """Undamped (zeta = 0) steady state: the work of the force per period
+    equals the energy the contact dissipates (delta sweep, contact and
+    separation)."""
+    _dyn()
+    ds = frc_sweep([0.8], etas=[0.5, 1.5], betas=[1.0], deltas=[0.0, 90.0], directions=("up",),
+                   n_workers=1, progress=False)
+    assert (ds.status.values == 0).all()
+    np.testing.assert_allclose(ds.energy_contact_J.values, ds.work_force_J.values, rtol=1e-3)
+    assert (ds.energy_contact_J.values > 0).all()

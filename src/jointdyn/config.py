@@ -49,10 +49,25 @@ TI_BLOWUP_FACTOR = 1e8
 SS_AMP_RTOL = 1e-4
 #: steady state: default relative tolerance on the energy per period
 SS_ENERGY_RTOL = 1e-3
+#: steady state: work of the forcing = dissipation per period to this
+#: (relative; the energy integrals carry the discretisation error)
+SS_BALANCE_RTOL = 1e-2
 #: steady state: windows (of p periods) that must agree
 SS_CHECK_PERIODS = 3
 #: steady state: largest period multiple p looked for
 SS_MAX_MULTIPLE = 4
+#: steady state: longer multiples (up to this) are detected and reported
+#: as "not-settled", detail "period-P", instead of running to max_periods
+SS_DETECT_MULTIPLE = 12
+#: steady state: a multiple p > 1 is accepted only when the largest
+#: one-period mismatch over the last K p periods is at least this fraction
+#: of that over the K p periods before (no decaying beat)
+SS_MULTIPLE_DECAY = 0.97
+#: steady state: after shooting, stop as "quasi-periodic-or-chaotic" when
+#: the largest one-period mismatch over the last SS_STALL_PERIODS/2 periods
+#: is >= SS_STALL_RATIO times that over the half before
+SS_STALL_PERIODS = 240
+SS_STALL_RATIO = 0.9
 #: steady state: default cap on integrated periods
 SS_MAX_PERIODS = 1500
 #: steady state: periods integrated between two checks
@@ -66,6 +81,9 @@ SS_SHOOT_MAXIT = 12
 #: step halvings of the line search
 SS_SHOOT_MAXSTEP = 1.0
 SS_SHOOT_HALVINGS = 8
+#: steady state: before shooting (section at phase 0), rebuild the law
+#: states from the last period alone (forget the transient's memory)
+SS_SHOOT_CLEAN_STATE = True
 #: steady state: shooting attempts per run
 SS_MAX_SHOTS = 3
 #: steady state: relative finite-difference step of the monodromy matrix

@@ -210,7 +210,10 @@ def _run_hb(args, gammas):
         n=args.n,
         m=args.m, k=args.k, kt=args.kt, mu=args.mu, n0=args.n0,
     )
-    ds = frc_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics, samples=args.samples)
+    if gammas.size < 2:
+        raise ValueError("--gamma must span a range (STOP > START) for --method hb")
+    ds = frc_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics, samples=args.samples,
+                progress=None if not args.json else False)
     result = _header(args)
     result["harmonics"] = args.harmonics
     result["samples"] = args.samples
@@ -238,7 +241,7 @@ def _plot(result, path: Path) -> None:
             amp = np.array([np.nan if v is None else v for v in r["amplitude_q"]], float)
             codes = [config.SWEEP_STATUS.index(s) for s in r["status"]]
             plot_frc_curve(ax, r["gamma"], amp, codes, color="C0" if d == "up" else "C3",
-                           linestyle=style, label=f"sweep {d}")
+                           linestyle=style, label=f"sweep {d}", rug_y=0.03 if d == "up" else 0.07)
         mark_legend(ax, fontsize=8)
     else:
         for i, br in enumerate(result["branches"]):
@@ -279,8 +282,9 @@ def run(args) -> int:
 
             with atomic_path(out / "frc.nc") as tmp:
                 ds.to_netcdf(tmp, engine="scipy")
-            with atomic_path(out / "frc.csv") as tmp:
-                ds.to_dataframe().reset_index().to_csv(tmp, index=False)
+            with atomic_path(out / "frc.csv") as tmp:  # one row per point (per-harmonic data in frc.nc)
+                flat = ds.drop_dims([d for d in ds.dims if d != "point"])
+                flat.to_dataframe().reset_index().to_csv(tmp, index=False)
         _plot(result, out / "frc.png")
     if args.json:
         print(json.dumps(result))

@@ -82,11 +82,15 @@ class Trajectory:
 class _Model:
     """A System packed into flat arrays for the compiled runner at one frequency."""
 
-    def __init__(self, system: System, w: float, steps_per_period: int):
+    def __init__(self, system: System, w: float, steps_per_period: int, *, events: bool = True):
         if not isinstance(system, System):
             raise ValueError(f"system must be a System, got {type(system).__name__}")
         self.system = system
         self.w = float(w)
+        # events=False (for the convergence study only): no step boundaries
+        # at separation/re-contact and no splits at velocity reversals
+        self.events = bool(events)
+        self.max_split = config.TI_MAX_SPLITS if events else 0
         n = system.ndof
         self.n = n
         self.nc = len(system.contacts)
@@ -151,7 +155,7 @@ class _Model:
         t = np.linspace(0.0, Tp, J + 1)
         events = []  # (time, contact, rising)
         for ci, c in enumerate(self.system.contacts):
-            if c.n1 > c.n0:
+            if c.n1 > c.n0 and self.events:
                 hl = HarmonicLoad(c.n0, c.n1, self.w, c.delta)
                 for te in hl.zero_crossings(-1e-300, Tp):
                     te = float(te) % Tp
@@ -235,7 +239,7 @@ class _Model:
         _, status, done = self.runner(
             0, tg, Ng, self.Fgrid, nper, 0.0, self.w, self.fvec,
             self.n0, self.n1, self.dlt, self.Minv, self.K, self.C, self.cdof, self.cdof2,
-            self.P, S, x, v, rdof, self.xcap, config.TI_MAX_SPLITS,
+            self.P, S, x, v, rdof, self.xcap, self.max_split,
             False, *bufs, summ, zend,
         )  # fmt: skip
         return summ[:done], zend[:done], status, done
@@ -260,7 +264,7 @@ class _Model:
             nrec, status, done = self.runner(
                 0, self.tgrid, self.Ngrid, self.Fgrid, nper, 0.0, self.w, self.fvec,
                 self.n0, self.n1, self.dlt, self.Minv, self.K, self.C, self.cdof, self.cdof2,
-                self.P, S, x, v, rdof, self.xcap, config.TI_MAX_SPLITS,
+                self.P, S, x, v, rdof, self.xcap, self.max_split,
                 rec, *bufs, summ, zend,
             )  # fmt: skip
             if status != RUN_OVERFLOW:
@@ -348,6 +352,8 @@ def integrate(
         Samples at every accepted step end (grid points, separation and
         re-contact instants, velocity reversals of the contacts).
     """
+    if not isinstance(system, System):
+        raise ValueError(f"system must be a System, got {type(system).__name__}")
     spp = V.positive_int("steps_per_period", config.TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period, 4)
     periods = V.positive_int("periods", periods)
     w = _omega(system, gamma)

@@ -48,8 +48,12 @@ class SteadyState:
         ``"periodic"``, ``"not-settled"`` or ``"unbounded"``.
     detail : str
         More on the status: ``"integration"`` or ``"shooting"`` (how a
-        periodic state was reached); ``"growing"``, ``"blow-up"``;
-        ``"slowly-converging"``, ``"quasi-periodic-or-chaotic"``.
+        periodic state was reached); ``"growing"``, ``"blow-up"``
+        (unbounded); ``"period-P"`` (repeats every P > SS_MAX_MULTIPLE
+        periods), ``"slowly-converging"`` (Poincare distance still
+        shrinking at max_periods), ``"quasi-periodic-or-chaotic"`` (the
+        one-period mismatch stopped shrinking over SS_STALL_PERIODS periods,
+        after shooting; quasi-periodic and chaotic are not told apart).
     period_multiple : int
         p: the response repeats every p forcing periods (0 if not periodic).
     gamma, omega : float
@@ -106,6 +110,15 @@ class SteadyState:
         """True when a periodic steady state was found."""
         return self.status == "periodic"
 
+    def to_record(self) -> dict:
+        """The scalar fields as a flat dict (one row of a sweep table)."""
+        keys = (
+            "status", "detail", "period_multiple", "gamma", "omega", "amplitude_q", "amplitude_m",
+            "offset_m", "max_abs_m", "energy_contact_J", "energy_viscous_J", "work_force_J",
+            "periods", "steps", "shooting_iterations", "floquet_max", "last_amplitude_m",
+        )  # fmt: skip
+        return {k: getattr(self, k) for k in keys}
+
 
 class _History:
     """Per-period summaries since the last jump of the state."""
@@ -113,6 +126,7 @@ class _History:
     def __init__(self, z0):
         self.Z = [np.array(z0, dtype=float)]
         self.summ = []
+        self.shot_checked = False
 
     def add(self, summ, zend):
         self.summ.extend(summ)
@@ -151,8 +165,20 @@ def _check_periodic(h: _History, p: int, K: int, model, amp_rtol, energy_rtol):
         dz = Z[(i + 1) * p] - Z[i * p]
         if np.max(np.abs(dz[:n])) > amp_rtol * xs or np.max(np.abs(dz[n:])) > amp_rtol * xs * wscale:
             return False
-    escale = max(max(abs(w) for w in ws), max(abs(e) for e in es), 1e-300)
-    if max(es) - min(es) > energy_rtol * escale or max(ws) - min(ws) > energy_rtol * escale:
+    # energy scale: the flow per period, but not below amp_rtol times the
+    # energy stored in the motion (a residual transient of relative size
+    # amp_rtol exchanges that much per period; matters when almost nothing
+    # is dissipated, e.g. beta = 1000 far from resonance)
+    zl = Z[-1]
+    stored = 0.5 * (zl[:n] @ model.K_stuck @ zl[:n] + zl[n:] @ model.system.M @ zl[n:])
+    stored = max(stored, 0.5 * float(np.max(np.diag(model.K_stuck))) * A * A)
+    etol = max(energy_rtol * max(max(abs(w) for w in ws), max(abs(e) for e in es)), amp_rtol * stored, 1e-300)
+    if max(es) - min(es) > etol or max(ws) - min(ws) > etol:
+        return False
+    # a periodic motion returns its stored energy: work = dissipation (to
+    # SS_BALANCE_RTOL: the energy integrals carry the discretisation error)
+    btol = max(config.SS_BALANCE_RTOL * max(max(abs(w) for w in ws), max(abs(e) for e in es)), amp_rtol * stored)
+    if abs(np.mean(ws) - np.mean(es)) > btol:
         return False
     return True
 
@@ -187,14 +213,50 @@ def _growing(h: _History, model, amp_rtol) -> bool:
     return True
 
 
+def _long_period(h: _History, K: int, model, amp_rtol, energy_rtol) -> int:
+    """Smallest multiple p in (SS_MAX_MULTIPLE, SS_DETECT_MULTIPLE] that repeats (0 if none)."""
+    for p in range(config.SS_MAX_MULTIPLE + 1, config.SS_DETECT_MULTIPLE + 1):
+        if h.size < K * p:
+            break
+        if _check_periodic(h, p, K, model, amp_rtol, energy_rtol) and not _one_period_decaying(h, K * p, model):
+            return p
+    return 0
+
+
 def _one_period_decaying(h: _History, m: int, model) -> bool:
-    """True if the one-period mismatch of the Poincare points decays over the last m periods."""
-    Z = np.asarray(h.Z[-(m + 1):])
+    """True unless the one-period mismatch of the Poincare points has stopped decaying.
+
+    A genuine p-periodic orbit repeats its one-period mismatches exactly; a
+    slowly decaying beat that happens to be nearly commensurate with the
+    forcing (lightly damped transients) shrinks them. Compares the largest
+    mismatch over the last m periods with that over the m periods before
+    (needs 2m periods of history; undecided counts as decaying).
+    """
+    if h.size < 2 * m:
+        return True
+    Z = np.asarray(h.Z[-(2 * m + 1):])
     n = model.n
     D = np.diff(Z, axis=0)
     D[:, n:] /= max(model.w, 1e-300)
     d = np.max(np.abs(D), axis=1)
-    return d[-1] < 0.7 * d[0]
+    return d[m:].max() < config.SS_MULTIPLE_DECAY * d[:m].max()
+
+
+def _stalled(h: _History, model) -> bool:
+    """True when the one-period mismatch has stopped shrinking (quasi-periodic, chaotic).
+
+    Compares the largest mismatch over the last SS_STALL_PERIODS / 2 periods
+    with that over the half before.
+    """
+    m = config.SS_STALL_PERIODS // 2
+    if h.size < 2 * m:
+        return False
+    Z = np.asarray(h.Z[-(2 * m + 1):])
+    n = model.n
+    D = np.diff(Z, axis=0)
+    D[:, n:] /= max(model.w, 1e-300)
+    d = np.max(np.abs(D), axis=1)
+    return d[m:].max() >= config.SS_STALL_RATIO * d[:m].max()
 
 
 def _contraction(h: _History, model):
@@ -273,6 +335,36 @@ def _linear_start(model: _Model):
     return x, v, S
 
 
+def _clean_states(model: _Model, x, v, S, rdof, count):
+    """One recorded period, then law states rebuilt from that period alone.
+
+    A slowly decaying transient leaves a long nested sequence of reversal
+    points in a Masing law's memory, which makes the state at a period
+    boundary differ from period to period even once (x, v) repeat. The law
+    is re-marched (drivers.march) from its virgin state over two repetitions
+    of the last period's contact displacement and normal load, which keeps
+    the current loop and forgets the transient. Returns (x, v, S) at the
+    end of the period, or None on a blow-up.
+    """
+    x = x.copy()
+    v = v.copy()
+    S = S.copy()
+    summ, _, st_, done, smp = model.run_periods(x, v, S, 1, rec=True, rdof=rdof)
+    count(summ, done)
+    if st_ != 0 or done < 1:
+        return None
+    _, X, _, _, N, _ = smp
+    Snew = np.zeros_like(S)
+    for i, c in enumerate(model.system.contacts):
+        u = X[:, c.dof] - (X[:, c.dof2] if c.dof2 >= 0 else 0.0)
+        uu = np.concatenate([u, u[1:]])
+        NN = np.concatenate([N[:, i], N[1:, i]])
+        s0 = c.law.initial_state(float(uu[0]), float(NN[0]))
+        sf = march(c.law, uu, NN, state=s0)[3]
+        Snew[i, : sf.size] = sf
+    return x, v, np.ascontiguousarray(Snew)
+
+
 def _shoot(model: _Model, x, v, S, rdof, tol, counters):
     """Newton on the period map (x, v) -> (x, v)(t + T) with the law state carried.
 
@@ -304,6 +396,11 @@ def _shoot(model: _Model, x, v, S, rdof, tol, counters):
         tgp, Ngp = model.segment_grid(ts, ts + Tp)
     else:
         tgp, Ngp = model.tgrid, model.Ngrid
+        if config.SS_SHOOT_CLEAN_STATE and model.nc:
+            cl = _clean_states(model, x, v, S, rdof, count)
+            if cl is None:
+                return x0, v0, S0, False, floq
+            x, v, S = cl
     z = np.concatenate([x, v])
 
     def phi(zz, SS):
@@ -320,20 +417,28 @@ def _shoot(model: _Model, x, v, S, rdof, tol, counters):
     if z1 is None:
         return x0, v0, S0, False, floq
     converged = False
-    best = None  # (residual, z, S) of the best iterate
+    best = None  # (residual, z, S, first residual) in the fixed scale D0
+    D0 = None
     for _ in range(config.SS_SHOOT_MAXIT):
         A = 0.5 * (s1[S_XMAX] - s1[S_XMIN])
         xs = _amplitude_scale(model, max(A, np.max(np.abs(z[:n]))))
         D = np.concatenate([np.full(n, xs), np.full(n, xs * w)])
-        r = (z1 - z) / D
+        if D0 is None:
+            # residuals are compared in the scale of the first iterate, so
+            # that a step that merely inflates the amplitude (a relative
+            # residual shrinking because the scale grows: an undamped
+            # resonance) is never taken for progress
+            D0 = D
+        r = (z1 - z) / D0
         if _DEBUG:
             print("shoot r", np.max(np.abs(r)), z)
         rn = float(np.max(np.abs(r)))
         if best is None or rn < best[0]:
             best = (rn, z.copy(), S.copy(), rn if best is None else best[3])
-        if rn <= tol:
+        if float(np.max(np.abs((z1 - z) / D))) <= tol:
             converged = True
             break
+        D = D0
         counters["shoot"] += 1
         Jm = np.empty((2 * n, 2 * n))
         for j in range(2 * n):
@@ -410,6 +515,7 @@ def steady_state(
     response_dof: int = 0,
     keep_loop: bool = True,
     shooting: bool = True,
+    _events: bool = True,
 ) -> SteadyState:
     """Steady periodic response at frequency ratio ``gamma``, classified.
 
@@ -467,7 +573,7 @@ def steady_state(
         raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {rdof}")
     w = _omega(system, gamma)
     gamma = float(gamma)
-    model = _Model(system, w, spp)
+    model = _Model(system, w, spp, events=_events)
 
     if start is not None:
         x, v, S = _unpack_start(start, model)
@@ -505,17 +611,36 @@ def steady_state(
                     continue  # a slowly alternating approach to a period-1 state
                 p_found = p
                 break
+        long_p = 0 if p_found else _long_period(hist, K, model, amp_rtol, energy_rtol)
+        growing = False if (p_found or long_p) else _growing(hist, model, amp_rtol)
+        can_shoot = shooting and shots < config.SS_MAX_SHOTS
+        # a multiple p > 1 may be a lightly damped transient whose free
+        # frequency is commensurate with the forcing: first look for a
+        # stable period-1 orbit by shooting (once per history)
+        if (p_found > 1 or long_p) and can_shoot and not hist.shot_checked:
+            hist.shot_checked = True
+            shots += 1
+            xs_, vs_, Ss_, ok, floq = _shoot(model, x.copy(), v.copy(), S.copy(), rdof, 0.1 * amp_rtol, counters)
+            if ok and not (floq > 1.0 + config.SS_FLOQUET_TOL):
+                x, v, S = xs_, vs_, np.ascontiguousarray(Ss_)
+                hist = _History(np.concatenate([x, v]))
+                p_found = 0
+                continue
         if p_found:
             status = "periodic"
             detail = "shooting" if counters["shoot"] else "integration"
             break
-        growing = _growing(hist, model, amp_rtol)
-        if growing and not (shooting and shots < config.SS_MAX_SHOTS):
+        if long_p:
+            status, detail = "not-settled", f"period-{long_p}"
+            break
+        if growing and not can_shoot:
             status, detail = "unbounded", "growing"
             break
         if counters["periods"] >= maxp:
             break
-        if shooting and shots < config.SS_MAX_SHOTS:
+        if not can_shoot and _stalled(hist, model):
+            break
+        if can_shoot:
             est = _contraction(hist, model)
             need_shoot = False
             if est is not None:
@@ -538,11 +663,10 @@ def steady_state(
     if status is None:
         # did not settle within max_periods: say why if we can
         status = "not-settled"
-        est = _contraction(hist, model)
-        if est is not None and est[0] < 0.999:
-            detail = "slowly-converging"
-        else:
+        if hist.size >= config.SS_STALL_PERIODS and _stalled(hist, model):
             detail = "quasi-periodic-or-chaotic"
+        else:
+            detail = "slowly-converging"
     last = hist.summ[-1] if hist.size else None
     last_amp = 0.5 * (last[S_XMAX] - last[S_XMIN]) if last is not None else math.nan
 

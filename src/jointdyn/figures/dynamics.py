@@ -88,6 +88,8 @@ def _plot_fig6(tables, out_dir):
                                label=f"beta = {beta:g}" if d == "up" else None,
                                rug_y=0.02 + 0.025 * ib)
         ax.set_yscale("log")
+        lo, hi = ax.get_ylim()  # free the bottom quarter for the rug markers
+        ax.set_ylim(lo / (hi / lo) ** 0.3, hi)
         ax.set_title(f"eta = {eta:g}" + (" (separation)" if eta > 1 else ""), fontsize=10)
         ax.axvline(1.0, color="0.7", lw=0.6)
         ax.axvline(math.sqrt(1 + 3e5 / 3.9e5), color="0.7", lw=0.6, ls=":")
@@ -96,10 +98,14 @@ def _plot_fig6(tables, out_dir):
         ax.set_xlabel("gamma = w / w0")
     for ax in axes[:, 0]:
         ax.set_ylabel("amplitude of q = kt x / fy")
-    mark_legend(axes[0, 0], fontsize=7, ncol=2)
+    mark_legend(axes[0, 0], fontsize=7, ncol=8)
+    leg = axes[0, 0].get_legend()
+    handles, labels = leg.legend_handles, [t.get_text() for t in leg.get_texts()]
+    leg.remove()
+    fig.legend(handles, labels, loc="lower center", ncol=8, fontsize=7, frameon=False)
     fig.suptitle("Fig 6: steady response, sweep up (solid) and down (dashed); markers at the bottom: "
                  "no steady state (x unbounded, o not settled)", fontsize=9)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
     return _save(fig, out_dir, "fig6")
 
 

@@ -24,6 +24,8 @@ With ``out=DIR`` each finished line is written atomically to
 ``DIR/lines/<key>.nc`` together with the full description of the line; a
 rerun loads every line whose description matches instead of recomputing it.
 The assembled Dataset goes to ``DIR/frc.nc`` and a tidy CSV ``DIR/frc.csv``.
+The description covers the parameters, not the solver's code: delete
+``DIR/lines`` after changing the solver to recompute everything.
 """
 
 from __future__ import annotations
@@ -179,14 +181,14 @@ def _solve_line(spec: LineSpec) -> dict:
     -------
     dict
         ``status`` (int8 codes), every name of :data:`VARIABLES` (float64)
-        and :data:`INT_VARIABLES` (int64), each of length ``len(gammas)``.
+        and :data:`INT_VARIABLES` (int32), each of length ``len(gammas)``.
     """
     solve = _steady_state_fn()
     system = spec.system()
     g = np.asarray(spec.gammas, dtype=float)
     m = g.size
     out = {name: np.full(m, np.nan) for name in VARIABLES}
-    out.update({name: np.zeros(m, dtype=np.int64) for name in INT_VARIABLES})
+    out.update({name: np.zeros(m, dtype=np.int32) for name in INT_VARIABLES})
     out["status"] = np.full(m, _MISSING, dtype=np.int8)
     order = range(m) if spec.direction == "up" else range(m - 1, -1, -1)
     kwargs = {"keep_loop": False}
@@ -231,7 +233,7 @@ def _read_line(path: Path, spec: LineSpec) -> dict | None:
                 return None
             return {
                 name: np.asarray(ds[name].values).astype(
-                    np.int8 if name == "status" else (np.int64 if name in INT_VARIABLES else np.float64)
+                    np.int8 if name == "status" else (np.int32 if name in INT_VARIABLES else np.float64)
                 )
                 for name in (*VARIABLES, *INT_VARIABLES, "status")
             }
@@ -262,7 +264,11 @@ def _iter_results(todo, client, n_workers, pool):
     else:
         import multiprocessing as mp
 
-        ex = cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=mp.get_context("spawn"))
+        # fork (Linux): workers inherit the compiled kernels and do not
+        # re-import the caller's __main__ (spawn would, breaking scripts
+        # without a main guard); spawn elsewhere
+        method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
+        ex = cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=mp.get_context(method))
     with ex:
         futs = {ex.submit(_solve_line, spec): i for i, spec in todo}
         try:
@@ -440,7 +446,7 @@ def frc_sweep(
 
     shape = (len(etas), len(loads), len(deltas), len(directions), len(g))
     arrays = {name: np.full(shape, np.nan) for name in VARIABLES}
-    arrays.update({name: np.zeros(shape, dtype=np.int64) for name in INT_VARIABLES})
+    arrays.update({name: np.zeros(shape, dtype=np.int32) for name in INT_VARIABLES})
     arrays["status"] = np.full(shape, _MISSING, dtype=np.int8)
 
     line_dir = None if out is None else Path(out) / "lines"
