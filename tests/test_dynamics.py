@@ -228,6 +228,21 @@ def test_separation_and_recontact_are_step_boundaries():
     assert np.all(tr.N[sep, 0] <= 0.0)
 
 
+@pytest.mark.parametrize("delta", [math.pi + math.asin(1 / 1.5), -math.asin(1 / 1.5)])
+def test_event_at_the_period_boundary(delta):
+    # separation (first) or re-contact (second) exactly at w t = 0 mod 2 pi
+    s = System.paper_damper(eta=1.5, beta=2.0, delta=delta)
+    tr = integrate(s, 1.1, periods=3)
+    law = s.contacts[0].law
+    T = march(law, tr.x[:, 0], tr.N[:, 0])[0]
+    assert np.max(np.abs(T - tr.T[:, 0])) <= config.TEST_TI_MARCH_ATOL_FY * law.fy
+    assert 0.0 <= tr.N[0, 0] <= 1e-9 * law.n_ref
+    a = steady_state(s, 1.1, keep_loop=False)
+    b = steady_state(s, 1.1, steps_per_period=2 * config.TI_STEPS_PER_PERIOD, keep_loop=False)
+    assert a.ok and b.ok
+    assert b.amplitude_m == pytest.approx(a.amplitude_m, rel=config.TEST_TI_STEP_HALVING_RTOL)
+
+
 def test_velocity_reversals_are_step_boundaries():
     # each sign change of the contact velocity has a sample at the extremum
     s = System.paper_damper(eta=0.5, beta=2.0)
@@ -257,6 +272,14 @@ def test_sampled_loads_match_harmonic_run():
     # callables are sampled at t
     c2 = integrate_sampled(s, t, lambda tt: [s.force[0] * math.sin(w * tt)], lambda tt: [c.n0 + c.n1 * math.sin(w * tt)])
     assert np.array_equal(c2.x, a.x)
+
+
+def test_sampled_free_vibration_without_contacts():
+    s = System.sdof(m=1.0, k=100.0)
+    t = np.linspace(0.0, 10.0, 2001)
+    tr = integrate_sampled(s, t, np.zeros((t.size, 1)), None, x0=[1.0])
+    assert tr.status == "ok" and tr.t.size == t.size
+    assert np.max(np.abs(tr.x[:, 0] - np.cos(10.0 * t))) <= 1e-5
 
 
 # --- steady-state bookkeeping -----------------------------------------------

@@ -148,6 +148,12 @@ class _Model:
         xcap = config.TI_BLOWUP_FACTOR * xs
         self.xcap = np.concatenate([np.full(self.n, xcap), np.full(self.n, xcap * max(self.w_max, self.w, 1.0))])
 
+    def cap(self, x, v) -> np.ndarray:
+        """Blow-up caps, never below TI_BLOWUP_FACTOR times the starting state."""
+        wv = max(self.w_max, self.w, 1.0)
+        xs = float(np.max(np.abs(x))) + float(np.max(np.abs(v))) / wv
+        return np.maximum(self.xcap, config.TI_BLOWUP_FACTOR * np.concatenate([np.full(self.n, xs), np.full(self.n, xs * wv)]))
+
     # -- grid of one forcing period with the separation/re-contact instants --
     def _harmonic_grid(self) -> None:
         Tp = 2 * math.pi / self.w
@@ -239,7 +245,7 @@ class _Model:
         _, status, done = self.runner(
             0, tg, Ng, self.Fgrid, nper, 0.0, self.w, self.fvec,
             self.n0, self.n1, self.dlt, self.Minv, self.K, self.C, self.cdof, self.cdof2,
-            self.P, S, x, v, rdof, self.xcap, self.max_split,
+            self.P, S, x, v, rdof, self.cap(x, v), self.max_split,
             False, *bufs, summ, zend,
         )  # fmt: skip
         return summ[:done], zend[:done], status, done
@@ -248,7 +254,9 @@ class _Model:
         S = np.zeros((self.nc, self.slen))
         for i, c in enumerate(self.system.contacts):
             u = x[c.dof] - (x[c.dof2] if c.dof2 >= 0 else 0.0)
-            n_at0 = c.n0 + c.n1 * math.sin(c.delta)
+            # the grid value at t = 0 (event-snapped: a re-contact at t = 0
+            # must start the virgin curve there)
+            n_at0 = self.Ngrid[0, i] if hasattr(self, "Ngrid") else c.n0 + c.n1 * math.sin(c.delta)
             s = c.law.initial_state(float(u), float(n_at0))
             S[i, : s.size] = s
         return S
@@ -264,7 +272,7 @@ class _Model:
             nrec, status, done = self.runner(
                 0, self.tgrid, self.Ngrid, self.Fgrid, nper, 0.0, self.w, self.fvec,
                 self.n0, self.n1, self.dlt, self.Minv, self.K, self.C, self.cdof, self.cdof2,
-                self.P, S, x, v, rdof, self.xcap, self.max_split,
+                self.P, S, x, v, rdof, self.cap(x, v), self.max_split,
                 rec, *bufs, summ, zend,
             )  # fmt: skip
             if status != RUN_OVERFLOW:
@@ -469,7 +477,7 @@ def integrate_sampled(
         nrec, status, _ = model.runner(
             1, tg, Ng, Fg, 1, 0.0, 0.0, model.fvec, model.n0, model.n1, model.dlt,
             model.Minv, model.K, model.C, model.cdof, model.cdof2, model.P, S, x, v, 0,
-            model.xcap, config.TI_MAX_SPLITS, True, *bufs, summ, zend,
+            model.cap(x, v), config.TI_MAX_SPLITS, True, *bufs, summ, zend,
         )  # fmt: skip
         if status != RUN_OVERFLOW:
             break

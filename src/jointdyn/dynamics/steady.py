@@ -28,7 +28,6 @@ from ._core import S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
 from .integrate import Restart, Trajectory, _Model, _omega
 
 __all__ = ["SteadyState", "steady_state", "STATUSES"]
-_DEBUG = False
 
 #: possible values of :attr:`SteadyState.status`
 STATUSES = ("periodic", "not-settled", "unbounded")
@@ -430,8 +429,6 @@ def _shoot(model: _Model, x, v, S, rdof, tol, counters):
             # resonance) is never taken for progress
             D0 = D
         r = (z1 - z) / D0
-        if _DEBUG:
-            print("shoot r", np.max(np.abs(r)), z)
         rn = float(np.max(np.abs(r)))
         if best is None or rn < best[0]:
             best = (rn, z.copy(), S.copy(), rn if best is None else best[3])
