@@ -215,6 +215,14 @@ def _damper(eta=0.1, delta=0.0, n0=100.0, f1=25.0):
     return System.sdof(m=10.0, k=3.9e5, law=law, f1=f1, n0=n0, eta=eta, delta=delta)
 
 
+def test_turning_points_ignore_jitter_within_the_band():
+    from jointdyn.hb import turning_points
+
+    lam = np.array([0.0, 1.0, 2.0, 2.0001, 1.99995, 2.5, 3.0, 2.0, 1.0, 1.5, 4.0])
+    assert list(turning_points(lam, band=0.01)) == [6, 8]
+    assert list(turning_points(lam, band=0.0)) == [3, 4, 6, 8]
+
+
 @pytest.mark.parametrize("par,start,stop", [("eta", 0.1, 0.6), ("delta", 0.0, 1.5), ("n0", 80.0, 140.0),
                                             ("f1", 10.0, 40.0)])
 def test_continuation_in_a_parameter_matches_fixed_solutions(par, start, stop):

@@ -2,7 +2,7 @@
 Jacobians, arc-length continuation, Hill stability, unbounded-response
 detection (see docs/harmonic-balance.md)."""
 
-from .continuation import ContinuationResult, continuation, newton
+from .continuation import ContinuationResult, continuation, newton, turning_points
 from .frc import HBBranch, HBSolution, branch_dataset, continue_hb, frc_hb, harmonic_balance
 from .problem import PARAMETERS, HBProblem
 from .stability import hill_exponents, hill_stability, monodromy_multipliers
@@ -18,6 +18,7 @@ __all__ = [
     "PARAMETERS",
     "continuation",
     "newton",
+    "turning_points",
     "ContinuationResult",
     "hill_exponents",
     "hill_stability",

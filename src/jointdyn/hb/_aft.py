@@ -142,11 +142,16 @@ def _initial_state_jacobian(law, x0, n0, dx0, dn0):
             _DS0_CACHE.clear()
         hit = _DS0_CACHE[key] = (law, sx, sn)
     _, sx, sn = hit
-    ds0 = np.outer(sx, dx0) + np.outer(sn, dn0)
-    return s0, np.ascontiguousarray(ds0)
+    ds0 = sx[:, None] * dx0[None, :]
+    if dn0.any():
+        ds0 += sn[:, None] * dn0[None, :]
+    return s0, ds0
 
 
-def aft_contact(law, E, P, U, Nsamp, dNsamp=None, *, max_passes=8, rtol=1e-10, params=None):
+_DU_CACHE: dict = {}
+
+
+def aft_contact(law, E, P, U, Nsamp, dNsamp=None, *, max_passes=8, rtol=1e-10, params=None, kernel=None):
     """Periodic force coefficients of one contact and their Jacobians.
 
     Parameters
@@ -169,6 +174,8 @@ def aft_contact(law, E, P, U, Nsamp, dNsamp=None, *, max_passes=8, rtol=1e-10, p
         by at most ``rtol * max|T|``.
     params : ndarray, optional
         ``law.params`` if already at hand (saves rebuilding it).
+    kernel : dispatcher, optional
+        The specialised march for ``law`` if already at hand.
 
     Returns
     -------
@@ -188,24 +195,34 @@ def aft_contact(law, E, P, U, Nsamp, dNsamp=None, *, max_passes=8, rtol=1e-10, p
     ns, nh = E.shape
     u = E @ U
     nd = nh + (1 if dNsamp is not None else 0)
-    du = np.zeros((ns, nd))
-    du[:, :nh] = E
-    dN = np.zeros((ns, nd))
+    key = (id(E), nd)
+    du = _DU_CACHE.get(key)
+    if du is None or du[0] is not E:
+        d = np.zeros((ns, nd))
+        d[:, :nh] = E
+        if len(_DU_CACHE) > 64:
+            _DU_CACHE.clear()
+        du = _DU_CACHE[key] = (E, d, np.zeros((ns, nd)))
+    _, du, dN0 = du
     # the virgin state is started at the mean displacement and the load of
     # the first sample: direction d moves the mean by U-direction 0 only
     dx0 = np.zeros(nd)
     dx0[0] = 1.0
     dn0 = np.zeros(nd)
     if dNsamp is not None:
+        dN = np.zeros((ns, nd))
         dN[:, nh] = dNsamp
         dn0[nh] = dNsamp[0]
+    else:
+        dN = dN0
     s0, ds0 = _initial_state_jacobian(law, float(U[0]), float(Nsamp[0]), dx0, dn0)
     T = np.empty(ns)
     dT = np.empty((ns, nd))
     code = np.empty(ns, dtype=np.int64)
     info = np.zeros(3)
-    _aft_kernel(law)(law.params if params is None else params, s0, ds0, u, du, np.ascontiguousarray(Nsamp, dtype=np.float64), dN,
-                     int(max_passes), float(rtol), T, dT, code, info)
+    fn = _aft_kernel(law) if kernel is None else kernel
+    fn(law.params if params is None else params, s0, ds0, u, du, np.ascontiguousarray(Nsamp, dtype=np.float64), dN,
+       int(max_passes), float(rtol), T, dT, code, info)
     F = P @ T
     G = P @ dT
     dF_dp = G[:, nh] if dNsamp is not None else None

@@ -30,7 +30,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ..systems import Contact, System
-from ._aft import aft_contact, fourier_matrices
+from ._aft import _aft_kernel, aft_contact, fourier_matrices
 
 __all__ = ["HBProblem", "PARAMETERS"]
 
@@ -98,6 +98,7 @@ class HBProblem:
         self._fine = {}
         self._lin = None
         self._params = [c.law.params for c in system.contacts]
+        self._kernels = [_aft_kernel(c.law) for c in system.contacts]
         self.contacts = list(system.contacts)
         fmax = float(np.max(np.abs(system.force))) if system.force.size else 0.0
         self.f_dir = system.force / fmax if fmax > 0 else system.force.copy()
@@ -218,12 +219,12 @@ class HBProblem:
         Ts, codes = [], []
         info = np.zeros(3)
         info[2] = 1.0
-        for c, b, (n0, n1, dl, dn), prm in zip(self.contacts, self.B, loads, self._params):
+        for c, b, (n0, n1, dl, dn), prm, krn in zip(self.contacts, self.B, loads, self._params, self._kernels):
             U = Xm @ b
             Nsamp = n0 + n1 * np.sin(self.tau + dl)
             F, dFdU, dFdp, T, code, inf = aft_contact(c.law, self.E, self.P, U, Nsamp, dn,
                                                       max_passes=self.max_passes,
-                                                      rtol=config.HB_PERIODIC_RTOL, params=prm)
+                                                      rtol=config.HB_PERIODIC_RTOL, params=prm, kernel=krn)
             # scatter: R[h*n + i] += b_i F_h ; JX[(h,i),(g,j)] += b_i b_j dF_hg
             if self.n == 1:
                 R += F * b[0]
@@ -254,34 +255,32 @@ class HBProblem:
             Ef = self._fine[points] = fourier_matrices(self.H, points)[0]
         return Ef @ X.reshape(self.nh, self.n)[:, dof]
 
-    def _extremum(self, c, tau):
-        """Refine a grid extremum of sum_k c_k Q_k(tau) by Newton on x'(tau) = 0."""
-        k = np.arange(1, self.H + 1)
-        a, b = c[1::2], c[2::2]
-        for _ in range(4):
-            s_, co = np.sin(k * tau), np.cos(k * tau)
-            d1 = np.sum(k * (-a * s_ + b * co))
-            d2 = np.sum(k * k * (-a * co - b * s_))
-            if d2 == 0.0:
-                break
-            step = d1 / d2
-            if abs(step) > 2.0 * np.pi / 1024:
-                break
-            tau -= step
-        return c[0] + np.sum(a * np.cos(k * tau) + b * np.sin(k * tau))
+    @staticmethod
+    def _peak(x, i):
+        """Parabolic refinement of the grid extremum x[i] (periodic samples).
+
+        The error of the vertex of the parabola through three samples is
+        O(h^4) for a smooth peak: with 1024 samples per period about 1e-9
+        of the amplitude (the raw grid value is up to 5e-6 off).
+        """
+        n = x.size
+        xm, x0, xp = x[(i - 1) % n], x[i], x[(i + 1) % n]
+        den = xm - 2.0 * x0 + xp
+        if den == 0.0:
+            return float(x0)
+        return float(x0 - 0.125 * (xp - xm) ** 2 / den)
 
     def amplitudes(self, X, dof: int):
         """(half peak-to-peak, mean, max |x|) of x_dof(t), m.
 
-        Extrema located on 1024 samples per period and refined by Newton's
-        method on the derivative of the Fourier series.
+        Extrema located on 1024 samples per period and refined by a
+        parabola through the three samples around each.
         """
         x = self.reconstruct(X, dof)
-        c = X.reshape(self.nh, self.n)[:, dof]
-        tau = 2.0 * np.pi / x.size
-        hi = max(self._extremum(c, tau * int(np.argmax(x))), float(x.max()))
-        lo = min(self._extremum(c, tau * int(np.argmin(x))), float(x.min()))
-        return 0.5 * (hi - lo), float(c[0]), max(abs(hi), abs(lo))
+        hi = max(self._peak(x, int(np.argmax(x))), float(x.max()))
+        lo = min(self._peak(x, int(np.argmin(x))), float(x.min()))
+        c0 = float(X.reshape(self.nh, self.n)[0, dof])
+        return 0.5 * (hi - lo), c0, max(abs(hi), abs(lo))
 
     def first_harmonic_amplitude(self, X, dof: int) -> float:
         """sqrt(a_1^2 + b_1^2) of DOF ``dof``, m."""

@@ -80,16 +80,19 @@ _PARTS: dict = {}
 
 
 def _hill_parts(M, C, H):
-    """(I (x) M^-1, [I (x) M^-1 (I (x) C), I (x) M^-1 (2 nabla (x) M)]), cached."""
+    """(I (x) M^-1, [I (x) M^-1 (I (x) C), I (x) M^-1 (2 nabla (x) M)], companion template), cached."""
     key = (M.tobytes(), C.tobytes(), M.shape[0], H)
     hit = _PARTS.get(key)
     if hit is None:
         nh = 2 * H + 1
         D2i = np.kron(np.eye(nh), np.linalg.inv(M))
         B1 = (D2i @ np.kron(np.eye(nh), C), D2i @ (2.0 * np.kron(derivative_matrix(H), M)))
+        N = M.shape[0] * nh
+        A0 = np.zeros((2 * N, 2 * N))
+        A0[:N, N:] = np.eye(N)
         if len(_PARTS) > 64:
             _PARTS.clear()
-        hit = _PARTS[key] = (D2i, B1)
+        hit = _PARTS[key] = (D2i, B1, A0)
     return hit
 
 
@@ -115,9 +118,8 @@ def hill_exponents(JX, M, C, w, H):
     """
     n = M.shape[0]
     N = n * (2 * H + 1)
-    D2iJ_pre, B1 = _hill_parts(M, C, H)
-    A = np.zeros((2 * N, 2 * N))
-    A[:N, N:] = np.eye(N)
+    D2iJ_pre, B1, A0 = _hill_parts(M, C, H)
+    A = A0.copy()
     A[N:, :N] = -(D2iJ_pre @ JX)
     A[N:, N:] = -(B1[0] + w * B1[1])
     lam = np.linalg.eigvals(A)
