@@ -15,6 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 import xarray as xr
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from jointdyn.sweeps import STATUS_CODES, frc_sweep, status_name
 from jointdyn.sweeps import _frc
@@ -265,3 +267,55 @@ def test_energy_balance_real_solver():
     assert (ds.status.values == 0).all()
     np.testing.assert_allclose(ds.energy_contact_J.values, ds.work_force_J.values, rtol=1e-3)
     assert (ds.energy_contact_J.values > 0).all()
+
+
+def test_gamma_order_does_not_matter(fake):
+    a = frc_sweep(GAMMAS, n_workers=1, progress=False)
+    b = frc_sweep(GAMMAS[::-1], n_workers=1, progress=False)
+    xr.testing.assert_identical(a, b)
+
+
+def test_line_keys_distinct_and_stable():
+    from jointdyn.sweeps import LineSpec
+
+    base = dict(eta=0.5, beta=2.0, f1=None, delta_deg=0.0, direction="up", gammas=(0.9, 1.0))
+    variants = [
+        {}, {"eta": 0.5000001}, {"beta": None, "f1": 2.0}, {"delta_deg": 90.0}, {"direction": "down"},
+        {"gammas": (0.9, 1.0, 1.1)}, {"model": "discrete"}, {"n": 200}, {"zeta": 0.01},
+        {"overrides": (("m", 11.0),)}, {"steps_per_period": 512},
+    ]
+    keys = [LineSpec(**{**base, **v}).key for v in variants]
+    assert len(set(keys)) == len(keys)
+    assert LineSpec(**base).key == LineSpec(**base).key
+
+
+@settings(max_examples=8, deadline=None)
+@given(st.integers(min_value=1, max_value=7))
+def test_resume_from_any_interruption(k):
+    """Stopping after any k of 8 lines and resuming gives the uninterrupted
+    result and computes exactly the 8 - k missing lines."""
+    import tempfile
+    from pathlib import Path
+    from unittest import mock
+
+    f = _Fake()
+    kw = dict(etas=[0.5, 1.5], betas=[1.0, 2.0], n_workers=1, progress=False)
+
+    class Stop(Exception):
+        pass
+
+    with mock.patch.object(_frc, "_steady_state_fn", lambda: f), tempfile.TemporaryDirectory() as d:
+        full = frc_sweep(GAMMAS, **kw)
+        done = []
+
+        def stop(spec, computed):
+            done.append(spec)
+            if len(done) == k:
+                raise Stop
+
+        with pytest.raises(Stop):
+            frc_sweep(GAMMAS, **kw, out=Path(d), on_line=stop)
+        f.calls.clear()
+        again = frc_sweep(GAMMAS, **kw, out=Path(d))
+        assert len(f.calls) == (8 - k) * len(GAMMAS)
+        xr.testing.assert_identical(again, full)
