@@ -39,34 +39,48 @@ def fourier_matrices(harmonics: int, samples: int):
     for k in range(1, harmonics + 1):
         E[:, 2 * k - 1] = np.cos(k * tau)
         E[:, 2 * k] = np.sin(k * tau)
-    P = E.T * (2.0 / samples)
+    P = np.ascontiguousarray(E.T * (2.0 / samples))
     P[0] *= 0.5
     return E, P
 
 
-def _aft_template(params, s0, ds0, u, du, N, dN, max_passes, rtol, T, dT, code, info):  # pragma: no cover - compiled
-    """March ``STEP_JVP`` over whole periods of samples until the force repeats.
+def _aft_template(params, s0, ds0, E, P, U, N, dNp, has_p, max_passes, rtol, F, G, T, code, info):  # pragma: no cover - compiled
+    """AFT of one contact: sample, march ``STEP_JVP`` until the force repeats, project.
 
-    Stops when two consecutive passes agree to ``rtol * max|T|`` (period 1).
-    If instead passes p and p-2 agree (the law's state alternates between
-    two cycles: a period-2 force under a period-1 displacement), the force
-    and its derivatives are the mean of the last two passes, which is the
-    exact projection of the 2T-periodic force on the T-periodic harmonics.
-    ``info`` receives ``[passes, max |T_p - T_(p-1)|, period (1, 2; 0 if
-    neither repeated within max_passes)]``.
+    Directions: the 2H+1 coefficients of u (du_i = E[i, d]) and, when
+    ``has_p``, one parameter entering the normal load (dN_i = dNp[i]).
+    Stops when two consecutive passes agree to ``rtol * max|T|``, or when
+    the committed state at the end of a pass equals (to ``rtol``, entry by
+    entry) the one at the end of the previous pass, so that the next pass
+    would repeat this one (period 1; saves a pass). If instead passes p and p-2 agree (the law's state alternates
+    between two cycles: a period-2 force under a period-1 displacement),
+    the force and its derivatives are the mean of the last two passes,
+    which is the exact projection of the 2T-periodic force on the
+    T-periodic harmonics. Outputs ``F = P T`` and ``G = P dT``;
+    ``info = [passes, max |T_p - T_(p-1)| (0 when the end states
+    repeated), period (1, 2; 0 if neither repeated within max_passes)]``.
     """
-    ns = u.shape[0]
-    nd = du.shape[1]
+    ns = E.shape[0]
+    nh = E.shape[1]
+    nd = nh + (1 if has_p else 0)
     a = s0.copy()
     b = np.empty_like(s0)
     da = ds0.copy()
     db = np.empty_like(ds0)
-    dxj = np.empty(nd)
-    dNj = np.empty(nd)
+    u = np.zeros(ns)
+    for i in range(ns):
+        acc = 0.0
+        for h in range(nh):
+            acc += E[i, h] * U[h]
+        u[i] = acc
+    dxj = np.zeros(nd)
+    dNj = np.zeros(nd)
     dTj = np.empty(nd)
+    dT = np.empty((ns, nd))
     T1 = np.zeros(ns)
     T2 = np.zeros(ns)
     dT1 = np.zeros((ns, nd))
+    s_end = np.empty_like(s0)
     passes = 0
     err = np.inf
     period = 0.0
@@ -75,9 +89,10 @@ def _aft_template(params, s0, ds0, u, du, N, dN, max_passes, rtol, T, dT, code, 
         err2 = 0.0
         tmax = 0.0
         for i in range(ns):
-            for d in range(nd):
-                dxj[d] = du[i, d]
-                dNj[d] = dN[i, d]
+            for d in range(nh):
+                dxj[d] = E[i, d]
+            if has_p:
+                dNj[nh] = dNp[i]
             t_, k_, c_ = STEP_JVP(params, a, da, b, db, u[i], dxj, N[i], dNj, dTj)  # noqa: F821
             e = abs(t_ - T1[i])
             if e > err:
@@ -97,6 +112,22 @@ def _aft_template(params, s0, ds0, u, du, N, dN, max_passes, rtol, T, dT, code, 
         if passes >= 2 and err <= rtol * tmax:
             period = 1.0
             break
+        if passes >= 2:
+            # the committed state at the end of this pass equals the one at
+            # the end of the previous pass: the next pass would repeat this
+            # one exactly, so this pass is the periodic force already
+            same = True
+            for r in range(a.shape[0]):
+                m = max(abs(a[r]), abs(s_end[r]))
+                if abs(a[r] - s_end[r]) > rtol * m:
+                    same = False
+                    break
+            if same:
+                period = 1.0
+                err = 0.0  # the next pass would repeat this one exactly
+                break
+        for r in range(a.shape[0]):
+            s_end[r] = a[r]
         if passes >= 4 and err2 <= rtol * tmax:
             period = 2.0
             for i in range(ns):
@@ -109,6 +140,8 @@ def _aft_template(params, s0, ds0, u, du, N, dN, max_passes, rtol, T, dT, code, 
             T1[i] = T[i]
             for d in range(nd):
                 dT1[i, d] = dT[i, d]
+    F[:] = np.dot(P, T)
+    G[:, :] = np.dot(P, dT)
     info[0] = passes
     info[1] = err
     info[2] = period
@@ -148,7 +181,7 @@ def _initial_state_jacobian(law, x0, n0, dx0, dn0):
     return s0, ds0
 
 
-_DU_CACHE: dict = {}
+_EMPTY = np.zeros(1)
 
 
 def aft_contact(law, E, P, U, Nsamp, dNsamp=None, *, max_passes=8, rtol=1e-10, params=None, kernel=None):
@@ -193,37 +226,26 @@ def aft_contact(law, E, P, U, Nsamp, dNsamp=None, *, max_passes=8, rtol=1e-10, p
         is used) or 0 (no repetition within ``max_passes``).
     """
     ns, nh = E.shape
-    u = E @ U
-    nd = nh + (1 if dNsamp is not None else 0)
-    key = (id(E), nd)
-    du = _DU_CACHE.get(key)
-    if du is None or du[0] is not E:
-        d = np.zeros((ns, nd))
-        d[:, :nh] = E
-        if len(_DU_CACHE) > 64:
-            _DU_CACHE.clear()
-        du = _DU_CACHE[key] = (E, d, np.zeros((ns, nd)))
-    _, du, dN0 = du
+    has_p = dNsamp is not None
+    nd = nh + (1 if has_p else 0)
     # the virgin state is started at the mean displacement and the load of
-    # the first sample: direction d moves the mean by U-direction 0 only
+    # the first sample: direction 0 (the constant term) moves the mean
     dx0 = np.zeros(nd)
     dx0[0] = 1.0
     dn0 = np.zeros(nd)
-    if dNsamp is not None:
-        dN = np.zeros((ns, nd))
-        dN[:, nh] = dNsamp
-        dn0[nh] = dNsamp[0]
+    if has_p:
+        dNp = np.ascontiguousarray(dNsamp, dtype=np.float64)
+        dn0[nh] = dNp[0]
     else:
-        dN = dN0
+        dNp = _EMPTY
     s0, ds0 = _initial_state_jacobian(law, float(U[0]), float(Nsamp[0]), dx0, dn0)
+    F = np.empty(nh)
+    G = np.empty((nh, nd))
     T = np.empty(ns)
-    dT = np.empty((ns, nd))
     code = np.empty(ns, dtype=np.int64)
     info = np.zeros(3)
     fn = _aft_kernel(law) if kernel is None else kernel
-    fn(law.params if params is None else params, s0, ds0, u, du, np.ascontiguousarray(Nsamp, dtype=np.float64), dN,
-       int(max_passes), float(rtol), T, dT, code, info)
-    F = P @ T
-    G = P @ dT
-    dF_dp = G[:, nh] if dNsamp is not None else None
+    fn(law.params if params is None else params, s0, ds0, E, P, np.ascontiguousarray(U, dtype=np.float64),
+       np.ascontiguousarray(Nsamp, dtype=np.float64), dNp, has_p, int(max_passes), float(rtol), F, G, T, code, info)
+    dF_dp = G[:, nh] if has_p else None
     return F, G[:, :nh], dF_dp, T, code, info
