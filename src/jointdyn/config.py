@@ -133,5 +133,46 @@ TEST_TI_STEP_HALVING_RTOL = 0.005
 TEST_TI_MARCH_ATOL_FY = 1e-9
 
 # --- sweeps (issue 3) -----------------------------------------------------
+#: default CLI gamma grid START:STOP:STEP (the paper's Fig 6 range)
+SWEEP_GAMMA_DEFAULT = (0.6, 1.8, 0.01)
+#: local pool for sweep lines when no Dask client is given: "process" or
+#: "thread" (numba kernels release the GIL; see the report for the measurement)
+SWEEP_POOL = "process"
+#: status codes of a swept point (netCDF-friendly int8); index = code
+SWEEP_STATUS = ("periodic", "not-settled", "unbounded")
+#: code of a point that was not computed (never written by a finished sweep)
+SWEEP_STATUS_MISSING = -1
 
 # --- harmonic balance, continuation, stability (issue 4) ------------------
+#: bound on the periods marched per AFT evaluation (two normally suffice
+#: for Masing-type laws; the force must repeat to HB_PERIODIC_RTOL)
+HB_MAX_PASSES = 8
+#: two consecutive marched periods agree when max|T_p - T_(p-1)| <= rtol max|T|
+HB_PERIODIC_RTOL = 1e-10
+#: default harmonics and time samples per period
+HB_HARMONICS = 7
+HB_SAMPLES = 128
+#: Newton: converged when |R| <= rtol * force scale and |dX| <= rtol * (|X| + x scale)
+HB_NEWTON_RTOL = 1e-9
+HB_NEWTON_MAX_ITER = 12
+#: continuation: step-length control (in the scaled unknowns), bounds
+HB_DS_MIN = 1e-6
+HB_DS_MAX = 0.1
+HB_DS_GROW = 1.6
+HB_TARGET_NEWTON_ITER = 4
+HB_MAX_POINTS = 2000
+#: response declared unbounded when q = kt X / fy exceeds this (hard bound)
+HB_UNBOUNDED_Q = 1e5
+#: describing-function saturation test (MODEL.md section 6, Den Hartog):
+#: applied once q exceeds HB_SATURATION_Q, the contact slips at least this
+#: fraction of the period and viscous damping is negligible
+HB_SATURATION_Q = 30.0
+HB_SATURATION_SLIP_FRACTION = 0.9
+#: a Floquet exponent with Re(s) > HB_STABILITY_RTOL * w marks instability
+HB_STABILITY_RTOL = 1e-6
+#: test tolerances
+TEST_HB_JACOBIAN_RTOL = 1e-6
+TEST_HB_DF_RTOL = 1e-4
+TEST_HB_VS_TIME_RTOL = 1e-2
+#: turning points of a branch (secant): dead band as a fraction of the range
+HB_TURNING_BAND = 5e-4

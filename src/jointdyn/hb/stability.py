@@ -1,0 +1,300 @@
+"""Stability of harmonic-balance solutions: Hill's method and a monodromy check.
+
+Hill's method
+-------------
+A perturbation ``x = x*(t) + exp(s t) p(tau)`` with ``p`` periodic,
+``p = Q(tau) P`` in the HB basis, turns the linearised equation of motion
+into the quadratic eigenvalue problem (von Groll & Ewins, J. Sound Vib. 241,
+2001; Detroux, Renson, Masset & Kerschen, CMAME 296, 2015, eq. 24)::
+
+    (s^2 Delta_2 + s Delta_1 + J_X) P = 0,
+    Delta_2 = I (x) M,   Delta_1 = 2 w (nabla (x) M) + I (x) C,
+
+with J_X the HB Jacobian dR/dX (the contact part is the AFT-derived
+derivative of the periodic force coefficients, the standard choice for
+hysteretic forces, which are not differentiable in velocity) and nabla the
+d/dtau operator on the coefficients. It is solved in first-order (companion)
+form, size 2 n (2H+1). Each Floquet exponent s appears there as a family
+s + i k w (k = -H..H), of which the truncation resolves well only the
+members whose eigenvectors are centred on the low harmonics. Following
+Moore (Int. J. Numer. Meth. Eng. 62, 2005) and the comparison of Peletan,
+Baguet, Torkhani & Jacquet-Richardet (Nonlinear Dyn. 72, 2013), the 2n
+exponents are the eigenvalues with the smallest |Im s| (one representative
+per family lies in |Im s| <= w/2); ties (several real eigenvalues, whose
+real eigenvectors are all symmetric) are broken by the symmetry criterion
+of Lazarus & Thomas (C. R. Mecanique 338, 2010; Guillot et al., J. Comput.
+Phys. 416, 2020): the eigenvector's harmonic centroid, in the complex
+exponential basis, nearest to 0. The large-|Im| eigenvalues that this
+discards include the truncation artefacts at the edge of the harmonic
+range, which may have spurious positive real parts. The solution is
+unstable when a selected exponent has ``Re(s) > HB_STABILITY_RTOL * w``.
+Floquet multipliers are ``exp(2 pi s / w)``.
+
+Monodromy check
+---------------
+:func:`monodromy_multipliers` integrates the equations of motion over one
+period (compiled velocity-Verlet march of the same contact kernels, the
+contact state taken from the periodic HB orbit) and differentiates the
+period map by central finite differences in the 2n positions and
+velocities.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import config
+from .._jit import specialize
+from ..drivers import march
+from ..laws import MACROSLIP, SEPARATION
+
+__all__ = ["hill_exponents", "hill_stability", "monodromy_multipliers", "derivative_matrix"]
+
+
+def derivative_matrix(H: int) -> np.ndarray:
+    """d/dtau on the real coefficients (1, cos tau, sin tau, ..., sin H tau)."""
+    D = np.zeros((2 * H + 1, 2 * H + 1))
+    for k in range(1, H + 1):
+        D[2 * k - 1, 2 * k] = k
+        D[2 * k, 2 * k - 1] = -k
+    return D
+
+
+def _centroids(V, n, H):
+    """Harmonic centroid of the displacement part of each eigenvector."""
+    nh = 2 * H + 1
+    P = V[: n * nh].reshape(nh, n, -1)
+    num = np.zeros(V.shape[1])
+    den = np.sum(np.abs(P[0]) ** 2, axis=0)
+    for k in range(1, H + 1):
+        a = P[2 * k - 1]
+        b = P[2 * k]
+        cp = np.sum(np.abs(0.5 * (a - 1j * b)) ** 2, axis=0)
+        cm = np.sum(np.abs(0.5 * (a + 1j * b)) ** 2, axis=0)
+        num += k * (cp - cm)
+        den += cp + cm
+    return num / np.where(den > 0, den, 1.0)
+
+
+_PARTS: dict = {}
+
+
+def _hill_parts(M, C, H):
+    """(I (x) M^-1, [I (x) M^-1 (I (x) C), I (x) M^-1 (2 nabla (x) M)], companion template), cached."""
+    key = (M.tobytes(), C.tobytes(), M.shape[0], H)
+    hit = _PARTS.get(key)
+    if hit is None:
+        nh = 2 * H + 1
+        D2i = np.kron(np.eye(nh), np.linalg.inv(M))
+        B1 = (D2i @ np.kron(np.eye(nh), C), D2i @ (2.0 * np.kron(derivative_matrix(H), M)))
+        N = M.shape[0] * nh
+        A0 = np.zeros((2 * N, 2 * N))
+        A0[:N, N:] = np.eye(N)
+        if len(_PARTS) > 64:
+            _PARTS.clear()
+        hit = _PARTS[key] = (D2i, B1, A0)
+    return hit
+
+
+def hill_exponents(JX, M, C, w, H):
+    """All Hill eigenvalues and the 2n selected Floquet exponents.
+
+    Parameters
+    ----------
+    JX : ndarray (n(2H+1), n(2H+1))
+        HB Jacobian dR/dX (harmonic-major ordering), N/m.
+    M, C : ndarray (n, n)
+        Mass (kg) and damping (N s/m) matrices.
+    w : float
+        Angular frequency of the periodic solution, rad/s.
+    H : int
+        Number of harmonics.
+
+    Returns
+    -------
+    exponents : ndarray complex (2n,)
+        Floquet exponents s, 1/s (sorted by decreasing real part).
+    all_eigenvalues : ndarray complex (2 n (2H+1),)
+    """
+    n = M.shape[0]
+    N = n * (2 * H + 1)
+    D2iJ_pre, B1, A0 = _hill_parts(M, C, H)
+    A = A0.copy()
+    A[N:, :N] = -(D2iJ_pre @ JX)
+    A[N:, N:] = -(B1[0] + w * B1[1])
+    lam = np.linalg.eigvals(A)
+    key_imag = np.round(np.abs(lam.imag) / w, 8)
+    order = np.argsort(key_imag, kind="stable")
+    cut = key_imag[order[2 * n - 1]]
+    if order.size > 2 * n and key_imag[order[2 * n]] == cut:
+        # a tie at the cut: break it by the eigenvector centroid
+        lam, V = np.linalg.eig(A)
+        key_imag = np.round(np.abs(lam.imag) / w, 8)
+        cen = _centroids(V, n, H)
+        order = np.lexsort((np.abs(cen), key_imag))
+    sel = lam[order[: 2 * n]]
+    sel = sel[np.argsort(-sel.real, kind="stable")]
+    return sel, lam
+
+
+def hill_stability(JX, M, C, w, H, rtol: float = config.HB_STABILITY_RTOL):
+    """(stable, max Re(s) / w, Floquet multipliers) of a periodic HB solution.
+
+    See the module docstring for the method and references.
+    """
+    sel, _ = hill_exponents(JX, M, C, w, H)
+    growth = float(np.max(sel.real)) / w
+    mult = np.exp(sel * 2.0 * np.pi / w)
+    return growth <= rtol, growth, mult
+
+
+def _verlet_template(Minv, C, K, f, Bm, params, states, n0, n1, dl, w, t0, x0, v0, h, nsteps, xo, vo):  # pragma: no cover - compiled
+    """Velocity-Verlet march of M x'' + C x' + K x + sum B_c T_c = f sin(w t)."""
+    n = x0.shape[0]
+    nc = Bm.shape[0]
+    x = x0.copy()
+    v = v0.copy()
+    sa = states.copy()
+    sb = states.copy()
+    Tc = np.zeros(nc)
+    a = np.zeros(n)
+    rhs = np.zeros(n)
+    # force at t = 0, committed: the perturbation of x0 loads the contact
+    for c in range(nc):
+        u = 0.0
+        for i in range(n):
+            u += Bm[c, i] * x[i]
+        N = n0[c] + n1[c] * np.sin(w * t0 + dl[c])
+        t_, k_, c_ = STEP(params[c], sa[c], sb[c], u, N)  # noqa: F821
+        Tc[c] = t_
+    sa, sb = sb, sa
+    for i in range(n):
+        r = f[i] * np.sin(w * t0) - K[i, :] @ x - C[i, :] @ v
+        for c in range(nc):
+            r -= Bm[c, i] * Tc[c]
+        rhs[i] = r
+    a[:] = Minv @ rhs
+    for step in range(nsteps):
+        t1 = t0 + (step + 1) * h
+        xn = x + h * v + 0.5 * h * h * a
+        vp = v + h * a
+        for c in range(nc):
+            u = 0.0
+            for i in range(n):
+                u += Bm[c, i] * xn[i]
+            N = n0[c] + n1[c] * np.sin(w * t1 + dl[c])
+            t_, k_, c_ = STEP(params[c], sa[c], sb[c], u, N)  # noqa: F821
+            Tc[c] = t_
+        sa, sb = sb, sa
+        for i in range(n):
+            r = f[i] * np.sin(w * t1) - K[i, :] @ xn - C[i, :] @ vp
+            for c in range(nc):
+                r -= Bm[c, i] * Tc[c]
+            rhs[i] = r
+        an = Minv @ rhs
+        v = v + 0.5 * h * (a + an)
+        x = xn
+        a = an
+    xo[:] = x
+    vo[:] = v
+    states[:, :] = sa
+
+
+def _pad_stack(rows):
+    m = max(len(r) for r in rows)
+    out = np.zeros((len(rows), m))
+    for i, r in enumerate(rows):
+        out[i, : len(r)] = r
+    return out
+
+
+def monodromy_multipliers(problem, X, p, *, steps: int = 4096, eps: float = 1e-6, warm_periods: int = 3):
+    """Floquet multipliers from finite differences of the period map.
+
+    Parameters
+    ----------
+    problem : HBProblem
+        The harmonic-balance problem (system, parameter).
+    X : ndarray
+        HB coefficients of the periodic solution.
+    p : float
+        Parameter value.
+    steps : int
+        Velocity-Verlet steps per period.
+    eps : float
+        Relative perturbation of positions (scaled by the amplitude) and
+        velocities (scaled by w times the amplitude).
+    warm_periods : int
+        Periods of the HB displacement marched through each contact law to
+        obtain the contact state at t = 0.
+
+    Returns
+    -------
+    ndarray complex (2n,)
+        Eigenvalues of the finite-difference monodromy matrix.
+    """
+    sysm = problem.system
+    n = problem.n
+    w = problem.omega(p)
+    Tper = 2.0 * np.pi / w
+    h = Tper / steps
+    w_, f, loads = problem._split(p)
+    Xm = X.reshape(problem.nh, n)
+    # Poincare section where the contacts hold the least memory (all open,
+    # else all in macroslip): there the contact state is a function of the
+    # positions, velocities and load, so the 2n-dimensional period map is exact
+    ev = problem.evaluate(X, p)
+    codes = np.array(ev.code).reshape(len(ev.code), -1)
+    j0 = 0
+    for target in (SEPARATION, MACROSLIP):
+        hit = np.flatnonzero(np.all(codes == target, axis=0))
+        if hit.size:
+            j0 = int(hit[hit.size // 2])
+            break
+    tau0 = 2.0 * np.pi * j0 / problem.Ns
+    D = derivative_matrix(problem.H)
+
+    def basis(tau):
+        E = np.ones((tau.size, problem.nh))
+        for k in range(1, problem.H + 1):
+            E[:, 2 * k - 1] = np.cos(k * tau)
+            E[:, 2 * k] = np.sin(k * tau)
+        return E
+
+    e0 = basis(np.array([tau0]))[0]
+    x0 = e0 @ Xm
+    v0 = w * (e0 @ (D @ Xm))
+    tt = tau0 + np.arange(warm_periods * steps + 1) * (2.0 * np.pi / steps)
+    xs = basis(tt) @ Xm
+    states, params = [], []
+    for c, b, (n0, n1, dl, _) in zip(problem.contacts, problem.B, loads):
+        N = n0 + n1 * np.sin(tt + dl)
+        s = march(c.law, xs @ b, N)[3]
+        states.append(s)
+        params.append(c.law.params)
+    S = _pad_stack(states)
+    Pm = _pad_stack(params)
+    Bm = np.array(problem.B) if problem.B else np.zeros((0, n))
+    n0a = np.array([l[0] for l in loads])
+    n1a = np.array([l[1] for l in loads])
+    dla = np.array([l[2] for l in loads])
+    law = problem.contacts[0].law
+    fn = specialize(_verlet_template, STEP=law.step)
+    Minv = np.linalg.inv(sysm.M)
+    amp = max(float(np.max(np.abs(xs))), 1e-12)
+
+    def pmap(z):
+        xo = np.empty(n)
+        vo = np.empty(n)
+        st = S.copy()
+        fn(Minv, sysm.C, sysm.K, f, Bm, Pm, st, n0a, n1a, dla, w, tau0 / w, z[:n].copy(), z[n:].copy(), h, steps, xo, vo)
+        return np.concatenate((xo, vo))
+
+    z0 = np.concatenate((x0, v0))
+    scale = np.concatenate((np.full(n, amp), np.full(n, amp * w)))
+    Phi = np.empty((2 * n, 2 * n))
+    for j in range(2 * n):
+        dz = np.zeros(2 * n)
+        dz[j] = eps * scale[j]
+        Phi[:, j] = (pmap(z0 + dz) - pmap(z0 - dz)) / (2 * dz[j])
+    return np.linalg.eigvals(Phi)

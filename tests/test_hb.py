@@ -1,0 +1,307 @@
+"""Harmonic balance: oracles (describing function, finite differences, time
+integration, monodromy), folds and stability, unbounded responses, input
+validation."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from jointdyn import System, config
+from jointdyn.hb import (
+    HBProblem,
+    continuation,
+    continue_hb,
+    frc_hb,
+    harmonic_balance,
+    hill_exponents,
+    monodromy_multipliers,
+)
+from jointdyn.laws import Jenkins
+
+KT, FY, M, K, F1, ZETA = 3e5, 50.0, 10.0, 3.9e5, 20.0, 1e-3
+
+
+def _jenkins_system():
+    law = Jenkins(kt=KT, mu=0.5, n_ref=100.0)
+    return System.sdof(m=M, k=K, law=law, f1=F1, zeta=ZETA)
+
+
+def _df_amplitude(gamma):
+    """Describing-function amplitude of the Jenkins oscillator (closed form).
+
+    Equivalent stiffness and damping of a Jenkins element (spring kt, slip
+    force fy) for x = A cos(theta) (Caughey 1960): with
+    cos(theta*) = 1 - 2 fy / (kt A), k_eq = kt (theta* - sin(2 theta*)/2) / pi
+    and d_eq = 4 fy (1 - fy / (kt A)) / (pi A) for A > fy/kt; k_eq = kt,
+    d_eq = 0 below. Amplitude equation:
+    A^2 [(k + k_eq - m w^2)^2 + (c w + d_eq)^2] = F1^2.
+    """
+    w = gamma * math.sqrt(K / M)
+    c = 2 * ZETA * math.sqrt(K * M)
+
+    def res(A):
+        if A <= FY / KT:
+            keq, deq = KT, 0.0
+        else:
+            ts = math.acos(1 - 2 * FY / (KT * A))
+            keq = KT / math.pi * (ts - 0.5 * math.sin(2 * ts))
+            deq = 4 * FY / (math.pi * A) * (1 - FY / (KT * A))
+        return A * A * ((K + keq - M * w * w) ** 2 + (c * w + deq) ** 2) - F1 * F1
+
+    grid = np.geomspace(1e-7, 1e-1, 3000)
+    r = np.array([res(a) for a in grid])
+    idx = np.flatnonzero(np.sign(r[:-1]) != np.sign(r[1:]))
+    assert idx.size == 1, "the DF equation must have a single root at the test frequencies"
+    return brentq(res, grid[idx[0]], grid[idx[0] + 1], xtol=1e-18, rtol=1e-15)
+
+
+@pytest.mark.parametrize("gamma", [1.0, 1.25, 1.35, 1.42])
+def test_one_harmonic_equals_describing_function(gamma):
+    # 1024 samples per period: the AFT quadrature of the kinked Jenkins force
+    # converges as Ns^-2 (measured: 256 -> 3e-5, 1024 -> 4e-7 relative)
+    sol = harmonic_balance(_jenkins_system(), gamma, harmonics=1, samples=1024)
+    assert sol.converged
+    A = math.hypot(sol.X[1], sol.X[2])
+    assert abs(sol.X[0]) < 1e-12  # symmetric loop: no offset
+    assert abs(A - _df_amplitude(gamma)) <= config.TEST_HB_DF_RTOL * _df_amplitude(gamma)
+
+
+@pytest.mark.parametrize(
+    "model,eta,par",
+    [("iwan", 0.5, "eta"), ("jenkins", 0.5, "delta"), ("discrete", 0.3, "n0"), ("iwan", 0.5, "gamma"),
+     ("iwan-paper", 0.5, "f1")],
+)
+def test_jacobian_matches_central_differences(model, eta, par):
+    sysm = System.paper_damper(eta=eta, beta=2.0, model=model, n=20, delta=0.3, zeta=0.01)
+    g = 1.1
+    p = HBProblem(sysm, harmonics=4, samples=128, parameter=par, gamma=None if par == "gamma" else g)
+    lam = {"eta": eta, "delta": 0.3, "n0": 100.0, "gamma": g, "f1": p.f1_ref}[par]
+    X = harmonic_balance(sysm, g, harmonics=4, samples=128).X
+    ev = p.evaluate(X, lam)
+    Ja = np.c_[ev.JX, ev.Jp]
+    Jfd = np.empty_like(Ja)
+    for j in range(X.size + 1):
+        Xp, Xm, lp, lm = X.copy(), X.copy(), lam, lam
+        if j < X.size:
+            h = 1e-6 * np.abs(X).max()
+            Xp[j] += h
+            Xm[j] -= h
+        else:
+            h = 1e-6 * max(abs(lam), 1e-3)
+            lp, lm = lam + h, lam - h
+        Jfd[:, j] = (p.evaluate(Xp, lp).R - p.evaluate(Xm, lm).R) / (2 * h)
+    assert np.max(np.abs(Ja - Jfd)) <= config.TEST_HB_JACOBIAN_RTOL * np.max(np.abs(Ja))
+    assert ev.info[2] == 1.0  # the marched force repeated
+
+
+def test_hb_equals_time_integration_at_stable_points():
+    from jointdyn.dynamics import steady_state
+
+    cases = [(System.paper_damper(eta=0.01, beta=1.0, model="iwan"), 1.25),
+             (System.paper_damper(eta=0.5, beta=2.0, model="iwan"), 1.5)]
+    for sysm, g in cases:
+        sol = harmonic_balance(sysm, g, harmonics=7, samples=128)
+        assert sol.converged and sol.stable
+        ss = steady_state(sysm, g)
+        assert ss.status == "periodic"
+        assert abs(sol.amplitude_m - ss.amplitude_m) <= config.TEST_HB_VS_TIME_RTOL * ss.amplitude_m
+
+
+def test_jenkins_branch_complete_and_agrees_with_df():
+    ds = frc_hb(_jenkins_system(), 0.6, 1.8, harmonics=1, samples=1024)
+    assert ds.attrs["status"] == "complete"
+    assert ds.gamma.values[0] == 0.6 and ds.gamma.values[-1] == 1.8
+    assert ds.stable.values.all() and ds.attrs["folds"] == 0
+    for i in range(0, ds.sizes["point"], 7):
+        g = float(ds.gamma[i])
+        A = float(ds.amplitude_m[i])
+        assert abs(A - _df_amplitude(g)) <= 1e-3 * _df_amplitude(g)
+    for name in ("gamma", "amplitude_q", "amplitude_m", "offset_m", "max_abs_m", "stable", "fold"):
+        assert ds[name].dims == ("point",)
+    assert ds.attrs["harmonics"] == 1 and ds.attrs["samples"] == 1024
+
+
+def test_eta_1p5_folds_with_unstable_segment_between():
+    ds = frc_hb(System.paper_damper(eta=1.5, beta=20.0, model="iwan"), 0.8, 1.8)
+    assert ds.attrs["status"] == "complete"
+    f = np.flatnonzero(ds.fold.values)
+    assert f.size >= 2
+    between = ds.stable.values[f[0]:f[-1] + 1]
+    assert (~between).any()
+    # far from the folds the response is stable
+    assert ds.stable.values[: max(f[0] - 5, 1)].all() and ds.stable.values[f[-1] + 5:].all()
+
+
+def test_eta_1p5_time_domain_sweeps_jump_at_the_hb_turning_points():
+    # eta = 1.5 (separation), beta = 1.5: the HB branch turns back at A and
+    # forward again at B < A; the up sweep jumps up near A, the down sweep
+    # jumps down near B, and the HB branch between them is unstable
+    from jointdyn.sweeps import frc_sweep, to_frame
+
+    ds = frc_hb(System.paper_damper(eta=1.5, beta=1.5), 1.0, 1.3, samples=512)
+    assert ds.attrs["status"] == "complete"
+    tp = np.flatnonzero(ds.turning.values)
+    assert tp.size == 2 and ds.attrs["folds"] >= 2
+    gB, gA = np.sort(ds.gamma.values[tp])
+    qA, qB = ds.amplitude_q.values[tp[0]], ds.amplitude_q.values[tp[1]]
+    assert qB > qA
+    between = (ds.point > tp[0]) & (ds.point < tp[1])
+    assert (~ds.stable.values[between.values]).any()
+    g = np.round(np.arange(1.121, 1.1290001, 0.001), 6)
+    td = to_frame(frc_sweep(g, etas=(1.5,), betas=(1.5,), directions=("up", "down"), progress=False,
+                            n_workers=1))
+    mid = 0.5 * (qA + qB)
+    up = td[(td.direction == "up") & (td.status_name == "periodic")].sort_values("gamma")
+    dn = td[(td.direction == "down") & (td.status_name == "periodic")].sort_values("gamma")
+    g_up = up.gamma[up.amplitude_q > mid].min()  # first high point sweeping up
+    g_up_low = up.gamma[up.amplitude_q < mid].max()  # last low point
+    g_dn = dn.gamma[dn.amplitude_q > mid].min()  # last high point sweeping down
+    g_dn_low = dn.gamma[dn.amplitude_q < mid].max()  # first low point
+    assert g_up_low < gA + 1e-3 and g_up > gA - 1e-3
+    assert g_dn_low < gB + 1e-3 and g_dn > gB - 1e-3
+    assert g_up > g_dn  # hysteresis: the two sweeps jump at different gammas
+
+
+def test_hill_agrees_with_monodromy():
+    br = continue_hb(System.paper_damper(eta=10.0, beta=2.0, model="iwan"), 0.5, 2.0)
+    f = np.flatnonzero(br.fold)
+    assert f.size >= 2
+    picks = [f[0] - 3, (f[0] + f[-1]) // 2, f[-1] + 3, br.lam.size // 4]
+    seen = set()
+    for i in picks:
+        ev = br.problem.evaluate(br.X[i], br.lam[i])
+        w = br.problem.omega(br.lam[i])
+        s, _ = hill_exponents(ev.JX, br.problem.system.M, br.problem.system.C, w, br.problem.H)
+        mu_hill = np.max(np.abs(np.exp(s * 2 * np.pi / w)))
+        mu_mono = np.max(np.abs(monodromy_multipliers(br.problem, br.X[i], br.lam[i])))
+        assert abs(mu_hill - mu_mono) < 1e-2
+        if abs(mu_mono - 1) > 2e-3:
+            assert (mu_mono > 1) == (not br.stable[i])
+        seen.add(bool(br.stable[i]))
+    assert seen == {True, False}
+
+
+def test_unbounded_below_den_hartog_limit():
+    # beta = 0.5 < pi/4, no viscous damping: no steady state near gamma = 1
+    ds = frc_hb(System.paper_damper(eta=0.01, beta=0.5, model="iwan"), 0.6, 1.6)
+    assert ds.attrs["status"] == "unbounded"
+    assert "gamma" in ds.attrs["message"] and "Den Hartog" in ds.attrs["message"]
+    seg = ds.branch.values
+    assert set(seg) == {0, 1}
+    assert ds.gamma.values[seg == 0].max() < 1.0 < ds.gamma.values[seg == 1].min()
+    # above the limit the same system is bounded
+    ok = frc_hb(System.paper_damper(eta=0.01, beta=1.0, model="iwan"), 0.6, 1.6)
+    assert ok.attrs["status"] == "complete"
+
+
+def test_generic_continuation_finds_both_folds_of_a_cubic():
+    # y^3 - y + lam = 0: folds at lam = -+2 / (3 sqrt 3)
+    def res(y, lam):
+        return np.array([y[0] ** 3 - y[0] + lam]), np.array([[3 * y[0] ** 2 - 1]]), np.array([1.0])
+
+    r = continuation(res, np.array([1.5]), -1.5, 1.5, ds=0.05, ds_max=0.1)
+    assert r.status == "complete" and r.counters["folds"] == 2
+    lam_f = np.sort(r.lam[r.fold])
+    assert np.allclose(lam_f, [-2 / (3 * math.sqrt(3)), 2 / (3 * math.sqrt(3))], atol=0.05)
+    assert np.all(np.abs(r.y[:, 0] ** 3 - r.y[:, 0] + r.lam) < 1e-8)
+
+
+def _damper(eta=0.1, delta=0.0, n0=100.0, f1=25.0):
+    from jointdyn.laws import Iwan
+
+    law = Iwan(kt=3e5, mu=0.5, n_ref=100.0)
+    return System.sdof(m=10.0, k=3.9e5, law=law, f1=f1, n0=n0, eta=eta, delta=delta)
+
+
+def test_turning_points_ignore_jitter_within_the_band():
+    from jointdyn.hb import turning_points
+
+    lam = np.array([0.0, 1.0, 2.0, 2.0001, 1.99995, 2.5, 3.0, 2.0, 1.0, 1.5, 4.0])
+    assert list(turning_points(lam, band=0.01)) == [6, 8]
+    assert list(turning_points(lam, band=0.0)) == [3, 4, 6, 8]
+
+
+@pytest.mark.parametrize("par,start,stop", [("eta", 0.1, 0.6), ("delta", 0.0, 1.5), ("n0", 80.0, 140.0),
+                                            ("f1", 10.0, 40.0)])
+def test_continuation_in_a_parameter_matches_fixed_solutions(par, start, stop):
+    br = continue_hb(_damper(**{par: start}), start, stop, parameter=par, gamma=1.4, harmonics=5, samples=128)
+    assert br.status == "complete" and br.lam[-1] == stop
+    for i in (br.lam.size // 3, br.lam.size - 1):
+        ref = harmonic_balance(_damper(**{par: float(br.lam[i])}), 1.4, harmonics=5, samples=128, guess=br.X[i])
+        assert ref.converged and ref.iterations <= 2
+        assert np.allclose(ref.X, br.X[i], rtol=0, atol=1e-8 * np.abs(ref.X).max())
+
+
+def test_downward_frequency_sweep_matches_upward():
+    up = frc_hb(_jenkins_system(), 0.8, 1.6, harmonics=3)
+    down = frc_hb(_jenkins_system(), 1.6, 0.8, harmonics=3)
+    assert up.attrs["status"] == down.attrs["status"] == "complete"
+    g = np.linspace(0.85, 1.55, 8)
+    iu, idn = np.argsort(up.gamma.values), np.argsort(down.gamma.values)
+    a_up = np.interp(g, up.gamma.values[iu], up.amplitude_m.values[iu])
+    a_dn = np.interp(g, down.gamma.values[idn], down.amplitude_m.values[idn])
+    assert np.allclose(a_up, a_dn, rtol=2e-2)
+
+
+@pytest.mark.parametrize(
+    "kwargs,name",
+    [
+        (dict(harmonics=0), "harmonics"),
+        (dict(harmonics=7, samples=10), "samples"),
+        (dict(gamma_start=1.0, gamma_stop=1.0), "gamma"),
+        (dict(gamma_start=-0.5), "gamma_start"),
+        (dict(gamma_stop=float("nan")), "gamma_stop"),
+        (dict(response_dof=3), "response_dof"),
+    ],
+)
+def test_bad_input_names_the_parameter(kwargs, name):
+    args = dict(gamma_start=0.6, gamma_stop=1.8)
+    args.update(kwargs)
+    g0, g1 = args.pop("gamma_start"), args.pop("gamma_stop")
+    with pytest.raises(ValueError, match=name):
+        frc_hb(_jenkins_system(), g0, g1, **args)
+
+
+def test_two_dof_contact_between_masses_equals_time_integration():
+    from jointdyn.dynamics import steady_state
+    from jointdyn.laws import Iwan
+    from jointdyn.systems import Contact
+
+    law = Iwan(kt=3e5, mu=0.5, n_ref=100.0)
+    M = np.diag([10.0, 5.0])
+    K = np.array([[5.9e5, -2e5], [-2e5, 2e5]])
+    s = System(M=M, C=1e-4 * K, K=K, force=[40.0, 0.0],
+               contacts=(Contact(law=law, dof=0, dof2=1, n0=100.0, n1=30.0, delta=0.4),))
+    for g in (1.0, 1.2):
+        sol = harmonic_balance(s, g, harmonics=7, samples=256)
+        ss = steady_state(s, g)
+        assert sol.converged and sol.stable and ss.status == "periodic"
+        assert abs(sol.amplitude_m - ss.amplitude_m) <= config.TEST_HB_VS_TIME_RTOL * ss.amplitude_m
+
+
+def test_fully_stuck_contact_gives_the_linear_solution():
+    # slip force far above anything the forcing can reach: the contact is a
+    # linear spring kt and HB must return the stuck linear solution exactly
+    law = Jenkins(kt=KT, mu=1e6, n_ref=100.0)
+    s = System.sdof(m=M, k=K, law=law, f1=F1, zeta=0.02)
+    for g in (0.7, 1.3, 1.6):
+        sol = harmonic_balance(s, g, harmonics=3, samples=64)
+        w = g * math.sqrt(K / M)
+        c = 2 * 0.02 * math.sqrt(K * M)
+        A = F1 / math.hypot(K + KT - M * w * w, c * w)
+        assert sol.converged and abs(sol.amplitude_m - A) <= 1e-10 * A
+
+
+def test_fig6_hb_figure_from_saved_tables(tmp_path):
+    import pandas as pd
+
+    from jointdyn.figures.hb import _plot_fig6_hb, fig6_hb_data
+
+    tables = fig6_hb_data(etas=(0.5,), betas=(2.0,), gamma=(0.8, 1.6), time_domain=False)
+    hb = tables["hb"]
+    assert {"gamma", "amplitude_q", "stable", "fold", "gap", "branch"} <= set(hb.columns)
+    hb.to_csv(tmp_path / "hb.csv", index=False)
+    paths = _plot_fig6_hb({"hb": pd.read_csv(tmp_path / "hb.csv")}, tmp_path)
+    assert all(p.exists() and p.stat().st_size > 0 for p in paths)
