@@ -4,8 +4,14 @@ Public API (everything else is private):
 
 - contact laws: :class:`Iwan`, :class:`DiscreteIwan`, :class:`Jenkins`,
   :func:`make_law`, normal loads;
-- drivers: :func:`march` (and the quasi-static analysis);
-- systems: :class:`System`, :class:`Contact`.
+- drivers: :func:`march`, :func:`quasistatic`, :func:`harmonic_loop`;
+- systems: :class:`System`, :class:`Contact`;
+- time integration: :func:`integrate`, :func:`steady_state`;
+- harmonic balance: :func:`harmonic_balance`, :func:`frc_hb`;
+- sweeps: :func:`frc_sweep`.
+
+The time-integration, harmonic-balance and sweep names are imported on
+first use, so that ``import jointdyn`` (and the CLI) stays fast.
 """
 
 from .laws import (
@@ -24,10 +30,40 @@ from .laws import (
     law_names,
     make_law,
 )
-from .drivers import march
+from .drivers import LoopResult, harmonic_history, harmonic_loop, march, quasistatic, read_history_csv
 from .systems import PAPER, Contact, System
 
 __version__ = "0.1.0"
+
+_LAZY = {
+    "integrate": "dynamics",
+    "integrate_sampled": "dynamics",
+    "steady_state": "dynamics",
+    "SteadyState": "dynamics",
+    "Trajectory": "dynamics",
+    "Restart": "dynamics",
+    "harmonic_balance": "hb",
+    "frc_hb": "hb",
+    "continue_hb": "hb",
+    "continuation": "hb",
+    "hill_stability": "hb",
+    "frc_sweep": "sweeps",
+}
+
+
+def __getattr__(name):
+    sub = _LAZY.get(name)
+    if sub is None:
+        raise AttributeError(f"module 'jointdyn' has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(f".{sub}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))
 
 __all__ = [
     "STICK_SLIP",
@@ -45,7 +81,13 @@ __all__ = [
     "SampledLoad",
     "UnilateralSpring",
     "march",
+    "quasistatic",
+    "harmonic_loop",
+    "harmonic_history",
+    "read_history_csv",
+    "LoopResult",
     "System",
     "Contact",
     "PAPER",
+    *_LAZY,
 ]
