@@ -340,8 +340,11 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
     points, with a dead band of ``config.HB_TURNING_BAND`` of the range;
     on a piecewise-smooth branch they can differ from ``fold``),
     ``branch`` (segment index), ``gap``, ``growth``
-    (max Re(s)/w of the Floquet exponents), ``harmonic_amplitude_m``
-    (dims point, harmonic: sqrt(a_k^2 + b_k^2), |a_0| for k = 0).
+    (max Re(s)/w of the Floquet exponents), ``aft_passes`` (periods
+    marched), ``force_period`` (1; 2 when the law alternated between two
+    cycles and their mean was used; 0 if the force did not repeat),
+    ``harmonic_amplitude_m`` (dims point, harmonic: sqrt(a_k^2 + b_k^2),
+    |a_0| for k = 0).
     """
     import xarray as xr
 
@@ -438,10 +441,11 @@ def frc_hb(
     xarray.Dataset
         Dim ``point``; variables ``gamma``, ``amplitude_q``,
         ``amplitude_m``, ``offset_m``, ``max_abs_m``, ``stable``, ``fold``
-        (and ``branch``, ``gap``, ``growth``, ``harmonic_amplitude_m``); attrs
-        ``status`` (``complete`` | ``unbounded`` | ``failed`` |
-        ``max-points``), ``message``, ``harmonics``, ``samples`` and the
-        counters.
+        (and ``turning``, ``branch``, ``gap``, ``growth``, ``aft_passes``,
+        ``force_period``, ``harmonic_amplitude_m``; see
+        :func:`branch_dataset`); attrs ``status`` (``complete`` |
+        ``unbounded`` | ``failed`` | ``max-points``), ``message``,
+        ``harmonics``, ``samples`` and the counters (``counter_*``).
     """
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
