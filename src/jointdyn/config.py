@@ -152,7 +152,7 @@ HB_PERIODIC_RTOL = 1e-10
 #: default harmonics and time samples per period
 HB_HARMONICS = 7
 HB_SAMPLES = 128
-#: Newton: converged when |R| <= rtol * force scale and |dX| <= rtol * (|X| + x scale)
+#: Newton: converged when max|R| <= this, R scaled by max(F1, fy) (damped Newton)
 HB_NEWTON_RTOL = 1e-9
 HB_NEWTON_MAX_ITER = 12
 #: continuation: step-length control (in the scaled unknowns), bounds
@@ -164,8 +164,8 @@ HB_MAX_POINTS = 2000
 #: response declared unbounded when q = kt X / fy exceeds this (hard bound)
 HB_UNBOUNDED_Q = 1e5
 #: describing-function saturation test (MODEL.md section 6, Den Hartog):
-#: applied once q exceeds HB_SATURATION_Q, the contact slips at least this
-#: fraction of the period and viscous damping is negligible
+#: applied once q exceeds HB_SATURATION_Q, when the contact slips at least
+#: this fraction of the period and C = 0 (single DOF)
 HB_SATURATION_Q = 30.0
 HB_SATURATION_SLIP_FRACTION = 0.9
 #: a Floquet exponent with Re(s) > HB_STABILITY_RTOL * w marks instability

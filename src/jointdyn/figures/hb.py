@@ -126,7 +126,7 @@ def _plot_fig6_hb(tables, out_dir):
     h.plot([], [], "k^", mfc="none", label="time, sweep up")
     h.plot([], [], "kv", mfc="none", label="time, sweep down")
     h.plot([], [], " ", label="(time points: periodic only)")
-    h.legend(fontsize=7, ncol=2)
+    h.legend(fontsize=7, ncol=2, loc="upper right")
     fig.suptitle("Fig 6 by harmonic balance (H = 7, 128 samples; 512 for eta > 1; Hill stability) "
                  "over time-domain steady states",
                  fontsize=9)

@@ -386,7 +386,8 @@ def continuation(
                 Y.append(y_end); L.append(lam_end); TL.append(te[n] if te is not None else np.nan)
                 FOLD.append(fold); IT.append(it_end); GAP.append(False)
             where = "lam_stop" if lam_end == lam_stop else "the start of the range (the branch turned back)"
-            return finish("complete", f"reached {where} lam = {lam_end:.6g}")
+            note = "" if ok_end else f" (Newton at lam = {lam_end:.6g} itself failed; last point lam = {u[n]:.6g})"
+            return finish("complete", f"reached {where} lam = {lam_end:.6g}{note}")
         u_prev = u
         u_prev_t = t
         u = v

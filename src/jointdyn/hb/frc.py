@@ -265,10 +265,18 @@ def continue_hb(
 
     from tqdm.auto import tqdm
 
+    from .continuation import newton
+
     def run(lam_a, lam_b, npts):
         with tqdm(total=npts, desc=f"HB {parameter}", disable=None if progress is None else not progress,
                   leave=False) as bar:
             y0 = problem.linear_guess(lam_a) / xs
+            if parameter == "gamma" and not newton(residual, y0, lam_a / ls, tol=tol, max_iter=30)[1]:
+                # start by a homotopy in the forcing amplitude at this gamma
+                # when Newton from the stuck-contact solution fails
+                sol = harmonic_balance(system, lam_a, harmonics=harmonics, samples=samples, tol=tol)
+                if sol.converged:
+                    y0 = sol.X / xs
             return continuation(residual, y0, lam_a / ls, lam_b / ls, ds=ds, ds_max=ds_max, max_points=npts,
                                 tol=tol, predictor=predictor, monitor=monitor, progress=bar)
 
@@ -280,6 +288,10 @@ def continue_hb(
         back = _relabel_failure(run(stop, start, max_points - res.lam.size), xs, qamp)
         parts.append(back)
         message += f"; continued back from {parameter} = {stop:.6g}: {back.status} ({back.message})"
+        if res.lam.size == 0 and back.status == "complete":
+            # no start at `start`, but the branch from `stop` covers the range
+            status = "complete"
+            message = f"computed from {parameter} = {stop:.6g} back to {start:.6g} ({message})"
     lam = np.concatenate([p.lam * ls for p in parts])
     X = np.concatenate([p.y * xs for p in parts]) if lam.size else np.empty((0, problem.size))
     seg = np.concatenate([np.full(p.lam.size, i) for i, p in enumerate(parts)]).astype(int)
@@ -328,8 +340,11 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
     points, with a dead band of ``config.HB_TURNING_BAND`` of the range;
     on a piecewise-smooth branch they can differ from ``fold``),
     ``branch`` (segment index), ``gap``, ``growth``
-    (max Re(s)/w of the Floquet exponents), ``harmonic_amplitude_m``
-    (dims point, harmonic: sqrt(a_k^2 + b_k^2), |a_0| for k = 0).
+    (max Re(s)/w of the Floquet exponents), ``aft_passes`` (periods
+    marched), ``force_period`` (1; 2 when the law alternated between two
+    cycles and their mean was used; 0 if the force did not repeat),
+    ``harmonic_amplitude_m`` (dims point, harmonic: sqrt(a_k^2 + b_k^2),
+    |a_0| for k = 0).
     """
     import xarray as xr
 
@@ -426,10 +441,11 @@ def frc_hb(
     xarray.Dataset
         Dim ``point``; variables ``gamma``, ``amplitude_q``,
         ``amplitude_m``, ``offset_m``, ``max_abs_m``, ``stable``, ``fold``
-        (and ``branch``, ``gap``, ``growth``, ``harmonic_amplitude_m``); attrs
-        ``status`` (``complete`` | ``unbounded`` | ``failed`` |
-        ``max-points``), ``message``, ``harmonics``, ``samples`` and the
-        counters.
+        (and ``turning``, ``branch``, ``gap``, ``growth``, ``aft_passes``,
+        ``force_period``, ``harmonic_amplitude_m``; see
+        :func:`branch_dataset`); attrs ``status`` (``complete`` |
+        ``unbounded`` | ``failed`` | ``max-points``), ``message``,
+        ``harmonics``, ``samples`` and the counters (``counter_*``).
     """
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
