@@ -96,7 +96,10 @@ def test_beta_and_f1_exclusive(capsys):
 
 def test_hb_json_and_files(capsys, tmp_path):
     pytest.importorskip("jointdyn.hb")
+    # the discrete contact: the closed form's history-dependent offsets make
+    # its HB residual discontinuous near gamma 1.13 here (see harmonic-balance.md)
     rc = main(["frc", "--method", "hb", "--gamma", "1.1:1.3:0.1", "--eta", "0.5", "--beta", "2",
+               "--model", "discrete", "--n", "50",
                "--harmonics", "7", "--samples", "128", "--json", "--out", str(tmp_path)])
     assert rc == 0
     out = json.loads(capsys.readouterr().out)

@@ -135,23 +135,25 @@ def test_eta_1p5_folds_with_unstable_segment_between():
 
 
 def test_eta_1p5_time_domain_sweeps_jump_at_the_hb_turning_points():
-    # eta = 1.5 (separation), beta = 1.5: the HB branch turns back at A and
-    # forward again at B < A; the up sweep jumps up near A, the down sweep
-    # jumps down near B, and the HB branch between them is unstable
+    # eta = 1.5 (separation), beta = 2, the paper's contact model (last
+    # reversal rule): the HB branch turns back at A and forward again at
+    # B < A; the up sweep jumps up at A, the down sweep jumps down at B, and
+    # the HB branch between them is unstable
     from jointdyn.sweeps import frc_sweep, to_frame
 
-    ds = frc_hb(System.paper_damper(eta=1.5, beta=1.5), 1.0, 1.3, samples=512)
+    ds = frc_hb(System.paper_damper(eta=1.5, beta=2.0, model="iwan-paper"), 1.0, 1.3, samples=512)
     assert ds.attrs["status"] == "complete"
     tp = np.flatnonzero(ds.turning.values)
     assert tp.size == 2 and ds.attrs["folds"] >= 2
     gB, gA = np.sort(ds.gamma.values[tp])
+    assert gA - gB > 5e-3
     qA, qB = ds.amplitude_q.values[tp[0]], ds.amplitude_q.values[tp[1]]
     assert qB > qA
     between = (ds.point > tp[0]) & (ds.point < tp[1])
     assert (~ds.stable.values[between.values]).any()
-    g = np.round(np.arange(1.121, 1.1290001, 0.001), 6)
-    td = to_frame(frc_sweep(g, etas=(1.5,), betas=(1.5,), directions=("up", "down"), progress=False,
-                            n_workers=1))
+    g = np.round(np.arange(gB - 0.004, gA + 0.004, 0.001), 6)
+    td = to_frame(frc_sweep(g, etas=(1.5,), betas=(2.0,), model="iwan-paper", directions=("up", "down"),
+                            progress=False, n_workers=1))
     mid = 0.5 * (qA + qB)
     up = td[(td.direction == "up") & (td.status_name == "periodic")].sort_values("gamma")
     dn = td[(td.direction == "down") & (td.status_name == "periodic")].sort_values("gamma")
@@ -159,9 +161,19 @@ def test_eta_1p5_time_domain_sweeps_jump_at_the_hb_turning_points():
     g_up_low = up.gamma[up.amplitude_q < mid].max()  # last low point
     g_dn = dn.gamma[dn.amplitude_q > mid].min()  # last high point sweeping down
     g_dn_low = dn.gamma[dn.amplitude_q < mid].max()  # first low point
-    assert g_up_low < gA + 1e-3 and g_up > gA - 1e-3
-    assert g_dn_low < gB + 1e-3 and g_dn > gB - 1e-3
-    assert g_up > g_dn  # hysteresis: the two sweeps jump at different gammas
+    assert g_up_low < gA + 1.5e-3 and g_up > gA - 1.5e-3
+    assert g_dn_low < gB + 1.5e-3 and g_dn > gB - 1.5e-3
+    assert g_up > g_dn + 5e-3  # hysteresis: the two sweeps jump at different gammas
+
+
+def test_eta_1p5_discrete_ground_truth_has_no_jump():
+    # the same case with the exact discrete contact: one stable branch, no
+    # fold; the jump above comes from the closed form's approximation
+    ds = frc_hb(System.paper_damper(eta=1.5, beta=2.0, model="discrete", n=100), 1.0, 1.3, samples=512)
+    assert ds.attrs["status"] == "complete"
+    assert not ds.fold.values.any() and not ds.turning.values.any()
+    assert ds.stable.values.all()
+    assert np.all(np.diff(ds.gamma.values) > 0)
 
 
 def test_hill_agrees_with_monodromy():
