@@ -112,6 +112,9 @@ SS_SHOOT_FD = 1e-6
 SS_FLOQUET_TOL = 1e-3
 #: steady state: describing-function iterations of the linear start
 SS_LINEAR_ITERS = 30
+#: relative change of the describing-function amplitude that ends that
+#: iteration (it only seeds the integration, which does the rest)
+SS_LINEAR_RTOL = 1e-2
 #: unbounded: amplitude increasing over this many consecutive periods ...
 SS_GROWTH_PERIODS = 40
 #: ... with increments of the second half >= this fraction of the first

@@ -109,6 +109,18 @@ def _run_template(
     for i in range(n):
         y0[i] = x_io[i]
         y0[n + i] = v_io[i]
+    # harmonic loads at the midpoint and the end of every grid step: the grid
+    # repeats each period, so the sines of an unsplit step are computed once
+    sin_mid = np.zeros(J)
+    sin_end = np.zeros(J)
+    N_mid = np.zeros((J, nc))
+    if mode == 0:
+        for jj in range(J):
+            pm = phase0 + w * (tgrid[jj] + 0.5 * (tgrid[jj + 1] - tgrid[jj]))
+            sin_mid[jj] = math.sin(pm)
+            sin_end[jj] = math.sin(phase0 + w * tgrid[jj + 1])
+            for c in range(nc):
+                N_mid[jj, c] = n0[c] + n1[c] * math.sin(pm + dlt[c])
     nrec = 0
     cap = out_t.shape[0]
     status = 0
@@ -175,16 +187,25 @@ def _run_template(
             gidx = end_idx
         # ---- loads at tau (grid value at a grid point) --------------------
         if mode == 0:
-            ph = phase0 + w * tau
-            sp = math.sin(ph)
+            # an unsplit grid step (attempt 0, no split yet) evaluates at its
+            # midpoint (stages 2, 3) and its end (stage 4, commit)
+            fresh = e >= 0 and attempt == 0 and nsplit == 0
+            if fresh:
+                sp = sin_mid[j] if e < 2 else sin_end[j]
+            else:
+                ph = phase0 + w * tau
+                sp = math.sin(ph)
             for i in range(n):
                 Fv[i] = fvec[i] * sp
             if gidx >= 0:
                 for c in range(nc):
                     Nv[c] = Ngrid[gidx, c]
+            elif fresh:
+                for c in range(nc):
+                    Nv[c] = N_mid[j, c]
             else:
                 for c in range(nc):
-                    Nv[c] = n0[c] + n1[c] * math.sin(ph + dlt[c])
+                    Nv[c] = n0[c] + n1[c] * math.sin(phase0 + w * tau + dlt[c])
         else:
             if gidx >= 0:
                 for i in range(n):

@@ -24,7 +24,7 @@ from .. import _validate as V
 from .. import config
 from ..drivers import march
 from ..systems import System
-from ._core import S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
+from ._core import N_SUMMARY, S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
 from .integrate import Restart, Trajectory, _Model, _omega
 
 __all__ = ["SteadyState", "steady_state", "STATUSES"]
@@ -120,16 +120,21 @@ class SteadyState:
 
 
 class _History:
-    """Per-period summaries since the last jump of the state."""
+    """Per-period summaries since the last jump of the state.
+
+    ``summ`` (periods x N_SUMMARY) and ``Z`` (periods + 1 x 2n, the state at
+    the period boundaries) are arrays, so the periodicity checks slice views.
+    """
 
     def __init__(self, z0):
-        self.Z = [np.array(z0, dtype=float)]
-        self.summ = []
+        z0 = np.array(z0, dtype=float)
+        self.Z = z0[None, :]
+        self.summ = np.empty((0, N_SUMMARY))
         self.shot_checked = False
 
     def add(self, summ, zend):
-        self.summ.extend(summ)
-        self.Z.extend(zend)
+        self.summ = np.concatenate([self.summ, summ])
+        self.Z = np.concatenate([self.Z, zend])
 
     @property
     def size(self):
@@ -146,24 +151,20 @@ def _check_periodic(h: _History, p: int, K: int, model, amp_rtol, energy_rtol):
     P = h.size
     if P < K * p:
         return False
-    S = np.asarray(h.summ[P - K * p:])
-    Z = np.asarray(h.Z[P - K * p:])
+    S = h.summ[P - K * p:].reshape(K, p, N_SUMMARY)  # K windows of p periods
+    Z = h.Z[P - K * p:]
     n = model.n
-    amps, es, ws = [], [], []
-    for i in range(K):
-        win = S[i * p:(i + 1) * p]
-        amps.append(0.5 * (win[:, S_XMAX].max() - win[:, S_XMIN].min()))
-        es.append(np.mean(win[:, S_EC] + win[:, S_EV]))
-        ws.append(np.mean(win[:, S_W]))
-    A = max(amps)
+    amps = 0.5 * (S[:, :, S_XMAX].max(axis=1) - S[:, :, S_XMIN].min(axis=1))
+    es = (S[:, :, S_EC] + S[:, :, S_EV]).mean(axis=1)
+    ws = S[:, :, S_W].mean(axis=1)
+    A = float(amps.max())
     xs = _amplitude_scale(model, A)
-    if max(amps) - min(amps) > amp_rtol * xs:
+    if A - amps.min() > amp_rtol * xs:
         return False
     wscale = max(model.w, 1e-300)
-    for i in range(K):
-        dz = Z[(i + 1) * p] - Z[i * p]
-        if np.max(np.abs(dz[:n])) > amp_rtol * xs or np.max(np.abs(dz[n:])) > amp_rtol * xs * wscale:
-            return False
+    dz = np.abs(Z[p::p][:K] - Z[:-1:p][:K])
+    if dz[:, :n].max() > amp_rtol * xs or dz[:, n:].max() > amp_rtol * xs * wscale:
+        return False
     # energy scale: the flow per period, but not below amp_rtol times the
     # energy stored in the motion (a residual transient of relative size
     # amp_rtol exchanges that much per period; matters when almost nothing
@@ -171,13 +172,14 @@ def _check_periodic(h: _History, p: int, K: int, model, amp_rtol, energy_rtol):
     zl = Z[-1]
     stored = 0.5 * (zl[:n] @ model.K_stuck @ zl[:n] + zl[n:] @ model.system.M @ zl[n:])
     stored = max(stored, 0.5 * float(np.max(np.diag(model.K_stuck))) * A * A)
-    etol = max(energy_rtol * max(max(abs(w) for w in ws), max(abs(e) for e in es)), amp_rtol * stored, 1e-300)
-    if max(es) - min(es) > etol or max(ws) - min(ws) > etol:
+    flow = max(np.abs(ws).max(), np.abs(es).max())
+    etol = max(energy_rtol * flow, amp_rtol * stored, 1e-300)
+    if es.max() - es.min() > etol or ws.max() - ws.min() > etol:
         return False
     # a periodic motion returns its stored energy: work = dissipation (to
     # SS_BALANCE_RTOL: the energy integrals carry the discretisation error)
-    btol = max(config.SS_BALANCE_RTOL * max(max(abs(w) for w in ws), max(abs(e) for e in es)), amp_rtol * stored)
-    if abs(np.mean(ws) - np.mean(es)) > btol:
+    btol = max(config.SS_BALANCE_RTOL * flow, amp_rtol * stored)
+    if abs(ws.mean() - es.mean()) > btol:
         return False
     return True
 
@@ -306,7 +308,7 @@ def _linear_start(model: _Model):
             return None
         if not np.all(np.isfinite(Xn)) or np.max(np.abs(Xn)) > 1e3 * xscale:
             return None
-        conv = X is not None and np.max(np.abs(Xn - X)) <= 1e-4 * np.max(np.abs(Xn))
+        conv = X is not None and np.max(np.abs(Xn - X)) <= config.SS_LINEAR_RTOL * np.max(np.abs(Xn))
         X = Xn
         if conv:
             break
