@@ -235,12 +235,16 @@ def _one_period_decaying(h: _History, m: int, model) -> bool:
     """
     if h.size < 2 * m:
         return True
-    Z = np.asarray(h.Z[-(2 * m + 1):])
-    n = model.n
-    D = np.diff(Z, axis=0)
-    D[:, n:] /= max(model.w, 1e-300)
-    d = np.max(np.abs(D), axis=1)
+    d = _mismatches(h, 2 * m, model)
     return d[m:].max() < config.SS_MULTIPLE_DECAY * d[:m].max()
+
+
+def _mismatches(h: _History, count: int, model) -> np.ndarray:
+    """Largest one-period change of the period-boundary state over the last
+    ``count`` periods (velocities scaled by 1/w to displacement units)."""
+    D = np.diff(h.Z[-(count + 1):], axis=0)
+    D[:, model.n:] /= max(model.w, 1e-300)
+    return np.max(np.abs(D), axis=1)
 
 
 def _stalled(h: _History, model) -> bool:
@@ -252,11 +256,7 @@ def _stalled(h: _History, model) -> bool:
     m = config.SS_STALL_PERIODS // 2
     if h.size < 2 * m:
         return False
-    Z = np.asarray(h.Z[-(2 * m + 1):])
-    n = model.n
-    D = np.diff(Z, axis=0)
-    D[:, n:] /= max(model.w, 1e-300)
-    d = np.max(np.abs(D), axis=1)
+    d = _mismatches(h, 2 * m, model)
     return d[m:].max() >= config.SS_STALL_RATIO * d[:m].max()
 
 
