@@ -299,6 +299,12 @@ def _linear_start(model: _Model):
     th = np.append(th, 0.0)
     xscale = float(np.max(np.abs(f))) / max(model.w_min_stuck**2 * float(np.min(np.diag(sysm.M))), 1e-300)
     xscale += sum(c.law.fy / c.law.kt for c in sysm.contacts)
+    # u(th) = Im(U e^{i th}) = Re(U) sin th + Im(U) cos th; first harmonic of
+    # T over the second cycle (same sums for every iteration)
+    sin_th, cos_th = np.sin(th), np.cos(th)
+    sl = slice(ns, 2 * ns)
+    proj = 2.0 / ns * np.stack([sin_th[sl], cos_th[sl]])
+    loads = [c.n0 + c.n1 * np.sin(th + c.delta) for c in sysm.contacts]
     X = None
     for it in range(config.SS_LINEAR_ITERS if model.nc else 1):
         Z = Z0 + (B.T * kc) @ B
@@ -316,22 +322,16 @@ def _linear_start(model: _Model):
         for i, c in enumerate(sysm.contacts):
             if abs(U[i]) == 0:
                 continue
-            u = np.imag(U[i] * np.exp(1j * th))
-            N = c.n0 + c.n1 * np.sin(th + c.delta)
-            T = march(c.law, u, N)[0]
-            sl = slice(ns, 2 * ns)
-            a = 2.0 / ns * np.sum(T[sl] * np.sin(th[sl]))
-            b = 2.0 / ns * np.sum(T[sl] * np.cos(th[sl]))
-            knew = (a + 1j * b) / U[i]
-            kc[i] = 0.5 * kc[i] + 0.5 * knew
+            u = U[i].real * sin_th + U[i].imag * cos_th
+            T = march(c.law, u, loads[i])[0]
+            a, b = proj @ T[sl]
+            kc[i] = 0.5 * kc[i] + 0.5 * (a + 1j * b) / U[i]
     x = np.imag(X).copy()
     v = w * np.real(X).copy()
     S = np.zeros((model.nc, model.slen))
     U = B @ X
     for i, c in enumerate(sysm.contacts):
-        u = np.imag(U[i] * np.exp(1j * th))
-        N = c.n0 + c.n1 * np.sin(th + c.delta)
-        s = march(c.law, u, N)[3]
+        s = march(c.law, U[i].real * sin_th + U[i].imag * cos_th, loads[i])[3]
         S[i, : s.size] = s
     return x, v, S
 
