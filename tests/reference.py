@@ -22,6 +22,9 @@ STICK_SLIP, MACROSLIP, SEPARATION = 0, 1, 2
 #: closed form reaches |G| = alpha only up to rounding); the same threshold
 #: as the compiled law, documented there as part of the clip
 SAT_RTOL = 1e-12
+#: a branch within this distance (normalised q) of an earlier reversal point
+#: has reached it (Masing rejoin): the tolerance documented in laws/iwan.py
+WIPE_TOL = 1e-9
 
 
 def goa(u, a):
@@ -171,14 +174,14 @@ class IwanRef:
         # difference (zero at constant alpha) to the rejoined branch
         if not self.last_only:
             while True:
-                if len(self.stack) >= 2 and d * (q - self.stack[-2][0]) >= 0.0:
+                if len(self.stack) >= 2 and d * (q - self.stack[-2][0]) >= -WIPE_TOL:
                     q_t = self.stack[-2][0]
                     before = self._branch(q_t, alpha, d)[0]
                     del self.stack[-2:]
                 elif (
                     len(self.stack) == 1
                     and self.base == "virgin"
-                    and d * (q - (2.0 * self.q_base - self.stack[0][0])) >= 0.0
+                    and d * (q - (2.0 * self.q_base - self.stack[0][0])) >= -WIPE_TOL
                 ):
                     q_t = 2.0 * self.q_base - self.stack[0][0]
                     before = self._branch(q_t, alpha, d)[0]

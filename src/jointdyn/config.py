@@ -9,6 +9,10 @@ from __future__ import annotations
 # --- contact-law kernels -------------------------------------------------
 #: default depth of the reversal-point stack of the closed-form Iwan law
 IWAN_MAX_DEPTH = 64
+#: a branch closer than this to an earlier reversal point (normalised
+#: displacement kt x / fy) has reached it (Masing rejoin); the force error
+#: is of the same order in units of fy
+IWAN_WIPE_TOL = 1e-9
 
 # --- quasi-static driver --------------------------------------------------
 QS_STEPS_PER_CYCLE = 2000

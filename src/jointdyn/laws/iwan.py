@@ -56,6 +56,11 @@ _Q, _G, _A, _DIR, _BASE, _BQ, _BA, _M, _BG = 0, 1, 2, 3, 4, 5, 6, 7, 8
 _HEAD = 9
 _SEP, _VIRGIN, _SAT = 0.0, 1.0, 2.0
 _SAT_RTOL = 1e-12
+# a branch within this distance (normalised q, units of fy/kt) of an earlier
+# reversal point has reached it: without it, rounding makes steady cycles
+# stop a hair short of their own earlier reversal points, and the stack
+# grows by one point every half cycle (memory of loops of size ~1e-16)
+_WIPE_TOL = config.IWAN_WIPE_TOL
 
 
 @jit(inline="always")
@@ -246,11 +251,11 @@ def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
             qt = 0.0
             if m >= 2:
                 qt = s_new[_HEAD + 3 * (m - 2)]
-                if d * (q - qt) >= 0.0:
+                if d * (q - qt) >= -_WIPE_TOL:
                     m_after = m - 2
             elif m == 1 and base == _VIRGIN:
                 qt = 2.0 * s_new[_BQ] - s_new[_HEAD]
-                if d * (q - qt) >= 0.0:
+                if d * (q - qt) >= -_WIPE_TOL:
                     m_after = 0
             if m_after < 0:
                 break
