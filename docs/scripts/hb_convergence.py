@@ -22,7 +22,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import brentq
 
 from jointdyn import System
 from jointdyn._io import atomic_write_text
@@ -31,6 +30,9 @@ from jointdyn.hb import harmonic_balance
 from jointdyn.laws import Jenkins
 
 PAGE = Path(__file__).resolve().parents[1] / "harmonic-balance.md"
+# the describing-function oracle of the tests (one copy of the closed form)
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests"))
+from test_hb import _df_amplitude  # noqa: E402
 HS = (1, 2, 3, 5, 7, 11, 15)
 KT, FY, M, K, F1, ZETA = 3e5, 50.0, 10.0, 3.9e5, 20.0, 1e-3
 
@@ -69,31 +71,12 @@ def convergence_table() -> str:
     return "\n".join(lines)
 
 
-def df_amplitude(gamma):
-    w = gamma * math.sqrt(K / M)
-    c = 2 * ZETA * math.sqrt(K * M)
-
-    def res(A):
-        if A <= FY / KT:
-            keq, deq = KT, 0.0
-        else:
-            ts = math.acos(1 - 2 * FY / (KT * A))
-            keq = KT / math.pi * (ts - 0.5 * math.sin(2 * ts))
-            deq = 4 * FY / (math.pi * A) * (1 - FY / (KT * A))
-        return A * A * ((K + keq - M * w * w) ** 2 + (c * w + deq) ** 2) - F1 * F1
-
-    grid = np.geomspace(1e-7, 1e-1, 3000)
-    r = np.array([res(a) for a in grid])
-    i = np.flatnonzero(np.sign(r[:-1]) != np.sign(r[1:]))[0]
-    return brentq(res, grid[i], grid[i + 1], xtol=1e-18, rtol=1e-15)
-
-
 def df_table() -> str:
     samples = (32, 64, 128, 256, 512, 1024, 4096)
     gammas = (1.25, 1.35, 1.42)
     lines = ["| gamma | DF q | " + " | ".join(f"Ns={n}" for n in samples) + " |", "|" + "---|" * (2 + len(samples))]
     for g in gammas:
-        A = df_amplitude(g)
+        A = _df_amplitude(g)
         cells = []
         for ns in samples:
             sol = harmonic_balance(_jenkins(), g, harmonics=1, samples=ns)
