@@ -14,6 +14,7 @@ kernel); their parameters may differ.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -127,7 +128,7 @@ class System:
     def ndof(self) -> int:
         return self.M.shape[0]
 
-    @property
+    @functools.cached_property
     def w0(self) -> float:
         """Lowest natural angular frequency of (M, K) without contacts, rad/s.
 
