@@ -100,12 +100,19 @@ def _run_template(
     y0 = np.zeros(ny)
     y1 = np.zeros(ny)
     ys = np.zeros(ny)
-    kk = np.zeros((5, ny))  # rows 1..3: stages 2..4; row 4: end of step (= next row 0)
+    kk = np.zeros((6, ny))  # rows 1..3: stages 2..4; row 4: end of step (= next row 0); row 5: probes
     work = np.zeros(n)
     Fv = np.zeros(n)
     Nv = np.zeros(nc)
     Tc = np.zeros(nc)
     codes = np.zeros(nc, dtype=np.int64)
+    code_c = np.zeros(nc, dtype=np.int64)  # motion state of the committed laws
+    # bisection for a change of motion state inside a step (e == 4 probes)
+    blo = 0.0
+    bhi = 1.0
+    bit = 0
+    sm = 0.0
+    located = False
     for i in range(n):
         y0[i] = x_io[i]
         y0[n + i] = v_io[i]
@@ -126,8 +133,9 @@ def _run_template(
     status = 0
     done = 0
     # evaluation state machine: e = 0, 1, 2 are the RK stages 2..4 of the
-    # current attempt, e = 3 the end of the step (commit); e = -1 the
-    # initial evaluation at the start.
+    # current attempt, e = 3 the end of the step (commit), e = 4 a probe of
+    # the bisection for a change of motion state inside the step; e = -1
+    # the initial evaluation at the start.
     k = 0
     j = 0
     tc = tgrid[0]
@@ -153,6 +161,15 @@ def _run_template(
                 ys[r] = y0[r] + a_ * kk[e, r]
             tau = tc + a_
             gidx = end_idx if e == 2 else -1
+        elif e == 4:
+            # probe at fraction sm of the step on the cubic Hermite
+            # interpolant of the step (only the contact states are used)
+            sm = 0.5 * (blo + bhi)
+            for i in range(n):
+                ys[i] = _hermite_value(y0[i], y1[i], y0[n + i], y1[n + i], h, sm)
+                ys[n + i] = y0[n + i] + sm * (y1[n + i] - y0[n + i])
+            tau = tc + sm * h
+            gidx = -1
         else:
             for r in range(ny):
                 y1[r] = y0[r] + h / 6.0 * (kk[0, r] + 2.0 * kk[1, r] + 2.0 * kk[2, r] + kk[3, r])
@@ -189,7 +206,7 @@ def _run_template(
         if mode == 0:
             # an unsplit grid step (attempt 0, no split yet) evaluates at its
             # midpoint (stages 2, 3) and its end (stage 4, commit)
-            fresh = e >= 0 and attempt == 0 and nsplit == 0
+            fresh = e >= 0 and e <= 3 and attempt == 0 and nsplit == 0
             if fresh:
                 sp = sin_mid[j] if e < 2 else sin_end[j]
             else:
@@ -219,7 +236,7 @@ def _run_template(
                 for c in range(nc):
                     Nv[c] = Ngrid[j, c] + al * (Ngrid[j + 1, c] - Ngrid[j, c])
         # ---- right-hand side: M x'' = F - C v - K x - sum_c B_c T_c ---------
-        row = e + 1 if (e >= 0 and e < 3) else 4
+        row = e + 1 if (e >= 0 and e < 3) else (5 if e == 4 else 4)
         for i in range(n):
             acc = Fv[i]
             for m in range(n):
@@ -258,6 +275,8 @@ def _run_template(
         kk[row, 2 * n + 3] = ys[rdof]
         # ---- after the evaluation -----------------------------------------
         if e == -1:
+            for c in range(nc):
+                code_c[c] = codes[c]
             for r in range(ny):
                 kk[0, r] = kk[4, r]
             if rec:
@@ -277,8 +296,51 @@ def _run_template(
         if e < 3:
             e += 1
             continue
+        if e == 4:
+            changed = False
+            for c in range(nc):
+                if codes[c] != code_c[c]:
+                    changed = True
+            if changed:
+                bhi = sm
+            else:
+                blo = sm
+            bit += 1
+            if bit < 40:
+                continue
+            if bhi > 1e-6 and bhi < 1.0 - 1e-6:
+                # redo the step up to the change of state
+                h = bhi * h
+                end_idx = -1
+                attempt = 1
+                e = 0
+                continue
+            # no split after all: the probes overwrote the trial buffers,
+            # evaluate the end of the step again and commit it
+            located = True
+            e = 3
+            continue
+        # change of motion state (e.g. onset or end of macroslip) inside the
+        # step: locate it by bisection on the law's state code (trial steps
+        # from the committed state) and redo the step up to there, so that
+        # kinks of the force are not smeared over a step (separation and
+        # re-contact are already grid points)
+        if attempt == 0 and nsplit < max_split and not located:
+            changed = False
+            for c in range(nc):
+                if codes[c] != code_c[c] and codes[c] != 2 and code_c[c] != 2:
+                    changed = True
+            if changed:
+                blo = 0.0
+                bhi = 1.0
+                bit = 0
+                e = 4
+                continue
+        located = False
         # commit the step: swap the law-state buffers
         Sa, Sb = Sb, Sa
+        for c in range(nc):
+            code_c[c] = codes[c]
         t_new = t_end if end_idx >= 0 else tc + h
         # extremum of the response DOF inside the step (Hermite)
         xr0 = y0[rdof]
