@@ -60,10 +60,17 @@ def march(law, x, N, state=None):
         s0 = np.array(state, dtype=np.float64)
         if s0.ndim != 1 or s0.shape[0] != law.state_size:
             raise ValueError(f"state must have shape ({law.state_size},) (law.state_size), got {s0.shape}")
+    return _march_unchecked(law, x, N, s0)
+
+
+def _march_unchecked(law, x, N, s0, params=None):
+    """:func:`march` without input validation, for histories the package built
+    itself (float64, finite, equal lengths; ``s0`` a valid state)."""
     n = x.shape[0]
     T = np.empty(n)
     kT = np.empty(n)
     code = np.empty(n, dtype=np.int8)
     s_final = np.empty_like(s0)
-    specialize(_march_template, STEP=law.step)(law.params, s0, x, N, T, kT, code, s_final)
+    p = law.params if params is None else params
+    specialize(_march_template, STEP=law.step)(p, s0, x, N, T, kT, code, s_final)
     return T, kT, code, s_final

@@ -23,6 +23,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ..drivers import march
+from ..drivers._march import _march_unchecked
 from ..systems import System
 from ._core import N_SUMMARY, S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
 from .integrate import Restart, Trajectory, _Model, _omega
@@ -305,6 +306,12 @@ def _linear_start(model: _Model):
     sl = slice(ns, 2 * ns)
     proj = 2.0 / ns * np.stack([sin_th[sl], cos_th[sl]])
     loads = [c.n0 + c.n1 * np.sin(th + c.delta) for c in sysm.contacts]
+    params = [c.law.params for c in sysm.contacts]
+
+    def _march(i, u):
+        c = sysm.contacts[i]
+        return _march_unchecked(c.law, u, loads[i], c.law.initial_state(float(u[0]), float(loads[i][0])), params[i])
+
     X = None
     for it in range(config.SS_LINEAR_ITERS if model.nc else 1):
         Z = Z0 + (B.T * kc) @ B
@@ -323,7 +330,7 @@ def _linear_start(model: _Model):
             if abs(U[i]) == 0:
                 continue
             u = U[i].real * sin_th + U[i].imag * cos_th
-            T = march(c.law, u, loads[i])[0]
+            T = _march(i, u)[0]
             a, b = proj @ T[sl]
             kc[i] = 0.5 * kc[i] + 0.5 * (a + 1j * b) / U[i]
     x = np.imag(X).copy()
@@ -331,7 +338,7 @@ def _linear_start(model: _Model):
     S = np.zeros((model.nc, model.slen))
     U = B @ X
     for i, c in enumerate(sysm.contacts):
-        s = march(c.law, U[i].real * sin_th + U[i].imag * cos_th, loads[i])[3]
+        s = _march(i, U[i].real * sin_th + U[i].imag * cos_th)[3]
         S[i, : s.size] = s
     return x, v, S
 
