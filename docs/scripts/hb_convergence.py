@@ -21,7 +21,6 @@ import math
 import sys
 from pathlib import Path
 
-import numpy as np
 
 from jointdyn import System
 from jointdyn._io import atomic_write_text

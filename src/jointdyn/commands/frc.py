@@ -224,10 +224,9 @@ def _run_hb(args, gammas):
 
 
 def _plot(result, path: Path) -> None:
-    import matplotlib
+    from ..figures import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from .._io import atomic_path
     from ..sweeps._plot import mark_legend, plot_frc_curve

@@ -92,10 +92,9 @@ def _validate_args(args):
 
 
 def _plot_png(res, title) -> bytes:
-    import matplotlib
+    from ..figures import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     import numpy as np
 
     from ..laws import SEPARATION

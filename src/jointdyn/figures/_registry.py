@@ -22,7 +22,7 @@ import pandas as pd
 
 from .._io import atomic_path
 
-__all__ = ["Figure", "register_figure", "figure_names", "make_figure", "FIGURES"]
+__all__ = ["Figure", "register_figure", "figure_names", "make_figure", "FIGURES", "pyplot", "save_figure"]
 
 FIGURES: dict[str, "Figure"] = {}
 
@@ -88,3 +88,25 @@ def make_figure(name: str, out_dir) -> list[Path]:
     saved = {key: pd.read_csv(out / f"{name}_{key}.csv") for key in tables}
     written += [Path(p) for p in fig.plot(saved, out)]
     return written
+
+
+def pyplot():
+    """matplotlib.pyplot on the non-interactive Agg backend (no display needed)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save_figure(fig, out_dir, name: str, dpi: int = 130) -> list[Path]:
+    """Write ``fig`` as ``<name>.png`` (at ``dpi``) and ``<name>.svg``, atomically; close it."""
+    paths = []
+    for ext in ("png", "svg"):
+        path = Path(out_dir) / f"{name}.{ext}"
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=dpi if ext == "png" else None)
+        paths.append(path)
+    pyplot().close(fig)
+    return paths

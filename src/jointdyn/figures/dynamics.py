@@ -25,7 +25,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from ._registry import register_figure
+from ._registry import pyplot, register_figure, save_figure
 
 #: Fig 6 grid (the paper's groups)
 FIG6_ETAS = (0.01, 0.5, 1.5, 10.0)
@@ -69,10 +69,7 @@ def fig6():
 
 @fig6.plotter
 def _plot_fig6(tables, out_dir):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from ..sweeps._plot import mark_legend, plot_frc_curve
 
@@ -108,22 +105,7 @@ def _plot_fig6(tables, out_dir):
     fig.suptitle("Fig 6: steady response, sweep up (solid) and down (dashed); markers at the bottom: "
                  "no steady state (x unbounded, o not settled)", fontsize=9)
     fig.tight_layout(rect=(0, 0.04, 1, 1))
-    return _save(fig, out_dir, "fig6")
-
-
-def _save(fig, out_dir, name):
-    import matplotlib.pyplot as plt
-
-    from .._io import atomic_path
-
-    paths = []
-    for ext in ("png", "svg"):
-        p = out_dir / f"{name}.{ext}"
-        with atomic_path(p) as tmp:
-            fig.savefig(tmp, dpi=130)
-        paths.append(p)
-    plt.close(fig)
-    return paths
+    return save_figure(fig, out_dir, "fig6")
 
 
 def steady_loop(eta, beta, gamma, delta_deg, *, model="iwan", **kw):
@@ -212,10 +194,7 @@ def _loop_axes(ax, df, label, color):
 
 @fig7.plotter
 def _plot_fig7(tables, out_dir):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     loops, info = tables["loops"], tables["cases"]
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
@@ -232,7 +211,7 @@ def _plot_fig7(tables, out_dir):
     fig.suptitle("Fig 7: separation under a small tangential load. (a) the contact opens while it carries "
                  "tangential load, so T falls to 0 at almost fixed x; (b) it opens near T = 0", fontsize=9)
     fig.tight_layout()
-    return _save(fig, out_dir, "fig7")
+    return save_figure(fig, out_dir, "fig7")
 
 
 @register_figure("fig8", "Steady loops for delta = 0..180 deg, in contact (eta 0.5) and with separation (eta 1.5)", 80)
@@ -244,10 +223,7 @@ def fig8():
 
 @fig8.plotter
 def _plot_fig8(tables, out_dir):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     loops, info = tables["loops"], tables["cases"]
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
@@ -266,7 +242,7 @@ def _plot_fig8(tables, out_dir):
         ax.legend(fontsize=7)
     fig.suptitle("Fig 8: steady hysteresis loops vs phase delta of the normal load (dots: separated)", fontsize=9)
     fig.tight_layout()
-    return _save(fig, out_dir, "fig8")
+    return save_figure(fig, out_dir, "fig8")
 
 
 @register_figure("energy_delta", "Energy dissipated per cycle vs delta, in contact and with separation", 85)
@@ -282,10 +258,7 @@ def energy_delta():
 
 @energy_delta.plotter
 def _plot_energy(tables, out_dir):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     df = tables["energy"]
     etas = sorted(df.eta.unique())
@@ -315,4 +288,4 @@ def _plot_energy(tables, out_dir):
         ax.legend(fontsize=7)
     fig.suptitle("Contact dissipation per cycle vs the phase delta of the normal load (forced damper)", fontsize=9)
     fig.tight_layout()
-    return _save(fig, out_dir, "energy_delta")
+    return save_figure(fig, out_dir, "energy_delta")

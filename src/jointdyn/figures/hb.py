@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ._registry import register_figure
+from ._registry import pyplot, register_figure, save_figure
 
 #: cases of fig6_hb (kept small: one HB branch is ~0.1-1 s, the time-domain
 #: sweep dominates the compute time)
@@ -72,12 +72,7 @@ def _runs(mask):
 
 @fig6_hb.plotter
 def _plot_fig6_hb(tables, out_dir):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .._io import atomic_path
+    plt = pyplot()
 
     hb = tables["hb"]
     td = tables.get("time")
@@ -131,11 +126,4 @@ def _plot_fig6_hb(tables, out_dir):
                  "over time-domain steady states",
                  fontsize=9)
     fig.tight_layout()
-    paths = []
-    for ext in ("png", "svg"):
-        p = out_dir / f"fig6_hb.{ext}"
-        with atomic_path(p) as tmp:
-            fig.savefig(tmp, dpi=130)
-        paths.append(p)
-    plt.close(fig)
-    return paths
+    return save_figure(fig, out_dir, "fig6_hb")

@@ -18,15 +18,13 @@ tabulated and plotted. Tables are long format (one row per sample).
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from .._io import atomic_path
 from ..drivers import harmonic_loop
 from ..laws import make_law
-from ._registry import register_figure
+from ._registry import pyplot, register_figure, save_figure
 
 #: paper section 2.2 (Figs 3-4)
 PAPER_QS = dict(kt=1.0e5, mu=0.1, n0=100.0, amplitude=0.5e-3, frequency=1.0)
@@ -84,13 +82,6 @@ def _cases(models, etas, delta_deg, amplitudes=(PAPER_QS["amplitude"],)):
 # --------------------------------------------------------------------------
 # drawing helpers (from the saved tables)
 # --------------------------------------------------------------------------
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _runs(mask):
@@ -129,17 +120,6 @@ def _state_legend(ax):
     ax.legend(h, lab, fontsize=7, loc="upper left")
 
 
-def _save(fig, out_dir, name):
-    paths = []
-    for ext in ("png", "svg"):
-        path = Path(out_dir) / f"{name}.{ext}"
-        with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=150 if ext == "png" else None)
-        paths.append(path)
-    _plt().close(fig)
-    return paths
-
-
 # --------------------------------------------------------------------------
 # Fig 2: the two kinds of Iwan loop
 # --------------------------------------------------------------------------
@@ -154,7 +134,7 @@ def fig2():
 
 @fig2.plotter
 def _plot_fig2(tables, out_dir):
-    plt = _plt()
+    plt = pyplot()
     loops = tables["loops"]
     p = PAPER_QS
     fy = p["mu"] * p["n0"]
@@ -190,14 +170,14 @@ def _plot_fig2(tables, out_dir):
     ax.grid(True, alpha=0.3)
     _state_legend(ax)
     fig.tight_layout()
-    return _save(fig, out_dir, "fig2")
+    return save_figure(fig, out_dir, "fig2", dpi=150)
 
 
 # --------------------------------------------------------------------------
 # Figs 3 and 4: varying normal load, in phase and out of phase
 # --------------------------------------------------------------------------
 def _plot_eta_family(tables, out_dir, name, delta_deg):
-    plt = _plt()
+    plt = pyplot()
     loops = tables["loops"]
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     for k, (eta, g) in enumerate(loops.groupby("eta", sort=True)):
@@ -212,7 +192,7 @@ def _plot_eta_family(tables, out_dir, name, delta_deg):
     ax.grid(True, alpha=0.3)
     _state_legend(ax)
     fig.tight_layout()
-    return _save(fig, out_dir, name)
+    return save_figure(fig, out_dir, name, dpi=150)
 
 
 @register_figure("fig3", "Loops under in-phase normal load (delta = 0), eta = 0 ... 1.2 (paper Fig 3)", order=30)
@@ -242,7 +222,7 @@ def fig4_discrete():
 
 @fig4_discrete.plotter
 def _plot_fig4_discrete(tables, out_dir):
-    plt = _plt()
+    plt = pyplot()
     loops = tables["loops"]
     metrics = tables["metrics"]
     fy = PAPER_QS["mu"] * PAPER_QS["n0"]
@@ -283,4 +263,4 @@ def _plot_fig4_discrete(tables, out_dir):
     fig.suptitle("delta = 90 deg: closed forms vs discrete ground truth (titles: energy per cycle relative "
                  "to discrete; S: separation)", fontsize=9)
     fig.tight_layout()
-    return _save(fig, out_dir, "fig4_discrete")
+    return save_figure(fig, out_dir, "fig4_discrete", dpi=150)

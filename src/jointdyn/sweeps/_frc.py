@@ -411,7 +411,6 @@ def frc_sweep(
     ValueError
         Bad input (names the parameter and the allowed range).
     """
-    import xarray as xr
     from tqdm import tqdm
 
     g, etas, betas, f1s, deltas, directions, model, n, zeta, ov, spp = _check_inputs(
