@@ -159,25 +159,16 @@ def _verlet_template(Minv, C, K, f, Bm, params, states, n0, n1, dl, w, t0, x0, v
     Tc = np.zeros(nc)
     a = np.zeros(n)
     rhs = np.zeros(n)
-    # force at t = 0, committed: the perturbation of x0 loads the contact
-    for c in range(nc):
-        u = 0.0
-        for i in range(n):
-            u += Bm[c, i] * x[i]
-        N = n0[c] + n1[c] * np.sin(w * t0 + dl[c])
-        t_, k_, c_ = STEP(params[c], sa[c], sb[c], u, N)  # noqa: F821
-        Tc[c] = t_
-    sa, sb = sb, sa
-    for i in range(n):
-        r = f[i] * np.sin(w * t0) - K[i, :] @ x - C[i, :] @ v
-        for c in range(nc):
-            r -= Bm[c, i] * Tc[c]
-        rhs[i] = r
-    a[:] = Minv @ rhs
-    for step in range(nsteps):
+    # step -1 evaluates (and commits) the force at t0, x0: the perturbation
+    # of x0 loads the contact; then velocity-Verlet steps
+    for step in range(-1, nsteps):
         t1 = t0 + (step + 1) * h
-        xn = x + h * v + 0.5 * h * h * a
-        vp = v + h * a
+        if step < 0:
+            xn = x.copy()
+            vp = v.copy()
+        else:
+            xn = x + h * v + 0.5 * h * h * a
+            vp = v + h * a
         for c in range(nc):
             u = 0.0
             for i in range(n):
@@ -192,8 +183,9 @@ def _verlet_template(Minv, C, K, f, Bm, params, states, n0, n1, dl, w, t0, x0, v
                 r -= Bm[c, i] * Tc[c]
             rhs[i] = r
         an = Minv @ rhs
-        v = v + 0.5 * h * (a + an)
-        x = xn
+        if step >= 0:
+            v = v + 0.5 * h * (a + an)
+            x = xn
         a = an
     xo[:] = x
     vo[:] = v
