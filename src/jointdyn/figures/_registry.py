@@ -24,7 +24,41 @@ from .._io import atomic_path
 
 __all__ = ["Figure", "register_figure", "figure_names", "make_figure", "FIGURES", "pyplot", "save_figure"]
 
-FIGURES: dict[str, "Figure"] = {}
+class _Registry(dict):
+    """Name -> Figure; reading it first imports every figure module, so a
+    lookup such as ``FIGURES["fig6"]`` works without a prior
+    :func:`figure_names` call."""
+
+    def _full(self):
+        _load_all()
+        return self
+
+    def __getitem__(self, name):
+        return dict.__getitem__(self._full(), name)
+
+    def __contains__(self, name):
+        return dict.__contains__(self._full(), name)
+
+    def __iter__(self):
+        return dict.__iter__(self._full())
+
+    def __len__(self):
+        return dict.__len__(self._full())
+
+    def get(self, name, default=None):
+        return dict.get(self._full(), name, default)
+
+    def keys(self):
+        return dict.keys(self._full())
+
+    def values(self):
+        return dict.values(self._full())
+
+    def items(self):
+        return dict.items(self._full())
+
+
+FIGURES: dict[str, "Figure"] = _Registry()
 
 
 @dataclass(frozen=True)
@@ -59,7 +93,12 @@ def figure_names() -> list[str]:
     return [f.name for f in sorted(FIGURES.values(), key=lambda f: (f.order, f.name))]
 
 
+_LOADED = []
+
+
 def _load_all() -> None:
+    if _LOADED:
+        return
     import importlib
     import pkgutil
 
@@ -68,6 +107,7 @@ def _load_all() -> None:
     for info in pkgutil.iter_modules(pkg_path):
         if not info.name.startswith("_"):
             importlib.import_module(f"{__package__}.{info.name}")
+    _LOADED.append(True)
 
 
 def make_figure(name: str, out_dir) -> list[Path]:
