@@ -2,10 +2,16 @@
 
 Kernel contract (OpenSees-style trial step from a committed state)
 -------------------------------------------------------------------
-Every contact law provides two compiled kernels::
+Every contact law provides three compiled kernels::
 
     T, kT, code = step(params, s_old, s_new, x, N)
     T, kT, code = step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT)
+    init(params, x0, n0, s)
+
+``init`` writes into ``s`` (in full) the virgin committed state at
+displacement ``x0`` (m) and normal load ``n0`` (N); ``law.initial_state`` is
+that kernel called from Python, and compiled loops that restart a law call it
+directly.
 
 ``params``  float64[:]   the law's parameters (from ``law.params``)
 ``s_old``   float64[:]   committed state; **never written**
@@ -26,7 +32,7 @@ Committing is the caller's business: it swaps ``s_old`` and ``s_new``.
 The kernels allocate nothing, so drivers, time integrators and harmonic
 balance call them in their innermost loops.
 
-A new law is one module with its two kernels and one thin frozen dataclass
+A new law is one module with its three kernels and one thin frozen dataclass
 deriving from :class:`ContactLaw`, which registers itself under a name with
 :func:`register`; nothing else in the package needs an edit.
 """
@@ -145,11 +151,22 @@ class ContactLaw:
         """Length of the state vector."""
         raise NotImplementedError
 
-    def initial_state(self, x0: float = 0.0, n0: float | None = None) -> np.ndarray:
-        """Virgin committed state at displacement ``x0`` (m) and load ``n0`` (N)."""
+    @property
+    def init(self):
+        """The compiled virgin-state kernel ``init(params, x0, n0, s)`` (see module docstring)."""
         raise NotImplementedError
 
     # --- shared -------------------------------------------------------------
+    def initial_state(self, x0: float = 0.0, n0: float | None = None) -> np.ndarray:
+        """Virgin committed state at displacement ``x0`` (m) and load ``n0`` (N).
+
+        ``n0`` defaults to ``n_ref`` (alpha = 1). Computed by the law's
+        ``init`` kernel, the same code compiled loops call.
+        """
+        s = np.empty(self.state_size)
+        self.init(self.params, float(x0), float(self.n_ref if n0 is None else n0), s)
+        return s
+
     @property
     def fy(self) -> float:
         """Macroslip force at the reference load, mu * n_ref (N)."""

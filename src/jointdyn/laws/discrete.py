@@ -150,6 +150,14 @@ def discrete_step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT):
     return _discrete_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT)
 
 
+@jit
+def discrete_init(params, x0, n0, s):
+    """Virgin committed state at displacement ``x0`` (m): every element
+    unstretched there (element forces zero); ``n0`` does not enter."""
+    s[:] = 0.0
+    s[0] = x0
+
+
 @dataclass(frozen=True)
 class DiscreteIwan(ContactLaw):
     """n parallel Jenkins elements, slip forces scaled by N(t)/N_ref.
@@ -196,10 +204,9 @@ class DiscreteIwan(ContactLaw):
     def state_size(self) -> int:
         return _S_HEAD + self.n
 
-    def initial_state(self, x0: float = 0.0, n0: float | None = None) -> np.ndarray:
-        s = np.zeros(self.state_size)
-        s[0] = x0
-        return s
+    @property
+    def init(self):
+        return discrete_init
 
 
 @dataclass(frozen=True)

@@ -361,6 +361,26 @@ def iwan_step(params, s_old, s_new, x, N):
 
 
 @jit
+def iwan_init(params, x0, n0, s):
+    """Virgin committed state at displacement ``x0`` (m) and normal load ``n0`` (N).
+
+    q = (kt / fy) x0 (the kernels' expression, bit for bit: a rounding
+    difference would look like motion and, under the paper's last-reversal
+    rule, turn the virgin curve into a reversal branch), alpha = n0 / n_ref,
+    base curve virgin (alpha > 0) or separated, empty reversal stack.
+    """
+    kt = params[0]
+    fy = params[1]
+    a = n0 / params[2]
+    q = (kt / fy) * x0 if fy > 0.0 else 0.0
+    s[:] = 0.0
+    s[_Q] = q
+    s[_A] = a
+    s[_BASE] = _VIRGIN if a > 0.0 else _SEP
+    s[_BQ] = q
+
+
+@jit
 def iwan_step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT):
     """:func:`iwan_step` with forward-mode derivatives along ``dx.size`` directions."""
     return _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT)
@@ -413,18 +433,9 @@ class Iwan(ContactLaw):
     def state_size(self) -> int:
         return _HEAD + 3 * self.max_depth
 
-    def initial_state(self, x0: float = 0.0, n0: float | None = None) -> np.ndarray:
-        s = np.zeros(self.state_size)
-        a = 1.0 if n0 is None else float(n0) / self.n_ref
-        # the same expression as the kernels' q = (kt/fy) x, bit for bit: a
-        # rounding difference would look like motion and, under the paper's
-        # last-reversal rule, turn the virgin curve into a reversal branch
-        q = (self.kt / self.fy) * x0 if self.fy > 0 else 0.0
-        s[_Q] = q
-        s[_A] = a
-        s[_BASE] = _VIRGIN if a > 0 else _SEP
-        s[_BQ] = q
-        return s
+    @property
+    def init(self):
+        return iwan_init
 
 
 def _make_iwan(*, kt, mu, n_ref, **_):
