@@ -94,6 +94,7 @@ class _Model:
         n = system.ndof
         self.n = n
         self.nc = len(system.contacts)
+        self.M = np.ascontiguousarray(system.M, dtype=np.float64)
         self.Minv = np.ascontiguousarray(np.linalg.inv(system.M))
         self.K = np.ascontiguousarray(system.K, dtype=np.float64)
         self.C = np.ascontiguousarray(system.C, dtype=np.float64)
@@ -112,12 +113,15 @@ class _Model:
                 self.P[i, : c.law.params.size] = c.law.params
             self.slen = slen
             self.step = cs[0].law.step
+            self.init = cs[0].law.init
         else:
             from ..laws import Jenkins
 
             self.P = np.zeros((0, 5))
             self.slen = 1
-            self.step = Jenkins(kt=1.0, mu=0.0, n_ref=1.0).step
+            dummy = Jenkins(kt=1.0, mu=0.0, n_ref=1.0)
+            self.step = dummy.step
+            self.init = dummy.init
         self.runner = compiled_runner(self.step)
         # stiffest linear mode with every contact stuck: keeps RK4 accurate/stable
         Kst = self.K.copy()
@@ -127,7 +131,7 @@ class _Model:
             if c.dof2 >= 0:
                 B[c.dof2] -= 1.0
             Kst += c.law.kt * np.outer(B, B)
-        self.K_stuck = Kst
+        self.K_stuck = np.ascontiguousarray(Kst)
         from scipy.linalg import eigh
 
         lam = eigh(0.5 * (Kst + Kst.T), system.M, eigvals_only=True)

@@ -22,8 +22,8 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
+from .._jit import jit, specialize
 from ..drivers import march
-from ..drivers._march import _march_unchecked
 from ..systems import System
 from ._core import N_SUMMARY, S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
 from .integrate import Restart, Trajectory, _Model, _omega
@@ -147,42 +147,97 @@ def _amplitude_scale(model, A):
     return max(A, floor)
 
 
-def _check_periodic(h: _History, p: int, K: int, model, amp_rtol, energy_rtol):
-    """True if the last K windows of p periods repeat within the tolerances."""
-    P = h.size
-    if P < K * p:
+@jit
+def _periodic_arrays(summ, Z, p, K, n, w, K_stuck, M, floor, amp_rtol, energy_rtol, balance_rtol):  # pragma: no cover - compiled
+    """:func:`_check_periodic` on the history arrays (compiled: it runs for
+    every candidate multiple p after every chunk of periods)."""
+    P = summ.shape[0]
+    m = K * p
+    if P < m:
         return False
-    S = h.summ[P - K * p:].reshape(K, p, N_SUMMARY)  # K windows of p periods
-    Z = h.Z[P - K * p:]
-    n = model.n
-    amps = 0.5 * (S[:, :, S_XMAX].max(axis=1) - S[:, :, S_XMIN].min(axis=1))
-    es = (S[:, :, S_EC] + S[:, :, S_EV]).mean(axis=1)
-    ws = S[:, :, S_W].mean(axis=1)
-    A = float(amps.max())
-    xs = _amplitude_scale(model, A)
-    if A - amps.min() > amp_rtol * xs:
+    r0 = P - m
+    amax = -np.inf
+    amin = np.inf
+    emax = -np.inf
+    emin = np.inf
+    wmax = -np.inf
+    wmin = np.inf
+    esum = 0.0
+    wsum = 0.0
+    flow = 0.0
+    for k in range(K):
+        hi = -np.inf
+        lo = np.inf
+        e = 0.0
+        wk = 0.0
+        for j in range(p):
+            row = r0 + k * p + j
+            hi = max(hi, summ[row, S_XMAX])
+            lo = min(lo, summ[row, S_XMIN])
+            e += summ[row, S_EC] + summ[row, S_EV]
+            wk += summ[row, S_W]
+        amp = 0.5 * (hi - lo)
+        e /= p
+        wk /= p
+        amax = max(amax, amp)
+        amin = min(amin, amp)
+        emax = max(emax, e)
+        emin = min(emin, e)
+        wmax = max(wmax, wk)
+        wmin = min(wmin, wk)
+        esum += e
+        wsum += wk
+        flow = max(flow, abs(e), abs(wk))
+    A = amax
+    xs = max(A, floor)
+    if A - amin > amp_rtol * xs:
         return False
-    wscale = max(model.w, 1e-300)
-    dz = np.abs(Z[p::p][:K] - Z[:-1:p][:K])
-    if dz[:, :n].max() > amp_rtol * xs or dz[:, n:].max() > amp_rtol * xs * wscale:
-        return False
+    # Poincare points one window apart
+    wscale = max(w, 1e-300)
+    for k in range(K):
+        a = r0 + k * p
+        b = a + p
+        for i in range(n):
+            if abs(Z[b, i] - Z[a, i]) > amp_rtol * xs:
+                return False
+            if abs(Z[b, n + i] - Z[a, n + i]) > amp_rtol * xs * wscale:
+                return False
     # energy scale: the flow per period, but not below amp_rtol times the
     # energy stored in the motion (a residual transient of relative size
     # amp_rtol exchanges that much per period; matters when almost nothing
     # is dissipated, e.g. beta = 1000 far from resonance)
-    zl = Z[-1]
-    stored = 0.5 * (zl[:n] @ model.K_stuck @ zl[:n] + zl[n:] @ model.system.M @ zl[n:])
-    stored = max(stored, 0.5 * float(np.max(np.diag(model.K_stuck))) * A * A)
-    flow = max(np.abs(ws).max(), np.abs(es).max())
+    zl = Z.shape[0] - 1
+    stored = 0.0
+    kdiag = 0.0
+    for i in range(n):
+        kdiag = max(kdiag, K_stuck[i, i])
+        for j in range(n):
+            stored += 0.5 * (Z[zl, i] * K_stuck[i, j] * Z[zl, j] + Z[zl, n + i] * M[i, j] * Z[zl, n + j])
+    stored = max(stored, 0.5 * kdiag * A * A)
     etol = max(energy_rtol * flow, amp_rtol * stored, 1e-300)
-    if es.max() - es.min() > etol or ws.max() - ws.min() > etol:
+    if emax - emin > etol or wmax - wmin > etol:
         return False
     # a periodic motion returns its stored energy: work = dissipation (to
-    # SS_BALANCE_RTOL: the energy integrals carry the discretisation error)
-    btol = max(config.SS_BALANCE_RTOL * flow, amp_rtol * stored)
-    if abs(ws.mean() - es.mean()) > btol:
+    # balance_rtol: the energy integrals carry the discretisation error)
+    btol = max(balance_rtol * flow, amp_rtol * stored)
+    if abs(wsum / K - esum / K) > btol:
         return False
     return True
+
+
+def _check_periodic(h: _History, p: int, K: int, model, amp_rtol, energy_rtol):
+    """True if the last K windows of p periods repeat within the tolerances.
+
+    Over the last K windows of p periods: the half peak-to-peak amplitudes
+    agree within ``amp_rtol`` of the amplitude, so do the Poincare points
+    (state one window apart; velocities scaled by w), the energy dissipated
+    and the work of the forcing per period within ``energy_rtol`` of the
+    energy flow, and work equals dissipation within ``SS_BALANCE_RTOL``.
+    """
+    if h.size < K * p:
+        return False
+    return bool(_periodic_arrays(h.summ, h.Z, p, K, model.n, model.w, model.K_stuck, model.M,
+                                 _amplitude_scale(model, 0.0), amp_rtol, energy_rtol, config.SS_BALANCE_RTOL))  # fmt: skip
 
 
 def _growing(h: _History, model, amp_rtol) -> bool:
@@ -275,21 +330,103 @@ def _contraction(h: _History, model):
     return (d[-1] / d[0]) ** (1.0 / (d.size - 1)), d[-1]
 
 
+def _df_template(Z0, f, B, kt, P, sin_th, cos_th, loads, ns, iters, rtol, xmax, S_out, X_out):  # pragma: no cover - compiled
+    """Describing-function iteration of :func:`_linear_start`, compiled (``STEP``, ``INIT`` bound).
+
+    Returns False if the iteration diverges (non-finite or absurdly large X);
+    else writes X (complex amplitudes, m) and the law states after the
+    two-cycle march of the final estimate. ``np.linalg.solve`` raises
+    ``LinAlgError`` for a singular dynamic stiffness.
+    """
+    n = f.shape[0]
+    nc = B.shape[0]
+    L = sin_th.shape[0]
+    slen = S_out.shape[1]
+    kc = np.zeros(nc, dtype=np.complex128)
+    for i in range(nc):
+        kc[i] = kt[i]
+    X = np.zeros(n, dtype=np.complex128)
+    U = np.zeros(nc, dtype=np.complex128)
+    Z = np.zeros((n, n), dtype=np.complex128)
+    sa = np.zeros(slen)
+    sb = np.zeros(slen)
+    have = False
+    final = False
+    it = 0
+    while True:
+        if not final:
+            for a in range(n):
+                for b in range(n):
+                    Z[a, b] = Z0[a, b]
+            for i in range(nc):
+                for a in range(n):
+                    for b in range(n):
+                        Z[a, b] += B[i, a] * kc[i] * B[i, b]
+            Xn = np.linalg.solve(Z, f)
+            big = 0.0
+            diff = 0.0
+            for a in range(n):
+                if not (np.isfinite(Xn[a].real) and np.isfinite(Xn[a].imag)):
+                    return False
+                big = max(big, abs(Xn[a]))
+                diff = max(diff, abs(Xn[a] - X[a]))
+            if big > xmax:
+                return False
+            conv = have and diff <= rtol * big
+            for a in range(n):
+                X[a] = Xn[a]
+            have = True
+            it += 1
+            final = conv or it >= iters
+        for i in range(nc):
+            acc = 0.0 + 0.0j
+            for a in range(n):
+                acc += B[i, a] * X[a]
+            U[i] = acc
+        for i in range(nc):
+            if U[i] == 0 and not final:
+                continue
+            ur = U[i].real
+            ui = U[i].imag
+            INIT(P[i], ur * sin_th[0] + ui * cos_th[0], loads[i, 0], sa)  # noqa: F821 - bound by specialize
+            ca = 0.0
+            cb = 0.0
+            for j in range(L):
+                T, _, _ = STEP(P[i], sa, sb, ur * sin_th[j] + ui * cos_th[j], loads[i, j])  # noqa: F821
+                sa, sb = sb, sa
+                if ns <= j < 2 * ns:
+                    ca += T * sin_th[j]
+                    cb += T * cos_th[j]
+            if final:
+                for r in range(slen):
+                    S_out[i, r] = sa[r]
+            else:
+                kc[i] = 0.5 * kc[i] + 0.5 * (2.0 / ns) * (ca + 1j * cb) / U[i]
+        if final:
+            break
+    for a in range(n):
+        X_out[a] = X[a]
+    return True
+
+
 def _linear_start(model: _Model):
     """Equivalent-linearisation estimate of the periodic state at phase 0.
 
     Solves (K - w^2 M + i w C + sum_c k_c B_c B_c^T) X = f with k_c the
     describing function (first harmonic of T over one cycle of
     u = Im(U e^{i w t}) with the actual N_c(t), marched with the real law),
-    started from the stuck stiffness kt and iterated with relaxation.
-    Returns x, v (m, m/s) and law states at t = 0 (law marched over the last
-    two cycles of the estimate), or None if the iteration diverges.
+    started from the stuck stiffness kt and iterated with relaxation 1/2
+    until X changes by less than ``config.SS_LINEAR_RTOL`` (at most
+    ``config.SS_LINEAR_ITERS`` solves). The iteration is one compiled call
+    (``_df_template``). Returns x, v (m, m/s) and law states at t = 0 (law
+    marched over the last two cycles of the estimate), or None if the
+    iteration diverges.
     """
     sysm = model.system
     n, w = model.n, model.w
-    Z0 = model.K - w * w * sysm.M + 1j * w * model.C
-    f = model.fvec.astype(complex)
-    kc = np.array([c.law.kt for c in sysm.contacts], dtype=complex)
+    Z0 = np.ascontiguousarray(model.K - w * w * sysm.M + 1j * w * model.C, dtype=np.complex128)
+    f = model.fvec.astype(np.complex128)
+    kt = np.array([c.law.kt for c in sysm.contacts], dtype=np.float64)
     B = np.zeros((model.nc, n))
     for i, c in enumerate(sysm.contacts):
         B[i, c.dof] = 1.0
@@ -301,46 +438,22 @@ def _linear_start(model: _Model):
     xscale = float(np.max(np.abs(f))) / max(model.w_min_stuck**2 * float(np.min(np.diag(sysm.M))), 1e-300)
     xscale += sum(c.law.fy / c.law.kt for c in sysm.contacts)
     # u(th) = Im(U e^{i th}) = Re(U) sin th + Im(U) cos th; first harmonic of
-    # T over the second cycle (same sums for every iteration)
+    # T over the second cycle
     sin_th, cos_th = np.sin(th), np.cos(th)
-    sl = slice(ns, 2 * ns)
-    proj = 2.0 / ns * np.stack([sin_th[sl], cos_th[sl]])
-    loads = [c.n0 + c.n1 * np.sin(th + c.delta) for c in sysm.contacts]
-    params = [c.law.params for c in sysm.contacts]
-
-    def _march(i, u):
-        c = sysm.contacts[i]
-        return _march_unchecked(c.law, u, loads[i], c.law.initial_state(float(u[0]), float(loads[i][0])), params[i])
-
-    X = None
-    for it in range(config.SS_LINEAR_ITERS if model.nc else 1):
-        Z = Z0 + (B.T * kc) @ B
-        try:
-            Xn = np.linalg.solve(Z, f)
-        except np.linalg.LinAlgError:
-            return None
-        if not np.all(np.isfinite(Xn)) or np.max(np.abs(Xn)) > 1e3 * xscale:
-            return None
-        conv = X is not None and np.max(np.abs(Xn - X)) <= config.SS_LINEAR_RTOL * np.max(np.abs(Xn))
-        X = Xn
-        if conv:
-            break
-        U = B @ X
-        for i, c in enumerate(sysm.contacts):
-            if abs(U[i]) == 0:
-                continue
-            u = U[i].real * sin_th + U[i].imag * cos_th
-            T = _march(i, u)[0]
-            a, b = proj @ T[sl]
-            kc[i] = 0.5 * kc[i] + 0.5 * (a + 1j * b) / U[i]
-    x = np.imag(X).copy()
-    v = w * np.real(X).copy()
-    S = np.zeros((model.nc, model.slen))
-    U = B @ X
+    loads = np.empty((model.nc, th.size))
     for i, c in enumerate(sysm.contacts):
-        s = _march(i, U[i].real * sin_th + U[i].imag * cos_th)[3]
-        S[i, : s.size] = s
-    return x, v, S
+        loads[i] = c.n0 + c.n1 * np.sin(th + c.delta)
+    S = np.zeros((model.nc, model.slen))
+    X = np.zeros(n, dtype=np.complex128)
+    run = specialize(_df_template, STEP=model.step, INIT=model.init)
+    try:
+        ok = run(Z0, f, B, kt, model.P, sin_th, cos_th, loads, ns,
+                 config.SS_LINEAR_ITERS if model.nc else 1, config.SS_LINEAR_RTOL, 1e3 * xscale, S, X)  # fmt: skip
+    except np.linalg.LinAlgError:
+        return None
+    if not ok:
+        return None
+    return np.imag(X).copy(), w * np.real(X).copy(), S
 
 
 def _clean_states(model: _Model, x, v, S, rdof, count):
