@@ -14,6 +14,7 @@ at separation/re-contact, steps split at velocity reversals) is described in
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -79,83 +80,108 @@ class Trajectory:
     status: str = "ok"
 
 
+_STATIC: dict = {}
+
+
+def _static_pack(system: System) -> dict:
+    """The frequency-independent part of a :class:`_Model`, computed once per
+    System object (a sweep builds one model per point)."""
+    key = id(system)
+    hit = _STATIC.get(key)
+    if hit is not None and hit["_system"]() is system:
+        return hit
+    n = system.ndof
+    cs = system.contacts
+    d = {"_system": weakref.ref(system)}
+    d["n"] = n
+    d["nc"] = len(cs)
+    d["M"] = np.ascontiguousarray(system.M, dtype=np.float64)
+    d["Minv"] = np.ascontiguousarray(np.linalg.inv(system.M))
+    d["K"] = np.ascontiguousarray(system.K, dtype=np.float64)
+    d["C"] = np.ascontiguousarray(system.C, dtype=np.float64)
+    d["fvec"] = np.ascontiguousarray(system.force, dtype=np.float64)
+    d["cdof"] = np.array([c.dof for c in cs], dtype=np.int64)
+    d["cdof2"] = np.array([c.dof2 for c in cs], dtype=np.int64)
+    d["n0"] = np.array([c.n0 for c in cs], dtype=np.float64)
+    d["n1"] = np.array([c.n1 for c in cs], dtype=np.float64)
+    d["dlt"] = np.array([c.delta for c in cs], dtype=np.float64)
+    if cs:
+        plen = max(c.law.params.size for c in cs)
+        P = np.zeros((len(cs), plen))
+        for i, c in enumerate(cs):
+            P[i, : c.law.params.size] = c.law.params
+        d["P"] = P
+        d["slen"] = max(c.law.state_size for c in cs)
+        d["step"] = cs[0].law.step
+        d["init"] = cs[0].law.init
+    else:
+        from ..laws import Jenkins
+
+        dummy = Jenkins(kt=1.0, mu=0.0, n_ref=1.0)
+        d["P"] = np.zeros((0, 5))
+        d["slen"] = 1
+        d["step"] = dummy.step
+        d["init"] = dummy.init
+    d["runner"] = compiled_runner(d["step"])
+    # stiffest linear mode with every contact stuck: keeps RK4 accurate/stable
+    Kst = d["K"].copy()
+    for c in cs:
+        B = np.zeros(n)
+        B[c.dof] = 1.0
+        if c.dof2 >= 0:
+            B[c.dof2] -= 1.0
+        Kst += c.law.kt * np.outer(B, B)
+    d["K_stuck"] = np.ascontiguousarray(Kst)
+    from scipy.linalg import eigh
+
+    lam = eigh(0.5 * (Kst + Kst.T), system.M, eigvals_only=True)
+    d["w_max"] = math.sqrt(max(lam[-1], 0.0))
+    d["w_min_stuck"] = math.sqrt(max(lam[0], 0.0))
+    d["xlin"] = sum(c.law.fy / c.law.kt for c in cs)
+    d["kmin"] = max(d["w_min_stuck"] ** 2 * float(np.min(np.diag(system.M))), 1e-300)
+    _STATIC[key] = d
+    weakref.finalize(system, _STATIC.pop, key, None)
+    return d
+
+
 class _Model:
-    """A System packed into flat arrays for the compiled runner at one frequency."""
+    """A System packed into flat arrays for the compiled runner at one frequency.
+
+    The arrays are shared by every model of the same System object (see
+    :func:`_static_pack`) and never written.
+    """
 
     def __init__(self, system: System, w: float, steps_per_period: int, *, events: bool = True):
         if not isinstance(system, System):
             raise ValueError(f"system must be a System, got {type(system).__name__}")
+        self.__dict__.update(_static_pack(system))
         self.system = system
         self.w = float(w)
         # events=False (for the convergence study only): no step boundaries
         # at separation/re-contact and no splits at velocity reversals
         self.events = bool(events)
         self.max_split = config.TI_MAX_SPLITS if events else 0
-        n = system.ndof
-        self.n = n
-        self.nc = len(system.contacts)
-        self.M = np.ascontiguousarray(system.M, dtype=np.float64)
-        self.Minv = np.ascontiguousarray(np.linalg.inv(system.M))
-        self.K = np.ascontiguousarray(system.K, dtype=np.float64)
-        self.C = np.ascontiguousarray(system.C, dtype=np.float64)
-        self.fvec = np.ascontiguousarray(system.force, dtype=np.float64)
-        cs = system.contacts
-        self.cdof = np.array([c.dof for c in cs], dtype=np.int64)
-        self.cdof2 = np.array([c.dof2 for c in cs], dtype=np.int64)
-        self.n0 = np.array([c.n0 for c in cs], dtype=np.float64)
-        self.n1 = np.array([c.n1 for c in cs], dtype=np.float64)
-        self.dlt = np.array([c.delta for c in cs], dtype=np.float64)
-        if cs:
-            plen = max(c.law.params.size for c in cs)
-            slen = max(c.law.state_size for c in cs)
-            self.P = np.zeros((self.nc, plen))
-            for i, c in enumerate(cs):
-                self.P[i, : c.law.params.size] = c.law.params
-            self.slen = slen
-            self.step = cs[0].law.step
-            self.init = cs[0].law.init
-        else:
-            from ..laws import Jenkins
-
-            self.P = np.zeros((0, 5))
-            self.slen = 1
-            dummy = Jenkins(kt=1.0, mu=0.0, n_ref=1.0)
-            self.step = dummy.step
-            self.init = dummy.init
-        self.runner = compiled_runner(self.step)
-        # stiffest linear mode with every contact stuck: keeps RK4 accurate/stable
-        Kst = self.K.copy()
-        for c in cs:
-            B = np.zeros(n)
-            B[c.dof] = 1.0
-            if c.dof2 >= 0:
-                B[c.dof2] -= 1.0
-            Kst += c.law.kt * np.outer(B, B)
-        self.K_stuck = np.ascontiguousarray(Kst)
-        from scipy.linalg import eigh
-
-        lam = eigh(0.5 * (Kst + Kst.T), system.M, eigvals_only=True)
-        self.w_max = math.sqrt(max(lam[-1], 0.0))
-        self.w_min_stuck = math.sqrt(max(lam[0], 0.0))
         J = int(steps_per_period)
         if self.w > 0:
             J = max(J, int(math.ceil(2 * math.pi * self.w_max / (self.w * config.TI_MAX_OMEGA_H))))
         self.J = J
+        self._nobufs = _buffers(1, self.n, self.nc)
         self.set_cap(float(np.max(np.abs(self.fvec))))
         if self.w > 0:
             self._harmonic_grid()
 
     def set_cap(self, fs: float) -> None:
         """Caps of the blow-up guard (non-finite or absurdly large state) for force scale fs (N)."""
-        kmin = max(self.w_min_stuck**2 * float(np.min(np.diag(self.system.M))), 1e-300)
-        xs = fs / kmin + sum(c.law.fy / c.law.kt for c in self.system.contacts) + 1e-12
-        xcap = config.TI_BLOWUP_FACTOR * xs
-        self.xcap = np.concatenate([np.full(self.n, xcap), np.full(self.n, xcap * max(self.w_max, self.w, 1.0))])
+        xs = fs / self.kmin + self.xlin + 1e-12
+        self._xcap0 = config.TI_BLOWUP_FACTOR * xs
+        self.xcap = np.concatenate([np.full(self.n, self._xcap0), np.full(self.n, self._xcap0 * max(self.w_max, self.w, 1.0))])
 
     def cap(self, x, v) -> np.ndarray:
         """Blow-up caps, never below TI_BLOWUP_FACTOR times the starting state."""
         wv = max(self.w_max, self.w, 1.0)
         xs = float(np.max(np.abs(x))) + float(np.max(np.abs(v))) / wv
+        if config.TI_BLOWUP_FACTOR * xs <= self._xcap0:
+            return self.xcap  # the usual case: the start is far below the caps
         return np.maximum(self.xcap, config.TI_BLOWUP_FACTOR * np.concatenate([np.full(self.n, xs), np.full(self.n, xs * wv)]))
 
     # -- grid of one forcing period with the separation/re-contact instants --
@@ -245,7 +271,7 @@ class _Model:
         """Run ``nper`` repetitions of a (partial or shifted) grid in place; (summary, zend, status, done)."""
         summ = np.zeros((nper, N_SUMMARY))
         zend = np.zeros((nper, 2 * self.n))
-        bufs = _buffers(1, self.n, self.nc)
+        bufs = self._nobufs  # nothing is recorded
         _, status, done = self.runner(
             0, tg, Ng, self.Fgrid, nper, 0.0, self.w, self.fvec,
             self.n0, self.n1, self.dlt, self.Minv, self.K, self.C, self.cdof, self.cdof2,
@@ -270,9 +296,10 @@ class _Model:
         summ = np.zeros((nper, N_SUMMARY))
         zend = np.zeros((nper, 2 * self.n))
         cap = (nper * (self.J + 4 * self.nc + 8) + 1) if rec else 1
-        x0, v0, S0 = x.copy(), v.copy(), S.copy()
+        if rec:
+            x0, v0, S0 = x.copy(), v.copy(), S.copy()
         while True:
-            bufs = _buffers(cap, self.n, self.nc)
+            bufs = _buffers(cap, self.n, self.nc) if rec else self._nobufs
             nrec, status, done = self.runner(
                 0, self.tgrid, self.Ngrid, self.Fgrid, nper, 0.0, self.w, self.fvec,
                 self.n0, self.n1, self.dlt, self.Minv, self.K, self.C, self.cdof, self.cdof2,
