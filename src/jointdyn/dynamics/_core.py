@@ -77,6 +77,7 @@ def _run_template(
     mode, tgrid, Ngrid, Fgrid, nper, phase0, w, fvec, n0, n1, dlt,
     Minv, K, C, cdof, cdof2, P, S_io, x_io, v_io, rdof, xcap, max_split,
     rec, out_t, out_x, out_v, out_T, out_N, out_code, summ, zend,
+    sin_mid, sin_end, N_mid,
 ):  # pragma: no cover - compiled
     """March ``nper`` repetitions of the step grid ``tgrid`` (see module docstring).
 
@@ -116,18 +117,8 @@ def _run_template(
     for i in range(n):
         y0[i] = x_io[i]
         y0[n + i] = v_io[i]
-    # harmonic loads at the midpoint and the end of every grid step: the grid
-    # repeats each period, so the sines of an unsplit step are computed once
-    sin_mid = np.zeros(J)
-    sin_end = np.zeros(J)
-    N_mid = np.zeros((J, nc))
-    if mode == 0:
-        for jj in range(J):
-            pm = phase0 + w * (tgrid[jj] + 0.5 * (tgrid[jj + 1] - tgrid[jj]))
-            sin_mid[jj] = math.sin(pm)
-            sin_end[jj] = math.sin(phase0 + w * tgrid[jj + 1])
-            for c in range(nc):
-                N_mid[jj, c] = n0[c] + n1[c] * math.sin(pm + dlt[c])
+    # mode 0: sin_mid, sin_end, N_mid (see grid_sines) are the harmonic loads
+    # at the midpoint and the end of every grid step, computed once per grid
     nrec = 0
     cap = out_t.shape[0]
     status = 0
@@ -423,6 +414,18 @@ def _run_template(
         for r in range(S_io.shape[1]):
             S_io[c, r] = Sa[c, r]
     return nrec, status, done
+
+
+def grid_sines(tgrid, w, phase0, n0, n1, dlt):
+    """Forcing sines at the midpoint and end of every step of a harmonic grid
+    and the normal loads at the midpoints (the grid repeats each period, so an
+    unsplit step reuses them; arguments ``sin_mid, sin_end, N_mid`` of the
+    runner in mode 0)."""
+    pm = phase0 + w * (tgrid[:-1] + 0.5 * (tgrid[1:] - tgrid[:-1]))
+    sin_mid = np.sin(pm)
+    sin_end = np.sin(phase0 + w * tgrid[1:])
+    N_mid = np.ascontiguousarray(n0[None, :] + n1[None, :] * np.sin(pm[:, None] + dlt[None, :]))
+    return sin_mid, sin_end, N_mid
 
 
 def compiled_runner(step):

@@ -23,7 +23,7 @@ from .. import _validate as V
 from .. import config
 from ..laws.normal import HarmonicLoad
 from ..systems import System
-from ._core import N_SUMMARY, RUN_BLOWUP, RUN_OVERFLOW, compiled_runner
+from ._core import N_SUMMARY, RUN_BLOWUP, RUN_OVERFLOW, compiled_runner, grid_sines
 
 __all__ = ["Trajectory", "Restart", "integrate", "integrate_sampled"]
 
@@ -229,6 +229,7 @@ class _Model:
                     N[0, ci] = N[k, ci]
         self.tgrid = tg
         self.Ngrid = np.ascontiguousarray(N)
+        self.sines = grid_sines(tg, self.w, 0.0, self.n0, self.n1, self.dlt)
         self.Fgrid = np.zeros((1, self.n))
         self.period = Tp
 
@@ -267,8 +268,14 @@ class _Model:
                 return 0.0
         return 0.0
 
-    def run_grid(self, x, v, S, tg, Ng, nper, rdof=0):
-        """Run ``nper`` repetitions of a (partial or shifted) grid in place; (summary, zend, status, done)."""
+    def run_grid(self, x, v, S, tg, Ng, nper, rdof=0, sines=None):
+        """Run ``nper`` repetitions of a (partial or shifted) grid in place; (summary, zend, status, done).
+
+        ``sines``: ``grid_sines`` of ``tg`` (computed here if not given; pass
+        it when the same grid runs many times).
+        """
+        if sines is None:
+            sines = self.sines_of(tg)
         summ = np.zeros((nper, N_SUMMARY))
         zend = np.zeros((nper, 2 * self.n))
         bufs = self._nobufs  # nothing is recorded
@@ -276,9 +283,15 @@ class _Model:
             0, tg, Ng, self.Fgrid, nper, 0.0, self.w, self.fvec,
             self.n0, self.n1, self.dlt, self.Minv, self.K, self.C, self.cdof, self.cdof2,
             self.P, S, x, v, rdof, self.cap(x, v), self.max_split,
-            False, *bufs, summ, zend,
+            False, *bufs, summ, zend, *sines,
         )  # fmt: skip
         return summ[:done], zend[:done], status, done
+
+    def sines_of(self, tg):
+        """``grid_sines`` of a step grid (cached for the period grid)."""
+        if tg is self.tgrid:
+            return self.sines
+        return grid_sines(tg, self.w, 0.0, self.n0, self.n1, self.dlt)
 
     def initial_states(self, x: np.ndarray) -> np.ndarray:
         S = np.zeros((self.nc, self.slen))
@@ -304,7 +317,7 @@ class _Model:
                 0, self.tgrid, self.Ngrid, self.Fgrid, nper, 0.0, self.w, self.fvec,
                 self.n0, self.n1, self.dlt, self.Minv, self.K, self.C, self.cdof, self.cdof2,
                 self.P, S, x, v, rdof, self.cap(x, v), self.max_split,
-                rec, *bufs, summ, zend,
+                rec, *bufs, summ, zend, *self.sines,
             )  # fmt: skip
             if status != RUN_OVERFLOW:
                 break
@@ -312,6 +325,10 @@ class _Model:
             x[:], v[:], S[:] = x0, v0, S0
         samples = tuple(b[:nrec] for b in bufs) if rec else None
         return summ[:done], zend[:done], status, done, samples
+
+
+# mode 1 (sampled loads) takes no precomputed sines
+_NO_SINES = (np.zeros(0), np.zeros(0), np.zeros((0, 0)))
 
 
 def _buffers(cap, n, nc):
@@ -508,7 +525,7 @@ def integrate_sampled(
         nrec, status, _ = model.runner(
             1, tg, Ng, Fg, 1, 0.0, 0.0, model.fvec, model.n0, model.n1, model.dlt,
             model.Minv, model.K, model.C, model.cdof, model.cdof2, model.P, S, x, v, 0,
-            model.cap(x, v), config.TI_MAX_SPLITS, True, *bufs, summ, zend,
+            model.cap(x, v), config.TI_MAX_SPLITS, True, *bufs, summ, zend, *_NO_SINES,
         )  # fmt: skip
         if status != RUN_OVERFLOW:
             break

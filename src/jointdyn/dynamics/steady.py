@@ -523,12 +523,13 @@ def _shoot(model: _Model, x, v, S, rdof, tol, counters):
                 return x0, v0, S0, False, floq
             x, v, S = cl
     z = np.concatenate([x, v])
+    sines = model.sines_of(tgp)
 
     def phi(zz, SS):
         xx = zz[:n].copy()
         vv = zz[n:].copy()
         S2 = SS.copy()
-        summ, zend, status, done = model.run_grid(xx, vv, S2, tgp, Ngp, 1, rdof)
+        summ, zend, status, done = model.run_grid(xx, vv, S2, tgp, Ngp, 1, rdof, sines)
         count(summ, done)
         if status != 0 or done < 1:
             return None, None, None
