@@ -37,6 +37,13 @@ N_SUMMARY = 7
 # run status
 RUN_OK, RUN_BLOWUP, RUN_OVERFLOW = 0, 1, 2
 
+# a change of motion state inside a step is located by this many probes (the
+# first at _SPLIT_GUARD, then bisection: 2^-22 of a step) and the step is
+# split there unless it lies within _SPLIT_GUARD of either end; compile-time
+# constants of the templates (a change here recompiles via the source hash)
+_BISECT_PROBES = 24
+_SPLIT_GUARD = 1e-6
+
 
 @jit
 def _hermite_root(u0, u1, du0, du1, h):
@@ -155,7 +162,9 @@ def _run_template(
         elif e == 4:
             # probe at fraction sm of the step on the cubic Hermite
             # interpolant of the step (only the contact states are used)
-            sm = 0.5 * (blo + bhi)
+            # first probe just after the start: a change right there (the
+            # first step after a reversal out of macroslip) needs no split
+            sm = _SPLIT_GUARD if bit == 0 else 0.5 * (blo + bhi)
             for i in range(n):
                 ys[i] = _hermite_value(y0[i], y1[i], y0[n + i], y1[n + i], h, sm)
                 ys[n + i] = y0[n + i] + sm * (y1[n + i] - y0[n + i])
@@ -297,9 +306,9 @@ def _run_template(
             else:
                 blo = sm
             bit += 1
-            if bit < 40:
+            if bit < _BISECT_PROBES and not (changed and bit == 1):
                 continue
-            if bhi > 1e-6 and bhi < 1.0 - 1e-6:
+            if bhi > _SPLIT_GUARD and bhi < 1.0 - _SPLIT_GUARD:
                 # redo the step up to the change of state
                 h = bhi * h
                 end_idx = -1
