@@ -198,25 +198,23 @@ class _Model:
                     rising = math.cos(self.w * te + c.delta) > 0.0
                     events.append((te, ci, rising))
         tol = config.TI_EVENT_MERGE * Tp / J
-        tl = list(t)
+        tg = t
         ev_at = {}
         for te, ci, rising in events:
-            k = int(np.argmin(np.abs(np.asarray(tl) - te)))
-            if abs(tl[k] - te) <= tol:
-                if k == 0 or k == len(tl) - 1:
+            k = int(np.argmin(np.abs(tg - te)))
+            if abs(tg[k] - te) <= tol:
+                if k == 0 or k == tg.size - 1:
                     # an event at the period boundary: keep the boundary exact
-                    te = tl[k]
+                    te = tg[k]
                 else:
-                    tl[k] = te
+                    tg[k] = te
                 ev_at.setdefault(k, []).append((ci, rising))
             else:
-                tl.append(te)
-                tl.sort()
-                k = tl.index(te)
+                k = int(np.searchsorted(tg, te))
+                tg = np.insert(tg, k, te)
                 # re-key events recorded at later indices
                 ev_at = {(kk + 1 if kk >= k else kk): v for kk, v in ev_at.items()}
                 ev_at.setdefault(k, []).append((ci, rising))
-        tg = np.array(tl)
         N = np.empty((tg.size, self.nc))
         for ci, c in enumerate(self.system.contacts):
             N[:, ci] = c.n0 + c.n1 * np.sin(self.w * tg + c.delta)
