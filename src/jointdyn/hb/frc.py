@@ -358,6 +358,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
     harm[:, 0] = np.abs(Xd[:, 0])
     for k in range(1, p.H + 1):
         harm[:, k] = np.hypot(Xd[:, 2 * k - 1], Xd[:, 2 * k])
+    turning = _turning_mask(branch)
     data = {
         "gamma": ("point", branch.gamma()),
         "amplitude_q": ("point", law.kt * amp / law.fy if law.fy > 0 else amp * np.nan),
@@ -366,7 +367,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
         "max_abs_m": ("point", mx),
         "stable": ("point", branch.stable),
         "fold": ("point", branch.fold),
-        "turning": ("point", _turning_mask(branch)),
+        "turning": ("point", turning),
         "branch": ("point", branch.segment),
         "gap": ("point", branch.gap),
         "growth": ("point", branch.growth),
@@ -391,7 +392,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
         response_dof=response_dof,
         points=int(branch.lam.size),
         folds=int(branch.fold.sum()),
-        turning_points=int(_turning_mask(branch).sum()),
+        turning_points=int(turning.sum()),
         unstable_points=int((~branch.stable).sum()),
         max_aft_passes=int(branch.passes.max()) if branch.passes.size else 0,
         force_period_2_points=int((branch.force_period == 2).sum()),

@@ -29,8 +29,9 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ..systems import Contact, System
+from .._jit import jit
 from ..laws.discrete import discrete_step_jvp
+from ..systems import Contact, System
 from ._aft import _eval_kernel, _initial_state_derivatives, fourier_matrices
 
 __all__ = ["HBProblem", "PARAMETERS"]
@@ -44,8 +45,8 @@ class _Eval:
     R: np.ndarray
     JX: np.ndarray
     Jp: np.ndarray
-    T: list
-    code: list
+    T: np.ndarray  # (contacts, Ns): force samples of each contact, N (a row per contact)
+    code: np.ndarray  # (contacts, Ns): motion-state codes of each contact
     info: np.ndarray
 
 
@@ -56,6 +57,28 @@ def _pad_rows(rows, width=None):
     for i, r in enumerate(rows):
         out[i, : len(r)] = r
     return out
+
+
+@jit
+def _extrema(Ef, c):  # pragma: no cover - compiled
+    """(max, min) of x = Ef c with the parabolic refinement of HBProblem._peak."""
+    x = Ef @ c
+    n = x.size
+    hi_i = np.argmax(x)
+    lo_i = np.argmin(x)
+    out = np.empty(2)
+    for k in range(2):
+        i = hi_i if k == 0 else lo_i
+        xm = x[(i - 1) % n]
+        x0 = x[i]
+        xp = x[(i + 1) % n]
+        den = xm - 2.0 * x0 + xp
+        pk = x0 if den == 0.0 else x0 - 0.125 * (xp - xm) ** 2 / den
+        if k == 0:
+            out[0] = x0 if pk < x0 else pk  # max(peak, grid max)
+        else:
+            out[1] = x0 if pk > x0 else pk  # min(peak, grid min)
+    return out[0], out[1]
 
 
 def _eval_kernel_no_contact():
@@ -301,7 +324,7 @@ class HBProblem:
         self._kernel(AK, AC, AM, float(w), float(dwdp), X, Fe, Fp, self._Bm, self._Pm, S0, SX, SN, self.E, self.P,
                      Nsamp, dN if has_p else self._dummy, has_p, int(self.max_passes),
                      float(config.HB_PERIODIC_RTOL), R, JX, Jp, T, code, info)
-        return _Eval(R, JX, Jp, list(T), list(code), info)
+        return _Eval(R, JX, Jp, T, code, info)
 
     # --- post-processing ----------------------------------------------------
     def reconstruct(self, X, dof: int, points: int = 1024):
@@ -330,12 +353,15 @@ class HBProblem:
         """(half peak-to-peak, mean, max |x|) of x_dof(t), m.
 
         Extrema located on 1024 samples per period and refined by a
-        parabola through the three samples around each.
+        parabola through the three samples around each (:meth:`_peak`;
+        compiled in :func:`_extrema`).
         """
-        x = self.reconstruct(X, dof)
-        hi = max(self._peak(x, int(np.argmax(x))), float(x.max()))
-        lo = min(self._peak(x, int(np.argmin(x))), float(x.min()))
-        c0 = float(X.reshape(self.nh, self.n)[0, dof])
+        Ef = self._fine.get(1024)
+        if Ef is None:
+            Ef = self._fine[1024] = fourier_matrices(self.H, 1024)[0]
+        Xm = np.asarray(X, dtype=np.float64).reshape(self.nh, self.n)
+        hi, lo = _extrema(Ef, np.ascontiguousarray(Xm[:, dof]))
+        c0 = float(Xm[0, dof])
         return 0.5 * (hi - lo), c0, max(abs(hi), abs(lo))
 
     def first_harmonic_amplitude(self, X, dof: int) -> float:

@@ -118,6 +118,22 @@ def _hill_eigvals(D2iJ, JX, B1c, B1w, w):  # pragma: no cover - compiled
     return eigvals_inplace(A)
 
 
+@jit
+def _select(lam, w, m):  # pragma: no cover - compiled
+    """The m eigenvalues with the smallest |Im| / w (rounded to 1e-8), by decreasing real part.
+
+    Returns ``(selected, tie)``; ``tie`` is True when the m-th and the
+    (m+1)-th smallest keys are equal (the caller then breaks the tie by the
+    eigenvector centroid).
+    """
+    key = np.round(np.abs(lam.imag) / w, 8)
+    order = np.argsort(key, kind="mergesort")  # stable, as NumPy's kind="stable"
+    tie = order.size > m and key[order[m]] == key[order[m - 1]]
+    sel = lam[order[:m]]
+    sel = sel[np.argsort(-sel.real, kind="mergesort")]
+    return sel, tie
+
+
 def _hill_matrix(JX, M, C, w, H):
     """The companion matrix of :func:`_hill_eigvals`, built with NumPy."""
     N = M.shape[0] * (2 * H + 1)
@@ -162,17 +178,15 @@ def hill_exponents(JX, M, C, w, H):
     lam, ok = _hill_eigvals(D2iJ_pre, np.ascontiguousarray(JX, dtype=np.float64), B1[0], B1[1], float(w))
     if not ok:
         lam = np.linalg.eigvals(_hill_matrix(JX, M, C, w, H))
-    key_imag = np.round(np.abs(lam.imag) / w, 8)
-    order = np.argsort(key_imag, kind="stable")
-    cut = key_imag[order[2 * n - 1]]
-    if order.size > 2 * n and key_imag[order[2 * n]] == cut:
+    sel, tie = _select(lam, float(w), 2 * n)
+    if tie:
         # a tie at the cut: break it by the eigenvector centroid
         lam, V = np.linalg.eig(_hill_matrix(JX, M, C, w, H))
         key_imag = np.round(np.abs(lam.imag) / w, 8)
         cen = _centroids(V, n, H)
         order = np.lexsort((np.abs(cen), key_imag))
-    sel = lam[order[: 2 * n]]
-    sel = sel[np.argsort(-sel.real, kind="stable")]
+        sel = lam[order[: 2 * n]]
+        sel = sel[np.argsort(-sel.real, kind="stable")]
     return sel, lam
 
 
