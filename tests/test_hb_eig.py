@@ -88,3 +88,25 @@ def test_hill_matrices_along_a_branch_match_lapack():
     for i in range(0, br.lam.size, 3):
         ev = p.evaluate(br.X[i], br.lam[i])
         _check(_hill_matrix(ev.JX, p.system.M, p.system.C, p.omega(br.lam[i]), p.H), 1e-12)
+
+
+@pytest.mark.parametrize("eta,splits", [(0.0, True), (0.5, False)])
+def test_hill_parity_split_matches_lapack(eta, splits):
+    # constant normal load: the orbit is half-wave symmetric, Hill's matrix
+    # is block diagonal in the harmonic parity and is solved by blocks; a
+    # varying load couples the parities and the whole matrix is solved
+    from jointdyn.hb import continue_hb
+    from jointdyn.hb.stability import _hill_eigvals, _hill_matrix, _hill_parts
+
+    br = continue_hb(System.paper_damper(eta=eta, beta=2.0, model="iwan"), 0.9, 1.5, progress=False)
+    p = br.problem
+    D2iJ, B1, _, parity = _hill_parts(p.system.M, p.system.C, p.H)
+    for i in range(0, br.lam.size, 4):
+        ev = p.evaluate(br.X[i], br.lam[i])
+        w = p.omega(br.lam[i])
+        lam, ok = _hill_eigvals(D2iJ, ev.JX, B1[0], B1[1], w, parity)
+        whole, _ = _hill_eigvals(D2iJ, ev.JX, B1[0], B1[1], w, np.zeros_like(parity))
+        assert ok
+        assert (not np.array_equal(lam, whole)) == splits
+        ref = np.linalg.eigvals(_hill_matrix(ev.JX, p.system.M, p.system.C, w, p.H))
+        assert _match_error(lam, ref) <= 1e-12 * w

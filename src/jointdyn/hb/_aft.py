@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import specialize
+from .._jit import jit, specialize
 
 __all__ = ["fourier_matrices"]
 
@@ -50,7 +50,7 @@ def fourier_matrices(harmonics: int, samples: int):
 
 
 def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsamp, dN, has_p, max_passes, rtol,
-                   R, JX, Jp, T, code, info):  # pragma: no cover - compiled
+                   R, JX, Jp, T, code, info, scl, Rs, JXs, Jps):  # pragma: no cover - compiled
     """Whole HB residual and Jacobian in one call: linear part + AFT of every contact.
 
     Linear part (``problem.py``): ``A = AK + w AC + w^2 AM``, ``R = A X - Fe``,
@@ -74,7 +74,10 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
     ``T[c]``, ``code[c]``: force samples and motion codes of the last
     pass; ``info = [max passes, max |T_p - T_(p-1)| (0 when the end states
     repeated), worst period (1, 2; 0 if a force did not repeat within
-    max_passes)]`` over the contacts.
+    max_passes)]`` over the contacts. When ``scl[0] > 0`` the scaled copies
+    ``Rs = R / scl[0]``, ``JXs = JX * scl[1]``, ``Jps = Jp * scl[2]`` are
+    written too (the continuation's unknowns and residual in units of
+    order one).
     """
     size = X.shape[0]
     n = Bm.shape[1]
@@ -98,6 +101,7 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
     info[1] = 0.0
     info[2] = 1.0
     if nc == 0:
+        _scale_outputs(R, JX, Jp, scl, Rs, JXs, Jps)
         return
     # directions of a sample: dx = E[i] (and 0 for the parameter), dN = dN[c, i]
     # on the parameter direction; copied into fixed buffers (cheaper than views)
@@ -225,6 +229,18 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
         # worst case over the contacts: 0 (not repeated) < 2 < 1
         if period == 0.0 or (period == 2.0 and info[2] == 1.0):
             info[2] = period
+    _scale_outputs(R, JX, Jp, scl, Rs, JXs, Jps)
+
+
+@jit(inline="always")
+def _scale_outputs(R, JX, Jp, scl, Rs, JXs, Jps):  # pragma: no cover - compiled
+    if scl[0] > 0.0:
+        size = R.shape[0]
+        for i in range(size):
+            Rs[i] = R[i] / scl[0]
+            Jps[i] = Jp[i] * scl[2]
+            for j in range(size):
+                JXs[i, j] = JX[i, j] * scl[1]
 
 
 def _eval_kernel(law):

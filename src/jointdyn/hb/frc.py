@@ -235,12 +235,13 @@ def continue_hb(
     law = contact_of(system).law
     cache = {}
 
+    scales = (xs, fs, ls)
+
     def residual(y, lam_s):
-        lam = lam_s * ls
-        X = y * xs
-        ev = problem.evaluate(X, lam)
+        # scaled residual and Jacobians: R / fs, JX xs / fs, Jp ls / fs
+        ev = problem.evaluate(y * xs, lam_s * ls, scales)
         cache["ev"] = ev
-        return ev.R / fs, ev.JX * (xs / fs), ev.Jp * (ls / fs)
+        return ev.scaled
 
     def qamp(X):
         return law.kt * problem.amplitudes(X, 0)[0] / law.fy if law.fy > 0 else 0.0

@@ -48,6 +48,8 @@ class _Eval:
     T: np.ndarray  # (contacts, Ns): force samples of each contact, N (a row per contact)
     code: np.ndarray  # (contacts, Ns): motion-state codes of each contact
     info: np.ndarray
+    #: (R, JX, Jp) scaled as asked by ``HBProblem.evaluate(..., scales=)`` (else None)
+    scaled: tuple | None = None
 
 
 def _pad_rows(rows, width=None):
@@ -161,6 +163,8 @@ class HBProblem:
         self._fixed_loads = None
         self._zero = np.zeros(self.size)
         self._dummy = np.zeros((1, 1))
+        self._zero1 = np.zeros(1)
+        self._noscale = np.zeros(3)
 
     # --- parameter handling -------------------------------------------------
     def parameter_value(self) -> float:
@@ -295,12 +299,14 @@ class HBProblem:
 
     _forcing_fixed = None
 
-    def evaluate(self, X, p) -> _Eval:
+    def evaluate(self, X, p, scales=None) -> _Eval:
         """Residual R (N), dR/dX (N/m) and dR/dp at coefficients X and parameter p.
 
         One compiled call (:func:`jointdyn.hb._aft._eval_template`): linear
         part, AFT of every contact with exact forward-mode derivatives, and
-        the scatter into R, dR/dX, dR/dp.
+        the scatter into R, dR/dX, dR/dp. With ``scales = (xs, fs, ps)``
+        (unknowns, forces and parameter scales) the same call also fills
+        ``scaled = (R / fs, JX * (xs / fs), Jp * (ps / fs))``.
         """
         X = np.ascontiguousarray(X, dtype=np.float64)
         w, dwdp, Fe, Fp, Nsamp, dN, SX, SN = self._eval_inputs(p)
@@ -321,10 +327,16 @@ class HBProblem:
         code = np.empty((nc, self.Ns), dtype=np.int64)
         info = np.empty(3)
         has_p = dN is not None
+        if scales is None:
+            scl, Rs, JXs, Jps = self._noscale, self._zero1, self._dummy, self._zero1
+        else:
+            xs, fs, ps = scales
+            scl = np.array([fs, xs / fs, ps / fs])
+            Rs, JXs, Jps = np.empty(self.size), np.empty((self.size, self.size)), np.empty(self.size)
         self._kernel(AK, AC, AM, float(w), float(dwdp), X, Fe, Fp, self._Bm, self._Pm, S0, SX, SN, self.E, self.P,
                      Nsamp, dN if has_p else self._dummy, has_p, int(self.max_passes),
-                     float(config.HB_PERIODIC_RTOL), R, JX, Jp, T, code, info)
-        return _Eval(R, JX, Jp, T, code, info)
+                     float(config.HB_PERIODIC_RTOL), R, JX, Jp, T, code, info, scl, Rs, JXs, Jps)
+        return _Eval(R, JX, Jp, T, code, info, None if scales is None else (Rs, JXs, Jps))
 
     # --- post-processing ----------------------------------------------------
     def reconstruct(self, X, dof: int, points: int = 1024):
