@@ -98,10 +98,15 @@ class HBBranch:
         self.force_period = np.zeros(n, dtype=int)
         sysm = problem.system
         evaluations = {} if evaluations is None else evaluations
+        #: (half peak-to-peak, mean, max |x|) of DOF 0 per point where the
+        #: continuation monitor computed them (NaN elsewhere)
+        self._response0 = np.full((n, 3), np.nan)
         for i in range(n):
             ev = evaluations.get(float(lam[i]))
             if ev is None or not np.array_equal(ev[0], X[i]):
                 ev = (X[i], problem.evaluate(X[i], lam[i]))
+            elif len(ev) > 2:
+                self._response0[i] = ev[2]
             ev = ev[1]
             st, g, _ = hill_stability(ev.JX, sysm.M, sysm.C, problem.omega(lam[i]), problem.H)
             self.stable[i] = st
@@ -118,7 +123,12 @@ class HBBranch:
 
     def response(self, dof: int = 0):
         """(amplitude_m, offset_m, max_abs_m) per point for DOF ``dof``."""
-        out = np.array([self.problem.amplitudes(x, dof) for x in self.X]).reshape(-1, 3)
+        out = np.empty((self.lam.size, 3))
+        for i, x in enumerate(self.X):
+            if dof == 0 and not np.isnan(self._response0[i, 0]):
+                out[i] = self._response0[i]  # computed by the monitor for the same X
+            else:
+                out[i] = self.problem.amplitudes(x, dof)
         return out[:, 0], out[:, 1], out[:, 2]
 
 
@@ -243,17 +253,21 @@ def continue_hb(
         cache["ev"] = ev
         return ev.scaled
 
-    def qamp(X):
-        return law.kt * problem.amplitudes(X, 0)[0] / law.fy if law.fy > 0 else 0.0
+    def qamp(X, amps=None):
+        if amps is None:
+            amps = problem.amplitudes(X, 0)
+        return law.kt * amps[0] / law.fy if law.fy > 0 else 0.0
 
     evaluations = {}
 
     def monitor(y, lam_s):
         X = y * xs
-        q = qamp(X)
+        amps = problem.amplitudes(X, 0)
+        q = qamp(X, amps)
         lam = lam_s * ls
         if "ev" in cache:
-            evaluations[float(lam)] = (X, cache["ev"])
+            # kept for the stability and the response of the accepted point
+            evaluations[float(lam)] = (X, cache["ev"], amps)
         if not np.isfinite(q) or q > config.HB_UNBOUNDED_Q:
             return "unbounded", f"q = kt X / fy = {q:.4g} exceeds {config.HB_UNBOUNDED_Q:g} at {parameter} = {lam:.6g}"
         ev = cache.get("ev")

@@ -298,6 +298,7 @@ class HBProblem:
         return w, dwdp, Fe, Fp, Nsamp, dN, SX, SN
 
     _forcing_fixed = None
+    _scales_seen = None
 
     def evaluate(self, X, p, scales=None) -> _Eval:
         """Residual R (N), dR/dX (N/m) and dR/dp at coefficients X and parameter p.
@@ -313,13 +314,20 @@ class HBProblem:
         AK, AC, AM = self._linear_parts()
         nc = len(self.contacts)
         # virgin state of each contact at its mean displacement and first load
-        S0 = np.zeros((nc, self._ssz))
         n = self.n
+        S0 = None
         for k, c in enumerate(self.contacts):
             b = self._Bm[k]
             u0 = float(X[0] * b[0]) if n == 1 else float(X[:n] @ b)
             s0 = c.law.initial_state(u0, float(Nsamp[k, 0]))
-            S0[k, : s0.size] = s0
+            if nc == 1 and s0.size == self._ssz and s0.dtype == np.float64:
+                S0 = s0.reshape(1, -1)
+            else:
+                if S0 is None:
+                    S0 = np.zeros((nc, self._ssz))
+                S0[k, : s0.size] = s0
+        if S0 is None:
+            S0 = np.zeros((0, self._ssz))
         R = np.empty(self.size)
         JX = np.empty((self.size, self.size))
         Jp = np.empty(self.size)
@@ -330,8 +338,11 @@ class HBProblem:
         if scales is None:
             scl, Rs, JXs, Jps = self._noscale, self._zero1, self._dummy, self._zero1
         else:
-            xs, fs, ps = scales
-            scl = np.array([fs, xs / fs, ps / fs])
+            if scales is not self._scales_seen:
+                xs, fs, ps = scales
+                self._scl = np.array([fs, xs / fs, ps / fs])
+                self._scales_seen = scales
+            scl = self._scl
             Rs, JXs, Jps = np.empty(self.size), np.empty((self.size, self.size)), np.empty(self.size)
         self._kernel(AK, AC, AM, float(w), float(dwdp), X, Fe, Fp, self._Bm, self._Pm, S0, SX, SN, self.E, self.P,
                      Nsamp, dN if has_p else self._dummy, has_p, int(self.max_passes),

@@ -189,6 +189,16 @@ def _select(lam, w, m):  # pragma: no cover - compiled
     return sel, tie
 
 
+@jit
+def _hill_core(D2iJ, JX, B1c, B1w, w, parity, m):  # pragma: no cover - compiled
+    """:func:`_hill_eigvals` and :func:`_select` in one call: ``(selected, all, ok, tie)``."""
+    lam, ok = _hill_eigvals(D2iJ, JX, B1c, B1w, w, parity)
+    if not ok:
+        return lam[:m], lam, False, False
+    sel, tie = _select(lam, w, m)
+    return sel, lam, True, tie
+
+
 def _hill_matrix(JX, M, C, w, H):
     """The companion matrix of :func:`_hill_eigvals`, built with NumPy."""
     N = M.shape[0] * (2 * H + 1)
@@ -230,10 +240,11 @@ def hill_exponents(JX, M, C, w, H):
     """
     n = M.shape[0]
     D2iJ_pre, B1, _, parity = _hill_parts(M, C, H)
-    lam, ok = _hill_eigvals(D2iJ_pre, np.ascontiguousarray(JX, dtype=np.float64), B1[0], B1[1], float(w), parity)
+    sel, lam, ok, tie = _hill_core(D2iJ_pre, np.ascontiguousarray(JX, dtype=np.float64), B1[0], B1[1], float(w),
+                                   parity, 2 * n)
     if not ok:
         lam = np.linalg.eigvals(_hill_matrix(JX, M, C, w, H))
-    sel, tie = _select(lam, float(w), 2 * n)
+        sel, tie = _select(lam, float(w), 2 * n)
     if tie:
         # a tie at the cut: break it by the eigenvector centroid
         lam, V = np.linalg.eig(_hill_matrix(JX, M, C, w, H))
@@ -251,7 +262,7 @@ def hill_stability(JX, M, C, w, H, rtol: float = config.HB_STABILITY_RTOL):
     See the module docstring for the method and references.
     """
     sel, _ = hill_exponents(JX, M, C, w, H)
-    growth = float(np.max(sel.real)) / w
+    growth = float(sel[0].real) / w  # sel is sorted by decreasing real part
     mult = np.exp(sel * 2.0 * np.pi / w)
     return growth <= rtol, growth, mult
 
