@@ -119,6 +119,12 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
     T1 = np.empty(ns)
     T2 = np.empty(ns)
     dT1 = np.empty((ns, nd))
+    # committed states of the first pass at every sample (small states only):
+    # the second pass (usually the last) stops marching once they repeat
+    hist = ssz <= _HIST_MAX_STATE
+    Sh = np.empty((ns if hist else 0, ssz))
+    dSh = np.empty((ns if hist else 0, ssz, nd))
+    cprev = np.empty(ns, dtype=code.dtype)
     for c in range(nc):
         for h in range(nh):
             acc = 0.0
@@ -172,6 +178,33 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
                 code[c, i] = c_
                 a, bb = bb, a
                 da, dbb = dbb, da
+                if hist:
+                    if passes == 1 and _same_bits(a, da, Sh, dSh, i):
+                        # the state and its derivatives after sample i are those of
+                        # the previous pass after sample i: the rest of this pass
+                        # repeats the previous one bit for bit (same kernel, same
+                        # inputs), so it is copied instead of marched
+                        for j in range(i + 1, ns):
+                            t_ = T1[j]
+                            e = abs(t_ - T2[j])
+                            if e > err2:
+                                err2 = e
+                            if abs(t_) > tmax:
+                                tmax = abs(t_)
+                            Tc[j] = t_
+                            for d in range(nd):
+                                dT[j, d] = dT1[j, d]
+                            code[c, j] = cprev[j]
+                        for r_ in range(ssz):
+                            a[r_] = Sh[ns - 1, r_]
+                            for d in range(nd):
+                                da[r_, d] = dSh[ns - 1, r_, d]
+                        break
+                    if passes == 0:
+                        for r_ in range(ssz):
+                            Sh[i, r_] = a[r_]
+                            for d in range(nd):
+                                dSh[i, r_, d] = da[r_, d]
             passes += 1
             if passes >= 2 and err <= rtol * tmax:
                 period = 1.0
@@ -203,6 +236,7 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
             T1, T2 = T2, T1
             for i in range(ns):
                 T1[i] = Tc[i]
+                cprev[i] = code[c, i]
             dT, dT1 = dT1, dT
         for i in range(ns):
             T[c, i] = Tc[i]
@@ -230,6 +264,29 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
         if period == 0.0 or (period == 2.0 and info[2] == 1.0):
             info[2] = period
     _scale_outputs(R, JX, Jp, scl, Rs, JXs, Jps)
+
+
+#: the march keeps the previous pass's states (and derivatives) at every
+#: sample, to stop marching once they repeat, for laws with states of at
+#: most this many entries (storing is then cheaper than the kernel calls)
+_HIST_MAX_STATE = 16
+
+
+@jit(inline="always")
+def _same_bits(a, da, Sh, dSh, i):  # pragma: no cover - compiled
+    """True if (a, da) equal (Sh[i], dSh[i]) entry by entry, signs of zeros included."""
+    for r in range(a.shape[0]):
+        x = a[r]
+        y = Sh[i, r]
+        if x != y or (x == 0.0 and np.copysign(1.0, x) != np.copysign(1.0, y)):
+            return False
+    for r in range(da.shape[0]):
+        for d in range(da.shape[1]):
+            x = da[r, d]
+            y = dSh[i, r, d]
+            if x != y or (x == 0.0 and np.copysign(1.0, x) != np.copysign(1.0, y)):
+                return False
+    return True
 
 
 @jit(inline="always")
