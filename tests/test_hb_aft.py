@@ -2,8 +2,10 @@
 plain-Python reference of the same AFT march: every pass marched in full,
 the law's kernels called one sample at a time from Python. Covers the
 shortcut of the compiled march (a pass stops once the state and its
-derivatives repeat those of the previous pass) on stuck, slipping and
-separating orbits, with and without a parameter direction."""
+derivatives repeat, to HB_PERIODIC_RTOL, those of the first pass at the
+same sample; the rest of the pass is then copied) on stuck, slipping and
+separating orbits, with and without a parameter direction: the results
+agree to rounding."""
 
 import numpy as np
 import pytest

@@ -71,6 +71,13 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
     a period-2 force under a period-1 displacement), the force and its
     derivatives are the mean of the last two passes, which is the exact
     projection of the 2T-periodic force on the T-periodic harmonics.
+    For laws with small states (at most ``_HIST_MAX_STATE`` entries) the
+    first pass's committed states and derivatives are kept at every
+    sample; once the second pass reaches, at some sample, the same state
+    and derivatives (to ``rtol``, entry by entry, the criterion of the
+    end-of-pass test), the rest of the pass would repeat the first one
+    and is copied from it instead of marched (saves most of the second
+    pass: the result agrees with the full march to rounding).
     ``T[c]``, ``code[c]``: force samples and motion codes of the last
     pass; ``info = [max passes, max |T_p - T_(p-1)| (0 when the end states
     repeated), worst period (1, 2; 0 if a force did not repeat within
@@ -179,11 +186,12 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
                 a, bb = bb, a
                 da, dbb = dbb, da
                 if hist:
-                    if passes == 1 and _same_bits(a, da, Sh, dSh, i):
+                    if passes == 1 and _same_state(a, da, Sh, dSh, i, rtol):
                         # the state and its derivatives after sample i are those of
-                        # the previous pass after sample i: the rest of this pass
-                        # repeats the previous one bit for bit (same kernel, same
-                        # inputs), so it is copied instead of marched
+                        # the first pass after sample i (to rtol, entry by entry,
+                        # as the end-of-pass test below): the rest of this pass
+                        # repeats the first one (same kernel, same inputs), so it
+                        # is copied instead of marched
                         for j in range(i + 1, ns):
                             t_ = T1[j]
                             e = abs(t_ - T2[j])
@@ -273,18 +281,18 @@ _HIST_MAX_STATE = 16
 
 
 @jit(inline="always")
-def _same_bits(a, da, Sh, dSh, i):  # pragma: no cover - compiled
-    """True if (a, da) equal (Sh[i], dSh[i]) entry by entry, signs of zeros included."""
+def _same_state(a, da, Sh, dSh, i, rtol):  # pragma: no cover - compiled
+    """True if (a, da) equal (Sh[i], dSh[i]) to ``rtol`` relative, entry by entry (False on NaN)."""
     for r in range(a.shape[0]):
         x = a[r]
         y = Sh[i, r]
-        if x != y or (x == 0.0 and np.copysign(1.0, x) != np.copysign(1.0, y)):
+        if not abs(x - y) <= rtol * max(abs(x), abs(y)):
             return False
     for r in range(da.shape[0]):
         for d in range(da.shape[1]):
             x = da[r, d]
             y = dSh[i, r, d]
-            if x != y or (x == 0.0 and np.copysign(1.0, x) != np.copysign(1.0, y)):
+            if not abs(x - y) <= rtol * max(abs(x), abs(y)):
                 return False
     return True
 
