@@ -49,6 +49,20 @@ def fourier_matrices(harmonics: int, samples: int):
     return E, P
 
 
+_FOURIER: dict = {}
+
+
+def _fourier_shared(harmonics: int, samples: int):
+    """:func:`fourier_matrices`, built once per (H, Ns) and shared (callers must not write to them)."""
+    key = (int(harmonics), int(samples))
+    hit = _FOURIER.get(key)
+    if hit is None:
+        if len(_FOURIER) > 64:
+            _FOURIER.clear()
+        hit = _FOURIER[key] = fourier_matrices(*key)
+    return hit
+
+
 def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsamp, dN, has_p, max_passes, rtol,
                    R, JX, Jp, T, code, info, scl, Rs, JXs, Jps):  # pragma: no cover - compiled
     """Whole HB residual and Jacobian in one call: linear part + AFT of every contact.

@@ -392,11 +392,11 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
     }
     if branch.parameter != "gamma":
         data[branch.parameter] = ("point", branch.lam)
+    attrs = {"gamma": {"long_name": "w / w0"}, "amplitude_q": {"long_name": "kt X / fy", "units": "1"},
+             **{v: {"units": "m"} for v in ("amplitude_m", "offset_m", "max_abs_m", "harmonic_amplitude_m")}}
+    # variables built with their attributes (no DataArray round trips afterwards)
+    data = {k: xr.Variable(dims, np.asarray(v), attrs=attrs.get(k)) for k, (dims, v) in data.items()}
     ds = xr.Dataset(data, coords={"point": np.arange(branch.lam.size), "harmonic": np.arange(p.H + 1)})
-    ds["gamma"].attrs.update(long_name="w / w0")
-    ds["amplitude_q"].attrs.update(long_name="kt X / fy", units="1")
-    for v in ("amplitude_m", "offset_m", "max_abs_m", "harmonic_amplitude_m"):
-        ds[v].attrs["units"] = "m"
     ds.attrs.update(
         status=branch.status,
         message=branch.message,

@@ -32,7 +32,7 @@ from .. import config
 from .._jit import jit
 from ..laws.discrete import discrete_step_jvp
 from ..systems import Contact, System
-from ._aft import _eval_kernel, _initial_state_derivatives, fourier_matrices
+from ._aft import _eval_kernel, _fourier_shared, _initial_state_derivatives
 
 __all__ = ["HBProblem", "PARAMETERS"]
 
@@ -136,7 +136,7 @@ class HBProblem:
         self.w0 = system.w0
         if not self.w0 > 0:
             raise ValueError("system must have a positive lowest natural frequency w0 (K positive definite)")
-        self.E, self.P = fourier_matrices(self.H, self.Ns)
+        self.E, self.P = _fourier_shared(self.H, self.Ns)
         self.tau = 2.0 * np.pi * np.arange(self.Ns) / self.Ns
         self._fine = {}
         self._lin = None
@@ -354,7 +354,7 @@ class HBProblem:
         """x_dof(tau) on a fine grid of ``points`` samples over one period, m."""
         Ef = self._fine.get(points)
         if Ef is None:
-            Ef = self._fine[points] = fourier_matrices(self.H, points)[0]
+            Ef = self._fine[points] = _fourier_shared(self.H, points)[0]
         return Ef @ X.reshape(self.nh, self.n)[:, dof]
 
     @staticmethod
@@ -381,7 +381,7 @@ class HBProblem:
         """
         Ef = self._fine.get(1024)
         if Ef is None:
-            Ef = self._fine[1024] = fourier_matrices(self.H, 1024)[0]
+            Ef = self._fine[1024] = _fourier_shared(self.H, 1024)[0]
         Xm = np.asarray(X, dtype=np.float64).reshape(self.nh, self.n)
         hi, lo = _extrema(Ef, np.ascontiguousarray(Xm[:, dof]))
         c0 = float(Xm[0, dof])
