@@ -180,6 +180,10 @@ _NO_D = np.zeros(0)
 def _as_arrays(R, Jy, Jl):
     """(R, R_y, R_lam) as C-contiguous float64 arrays of dims 1, 2, 1 (no copy when they are)."""
     f = np.float64
+    if (type(R) is np.ndarray and type(Jy) is np.ndarray and type(Jl) is np.ndarray and R.dtype == f
+            and Jy.dtype == f and Jl.dtype == f and R.ndim == 1 and Jy.ndim == 2 and Jl.ndim == 1
+            and R.flags.c_contiguous and Jy.flags.c_contiguous and Jl.flags.c_contiguous):
+        return R, Jy, Jl
     R = np.ascontiguousarray(R, dtype=f).reshape(-1)
     return R, np.ascontiguousarray(Jy, dtype=f).reshape(R.size, -1), np.ascontiguousarray(Jl, dtype=f).reshape(-1)
 

@@ -44,7 +44,7 @@ from ..laws import MACROSLIP, SEPARATION
 from ..systems import System
 from .continuation import ContinuationResult, continuation
 from .problem import PARAMETERS, HBProblem, contact_of
-from .stability import hill_stability
+from .stability import hill_growth, hill_stability
 
 __all__ = ["HBBranch", "HBSolution", "continue_hb", "frc_hb", "branch_dataset", "harmonic_balance"]
 
@@ -101,6 +101,7 @@ class HBBranch:
         #: (half peak-to-peak, mean, max |x|) of DOF 0 per point where the
         #: continuation monitor computed them (NaN elsewhere)
         self._response0 = np.full((n, 3), np.nan)
+        JXs = np.empty((n, problem.size, problem.size))
         for i in range(n):
             ev = evaluations.get(float(lam[i]))
             if ev is None or not np.array_equal(ev[0], X[i]):
@@ -108,12 +109,13 @@ class HBBranch:
             elif len(ev) > 2:
                 self._response0[i] = ev[2]
             ev = ev[1]
-            st, g, _ = hill_stability(ev.JX, sysm.M, sysm.C, problem.omega(lam[i]), problem.H)
-            self.stable[i] = st
-            self.growth[i] = g
+            JXs[i] = ev.JX
             self.passes[i] = int(ev.info[0])
             self.periodic_error[i] = ev.info[1]
             self.force_period[i] = int(ev.info[2])
+        # Hill stability of every point (hill_stability's criterion), one compiled loop
+        self.growth = hill_growth(JXs, sysm.M, sysm.C, np.array([problem.omega(v) for v in lam]), problem.H)
+        self.stable = self.growth <= config.HB_STABILITY_RTOL
 
     def gamma(self):
         """gamma = w / w0 per point."""

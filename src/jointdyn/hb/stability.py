@@ -50,7 +50,7 @@ from ..drivers import march
 from ..laws import MACROSLIP, SEPARATION
 from ._eig import eigvals_inplace
 
-__all__ = ["hill_exponents", "hill_stability", "monodromy_multipliers", "derivative_matrix"]
+__all__ = ["hill_exponents", "hill_stability", "hill_growth", "monodromy_multipliers", "derivative_matrix"]
 
 
 def derivative_matrix(H: int) -> np.ndarray:
@@ -254,6 +254,40 @@ def hill_exponents(JX, M, C, w, H):
         sel = lam[order[: 2 * n]]
         sel = sel[np.argsort(-sel.real, kind="stable")]
     return sel, lam
+
+
+@jit
+def _hill_growth_batch(D2iJ, JXs, B1c, B1w, ws, parity, m):  # pragma: no cover - compiled
+    """max Re(s) / w of the selected exponents of many points; (growth, ok) with ok False where
+    the QR iteration failed or the selection has a tie (the caller recomputes those)."""
+    P = JXs.shape[0]
+    growth = np.empty(P)
+    ok = np.empty(P, dtype=np.bool_)
+    for k in range(P):
+        sel, lam, good, tie = _hill_core(D2iJ, JXs[k], B1c, B1w, ws[k], parity, m)
+        ok[k] = good and not tie
+        growth[k] = sel[0].real / ws[k]
+    return growth, ok
+
+
+def hill_growth(JXs, M, C, ws, H):
+    """max Re(s) / w of the selected Floquet exponents at many points (one compiled loop).
+
+    ``JXs`` (points, N, N) are the HB Jacobians and ``ws`` (points,) the
+    angular frequencies; the same exponents as :func:`hill_exponents`
+    (points with a tie at the selection cut or a QR failure go through it).
+    """
+    JXs = np.ascontiguousarray(JXs, dtype=np.float64)
+    ws = np.ascontiguousarray(ws, dtype=np.float64)
+    n = M.shape[0]
+    if JXs.shape[0] == 0:
+        return np.empty(0)
+    D2iJ_pre, B1, _, parity = _hill_parts(M, C, H)
+    growth, ok = _hill_growth_batch(D2iJ_pre, JXs, B1[0], B1[1], ws, parity, 2 * n)
+    for k in np.flatnonzero(~ok):
+        sel, _ = hill_exponents(JXs[k], M, C, ws[k], H)
+        growth[k] = float(sel[0].real) / ws[k]
+    return growth
 
 
 def hill_stability(JX, M, C, w, H, rtol: float = config.HB_STABILITY_RTOL):
