@@ -131,6 +131,53 @@ def _bordered(Jy, Jl, d):  # pragma: no cover - compiled
 
 
 @jit
+def _lu_solve(A, b):  # pragma: no cover - compiled
+    """Solve A x = b in place by Gaussian elimination with partial pivoting.
+
+    The algorithm of LAPACK ``dgesv`` (row interchanges by the largest
+    pivot, LU factors overwrite A, b becomes x), written out: the systems
+    here are small (n(2H+1) + 1) and NumPy's per-call overhead and Numba's
+    LAPACK bindings (slow to compile) cost more than the arithmetic.
+    Returns False for an exactly singular matrix (a zero pivot, where
+    ``dgesv`` reports info > 0) or a non-finite solution.
+    """
+    n = A.shape[0]
+    for k in range(n):
+        p = k
+        amax = abs(A[k, k])
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > amax:
+                amax = abs(A[i, k])
+                p = i
+        if amax == 0.0 or amax != amax:
+            return False
+        if p != k:
+            for j in range(n):
+                t = A[k, j]
+                A[k, j] = A[p, j]
+                A[p, j] = t
+            t = b[k]
+            b[k] = b[p]
+            b[p] = t
+        piv = A[k, k]
+        for i in range(k + 1, n):
+            f = A[i, k] / piv
+            if f != 0.0:
+                A[i, k] = f
+                for j in range(k + 1, n):
+                    A[i, j] -= f * A[k, j]
+                b[i] -= f * b[k]
+    for i in range(n - 1, -1, -1):
+        acc = b[i]
+        for j in range(i + 1, n):
+            acc -= A[i, j] * b[j]
+        b[i] = acc / A[i, i]
+        if not np.isfinite(b[i]):
+            return False
+    return True
+
+
+@jit
 def _newton_direction(Jy, Jl, d, R, v, u_pred):  # pragma: no cover - compiled
     """Newton step of R(y, lam) = 0 (and d^T (v - u_pred) = 0 when d has entries).
 
@@ -147,14 +194,8 @@ def _newton_direction(Jy, Jl, d, R, v, u_pred):  # pragma: no cover - compiled
         for i in range(m):
             c += d[i] * (v[i] - u_pred[i])
         rhs[n] = -c
-    try:
-        dv = np.linalg.solve(A, rhs)
-    except Exception:  # singular to machine precision (LAPACK info > 0)
-        return rhs, False
-    for i in range(m):
-        if not np.isfinite(dv[i]):
-            return dv, False
-    return dv, True
+    ok = _lu_solve(A, rhs)
+    return rhs, ok
 
 
 @jit
@@ -162,13 +203,14 @@ def _tangent_solve(Jy, Jl, t_prev):  # pragma: no cover - compiled
     """Unit t with [R_y R_lam] t = 0, t_prev^T t = 1 (normalised); ok flag."""
     n = Jy.shape[0]
     A = _bordered(Jy, Jl, t_prev)
-    rhs = np.zeros(n + 1)
-    rhs[n] = 1.0
-    try:
-        t = np.linalg.solve(A, rhs)
-    except Exception:
-        return rhs, False
-    nt = np.linalg.norm(t)
+    t = np.zeros(n + 1)
+    t[n] = 1.0
+    if not _lu_solve(A, t):
+        return t, False
+    nt = 0.0
+    for i in range(n + 1):
+        nt += t[i] * t[i]
+    nt = np.sqrt(nt)
     if not np.isfinite(nt) or nt == 0:
         return t, False
     return t / nt, True

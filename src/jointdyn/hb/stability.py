@@ -127,11 +127,14 @@ def _hill_eigvals(D2iJ, JX, B1c, B1w, w, parity):  # pragma: no cover - compiled
     N = JX.shape[0]
     M2 = 2 * N
     A = np.zeros((M2, M2))
-    K = D2iJ @ JX
     for i in range(N):
         A[i, N + i] = 1.0
+        for k in range(N):  # A[N:, :N] = -(D2i JX), written out (no BLAS binding to compile)
+            dik = D2iJ[i, k]
+            if dik != 0.0:
+                for j in range(N):
+                    A[N + i, j] -= dik * JX[k, j]
         for j in range(N):
-            A[N + i, j] = -K[i, j]
             A[N + i, N + j] = -(B1c[i, j] + w * B1w[i, j])
     nrm2 = 0.0
     cross2 = 0.0
@@ -179,24 +182,34 @@ def _select(lam, w, m):  # pragma: no cover - compiled
 
     Returns ``(selected, tie)``; ``tie`` is True when the m-th and the
     (m+1)-th smallest keys are equal (the caller then breaks the tie by the
-    eigenvector centroid).
+    eigenvector centroid). Keys are ``numpy.round(|Im| / w, 8)`` (NumPy's
+    rule: ``rint(x * 1e8) / 1e8``); both orderings are stable (insertion
+    sorts: the arrays hold 2 n (2H+1) and m entries).
     """
-    key = np.round(np.abs(lam.imag) / w, 8)
-    order = np.argsort(key, kind="mergesort")  # stable, as NumPy's kind="stable"
-    tie = order.size > m and key[order[m]] == key[order[m - 1]]
-    sel = lam[order[:m]]
-    sel = sel[np.argsort(-sel.real, kind="mergesort")]
+    N = lam.shape[0]
+    key = np.empty(N)
+    for i in range(N):
+        key[i] = np.rint(abs(lam[i].imag) / w * 1e8) / 1e8
+    order = np.arange(N)
+    for i in range(1, N):
+        j = i
+        while j > 0 and key[order[j - 1]] > key[order[j]]:
+            t = order[j - 1]
+            order[j - 1] = order[j]
+            order[j] = t
+            j -= 1
+    tie = N > m and key[order[m]] == key[order[m - 1]]
+    sel = np.empty(m, dtype=np.complex128)
+    for i in range(m):
+        sel[i] = lam[order[i]]
+    for i in range(1, m):
+        j = i
+        while j > 0 and -sel[j - 1].real > -sel[j].real:
+            t = sel[j - 1]
+            sel[j - 1] = sel[j]
+            sel[j] = t
+            j -= 1
     return sel, tie
-
-
-@jit
-def _hill_core(D2iJ, JX, B1c, B1w, w, parity, m):  # pragma: no cover - compiled
-    """:func:`_hill_eigvals` and :func:`_select` in one call: ``(selected, all, ok, tie)``."""
-    lam, ok = _hill_eigvals(D2iJ, JX, B1c, B1w, w, parity)
-    if not ok:
-        return lam[:m], lam, False, False
-    sel, tie = _select(lam, w, m)
-    return sel, lam, True, tie
 
 
 def _hill_matrix(JX, M, C, w, H):
@@ -240,11 +253,10 @@ def hill_exponents(JX, M, C, w, H):
     """
     n = M.shape[0]
     D2iJ_pre, B1, _, parity = _hill_parts(M, C, H)
-    sel, lam, ok, tie = _hill_core(D2iJ_pre, np.ascontiguousarray(JX, dtype=np.float64), B1[0], B1[1], float(w),
-                                   parity, 2 * n)
+    lam, ok = _hill_eigvals(D2iJ_pre, np.ascontiguousarray(JX, dtype=np.float64), B1[0], B1[1], float(w), parity)
     if not ok:
         lam = np.linalg.eigvals(_hill_matrix(JX, M, C, w, H))
-        sel, tie = _select(lam, float(w), 2 * n)
+    sel, tie = _select(lam, float(w), 2 * n)
     if tie:
         # a tie at the cut: break it by the eigenvector centroid
         lam, V = np.linalg.eig(_hill_matrix(JX, M, C, w, H))
@@ -264,7 +276,8 @@ def _hill_growth_batch(D2iJ, JXs, B1c, B1w, ws, parity, m):  # pragma: no cover 
     growth = np.empty(P)
     ok = np.empty(P, dtype=np.bool_)
     for k in range(P):
-        sel, lam, good, tie = _hill_core(D2iJ, JXs[k], B1c, B1w, ws[k], parity, m)
+        lam, good = _hill_eigvals(D2iJ, JXs[k], B1c, B1w, ws[k], parity)
+        sel, tie = _select(lam, ws[k], m)
         ok[k] = good and not tie
         growth[k] = sel[0].real / ws[k]
     return growth, ok
