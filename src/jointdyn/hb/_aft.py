@@ -179,12 +179,20 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
             err = 0.0
             err2 = 0.0
             tmax = 0.0
+            # committed state in (a, da) when cur == 0, in (bb, dbb) when cur == 1:
+            # the kernel writes the other pair; no array variables are
+            # reassigned per sample (that costs reference counting)
+            cur = 0
             for i in range(ns):
                 for d in range(nh):
                     dxj[d] = E[i, d]
                 if has_p:
                     dNj[nh] = dN[c, i]
-                t_, k_, c_ = STEP_JVP(prm, a, da, bb, dbb, u[i], dxj, Nc[i], dNj, dTj)  # noqa: F821
+                if cur == 0:
+                    t_, k_, c_ = STEP_JVP(prm, a, da, bb, dbb, u[i], dxj, Nc[i], dNj, dTj)  # noqa: F821
+                else:
+                    t_, k_, c_ = STEP_JVP(prm, bb, dbb, a, da, u[i], dxj, Nc[i], dNj, dTj)  # noqa: F821
+                cur = 1 - cur
                 for d in range(nd):
                     dT[i, d] = dTj[d]
                 e = abs(t_ - T1[i])
@@ -197,10 +205,12 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
                     tmax = abs(t_)
                 Tc[i] = t_
                 code[c, i] = c_
-                a, bb = bb, a
-                da, dbb = dbb, da
                 if hist:
-                    if passes == 1 and _same_state(a, da, Sh, dSh, i, rtol):
+                    if cur == 0:
+                        hit = _history(a, da, Sh, dSh, i, passes, rtol)
+                    else:
+                        hit = _history(bb, dbb, Sh, dSh, i, passes, rtol)
+                    if hit:
                         # the state and its derivatives after sample i are those of
                         # the first pass after sample i (to rtol, entry by entry,
                         # as the end-of-pass test below): the rest of this pass
@@ -217,16 +227,14 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
                             for d in range(nd):
                                 dT[j, d] = dT1[j, d]
                             code[c, j] = cprev[j]
-                        for r_ in range(ssz):
-                            a[r_] = Sh[ns - 1, r_]
-                            for d in range(nd):
-                                da[r_, d] = dSh[ns - 1, r_, d]
+                        if cur == 0:
+                            _load_state(a, da, Sh, dSh, ns - 1)
+                        else:
+                            _load_state(bb, dbb, Sh, dSh, ns - 1)
                         break
-                    if passes == 0:
-                        for r_ in range(ssz):
-                            Sh[i, r_] = a[r_]
-                            for d in range(nd):
-                                dSh[i, r_, d] = da[r_, d]
+            if cur == 1:  # committed state back in (a, da), once per pass
+                a, bb = bb, a
+                da, dbb = dbb, da
             passes += 1
             if passes >= 2 and err <= rtol * tmax:
                 period = 1.0
@@ -309,6 +317,28 @@ def _same_state(a, da, Sh, dSh, i, rtol):  # pragma: no cover - compiled
             if not abs(x - y) <= rtol * max(abs(x), abs(y)):
                 return False
     return True
+
+
+@jit(inline="always")
+def _history(s, ds, Sh, dSh, i, passes, rtol):  # pragma: no cover - compiled
+    """Pass 0: store (s, ds) as sample i of the first pass; pass 1: True if they repeat it."""
+    if passes == 1:
+        return _same_state(s, ds, Sh, dSh, i, rtol)
+    if passes == 0:
+        for r in range(s.shape[0]):
+            Sh[i, r] = s[r]
+            for d in range(ds.shape[1]):
+                dSh[i, r, d] = ds[r, d]
+    return False
+
+
+@jit(inline="always")
+def _load_state(s, ds, Sh, dSh, i):  # pragma: no cover - compiled
+    """(s, ds) = (Sh[i], dSh[i])."""
+    for r in range(s.shape[0]):
+        s[r] = Sh[i, r]
+        for d in range(ds.shape[1]):
+            ds[r, d] = dSh[i, r, d]
 
 
 @jit(inline="always")
