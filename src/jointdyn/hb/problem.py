@@ -263,7 +263,6 @@ class HBProblem:
         Loads independent of p (parameters gamma and f1) are built once.
         """
         par = self.parameter
-        w, f, loads = None, None, None
         if par in ("gamma", "f1") and self._fixed_loads is not None:
             Nsamp, SX, SN = self._fixed_loads
             dN = None
