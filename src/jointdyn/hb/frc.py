@@ -104,7 +104,7 @@ class HBBranch:
         JXs = np.empty((n, problem.size, problem.size))
         for i in range(n):
             ev = evaluations.get(float(lam[i]))
-            if ev is None or not np.array_equal(ev[0], X[i]):
+            if ev is None or ev[0].tobytes() != X[i].tobytes():  # not kept for this very X
                 ev = (X[i], problem.evaluate(X[i], lam[i]))
             elif len(ev) > 2:
                 self._response0[i] = ev[2]
@@ -125,12 +125,10 @@ class HBBranch:
 
     def response(self, dof: int = 0):
         """(amplitude_m, offset_m, max_abs_m) per point for DOF ``dof``."""
-        out = np.empty((self.lam.size, 3))
-        for i, x in enumerate(self.X):
-            if dof == 0 and not np.isnan(self._response0[i, 0]):
-                out[i] = self._response0[i]  # computed by the monitor for the same X
-            else:
-                out[i] = self.problem.amplitudes(x, dof)
+        out = self._response0.copy() if dof == 0 else np.full((self.lam.size, 3), np.nan)
+        # rows computed by the monitor for the same X are kept; the others computed here
+        for i in np.flatnonzero(np.isnan(out[:, 0])):
+            out[i] = self.problem.amplitudes(self.X[i], dof)
         return out[:, 0], out[:, 1], out[:, 2]
 
 
@@ -270,7 +268,7 @@ def continue_hb(
         if "ev" in cache:
             # kept for the stability and the response of the accepted point
             evaluations[float(lam)] = (X, cache["ev"], amps)
-        if not np.isfinite(q) or q > config.HB_UNBOUNDED_Q:
+        if not math.isfinite(q) or q > config.HB_UNBOUNDED_Q:
             return "unbounded", f"q = kt X / fy = {q:.4g} exceeds {config.HB_UNBOUNDED_Q:g} at {parameter} = {lam:.6g}"
         ev = cache.get("ev")
         if ev is not None:

@@ -40,7 +40,7 @@ __all__ = ["HBProblem", "PARAMETERS"]
 PARAMETERS = ("gamma", "f1", "eta", "n0", "delta")
 
 
-@dataclass
+@dataclass(slots=True)
 class _Eval:
     R: np.ndarray
     JX: np.ndarray
@@ -263,6 +263,9 @@ class HBProblem:
         Loads independent of p (parameters gamma and f1) are built once.
         """
         par = self.parameter
+        if par == "gamma" and self._fixed_inputs is not None:
+            dwdp, Fe, Fp, Nsamp, dN, SX, SN = self._fixed_inputs
+            return p * self.w0, dwdp, Fe, Fp, Nsamp, dN, SX, SN
         if par in ("gamma", "f1") and self._fixed_loads is not None:
             Nsamp, SX, SN = self._fixed_loads
             dN = None
@@ -294,9 +297,12 @@ class HBProblem:
             Fe = self._forcing_fixed
             Fp = self._zero
         dwdp = self.w0 if par == "gamma" else 0.0
+        if par == "gamma":
+            self._fixed_inputs = (dwdp, Fe, Fp, Nsamp, dN, SX, SN)
         return w, dwdp, Fe, Fp, Nsamp, dN, SX, SN
 
     _forcing_fixed = None
+    _fixed_inputs = None
     _scales_seen = None
 
     def evaluate(self, X, p, scales=None) -> _Eval:
