@@ -5,7 +5,7 @@ detection (see docs/harmonic-balance.md)."""
 from .continuation import ContinuationResult, continuation, newton, turning_points
 from .frc import HBBranch, HBSolution, branch_dataset, continue_hb, frc_hb, harmonic_balance
 from .problem import PARAMETERS, HBProblem
-from .stability import hill_exponents, hill_stability, monodromy_multipliers
+from .stability import hill_exponents, hill_growth, hill_stability, monodromy_multipliers
 
 __all__ = [
     "frc_hb",
@@ -22,5 +22,6 @@ __all__ = [
     "ContinuationResult",
     "hill_exponents",
     "hill_stability",
+    "hill_growth",
     "monodromy_multipliers",
 ]

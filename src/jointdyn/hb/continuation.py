@@ -39,6 +39,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
+from .._jit import jit
 
 __all__ = ["ContinuationResult", "continuation", "newton", "turning_points"]
 
@@ -91,6 +92,144 @@ class ContinuationResult:
     counters: dict = field(default_factory=dict)
 
 
+@jit
+def _merit(R, d, v, u_pred):  # pragma: no cover - compiled
+    """max |R| (and |d^T (v - u_pred)| when d has entries); NaN if any entry is NaN."""
+    m = 0.0
+    for i in range(R.shape[0]):
+        a = abs(R[i])
+        if a != a:
+            return np.nan
+        if a > m:
+            m = a
+    if d.shape[0]:
+        c = 0.0
+        for i in range(d.shape[0]):
+            c += d[i] * (v[i] - u_pred[i])
+        c = abs(c)
+        if c != c:
+            return np.nan
+        if c > m:
+            m = c
+    return m
+
+
+@jit
+def _bordered(Jy, Jl, d):  # pragma: no cover - compiled
+    """The matrix [[R_y, R_lam], [d^T]] (or R_y alone when d is empty)."""
+    n = Jy.shape[0]
+    if d.shape[0] == 0:
+        return Jy.copy()
+    A = np.empty((n + 1, n + 1))
+    for i in range(n):
+        for j in range(n):
+            A[i, j] = Jy[i, j]
+        A[i, n] = Jl[i]
+    for j in range(n + 1):
+        A[n, j] = d[j]
+    return A
+
+
+@jit
+def _lu_solve(A, b):  # pragma: no cover - compiled
+    """Solve A x = b in place by Gaussian elimination with partial pivoting.
+
+    The algorithm of LAPACK ``dgesv`` (row interchanges by the largest
+    pivot, LU factors overwrite A, b becomes x), written out: the systems
+    here are small (n(2H+1) + 1) and NumPy's per-call overhead and Numba's
+    LAPACK bindings (slow to compile) cost more than the arithmetic.
+    Returns False for an exactly singular matrix (a zero pivot, where
+    ``dgesv`` reports info > 0) or a non-finite solution.
+    """
+    n = A.shape[0]
+    for k in range(n):
+        p = k
+        amax = abs(A[k, k])
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > amax:
+                amax = abs(A[i, k])
+                p = i
+        if amax == 0.0 or amax != amax:
+            return False
+        if p != k:
+            for j in range(n):
+                t = A[k, j]
+                A[k, j] = A[p, j]
+                A[p, j] = t
+            t = b[k]
+            b[k] = b[p]
+            b[p] = t
+        piv = A[k, k]
+        for i in range(k + 1, n):
+            f = A[i, k] / piv
+            if f != 0.0:
+                A[i, k] = f
+                for j in range(k + 1, n):
+                    A[i, j] -= f * A[k, j]
+                b[i] -= f * b[k]
+    for i in range(n - 1, -1, -1):
+        acc = b[i]
+        for j in range(i + 1, n):
+            acc -= A[i, j] * b[j]
+        b[i] = acc / A[i, i]
+        if not np.isfinite(b[i]):
+            return False
+    return True
+
+
+@jit
+def _newton_direction(Jy, Jl, d, R, v, u_pred):  # pragma: no cover - compiled
+    """Newton step of R(y, lam) = 0 (and d^T (v - u_pred) = 0 when d has entries).
+
+    Returns ``(dv, ok)``; ok is False for a singular matrix or a non-finite step.
+    """
+    n = Jy.shape[0]
+    A = _bordered(Jy, Jl, d)
+    m = A.shape[0]
+    rhs = np.empty(m)
+    for i in range(n):
+        rhs[i] = -R[i]
+    if m > n:
+        c = 0.0
+        for i in range(m):
+            c += d[i] * (v[i] - u_pred[i])
+        rhs[n] = -c
+    ok = _lu_solve(A, rhs)
+    return rhs, ok
+
+
+@jit
+def _tangent_solve(Jy, Jl, t_prev):  # pragma: no cover - compiled
+    """Unit t with [R_y R_lam] t = 0, t_prev^T t = 1 (normalised); ok flag."""
+    n = Jy.shape[0]
+    A = _bordered(Jy, Jl, t_prev)
+    t = np.zeros(n + 1)
+    t[n] = 1.0
+    if not _lu_solve(A, t):
+        return t, False
+    nt = 0.0
+    for i in range(n + 1):
+        nt += t[i] * t[i]
+    nt = np.sqrt(nt)
+    if not np.isfinite(nt) or nt == 0:
+        return t, False
+    return t / nt, True
+
+
+_NO_D = np.zeros(0)
+
+
+def _as_arrays(R, Jy, Jl):
+    """(R, R_y, R_lam) as C-contiguous float64 arrays of dims 1, 2, 1 (no copy when they are)."""
+    f = np.float64
+    if (type(R) is np.ndarray and type(Jy) is np.ndarray and type(Jl) is np.ndarray and R.dtype == f
+            and Jy.dtype == f and Jl.dtype == f and R.ndim == 1 and Jy.ndim == 2 and Jl.ndim == 1
+            and R.flags.c_contiguous and Jy.flags.c_contiguous and Jl.flags.c_contiguous):
+        return R, Jy, Jl
+    R = np.ascontiguousarray(R, dtype=f).reshape(-1)
+    return R, np.ascontiguousarray(Jy, dtype=f).reshape(R.size, -1), np.ascontiguousarray(Jl, dtype=f).reshape(-1)
+
+
 def _solve_damped(residual, v, lam, d, u_pred, *, tol, max_iter, cnt):
     """Damped Newton shared by the fixed-parameter and the arc-length corrector.
 
@@ -106,33 +245,24 @@ def _solve_damped(residual, v, lam, d, u_pred, *, tol, max_iter, cnt):
     residual and Jacobians at the returned point.
     """
 
+    dd = _NO_D if d is None else d
+    up = _NO_D if d is None else u_pred
+
     def ev(v):
         cnt["residual_evaluations"] += 1
         if d is None:
-            R, Jy, Jl = residual(v, lam)
-            return R, Jy, Jl, float(np.max(np.abs(R)))
-        n = v.size - 1
-        R, Jy, Jl = residual(v[:n], v[n])
-        return R, Jy, Jl, max(float(np.max(np.abs(R))), abs(float(d @ (v - u_pred))))
+            R, Jy, Jl = _as_arrays(*residual(v, lam))
+        else:
+            n = v.size - 1
+            R, Jy, Jl = _as_arrays(*residual(v[:n], v[n]))
+        return R, Jy, Jl, _merit(R, dd, v, up)
 
     R, Jy, Jl, merit = ev(v)
     if not math.isfinite(merit):
         return v, False, 0, (R, Jy, Jl)
     for it in range(1, max_iter + 1):
-        if d is None:
-            A, rhs = Jy, -R
-        else:
-            n = v.size - 1
-            A = np.empty((n + 1, n + 1))
-            A[:n, :n] = Jy
-            A[:n, n] = Jl
-            A[n] = d
-            rhs = np.concatenate((-R, [-(d @ (v - u_pred))]))
-        try:
-            dv = np.linalg.solve(A, rhs)
-        except np.linalg.LinAlgError:
-            return v, False, it, (R, Jy, Jl)
-        if not np.all(np.isfinite(dv)):
+        dv, ok = _newton_direction(Jy, Jl, dd, R, v, up)
+        if not ok:
             return v, False, it, (R, Jy, Jl)
         alpha = 1.0
         for _ in range(9):
@@ -162,21 +292,11 @@ def newton(residual, y, lam, *, tol, max_iter, counter=None):
 
 
 def _tangent(Jy, Jl, t_prev):
-    n = Jy.shape[0]
-    A = np.empty((n + 1, n + 1))
-    A[:n, :n] = Jy
-    A[:n, n] = Jl
-    A[n] = t_prev
-    rhs = np.zeros(n + 1)
-    rhs[n] = 1.0
-    try:
-        t = np.linalg.solve(A, rhs)
-    except np.linalg.LinAlgError:
-        return None
-    nt = np.linalg.norm(t)
-    if not np.isfinite(nt) or nt == 0:
-        return None
-    return t / nt
+    f = np.float64
+    Jl = np.ascontiguousarray(Jl, dtype=f).reshape(-1)
+    Jy = np.ascontiguousarray(Jy, dtype=f).reshape(Jl.size, -1)
+    t, ok = _tangent_solve(Jy, Jl, np.ascontiguousarray(t_prev, dtype=np.float64))
+    return t if ok else None
 
 
 def turning_points(lam, gap=None, band: float = 0.0):

@@ -44,7 +44,7 @@ from ..laws import MACROSLIP, SEPARATION
 from ..systems import System
 from .continuation import ContinuationResult, continuation
 from .problem import PARAMETERS, HBProblem, contact_of
-from .stability import hill_stability
+from .stability import hill_growth, hill_stability
 
 __all__ = ["HBBranch", "HBSolution", "continue_hb", "frc_hb", "branch_dataset", "harmonic_balance"]
 
@@ -98,17 +98,24 @@ class HBBranch:
         self.force_period = np.zeros(n, dtype=int)
         sysm = problem.system
         evaluations = {} if evaluations is None else evaluations
+        #: (half peak-to-peak, mean, max |x|) of DOF 0 per point where the
+        #: continuation monitor computed them (NaN elsewhere)
+        self._response0 = np.full((n, 3), np.nan)
+        JXs = np.empty((n, problem.size, problem.size))
         for i in range(n):
             ev = evaluations.get(float(lam[i]))
-            if ev is None or not np.array_equal(ev[0], X[i]):
+            if ev is None or ev[0].tobytes() != X[i].tobytes():  # not kept for this very X
                 ev = (X[i], problem.evaluate(X[i], lam[i]))
+            elif len(ev) > 2:
+                self._response0[i] = ev[2]
             ev = ev[1]
-            st, g, _ = hill_stability(ev.JX, sysm.M, sysm.C, problem.omega(lam[i]), problem.H)
-            self.stable[i] = st
-            self.growth[i] = g
+            JXs[i] = ev.JX
             self.passes[i] = int(ev.info[0])
             self.periodic_error[i] = ev.info[1]
             self.force_period[i] = int(ev.info[2])
+        # Hill stability of every point (hill_stability's criterion), one compiled loop
+        self.growth = hill_growth(JXs, sysm.M, sysm.C, np.array([problem.omega(v) for v in lam]), problem.H)
+        self.stable = self.growth <= config.HB_STABILITY_RTOL
 
     def gamma(self):
         """gamma = w / w0 per point."""
@@ -118,7 +125,10 @@ class HBBranch:
 
     def response(self, dof: int = 0):
         """(amplitude_m, offset_m, max_abs_m) per point for DOF ``dof``."""
-        out = np.array([self.problem.amplitudes(x, dof) for x in self.X]).reshape(-1, 3)
+        out = self._response0.copy() if dof == 0 else np.full((self.lam.size, 3), np.nan)
+        # rows computed by the monitor for the same X are kept; the others computed here
+        for i in np.flatnonzero(np.isnan(out[:, 0])):
+            out[i] = self.problem.amplitudes(self.X[i], dof)
         return out[:, 0], out[:, 1], out[:, 2]
 
 
@@ -235,25 +245,30 @@ def continue_hb(
     law = contact_of(system).law
     cache = {}
 
-    def residual(y, lam_s):
-        lam = lam_s * ls
-        X = y * xs
-        ev = problem.evaluate(X, lam)
-        cache["ev"] = ev
-        return ev.R / fs, ev.JX * (xs / fs), ev.Jp * (ls / fs)
+    scales = (xs, fs, ls)
 
-    def qamp(X):
-        return law.kt * problem.amplitudes(X, 0)[0] / law.fy if law.fy > 0 else 0.0
+    def residual(y, lam_s):
+        # scaled residual and Jacobians: R / fs, JX xs / fs, Jp ls / fs
+        ev = problem.evaluate(y * xs, lam_s * ls, scales)
+        cache["ev"] = ev
+        return ev.scaled
+
+    def qamp(X, amps=None):
+        if amps is None:
+            amps = problem.amplitudes(X, 0)
+        return law.kt * amps[0] / law.fy if law.fy > 0 else 0.0
 
     evaluations = {}
 
     def monitor(y, lam_s):
         X = y * xs
-        q = qamp(X)
+        amps = problem.amplitudes(X, 0)
+        q = qamp(X, amps)
         lam = lam_s * ls
         if "ev" in cache:
-            evaluations[float(lam)] = (X, cache["ev"])
-        if not np.isfinite(q) or q > config.HB_UNBOUNDED_Q:
+            # kept for the stability and the response of the accepted point
+            evaluations[float(lam)] = (X, cache["ev"], amps)
+        if not math.isfinite(q) or q > config.HB_UNBOUNDED_Q:
             return "unbounded", f"q = kt X / fy = {q:.4g} exceeds {config.HB_UNBOUNDED_Q:g} at {parameter} = {lam:.6g}"
         ev = cache.get("ev")
         if ev is not None:
@@ -358,6 +373,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
     harm[:, 0] = np.abs(Xd[:, 0])
     for k in range(1, p.H + 1):
         harm[:, k] = np.hypot(Xd[:, 2 * k - 1], Xd[:, 2 * k])
+    turning = _turning_mask(branch)
     data = {
         "gamma": ("point", branch.gamma()),
         "amplitude_q": ("point", law.kt * amp / law.fy if law.fy > 0 else amp * np.nan),
@@ -366,7 +382,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
         "max_abs_m": ("point", mx),
         "stable": ("point", branch.stable),
         "fold": ("point", branch.fold),
-        "turning": ("point", _turning_mask(branch)),
+        "turning": ("point", turning),
         "branch": ("point", branch.segment),
         "gap": ("point", branch.gap),
         "growth": ("point", branch.growth),
@@ -376,11 +392,11 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
     }
     if branch.parameter != "gamma":
         data[branch.parameter] = ("point", branch.lam)
+    attrs = {"gamma": {"long_name": "w / w0"}, "amplitude_q": {"long_name": "kt X / fy", "units": "1"},
+             **{v: {"units": "m"} for v in ("amplitude_m", "offset_m", "max_abs_m", "harmonic_amplitude_m")}}
+    # variables built with their attributes (no DataArray round trips afterwards)
+    data = {k: xr.Variable(dims, np.asarray(v), attrs=attrs.get(k)) for k, (dims, v) in data.items()}
     ds = xr.Dataset(data, coords={"point": np.arange(branch.lam.size), "harmonic": np.arange(p.H + 1)})
-    ds["gamma"].attrs.update(long_name="w / w0")
-    ds["amplitude_q"].attrs.update(long_name="kt X / fy", units="1")
-    for v in ("amplitude_m", "offset_m", "max_abs_m", "harmonic_amplitude_m"):
-        ds[v].attrs["units"] = "m"
     ds.attrs.update(
         status=branch.status,
         message=branch.message,
@@ -391,7 +407,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
         response_dof=response_dof,
         points=int(branch.lam.size),
         folds=int(branch.fold.sum()),
-        turning_points=int(_turning_mask(branch).sum()),
+        turning_points=int(turning.sum()),
         unstable_points=int((~branch.stable).sum()),
         max_aft_passes=int(branch.passes.max()) if branch.passes.size else 0,
         force_period_2_points=int((branch.force_period == 2).sum()),

@@ -29,8 +29,10 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
+from .._jit import jit
+from ..laws.discrete import discrete_step_jvp
 from ..systems import Contact, System
-from ._aft import _aft_kernel, aft_contact, fourier_matrices
+from ._aft import _eval_kernel, _fourier_shared, _initial_state_derivatives
 
 __all__ = ["HBProblem", "PARAMETERS"]
 
@@ -38,14 +40,55 @@ __all__ = ["HBProblem", "PARAMETERS"]
 PARAMETERS = ("gamma", "f1", "eta", "n0", "delta")
 
 
-@dataclass
+@dataclass(slots=True)
 class _Eval:
     R: np.ndarray
     JX: np.ndarray
     Jp: np.ndarray
-    T: list
-    code: list
+    T: np.ndarray  # (contacts, Ns): force samples of each contact, N (a row per contact)
+    code: np.ndarray  # (contacts, Ns): motion-state codes of each contact
     info: np.ndarray
+    #: (R, JX, Jp) scaled as asked by ``HBProblem.evaluate(..., scales=)`` (else None)
+    scaled: tuple | None = None
+
+
+def _pad_rows(rows, width=None):
+    """Stack 1-D arrays into a C-contiguous (len(rows), width) float array, zero-padded."""
+    m = max([len(r) for r in rows], default=1) if width is None else width
+    out = np.zeros((len(rows), max(m, 1)))
+    for i, r in enumerate(rows):
+        out[i, : len(r)] = r
+    return out
+
+
+@jit
+def _extrema(Ef, c):  # pragma: no cover - compiled
+    """(max, min) of x = Ef c with the parabolic refinement of HBProblem._peak."""
+    x = Ef @ c
+    n = x.size
+    hi_i = np.argmax(x)
+    lo_i = np.argmin(x)
+    out = np.empty(2)
+    for k in range(2):
+        i = hi_i if k == 0 else lo_i
+        xm = x[(i - 1) % n]
+        x0 = x[i]
+        xp = x[(i + 1) % n]
+        den = xm - 2.0 * x0 + xp
+        pk = x0 if den == 0.0 else x0 - 0.125 * (xp - xm) ** 2 / den
+        if k == 0:
+            out[0] = x0 if pk < x0 else pk  # max(peak, grid max)
+        else:
+            out[1] = x0 if pk > x0 else pk  # min(peak, grid min)
+    return out[0], out[1]
+
+
+def _eval_kernel_no_contact():
+    """Evaluation kernel for a system without contacts (the march is never reached)."""
+    from .._jit import specialize
+    from ._aft import _eval_template
+
+    return specialize(_eval_template, STEP_JVP=discrete_step_jvp)
 
 
 class HBProblem:
@@ -93,12 +136,10 @@ class HBProblem:
         self.w0 = system.w0
         if not self.w0 > 0:
             raise ValueError("system must have a positive lowest natural frequency w0 (K positive definite)")
-        self.E, self.P = fourier_matrices(self.H, self.Ns)
+        self.E, self.P = _fourier_shared(self.H, self.Ns)
         self.tau = 2.0 * np.pi * np.arange(self.Ns) / self.Ns
         self._fine = {}
         self._lin = None
-        self._params = [c.law.params for c in system.contacts]
-        self._kernels = [_aft_kernel(c.law) for c in system.contacts]
         self.contacts = list(system.contacts)
         fmax = float(np.max(np.abs(system.force))) if system.force.size else 0.0
         self.f_dir = system.force / fmax if fmax > 0 else system.force.copy()
@@ -111,6 +152,19 @@ class HBProblem:
             if c.dof2 >= 0:
                 b[c.dof2] -= 1.0
             self.B.append(b)
+        # inputs of the compiled evaluation, built once: selection rows,
+        # kernel parameters and virgin states padded to common lengths
+        nc = len(self.contacts)
+        self._Bm = np.array(self.B, dtype=np.float64).reshape(nc, self.n)
+        self._Pm = _pad_rows([c.law.params for c in self.contacts])
+        self._ssz = max([c.law.state_size for c in self.contacts], default=1)
+        # one law class per System (checked there): one kernel for every contact
+        self._kernel = _eval_kernel(self.contacts[0].law) if nc else _eval_kernel_no_contact()
+        self._fixed_loads = None
+        self._zero = np.zeros(self.size)
+        self._dummy = np.zeros((1, 1))
+        self._zero1 = np.zeros(1)
+        self._noscale = np.zeros(3)
 
     # --- parameter handling -------------------------------------------------
     def parameter_value(self) -> float:
@@ -203,56 +257,109 @@ class HBProblem:
         return np.linalg.solve(A, self.forcing(f))
 
     # --- residual -----------------------------------------------------------
-    def evaluate(self, X, p) -> _Eval:
-        """Residual R (N), dR/dX (N/m) and dR/dp at coefficients X and parameter p."""
-        w, f, loads = self._split(p)
-        A = self.linear_matrix(w)
-        R = A @ X - self.forcing(f)
-        JX = A.copy()
-        if self.parameter == "gamma":
-            Jp = self.linear_matrix_dw(w) @ X * self.w0
-        elif self.parameter == "f1":
-            Jp = -self.forcing(self.f_dir)
+    def _eval_inputs(self, p):
+        """(w, dw/dp, Fe, Fp, Nsamp (nc, Ns), dN (nc, Ns) or None, (sx, sn) rows).
+
+        Loads independent of p (parameters gamma and f1) are built once.
+        """
+        par = self.parameter
+        if par == "gamma" and self._fixed_inputs is not None:
+            dwdp, Fe, Fp, Nsamp, dN, SX, SN = self._fixed_inputs
+            return p * self.w0, dwdp, Fe, Fp, Nsamp, dN, SX, SN
+        if par in ("gamma", "f1") and self._fixed_loads is not None:
+            Nsamp, SX, SN = self._fixed_loads
+            dN = None
         else:
-            Jp = np.zeros(self.size)
-        Xm = X.reshape(self.nh, self.n)
-        Ts, codes = [], []
-        info = np.zeros(3)
-        info[2] = 1.0
-        for c, b, (n0, n1, dl, dn), prm, krn in zip(self.contacts, self.B, loads, self._params, self._kernels):
-            U = Xm @ b
-            Nsamp = n0 + n1 * np.sin(self.tau + dl)
-            F, dFdU, dFdp, T, code, inf = aft_contact(c.law, self.E, self.P, U, Nsamp, dn,
-                                                      max_passes=self.max_passes,
-                                                      rtol=config.HB_PERIODIC_RTOL, params=prm, kernel=krn)
-            # scatter: R[h*n + i] += b_i F_h ; JX[(h,i),(g,j)] += b_i b_j dF_hg
-            if self.n == 1:
-                R += F * b[0]
-                JX += dFdU * (b[0] * b[0])
-                if dFdp is not None:
-                    Jp += dFdp * b[0]
+            _, _, loads = self._split(p)
+            nc = len(self.contacts)
+            Nsamp = np.empty((nc, self.Ns))
+            dN = None if par in ("gamma", "f1") else np.empty((nc, self.Ns))
+            sx, sn = [], []
+            for k, (c, (n0, n1, dl, dn)) in enumerate(zip(self.contacts, loads)):
+                Nsamp[k] = n0 + n1 * np.sin(self.tau + dl)
+                if dN is not None:
+                    dN[k] = dn
+                dx_, dn_ = _initial_state_derivatives(c.law, 0.0, float(Nsamp[k, 0]))
+                sx.append(dx_)
+                sn.append(dn_)
+            SX = _pad_rows(sx, self._ssz)
+            SN = _pad_rows(sn, self._ssz)
+            if par in ("gamma", "f1"):
+                self._fixed_loads = (Nsamp, SX, SN)
+        gamma = p if par == "gamma" else self.gamma_fixed
+        w = gamma * self.w0
+        if par == "f1":
+            Fe = self.forcing(self.f_dir * p)
+            Fp = self.forcing(self.f_dir)
+        else:
+            if self._forcing_fixed is None:
+                self._forcing_fixed = self.forcing(self.f_dir * self.f1_ref)
+            Fe = self._forcing_fixed
+            Fp = self._zero
+        dwdp = self.w0 if par == "gamma" else 0.0
+        if par == "gamma":
+            self._fixed_inputs = (dwdp, Fe, Fp, Nsamp, dN, SX, SN)
+        return w, dwdp, Fe, Fp, Nsamp, dN, SX, SN
+
+    _forcing_fixed = None
+    _fixed_inputs = None
+    _scales_seen = None
+
+    def evaluate(self, X, p, scales=None) -> _Eval:
+        """Residual R (N), dR/dX (N/m) and dR/dp at coefficients X and parameter p.
+
+        One compiled call (:func:`jointdyn.hb._aft._eval_template`): linear
+        part, AFT of every contact with exact forward-mode derivatives, and
+        the scatter into R, dR/dX, dR/dp. With ``scales = (xs, fs, ps)``
+        (unknowns, forces and parameter scales) the same call also fills
+        ``scaled = (R / fs, JX * (xs / fs), Jp * (ps / fs))``.
+        """
+        X = np.ascontiguousarray(X, dtype=np.float64)
+        w, dwdp, Fe, Fp, Nsamp, dN, SX, SN = self._eval_inputs(p)
+        AK, AC, AM = self._linear_parts()
+        nc = len(self.contacts)
+        # virgin state of each contact at its mean displacement and first load
+        n = self.n
+        S0 = None
+        for k, c in enumerate(self.contacts):
+            b = self._Bm[k]
+            u0 = float(X[0] * b[0]) if n == 1 else float(X[:n] @ b)
+            s0 = c.law.initial_state(u0, float(Nsamp[k, 0]))
+            if nc == 1 and s0.size == self._ssz and s0.dtype == np.float64:
+                S0 = s0.reshape(1, -1)
             else:
-                R += (F[:, None] * b[None, :]).ravel()
-                bb = np.outer(b, b)
-                JX += (dFdU[:, None, :, None] * bb[None, :, None, :]).reshape(self.size, self.size)
-                if dFdp is not None:
-                    Jp += (dFdp[:, None] * b[None, :]).ravel()
-            Ts.append(T)
-            codes.append(code)
-            info[0] = max(info[0], inf[0])
-            info[1] = max(info[1], inf[1])
-            # worst case over the contacts: 0 (not repeated) < 2 < 1
-            rank = {1.0: 2, 2.0: 1, 0.0: 0}
-            if rank[float(inf[2])] < rank[float(info[2])]:
-                info[2] = inf[2]
-        return _Eval(R, JX, Jp, Ts, codes, info)
+                if S0 is None:
+                    S0 = np.zeros((nc, self._ssz))
+                S0[k, : s0.size] = s0
+        if S0 is None:
+            S0 = np.zeros((0, self._ssz))
+        R = np.empty(self.size)
+        JX = np.empty((self.size, self.size))
+        Jp = np.empty(self.size)
+        T = np.empty((nc, self.Ns))
+        code = np.empty((nc, self.Ns), dtype=np.int64)
+        info = np.empty(3)
+        has_p = dN is not None
+        if scales is None:
+            scl, Rs, JXs, Jps = self._noscale, self._zero1, self._dummy, self._zero1
+        else:
+            if scales is not self._scales_seen:
+                xs, fs, ps = scales
+                self._scl = np.array([fs, xs / fs, ps / fs])
+                self._scales_seen = scales
+            scl = self._scl
+            Rs, JXs, Jps = np.empty(self.size), np.empty((self.size, self.size)), np.empty(self.size)
+        self._kernel(AK, AC, AM, float(w), float(dwdp), X, Fe, Fp, self._Bm, self._Pm, S0, SX, SN, self.E, self.P,
+                     Nsamp, dN if has_p else self._dummy, has_p, int(self.max_passes),
+                     float(config.HB_PERIODIC_RTOL), R, JX, Jp, T, code, info, scl, Rs, JXs, Jps)
+        return _Eval(R, JX, Jp, T, code, info, None if scales is None else (Rs, JXs, Jps))
 
     # --- post-processing ----------------------------------------------------
     def reconstruct(self, X, dof: int, points: int = 1024):
         """x_dof(tau) on a fine grid of ``points`` samples over one period, m."""
         Ef = self._fine.get(points)
         if Ef is None:
-            Ef = self._fine[points] = fourier_matrices(self.H, points)[0]
+            Ef = self._fine[points] = _fourier_shared(self.H, points)[0]
         return Ef @ X.reshape(self.nh, self.n)[:, dof]
 
     @staticmethod
@@ -274,12 +381,15 @@ class HBProblem:
         """(half peak-to-peak, mean, max |x|) of x_dof(t), m.
 
         Extrema located on 1024 samples per period and refined by a
-        parabola through the three samples around each.
+        parabola through the three samples around each (:meth:`_peak`;
+        compiled in :func:`_extrema`).
         """
-        x = self.reconstruct(X, dof)
-        hi = max(self._peak(x, int(np.argmax(x))), float(x.max()))
-        lo = min(self._peak(x, int(np.argmin(x))), float(x.min()))
-        c0 = float(X.reshape(self.nh, self.n)[0, dof])
+        Ef = self._fine.get(1024)
+        if Ef is None:
+            Ef = self._fine[1024] = _fourier_shared(self.H, 1024)[0]
+        Xm = np.asarray(X, dtype=np.float64).reshape(self.nh, self.n)
+        hi, lo = _extrema(Ef, np.ascontiguousarray(Xm[:, dof]))
+        c0 = float(Xm[0, dof])
         return 0.5 * (hi - lo), c0, max(abs(hi), abs(lo))
 
     def first_harmonic_amplitude(self, X, dof: int) -> float:
