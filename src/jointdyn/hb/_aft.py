@@ -63,15 +63,16 @@ def _fourier_shared(harmonics: int, samples: int):
     return hit
 
 
-def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsamp, dN, has_p, max_passes, rtol,
+def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, ssz, SX, SN, E, P, Nsamp, dN, has_p, max_passes, rtol,
                    R, JX, Jp, T, code, info, scl, Rs, JXs, Jps):  # pragma: no cover - compiled
     """Whole HB residual and Jacobian in one call: linear part + AFT of every contact.
 
     Linear part (``problem.py``): ``A = AK + w AC + w^2 AM``, ``R = A X - Fe``,
     ``JX = A``, ``Jp = dwdp (AC + 2 w AM) X - Fp``. Then, per contact c
     (selection row ``Bm[c]``, kernel parameters ``Pm[c]``, virgin state
-    ``S0[c]`` with derivatives ``SX[c]`` per unit mean displacement and
-    ``SN[c]`` per unit load): ``U = Xm Bm[c]``, AFT march of ``STEP_JVP``
+    (law kernel ``INIT``, padded to ``ssz`` entries) at the mean displacement
+    and the first load sample, with derivatives ``SX[c]`` per unit mean
+    displacement and ``SN[c]`` per unit load): ``U = Xm Bm[c]``, AFT march of ``STEP_JVP``
     until the force repeats, projection, and scatter ``R += b F``,
     ``JX += b b^T dF/dU``, ``Jp += b dF/dp``.
 
@@ -133,7 +134,6 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
     u = np.empty(ns)
     F = np.empty(nh)
     G = np.empty((nh, nd))
-    ssz = S0.shape[1]
     s_end = np.empty(ssz)
     Tc = np.empty(ns)
     dT = np.empty((ns, nd))
@@ -159,7 +159,10 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
             u[i] = acc
         # virgin state at the mean displacement and the first load sample:
         # direction 0 (the constant term) moves the mean, the parameter the load
-        a = S0[c].copy()
+        Nc = Nsamp[c]
+        prm = Pm[c]
+        a = np.empty(ssz)
+        INIT(prm, U[0], Nc[0], a)  # noqa: F821 - bound by specialize
         bb = np.empty(ssz)
         da = np.zeros((ssz, nd))
         dbb = np.empty((ssz, nd))
@@ -167,8 +170,6 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, S0, SX, SN, E, P, Nsa
             da[r_, 0] = SX[c, r_]
             if has_p:
                 da[r_, nh] = SN[c, r_] * dN[c, 0]
-        Nc = Nsamp[c]
-        prm = Pm[c]
         for i in range(ns):
             T1[i] = 0.0
             T2[i] = 0.0
@@ -353,8 +354,8 @@ def _scale_outputs(R, JX, Jp, scl, Rs, JXs, Jps):  # pragma: no cover - compiled
 
 
 def _eval_kernel(law):
-    """The compiled HB evaluation with ``law.step_jvp`` bound (disk-cached)."""
-    return specialize(_eval_template, STEP_JVP=law.step_jvp)
+    """The compiled HB evaluation with ``law.step_jvp`` and ``law.init`` bound (disk-cached)."""
+    return specialize(_eval_template, STEP_JVP=law.step_jvp, INIT=law.init)
 
 
 _DS0_CACHE: dict = {}

@@ -30,7 +30,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from .._jit import jit
-from ..laws.discrete import discrete_step_jvp
+from ..laws.discrete import discrete_init, discrete_step_jvp
 from ..systems import Contact, System
 from ._aft import _eval_kernel, _fourier_shared, _initial_state_derivatives
 
@@ -88,7 +88,7 @@ def _eval_kernel_no_contact():
     from .._jit import specialize
     from ._aft import _eval_template
 
-    return specialize(_eval_template, STEP_JVP=discrete_step_jvp)
+    return specialize(_eval_template, STEP_JVP=discrete_step_jvp, INIT=discrete_init)
 
 
 class HBProblem:
@@ -318,21 +318,6 @@ class HBProblem:
         w, dwdp, Fe, Fp, Nsamp, dN, SX, SN = self._eval_inputs(p)
         AK, AC, AM = self._linear_parts()
         nc = len(self.contacts)
-        # virgin state of each contact at its mean displacement and first load
-        n = self.n
-        S0 = None
-        for k, c in enumerate(self.contacts):
-            b = self._Bm[k]
-            u0 = float(X[0] * b[0]) if n == 1 else float(X[:n] @ b)
-            s0 = c.law.initial_state(u0, float(Nsamp[k, 0]))
-            if nc == 1 and s0.size == self._ssz and s0.dtype == np.float64:
-                S0 = s0.reshape(1, -1)
-            else:
-                if S0 is None:
-                    S0 = np.zeros((nc, self._ssz))
-                S0[k, : s0.size] = s0
-        if S0 is None:
-            S0 = np.zeros((0, self._ssz))
         R = np.empty(self.size)
         JX = np.empty((self.size, self.size))
         Jp = np.empty(self.size)
@@ -349,7 +334,7 @@ class HBProblem:
                 self._scales_seen = scales
             scl = self._scl
             Rs, JXs, Jps = np.empty(self.size), np.empty((self.size, self.size)), np.empty(self.size)
-        self._kernel(AK, AC, AM, float(w), float(dwdp), X, Fe, Fp, self._Bm, self._Pm, S0, SX, SN, self.E, self.P,
+        self._kernel(AK, AC, AM, float(w), float(dwdp), X, Fe, Fp, self._Bm, self._Pm, self._ssz, SX, SN, self.E, self.P,
                      Nsamp, dN if has_p else self._dummy, has_p, int(self.max_passes),
                      float(config.HB_PERIODIC_RTOL), R, JX, Jp, T, code, info, scl, Rs, JXs, Jps)
         return _Eval(R, JX, Jp, T, code, info, None if scales is None else (Rs, JXs, Jps))
