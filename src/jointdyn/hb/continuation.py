@@ -230,7 +230,7 @@ def _as_arrays(R, Jy, Jl):
     return R, np.ascontiguousarray(Jy, dtype=f).reshape(R.size, -1), np.ascontiguousarray(Jl, dtype=f).reshape(-1)
 
 
-def _solve_damped(residual, v, lam, d, u_pred, *, tol, max_iter, cnt):
+def _solve_damped(residual, v, lam, d, u_pred, *, tol, max_iter, cnt, max_evals=None):
     """Damped Newton shared by the fixed-parameter and the arc-length corrector.
 
     With ``d is None`` solves R(v, lam) = 0 for v; otherwise v holds
@@ -241,8 +241,10 @@ def _solve_damped(residual, v, lam, d, u_pred, *, tol, max_iter, cnt):
     |J^-1| tol). The
     AFT residual of stick-slip laws is only piecewise smooth, and the plain
     Newton iteration can cycle between the pieces near a corner (onset of
-    slip). Returns ``(v, ok, iterations, (R, R_y, R_lam))`` with the
-    residual and Jacobians at the returned point.
+    slip). With ``max_evals`` the corrector gives up after that many
+    residual evaluations (a step that needs many damped iterations is
+    better retried smaller). Returns ``(v, ok, iterations, (R, R_y,
+    R_lam))`` with the residual and Jacobians at the returned point.
     """
 
     dd = _NO_D if d is None else d
@@ -257,6 +259,7 @@ def _solve_damped(residual, v, lam, d, u_pred, *, tol, max_iter, cnt):
             R, Jy, Jl = _as_arrays(*residual(v[:n], v[n]))
         return R, Jy, Jl, _merit(R, dd, v, up)
 
+    start = cnt["residual_evaluations"]
     R, Jy, Jl, merit = ev(v)
     if not math.isfinite(merit):
         return v, False, 0, (R, Jy, Jl)
@@ -266,6 +269,8 @@ def _solve_damped(residual, v, lam, d, u_pred, *, tol, max_iter, cnt):
             return v, False, it, (R, Jy, Jl)
         alpha = 1.0
         for _ in range(9):
+            if max_evals is not None and cnt["residual_evaluations"] - start >= max_evals:
+                return v, False, it, (R, Jy, Jl)
             w = v + alpha * dv
             R2, Jy2, Jl2, m2 = ev(w)
             if math.isfinite(m2) and (m2 < merit or m2 <= tol):
@@ -458,8 +463,12 @@ def continuation(
             else:
                 d = t
             u_pred = u + ds * d
-            v, ok, it, (R, Jy, Jl) = _solve_damped(residual, u_pred.copy(), None, d, u_pred,
-                                                   tol=tol, max_iter=max_iter, cnt=cnt)
+            # away from the smallest steps, a corrector that needs more than
+            # twice the target iterations is stopped: retrying at half the
+            # step is cheaper (a corner of a non-smooth branch)
+            v, ok, it, (R, Jy, Jl) = _solve_damped(
+                residual, u_pred.copy(), None, d, u_pred, tol=tol, max_iter=max_iter, cnt=cnt,
+                max_evals=2 * config.HB_TARGET_NEWTON_ITER if ds > _CORNER_DS else None)
             if ok and np.linalg.norm(v - u_pred) > 2.0 * ds and ds > _CORNER_DS:
                 # the corrector went much further than the step: maybe onto
                 # another part of the branch; retry smaller (at small steps
