@@ -46,6 +46,10 @@ __all__ = ["ContinuationResult", "continuation", "newton", "turning_points"]
 #: below this (scaled) step a sharp turn or a long correction is a corner of
 #: a piecewise-smooth branch, not a jump to another branch
 _CORNER_DS = 2e-3
+#: step factor after a rejection for a sharp turn or a far-away correction
+#: (a corner of a non-smooth branch or a jump to another branch): such a
+#: step is accepted only at corner size, reached here in fewer rejections
+_CORNER_SHRINK = 0.25
 #: the step is halved after a turn of the tangent by more than ~10 degrees
 _TURN_COS = 0.985
 #: bound on the jumps over discontinuities per branch
@@ -469,7 +473,9 @@ def continuation(
             v, ok, it, (R, Jy, Jl) = _solve_damped(
                 residual, u_pred.copy(), None, d, u_pred, tol=tol, max_iter=max_iter, cnt=cnt,
                 max_evals=2 * config.HB_TARGET_NEWTON_ITER if ds > _CORNER_DS else None)
+            corner_like = False
             if ok and np.linalg.norm(v - u_pred) > 2.0 * ds and ds > _CORNER_DS:
+                corner_like = True
                 # the corrector went much further than the step: maybe onto
                 # another part of the branch; retry smaller (at small steps
                 # the distance is that of a corner of a non-smooth branch)
@@ -481,9 +487,12 @@ def continuation(
                 # non-smooth branch (e.g. onset of slip) and is accepted
                 if t_new is None or (t_new @ t < 0.5 and ds > _CORNER_DS):
                     ok = False
+                    corner_like = t_new is not None
             if not ok:
                 cnt["steps_rejected"] += 1
-                ds *= 0.5
+                ds *= _CORNER_SHRINK if corner_like else 0.5
+                if corner_like and ds < _CORNER_DS:
+                    ds = _CORNER_DS
                 if ds < ds_min:
                     jump = None
                     if cnt["jumps"] < _MAX_JUMPS:
