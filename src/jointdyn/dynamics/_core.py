@@ -427,16 +427,34 @@ def _run_template(
     return nrec, status, done
 
 
+@jit
 def grid_sines(tgrid, w, phase0, n0, n1, dlt):
     """Forcing sines at the midpoint and end of every step of a harmonic grid
     and the normal loads at the midpoints (the grid repeats each period, so an
     unsplit step reuses them; arguments ``sin_mid, sin_end, N_mid`` of the
     runner in mode 0)."""
-    pm = phase0 + w * (tgrid[:-1] + 0.5 * (tgrid[1:] - tgrid[:-1]))
-    sin_mid = np.sin(pm)
-    sin_end = np.sin(phase0 + w * tgrid[1:])
-    N_mid = np.ascontiguousarray(n0[None, :] + n1[None, :] * np.sin(pm[:, None] + dlt[None, :]))
+    J = tgrid.shape[0] - 1
+    nc = n0.shape[0]
+    sin_mid = np.empty(J)
+    sin_end = np.empty(J)
+    N_mid = np.empty((J, nc))
+    for j in range(J):
+        pm = phase0 + w * (tgrid[j] + 0.5 * (tgrid[j + 1] - tgrid[j]))
+        sin_mid[j] = math.sin(pm)
+        sin_end[j] = math.sin(phase0 + w * tgrid[j + 1])
+        for c in range(nc):
+            N_mid[j, c] = n0[c] + n1[c] * math.sin(pm + dlt[c])
     return sin_mid, sin_end, N_mid
+
+
+@jit
+def grid_loads(tgrid, w, n0, n1, dlt):
+    """Normal loads N_c(t) = n0_c + n1_c sin(w t + delta_c) at the grid points, N."""
+    N = np.empty((tgrid.shape[0], n0.shape[0]))
+    for j in range(tgrid.shape[0]):
+        for c in range(n0.shape[0]):
+            N[j, c] = n0[c] + n1[c] * math.sin(w * tgrid[j] + dlt[c])
+    return N
 
 
 def compiled_runner(step):

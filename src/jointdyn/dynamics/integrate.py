@@ -23,7 +23,7 @@ from .. import _validate as V
 from .. import config
 from ..laws.normal import HarmonicLoad
 from ..systems import System
-from ._core import N_SUMMARY, RUN_BLOWUP, RUN_OVERFLOW, compiled_runner, grid_sines
+from ._core import N_SUMMARY, RUN_BLOWUP, RUN_OVERFLOW, compiled_runner, grid_loads, grid_sines
 
 __all__ = ["Trajectory", "Restart", "integrate", "integrate_sampled"]
 
@@ -132,12 +132,21 @@ def _static_pack(system: System) -> dict:
             B[c.dof2] -= 1.0
         Kst += c.law.kt * np.outer(B, B)
     d["K_stuck"] = np.ascontiguousarray(Kst)
+    # contact selection rows (u_c = B[c] . x) and stuck stiffnesses
+    Bsel = np.zeros((len(cs), n))
+    for i, c in enumerate(cs):
+        Bsel[i, c.dof] = 1.0
+        if c.dof2 >= 0:
+            Bsel[i, c.dof2] = -1.0
+    d["B"] = Bsel
+    d["kt"] = np.array([c.law.kt for c in cs], dtype=np.float64)
     from scipy.linalg import eigh
 
     lam = eigh(0.5 * (Kst + Kst.T), system.M, eigvals_only=True)
     d["w_max"] = math.sqrt(max(lam[-1], 0.0))
     d["w_min_stuck"] = math.sqrt(max(lam[0], 0.0))
     d["xlin"] = sum(c.law.fy / c.law.kt for c in cs)
+    d["fmax"] = float(np.max(np.abs(d["fvec"])))
     d["kmin"] = max(d["w_min_stuck"] ** 2 * float(np.min(np.diag(system.M))), 1e-300)
     _STATIC[key] = d
     weakref.finalize(system, _STATIC.pop, key, None)
@@ -166,7 +175,7 @@ class _Model:
             J = max(J, int(math.ceil(2 * math.pi * self.w_max / (self.w * config.TI_MAX_OMEGA_H))))
         self.J = J
         self._nobufs = _buffers(1, self.n, self.nc)
-        self.set_cap(float(np.max(np.abs(self.fvec))))
+        self.set_cap(self.fmax)
         if self.w > 0:
             self._harmonic_grid()
 
@@ -174,7 +183,10 @@ class _Model:
         """Caps of the blow-up guard (non-finite or absurdly large state) for force scale fs (N)."""
         xs = fs / self.kmin + self.xlin + 1e-12
         self._xcap0 = config.TI_BLOWUP_FACTOR * xs
-        self.xcap = np.concatenate([np.full(self.n, self._xcap0), np.full(self.n, self._xcap0 * max(self.w_max, self.w, 1.0))])
+        cap = np.empty(2 * self.n)
+        cap[: self.n] = self._xcap0
+        cap[self.n :] = self._xcap0 * max(self.w_max, self.w, 1.0)
+        self.xcap = cap
 
     def cap(self, x, v) -> np.ndarray:
         """Blow-up caps, never below TI_BLOWUP_FACTOR times the starting state."""
@@ -215,9 +227,7 @@ class _Model:
                 # re-key events recorded at later indices
                 ev_at = {(kk + 1 if kk >= k else kk): v for kk, v in ev_at.items()}
                 ev_at.setdefault(k, []).append((ci, rising))
-        N = np.empty((tg.size, self.nc))
-        for ci, c in enumerate(self.system.contacts):
-            N[:, ci] = c.n0 + c.n1 * np.sin(self.w * tg + c.delta)
+        N = grid_loads(tg, self.w, self.n0, self.n1, self.dlt)
         for k, lst in ev_at.items():
             for ci, rising in lst:
                 N[k, ci] = config.TI_RECONTACT_ALPHA * self.system.contacts[ci].n0 if rising else 0.0

@@ -25,6 +25,7 @@ from .. import config
 from .._jit import jit, specialize
 from ..drivers import march
 from ..systems import System
+from ._core import grid_loads
 from ._core import N_SUMMARY, S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
 from .integrate import Restart, Trajectory, _Model, _omega
 
@@ -409,6 +410,13 @@ def _df_template(Z0, f, B, kt, P, sin_th, cos_th, loads, ns, iters, rtol, xmax, 
     return True
 
 
+# the describing-function march: two cycles of 64 samples ending before t = 0
+# (theta = w t), and t = 0 itself; the first harmonic is taken over the second
+_DF_NS = 64
+_DF_TH = np.append(2 * math.pi * np.arange(2 * _DF_NS) / _DF_NS - 4 * math.pi, 0.0)
+_DF_GRID = (_DF_NS, _DF_TH, np.sin(_DF_TH), np.cos(_DF_TH))
+
+
 def _linear_start(model: _Model):
     """Equivalent-linearisation estimate of the periodic state at phase 0.
 
@@ -424,30 +432,16 @@ def _linear_start(model: _Model):
     """
     sysm = model.system
     n, w = model.n, model.w
-    Z0 = np.ascontiguousarray(model.K - w * w * sysm.M + 1j * w * model.C, dtype=np.complex128)
+    Z0 = model.K - w * w * model.M + 1j * w * model.C
     f = model.fvec.astype(np.complex128)
-    kt = np.array([c.law.kt for c in sysm.contacts], dtype=np.float64)
-    B = np.zeros((model.nc, n))
-    for i, c in enumerate(sysm.contacts):
-        B[i, c.dof] = 1.0
-        if c.dof2 >= 0:
-            B[i, c.dof2] = -1.0
-    ns = 64
-    th = 2 * math.pi * np.arange(2 * ns) / ns - 4 * math.pi  # two cycles ending before t = 0
-    th = np.append(th, 0.0)
-    xscale = float(np.max(np.abs(f))) / max(model.w_min_stuck**2 * float(np.min(np.diag(sysm.M))), 1e-300)
-    xscale += sum(c.law.fy / c.law.kt for c in sysm.contacts)
-    # u(th) = Im(U e^{i th}) = Re(U) sin th + Im(U) cos th; first harmonic of
-    # T over the second cycle
-    sin_th, cos_th = np.sin(th), np.cos(th)
-    loads = np.empty((model.nc, th.size))
-    for i, c in enumerate(sysm.contacts):
-        loads[i] = c.n0 + c.n1 * np.sin(th + c.delta)
+    ns, th, sin_th, cos_th = _DF_GRID
+    loads = grid_loads(th, 1.0, model.n0, model.n1, model.dlt).T.copy()
     S = np.zeros((model.nc, model.slen))
     X = np.zeros(n, dtype=np.complex128)
     run = specialize(_df_template, STEP=model.step, INIT=model.init)
+    xscale = model.fmax / model.kmin + model.xlin
     try:
-        ok = run(Z0, f, B, kt, model.P, sin_th, cos_th, loads, ns,
+        ok = run(Z0, f, model.B, model.kt, model.P, sin_th, cos_th, loads, ns,
                  config.SS_LINEAR_ITERS if model.nc else 1, config.SS_LINEAR_RTOL, 1e3 * xscale, S, X)  # fmt: skip
     except np.linalg.LinAlgError:
         return None
