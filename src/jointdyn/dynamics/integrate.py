@@ -200,7 +200,8 @@ class _Model:
     def _harmonic_grid(self) -> None:
         Tp = 2 * math.pi / self.w
         J = self.J
-        t = np.linspace(0.0, Tp, J + 1)
+        t = np.arange(J + 1) * (Tp / J)  # np.linspace(0, Tp, J + 1), bit for bit, cheaper
+        t[J] = Tp
         events = []  # (time, contact, rising)
         for ci, c in enumerate(self.system.contacts):
             if c.n1 > c.n0 and self.events:
