@@ -199,11 +199,7 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, ssz, SX, SN, E, P, Ns
                 e = abs(t_ - T1[i])
                 if e > err:
                     err = e
-                e = abs(t_ - T2[i])
-                if e > err2:
-                    err2 = e
-                if abs(t_) > tmax:
-                    tmax = abs(t_)
+                err2, tmax = _track(t_, T2[i], err2, tmax)
                 Tc[i] = t_
                 code[c, i] = c_
                 if hist:
@@ -219,11 +215,7 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, ssz, SX, SN, E, P, Ns
                         # is copied instead of marched
                         for j in range(i + 1, ns):
                             t_ = T1[j]
-                            e = abs(t_ - T2[j])
-                            if e > err2:
-                                err2 = e
-                            if abs(t_) > tmax:
-                                tmax = abs(t_)
+                            err2, tmax = _track(t_, T2[j], err2, tmax)
                             Tc[j] = t_
                             for d in range(nd):
                                 dT[j, d] = dT1[j, d]
@@ -301,6 +293,17 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, ssz, SX, SN, E, P, Ns
 #: sample, to stop marching once they repeat, for laws with states of at
 #: most this many entries (storing is then cheaper than the kernel calls)
 _HIST_MAX_STATE = 16
+
+
+@jit(inline="always")
+def _track(t, t2, err2, tmax):  # pragma: no cover - compiled
+    """Running max |t - t2| (change against two passes back) and max |t|."""
+    e = abs(t - t2)
+    if e > err2:
+        err2 = e
+    if abs(t) > tmax:
+        tmax = abs(t)
+    return err2, tmax
 
 
 @jit(inline="always")
