@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 from jointdyn.cli import main
-from jointdyn.config import TEST_ENERGY_RTOL, TEST_QS_FRACTION_ATOL
+from tolerances import TEST_ENERGY_RTOL, TEST_QS_FRACTION_ATOL
 from jointdyn.drivers import harmonic_history
 
 KT, MU, N0, A = 1e5, 0.1, 100.0, 0.5e-3

@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import tolerances
 from jointdyn import config
 from jointdyn.drivers import march
 from jointdyn.laws import SEPARATION, HarmonicLoad, make_law
@@ -40,7 +41,7 @@ def test_stuck_contact_is_linear_k_plus_kt_oscillator(gamma):
     assert r.status == "periodic" and r.period_multiple == 1
     w = gamma * math.sqrt(K / M)
     X = _linear_amp(K + KT, M, 2 * zeta * math.sqrt(K * M), 0.01, w)
-    assert r.amplitude_m == pytest.approx(X, rel=config.TEST_TI_LINEAR_RTOL)
+    assert r.amplitude_m == pytest.approx(X, rel=tolerances.TEST_TI_LINEAR_RTOL)
     assert r.amplitude_q == pytest.approx(KT * r.amplitude_m / 50.0, rel=1e-12)
 
 
@@ -59,7 +60,7 @@ def test_two_dof_contact_between_dofs_linear_limit():
     B = np.array([1.0, -1.0])
     Z = Kk + 2e5 * np.outer(B, B) - w * w * Mm + 1j * w * Cc
     X = np.linalg.solve(Z, f)
-    assert r.amplitude_m == pytest.approx(abs(X[1]), rel=config.TEST_TI_LINEAR_RTOL)
+    assert r.amplitude_m == pytest.approx(abs(X[1]), rel=tolerances.TEST_TI_LINEAR_RTOL)
     assert r.loop is not None and r.loop.x.shape[1] == 2
 
 
@@ -92,11 +93,11 @@ def test_two_dof_separating_contact_events_and_law():
     for te in ev:
         assert np.min(np.abs(tr.t - te)) <= 1e-12 * tr.t[-1]
     T = march(law, tr.x[:, 1], tr.N[:, 0])[0]
-    assert np.max(np.abs(T - tr.T[:, 0])) <= config.TEST_TI_MARCH_ATOL_FY * law.fy
+    assert np.max(np.abs(T - tr.T[:, 0])) <= tolerances.TEST_TI_MARCH_ATOL_FY * law.fy
     r = steady_state(s, gamma, response_dof=0)
     assert r.status == "periodic"
     diss = r.energy_contact_J + r.energy_viscous_J
-    assert diss == pytest.approx(r.work_force_J, rel=config.TEST_TI_ENERGY_RTOL)
+    assert diss == pytest.approx(r.work_force_J, rel=tolerances.TEST_TI_ENERGY_RTOL)
     rec = r.to_record()
     assert rec["status"] == "periodic" and rec["amplitude_m"] == r.amplitude_m
 
@@ -129,7 +130,7 @@ def test_lightly_damped_peak_at_stuck_frequency(eta):
     fine = np.arange(g0 - 0.02, g0 + 0.02001, 0.005)
     b = scan(fine, warm=True)
     peak = fine[int(np.argmax(b))]
-    assert abs(peak - g_lin) <= config.TEST_TI_PEAK_GAMMA_ATOL
+    assert abs(peak - g_lin) <= tolerances.TEST_TI_PEAK_GAMMA_ATOL
     # far from the peak the response is the linear stuck one (q << 1)
     assert a[0] < 0.2 * b.max()
 
@@ -160,7 +161,7 @@ def test_energy_balance_at_steady_state(kw, gamma):
     assert r.status == "periodic"
     diss = r.energy_contact_J + r.energy_viscous_J
     assert r.work_force_J > 0 and r.energy_contact_J > 0
-    assert diss == pytest.approx(r.work_force_J, rel=config.TEST_TI_ENERGY_RTOL)
+    assert diss == pytest.approx(r.work_force_J, rel=tolerances.TEST_TI_ENERGY_RTOL)
     if kw.get("zeta", 0.0) == 0.0:
         assert r.energy_viscous_J == 0.0
 
@@ -172,7 +173,7 @@ def test_step_halving_changes_amplitude_little(eta, gamma):
     a = steady_state(s, gamma, keep_loop=False)
     b = steady_state(s, gamma, steps_per_period=2 * config.TI_STEPS_PER_PERIOD, start=a, keep_loop=False)
     assert a.status == b.status == "periodic"
-    assert b.amplitude_m == pytest.approx(a.amplitude_m, rel=config.TEST_TI_STEP_HALVING_RTOL)
+    assert b.amplitude_m == pytest.approx(a.amplitude_m, rel=tolerances.TEST_TI_STEP_HALVING_RTOL)
 
 
 # --- the compiled law inside the integrator, events ------------------------
@@ -185,7 +186,7 @@ def test_integrator_law_agrees_with_march(model, eta):
     assert isinstance(tr, Trajectory) and tr.status == "ok"
     law = s.contacts[0].law
     T, _, code, _ = march(law, tr.x[:, 0], tr.N[:, 0])
-    assert np.max(np.abs(T - tr.T[:, 0])) <= config.TEST_TI_MARCH_ATOL_FY * law.fy
+    assert np.max(np.abs(T - tr.T[:, 0])) <= tolerances.TEST_TI_MARCH_ATOL_FY * law.fy
     assert np.array_equal(code.astype(np.int8), tr.code[:, 0])
 
 
@@ -206,7 +207,7 @@ def test_property_law_in_integrator_equals_march(eta, delta, beta, gamma, model)
     assert tr.status == "ok" and np.all(np.isfinite(tr.x)) and np.all(np.diff(tr.t) > 0)
     law = s.contacts[0].law
     T = march(law, tr.x[:, 0], tr.N[:, 0])[0]
-    assert np.max(np.abs(T - tr.T[:, 0])) <= config.TEST_TI_MARCH_ATOL_FY * law.fy
+    assert np.max(np.abs(T - tr.T[:, 0])) <= tolerances.TEST_TI_MARCH_ATOL_FY * law.fy
     assert np.all(np.abs(tr.T[:, 0]) <= law.fy * np.maximum(tr.N[:, 0], 0.0) / law.n_ref * (1 + 1e-9) + 1e-12)
 
 
@@ -235,12 +236,12 @@ def test_event_at_the_period_boundary(delta):
     tr = integrate(s, 1.1, periods=3)
     law = s.contacts[0].law
     T = march(law, tr.x[:, 0], tr.N[:, 0])[0]
-    assert np.max(np.abs(T - tr.T[:, 0])) <= config.TEST_TI_MARCH_ATOL_FY * law.fy
+    assert np.max(np.abs(T - tr.T[:, 0])) <= tolerances.TEST_TI_MARCH_ATOL_FY * law.fy
     assert 0.0 <= tr.N[0, 0] <= 1e-9 * law.n_ref
     a = steady_state(s, 1.1, keep_loop=False)
     b = steady_state(s, 1.1, steps_per_period=2 * config.TI_STEPS_PER_PERIOD, keep_loop=False)
     assert a.ok and b.ok
-    assert b.amplitude_m == pytest.approx(a.amplitude_m, rel=config.TEST_TI_STEP_HALVING_RTOL)
+    assert b.amplitude_m == pytest.approx(a.amplitude_m, rel=tolerances.TEST_TI_STEP_HALVING_RTOL)
 
 
 def test_velocity_reversals_are_step_boundaries():

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from jointdyn.config import TEST_ENERGY_RTOL, TEST_QS_FRACTION_ATOL
+from tolerances import TEST_ENERGY_RTOL, TEST_QS_FRACTION_ATOL
 from jointdyn.figures import FIGURES, figure_names, make_figure
 
 QS_FIGS = ["fig2", "fig3", "fig4", "fig4_discrete"]

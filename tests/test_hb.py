@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
+import tolerances
 from jointdyn import System, config
 from jointdyn.hb import (
     HBProblem,
@@ -65,7 +66,7 @@ def test_one_harmonic_equals_describing_function(gamma):
     assert sol.converged
     A = math.hypot(sol.X[1], sol.X[2])
     assert abs(sol.X[0]) < 1e-12  # symmetric loop: no offset
-    assert abs(A - _df_amplitude(gamma)) <= config.TEST_HB_DF_RTOL * _df_amplitude(gamma)
+    assert abs(A - _df_amplitude(gamma)) <= tolerances.TEST_HB_DF_RTOL * _df_amplitude(gamma)
 
 
 @pytest.mark.parametrize(
@@ -92,7 +93,7 @@ def test_jacobian_matches_central_differences(model, eta, par):
             h = 1e-6 * max(abs(lam), 1e-3)
             lp, lm = lam + h, lam - h
         Jfd[:, j] = (p.evaluate(Xp, lp).R - p.evaluate(Xm, lm).R) / (2 * h)
-    assert np.max(np.abs(Ja - Jfd)) <= config.TEST_HB_JACOBIAN_RTOL * np.max(np.abs(Ja))
+    assert np.max(np.abs(Ja - Jfd)) <= tolerances.TEST_HB_JACOBIAN_RTOL * np.max(np.abs(Ja))
     assert ev.info[2] == 1.0  # the marched force repeated
 
 
@@ -106,7 +107,7 @@ def test_hb_equals_time_integration_at_stable_points():
         assert sol.converged and sol.stable
         ss = steady_state(sysm, g)
         assert ss.status == "periodic"
-        assert abs(sol.amplitude_m - ss.amplitude_m) <= config.TEST_HB_VS_TIME_RTOL * ss.amplitude_m
+        assert abs(sol.amplitude_m - ss.amplitude_m) <= tolerances.TEST_HB_VS_TIME_RTOL * ss.amplitude_m
 
 
 def test_jenkins_branch_complete_and_agrees_with_df():
@@ -290,7 +291,7 @@ def test_two_dof_contact_between_masses_equals_time_integration():
         sol = harmonic_balance(s, g, harmonics=7, samples=256)
         ss = steady_state(s, g)
         assert sol.converged and sol.stable and ss.status == "periodic"
-        assert abs(sol.amplitude_m - ss.amplitude_m) <= config.TEST_HB_VS_TIME_RTOL * ss.amplitude_m
+        assert abs(sol.amplitude_m - ss.amplitude_m) <= tolerances.TEST_HB_VS_TIME_RTOL * ss.amplitude_m
 
 
 def test_fully_stuck_contact_gives_the_linear_solution():

@@ -19,7 +19,7 @@ import pytest
 import law_histories as H
 
 from jointdyn import DiscreteIwan, Iwan, backbone, march
-from jointdyn import config as C
+import tolerances as C
 
 KT, MU, NREF = 1e5, 0.1, 100.0
 FY = MU * NREF

@@ -16,7 +16,7 @@ import pytest
 import law_histories as H
 
 from jointdyn import DiscreteIwan, Iwan, Jenkins, march
-from jointdyn import config as C
+import tolerances as C
 from jointdyn._jit import specialize
 
 KT, MU, NREF = 1e5, 0.1, 100.0

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 import law_histories as H
 
 from jointdyn import DiscreteIwan, Iwan, Jenkins, march
-from jointdyn import config as C
+import tolerances as C
 
 SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 

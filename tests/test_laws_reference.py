@@ -16,7 +16,7 @@ import law_histories as H
 from reference import march_ref, reference_for
 
 from jointdyn import DiscreteIwan, Iwan, Jenkins, march
-from jointdyn import config as C
+import tolerances as C
 
 KT, MU, NREF = 1e5, 0.1, 100.0
 XS = 2.0 * MU * NREF / KT  # macroslip displacement 2 fy / kt

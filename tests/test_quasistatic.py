@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 from jointdyn import DiscreteIwan, HarmonicLoad, Iwan, make_law
-from jointdyn.config import TEST_ENERGY_RTOL, TEST_QS_FRACTION_ATOL
+from tolerances import TEST_ENERGY_RTOL, TEST_QS_FRACTION_ATOL
 from jointdyn.drivers import harmonic_history, harmonic_loop, quasistatic, read_history_csv
 from jointdyn.laws import MACROSLIP, SEPARATION, STICK_SLIP
 

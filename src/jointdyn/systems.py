@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _validate as V
+from . import config
 from .laws import ContactLaw, make_law
 
 __all__ = ["Contact", "System", "PAPER"]
@@ -198,7 +199,7 @@ class System:
         model: str = "iwan",
         zeta: float = 0.0,
         f1: float | None = None,
-        n: int = 1000,
+        n: int = config.LAW_DISCRETE_N,
         **overrides,
     ) -> "System":
         """The paper's friction damper (MODEL.md section 6) in its groups.

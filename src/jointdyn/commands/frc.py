@@ -37,7 +37,8 @@ def add_arguments(p) -> None:
     p.add_argument("--delta", type=float, default=0.0, help="normal-load phase, degrees (default 0)")
     p.add_argument("--sweep", default="both", help="up, down or both (default both)")
     p.add_argument("--model", default="iwan", help="contact law: iwan, iwan-paper, discrete, jenkins (default iwan)")
-    p.add_argument("--n", type=int, default=1000, help="elements of the discrete law (default 1000)")
+    p.add_argument("--n", type=int, default=config.LAW_DISCRETE_N,
+                   help=f"elements of the discrete law (default {config.LAW_DISCRETE_N})")
     p.add_argument("--zeta", type=float, default=0.0, help="viscous damping ratio (default 0)")
     p.add_argument("--m", type=float, default=PAPER["m"], help=f"mass, kg (default {PAPER['m']:g})")
     p.add_argument("--k", type=float, default=PAPER["k"], help=f"stiffness, N/m (default {PAPER['k']:g})")
@@ -50,8 +51,10 @@ def add_arguments(p) -> None:
     p.add_argument("--steps-per-period", type=int, default=None, help="time steps per forcing period (solver default)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="run the sweep lines on this Dask scheduler")
     p.add_argument("--workers", type=int, default=None, help="local parallel workers (default: all cores)")
-    p.add_argument("--harmonics", type=int, default=7, help="hb: number of harmonics (default 7)")
-    p.add_argument("--samples", type=int, default=128, help="hb: time samples per period (default 128)")
+    p.add_argument("--harmonics", type=int, default=config.HB_HARMONICS,
+                   help=f"hb: number of harmonics (default {config.HB_HARMONICS})")
+    p.add_argument("--samples", type=int, default=config.HB_SAMPLES,
+                   help=f"hb: time samples per period (default {config.HB_SAMPLES})")
     p.add_argument("--out", default=None, metavar="DIR", help="write frc.nc, frc.csv, frc.png here")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
 

@@ -25,6 +25,8 @@ import json
 import math
 from pathlib import Path
 
+from .. import config
+
 NAME = "loop"
 HELP = "quasi-static hysteresis loop of a contact law under prescribed tangential motion and normal load"
 
@@ -40,7 +42,8 @@ def add_arguments(p) -> None:
                    help="contact law: iwan (closed form, full Masing memory), iwan-paper (the paper's "
                         "last-reversal rule), discrete (n Jenkins elements, ground truth), jenkins "
                         "(default: iwan)")
-    p.add_argument("--n", type=int, default=1000, help="number of Jenkins elements of --model discrete (default 1000)")
+    p.add_argument("--n", type=int, default=config.LAW_DISCRETE_N,
+                   help=f"number of Jenkins elements of --model discrete (default {config.LAW_DISCRETE_N})")
     p.add_argument("--kt", type=float, default=1e5, help="total tangential stiffness kt, N/m (default 1e5)")
     p.add_argument("--mu", type=float, default=0.1, help="friction coefficient mu (default 0.1)")
     p.add_argument("--n-ref", type=float, default=100.0, dest="n_ref",
@@ -52,9 +55,10 @@ def add_arguments(p) -> None:
     p.add_argument("--frequency", type=float, default=1.0, help="frequency f, Hz (default 1)")
     p.add_argument("--eta", type=float, default=0.0, help="normal-load ratio N1 / N0 (default 0; > 1 separates)")
     p.add_argument("--delta", type=float, default=0.0, help="phase of the normal load, degrees (default 0)")
-    p.add_argument("--cycles", type=int, default=2, help="number of cycles (default 2); metrics of the last one")
-    p.add_argument("--steps-per-cycle", type=int, default=2000, dest="steps_per_cycle",
-                   help="time steps per cycle (default 2000)")
+    p.add_argument("--cycles", type=int, default=config.QS_CYCLES,
+                   help=f"number of cycles (default {config.QS_CYCLES}); metrics of the last one")
+    p.add_argument("--steps-per-cycle", type=int, default=config.QS_STEPS_PER_CYCLE, dest="steps_per_cycle",
+                   help=f"time steps per cycle (default {config.QS_STEPS_PER_CYCLE})")
     p.add_argument("--input", default=None, metavar="FILE.csv",
                    help="history from CSV with columns t, x, N (s, m, N), replacing the harmonic shorthand; "
                         "the whole history is then one cycle unless --period is given")

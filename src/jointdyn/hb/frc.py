@@ -240,7 +240,7 @@ def continue_hb(
     max_points = V.positive_int("max_points", max_points, 2)
     problem = HBProblem(system, harmonics=harmonics, samples=samples, parameter=parameter, gamma=gamma)
     xs, fs, ls = _scales(problem)
-    ds = 0.05 if ds is None else V.positive("ds", ds)
+    ds = config.HB_DS_START if ds is None else V.positive("ds", ds)
     ds_max = config.HB_DS_MAX if ds_max is None else V.positive("ds_max", ds_max)
     law = contact_of(system).law
     cache = {}

@@ -114,7 +114,7 @@ class HBProblem:
         Bound on the periods marched per AFT evaluation.
     """
 
-    def __init__(self, system: System, *, harmonics: int = 7, samples: int = 128,
+    def __init__(self, system: System, *, harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
                  parameter: str = "gamma", gamma: float | None = None,
                  max_passes: int = config.HB_MAX_PASSES):
         if not isinstance(system, System):

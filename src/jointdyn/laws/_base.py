@@ -2,16 +2,22 @@
 
 Kernel contract (OpenSees-style trial step from a committed state)
 -------------------------------------------------------------------
-Every contact law provides three compiled kernels::
+Every contact law provides four compiled kernels::
 
     T, kT, code = step(params, s_old, s_new, x, N)
     T, kT, code = step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT)
     init(params, x0, n0, s)
+    init_jvp(params, x0, dx0, n0, dn0, s, ds)
 
 ``init`` writes into ``s`` (in full) the virgin committed state at
 displacement ``x0`` (m) and normal load ``n0`` (N); ``law.initial_state`` is
 that kernel called from Python, and compiled loops that restart a law call it
-directly.
+directly. ``init_jvp`` does the same and writes the exact derivative of that
+state along ``ndir`` directions: ``dx0``, ``dn0`` are ``(ndir,)`` and ``ds``
+is ``(state_size, ndir)``. Solvers that restart a law from a state that
+depends on their unknowns (harmonic balance restarts every contact at the
+mean displacement of each evaluation) take the derivative from here, never
+by differencing the state.
 
 ``params``  float64[:]   the law's parameters (from ``law.params``)
 ``s_old``   float64[:]   committed state; **never written**
@@ -154,6 +160,11 @@ class ContactLaw:
     @property
     def init(self):
         """The compiled virgin-state kernel ``init(params, x0, n0, s)`` (see module docstring)."""
+        raise NotImplementedError
+
+    @property
+    def init_jvp(self):
+        """The compiled kernel ``init_jvp(params, x0, dx0, n0, dn0, s, ds)`` (see module docstring)."""
         raise NotImplementedError
 
     # --- shared -------------------------------------------------------------

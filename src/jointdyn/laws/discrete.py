@@ -13,10 +13,11 @@ from typing import ClassVar
 import numpy as np
 
 from .. import _validate as V
+from .. import config
 from .._jit import jit
 from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, register
 
-__all__ = ["DiscreteIwan", "Jenkins", "discrete_step", "discrete_step_jvp"]
+__all__ = ["DiscreteIwan", "Jenkins", "discrete_step", "discrete_step_jvp", "discrete_init", "discrete_init_jvp"]
 
 # params layout: [kt, fy, n_ref, n, f_1 ... f_n]  (f_i: total slip force of
 # element i at the reference load, i.e. element limit = alpha * f_i / n)
@@ -158,6 +159,18 @@ def discrete_init(params, x0, n0, s):
     s[0] = x0
 
 
+@jit
+def discrete_init_jvp(params, x0, dx0, n0, dn0, s, ds):
+    """:func:`discrete_init` and its derivative: d(x_prev) = dx0, the
+    element forces stay zero (``ds`` is (state size, directions))."""
+    discrete_init(params, x0, n0, s)
+    for r in range(ds.shape[0]):
+        for j in range(ds.shape[1]):
+            ds[r, j] = 0.0
+    for j in range(ds.shape[1]):
+        ds[0, j] = dx0[j]
+
+
 @dataclass(frozen=True)
 class DiscreteIwan(ContactLaw):
     """n parallel Jenkins elements, slip forces scaled by N(t)/N_ref.
@@ -179,7 +192,7 @@ class DiscreteIwan(ContactLaw):
         with slip force mu N(t) (use :class:`Jenkins`).
     """
 
-    n: int = 1000
+    n: int = config.LAW_DISCRETE_N
     name: ClassVar[str] = "discrete"
 
     def __post_init__(self) -> None:
@@ -208,6 +221,10 @@ class DiscreteIwan(ContactLaw):
     def init(self):
         return discrete_init
 
+    @property
+    def init_jvp(self):
+        return discrete_init_jvp
+
 
 @dataclass(frozen=True)
 class Jenkins(DiscreteIwan):
@@ -226,7 +243,7 @@ class Jenkins(DiscreteIwan):
             raise ValueError(f"n must be 1 for a Jenkins element (allowed range [1, 1]), got {self.n}")
 
 
-def _make_discrete(*, kt, mu, n_ref, n=1000, **_):
+def _make_discrete(*, kt, mu, n_ref, n=config.LAW_DISCRETE_N, **_):
     return DiscreteIwan(kt=kt, mu=mu, n_ref=n_ref, n=n)
 
 

@@ -46,7 +46,7 @@ from .. import config
 from .._jit import jit
 from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, register
 
-__all__ = ["Iwan", "iwan_step", "iwan_step_jvp", "backbone"]
+__all__ = ["Iwan", "iwan_step", "iwan_step_jvp", "iwan_init", "iwan_init_jvp", "backbone"]
 
 # params: [kt, fy, n_ref, memory (0 full, 1 last), max_depth]
 # state : [q_prev, G_prev, a_prev, dir, base, base_q, base_a, m, base_G, (q_i, G_i, a_i) * max_depth]
@@ -381,6 +381,26 @@ def iwan_init(params, x0, n0, s):
 
 
 @jit
+def iwan_init_jvp(params, x0, dx0, n0, dn0, s, ds):
+    """:func:`iwan_init` and its derivative along ``dx0.size`` directions.
+
+    The virgin state is linear in x0 (rows q and the base point q_c) and in
+    n0 (row alpha) on each side of n0 = 0; ``ds`` (state size, directions)
+    receives d(state) = (kt/fy) dx0 on those two rows, dn0 / n_ref on alpha.
+    """
+    iwan_init(params, x0, n0, s)
+    qs = params[0] / params[1] if params[1] > 0.0 else 0.0
+    ia = 1.0 / params[2]
+    for r in range(ds.shape[0]):
+        for j in range(ds.shape[1]):
+            ds[r, j] = 0.0
+    for j in range(ds.shape[1]):
+        ds[_Q, j] = qs * dx0[j]
+        ds[_BQ, j] = qs * dx0[j]
+        ds[_A, j] = ia * dn0[j]
+
+
+@jit
 def iwan_step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT):
     """:func:`iwan_step` with forward-mode derivatives along ``dx.size`` directions."""
     return _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT)
@@ -436,6 +456,10 @@ class Iwan(ContactLaw):
     @property
     def init(self):
         return iwan_init
+
+    @property
+    def init_jvp(self):
+        return iwan_init_jvp
 
 
 def _make_iwan(*, kt, mu, n_ref, **_):

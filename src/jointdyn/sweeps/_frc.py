@@ -126,7 +126,7 @@ class LineSpec:
     direction: str
     gammas: tuple
     model: str = "iwan"
-    n: int = 1000
+    n: int = config.LAW_DISCRETE_N
     zeta: float = 0.0
     overrides: tuple = ()
     steps_per_period: int | None = None
@@ -338,7 +338,7 @@ def frc_sweep(
     deltas=(0.0,),
     directions=("up", "down"),
     model: str = "iwan",
-    n: int = 1000,
+    n: int = config.LAW_DISCRETE_N,
     zeta: float = 0.0,
     m: float | None = None,
     k: float | None = None,

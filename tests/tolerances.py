@@ -1,0 +1,47 @@
+"""Test tolerances, in one place (they belong to the tests, not to the package).
+
+Each constant says what it bounds and in which units.
+"""
+
+# --- contact laws ----------------------------------------------------------
+#: closed-form energy per cycle vs the formula (relative)
+TEST_ENERGY_RTOL = 5e-3
+#: closed-form Iwan vs discrete (n = 4000), as a fraction of fy
+TEST_IWAN_VS_DISCRETE_FY = 5e-3
+#: compiled kernels vs plain-Python references (absolute, in units of fy)
+TEST_REFERENCE_ATOL_FY = 1e-9
+#: tangent kT of compiled kernels vs plain-Python references (absolute, in units of kt)
+TEST_REFERENCE_ATOL_KT = 1e-9
+#: energy created over a closed cycle may not exceed this fraction of fy*A
+TEST_ENERGY_CREATION_TOL = 1e-9
+#: step_jvp vs central finite differences of the march (relative to the
+#: largest derivative of the history)
+TEST_JVP_RTOL = 1e-6
+#: finite-difference step, relative to the history's scale
+TEST_JVP_FD_STEP = 1e-6
+#: |T| <= alpha fy (1 + this) (rounding of the clip)
+TEST_FORCE_BOUND_RTOL = 1e-12
+
+# --- quasi-static driver ---------------------------------------------------
+#: exactness of the separation time fraction with crossings inserted
+TEST_QS_FRACTION_ATOL = 1e-9
+
+# --- time integration --------------------------------------------------------
+#: peak of the beta = 1000 response vs sqrt((k + kt)/k)
+TEST_TI_PEAK_GAMMA_ATOL = 0.01
+#: eta = 0 tiny forcing vs linear (k + kt) oscillator, relative
+TEST_TI_LINEAR_RTOL = 0.01
+#: energy balance W = E_contact + E_viscous at steady state, relative
+TEST_TI_ENERGY_RTOL = 0.01
+#: amplitude change when the step is halved at the default steps, relative
+TEST_TI_STEP_HALVING_RTOL = 0.005
+#: compiled law inside the integrator vs drivers.march, in units of fy
+TEST_TI_MARCH_ATOL_FY = 1e-9
+
+# --- harmonic balance ----------------------------------------------------------
+#: exact Jacobian vs central finite differences (relative to max |J|)
+TEST_HB_JACOBIAN_RTOL = 1e-6
+#: one harmonic vs the describing function (relative)
+TEST_HB_DF_RTOL = 1e-4
+#: harmonic balance vs time-domain steady state (relative)
+TEST_HB_VS_TIME_RTOL = 1e-2
