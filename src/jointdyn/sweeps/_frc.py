@@ -329,6 +329,21 @@ def _check_inputs(gammas, etas, betas, f1s, deltas, directions, model, n, zeta, 
     return g, etas, betas, f1s, deltas, directions, model, n, zeta, tuple(ov), steps_per_period
 
 
+def _check_client(client) -> None:
+    """``client`` is None or a connected ``distributed.Client``."""
+    if client is None:
+        return
+    try:
+        from distributed import Client
+    except ImportError:  # pragma: no cover - dask[distributed] is a dependency
+        Client = None
+    if Client is None or not isinstance(client, Client):
+        raise ValueError(
+            "client must be a distributed.Client (connect first: distributed.Client('tcp://host:8786')) "
+            f"or None for local workers, got {type(client).__name__} {client!r:.80}"
+        )
+
+
 def frc_sweep(
     gammas,
     *,
@@ -384,13 +399,15 @@ def frc_sweep(
     steps_per_period : int, optional
         Integration steps per forcing period (solver default if None).
     client : distributed.Client, optional
-        Run the lines on this Dask cluster.
+        Run the lines on this Dask cluster (a connected client, not an
+        address).
     n_workers : int, optional
         Local parallel workers (default: all usable cores; 1 runs serially
         in this process).
     out : path, optional
         Directory for resumable per-line files and the final ``frc.nc`` and
-        ``frc.csv`` (all written atomically).
+        ``frc.csv`` (all written atomically); checked for writability before
+        anything is computed.
     progress : bool
         Show a tqdm bar over points (hidden when not a terminal).
     on_line : callable, optional
@@ -419,6 +436,9 @@ def frc_sweep(
     )
     if n_workers is not None:
         n_workers = V.positive_int("n_workers", n_workers)
+    _check_client(client)
+    if out is not None:  # before computing: no finished line is lost to an unwritable out
+        V.output_dir("out", out, files=("frc.nc", "frc.csv"), subdirs=("lines",))
     load_name, loads = ("beta", betas) if f1s is None else ("f1", f1s)
     if load_name == "beta" and dict(ov).get("mu", 0.5) <= 0:
         raise ValueError("mu must be > 0 when sweeping beta = mu N0 / F1")
