@@ -51,6 +51,7 @@ exclude_patterns = [
     "img",
     # the package index's copy of README.md (docs/scripts/long_description.py)
     "long-description.md",
+    "api/generated/cli.md",
     "sg_execution_times.rst",
     "auto_examples/*.ipynb",
     "auto_examples/*.py",
@@ -170,7 +171,20 @@ def write_api_pages() -> list[str]:
         (API_DIR / f"{modname}.rst").write_text(_module_page(modname, home))
     toc = ["```{toctree}", ":maxdepth: 1", ""] + [f"generated/{m}" for m in modules] + ["```", ""]
     (API_DIR / "toc.txt").write_text("\n".join(toc))
+    (API_DIR / "cli.md").write_text(cli_help())
     return modules
+
+
+def cli_help() -> str:
+    """``jointdyn --help`` and ``jointdyn <command> --help`` as Markdown sections."""
+    from jointdyn.cli import build_parser
+
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    out = ["## `jointdyn`", "", "```text", parser.format_help().rstrip(), "```", ""]
+    for name, p in sub.choices.items():
+        out += [f"## `jointdyn {name}`", "", "```text", p.format_help().rstrip(), "```", ""]
+    return "\n".join(out)
 
 
 write_api_pages()
