@@ -221,6 +221,17 @@ def escape_absolute_values(app, what, name, obj, options, lines):
             lines[i] = _escape_bars(line)
 
 
+def constant_values(app, what, name, obj, options, lines):
+    """``autodoc-process-docstring`` handler: a module constant (an int,
+    tuple, dict...) has no docstring of its own, and autodoc would show its
+    type's (``int([x]) -> integer``); show its value instead."""
+    own = type(obj).__doc__
+    if what in ("data", "attribute") and own and lines and lines[0].strip() == own.strip().splitlines()[0].strip():
+        text = repr(obj)
+        lines[:] = [f"Value: ``{text if len(text) <= 300 else text[:300] + ' ...'}``"]
+
+
 def setup(app):
+    app.connect("autodoc-process-docstring", constant_values, priority=400)
     # after numpydoc (priority 500) has turned the sections into reST
     app.connect("autodoc-process-docstring", escape_absolute_values, priority=600)

@@ -144,3 +144,12 @@ def test_sdist_and_wheel(tmp_path):
     cli = py.parent / ("jointdyn.exe" if os.name == "nt" else "jointdyn")
     out = subprocess.run([str(cli), "--version"], cwd=elsewhere, env=env, capture_output=True, text=True)
     assert out.returncode == 0 and version in out.stdout, out.stdout + out.stderr
+
+
+def test_gitignore_lists_no_tracked_file():
+    git = shutil.which("git")
+    if not (git and (ROOT / ".git").exists()):
+        pytest.skip("not a git checkout (an unpacked source distribution has no .gitignore to check)")
+    ignored = subprocess.run([git, "ls-files", "-ci", "--exclude-standard"], cwd=ROOT, capture_output=True,
+                             text=True, check=True).stdout.split()
+    assert not ignored, f".gitignore matches tracked files: {ignored}"
