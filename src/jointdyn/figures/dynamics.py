@@ -3,7 +3,8 @@
 ``fig6``
     Frequency-response curves: normalised amplitude of q = kt x / fy vs
     gamma for eta = 0.01, 0.5, 1.5, 10 and beta from 0.1 to 1000, swept up
-    and down (parallel sweep); points without a steady state are marked.
+    and down (parallel sweep); points without a steady state are marked on
+    a rug axis below each panel, never on the amplitude axis.
 ``fig7``
     Steady loops T vs x under a small tangential excitation with separation
     (eta > 1): the contact opens while it carries load (the force drops to
@@ -12,7 +13,8 @@
     normal load against the motion.
 ``fig8``
     Steady loops for delta from 0 to 180 deg, in contact (eta = 0.5) and with
-    separation (eta = 1.5).
+    separation (eta = 1.5), with the exact discrete model beside the closed
+    form, and the energy per cycle of both against delta.
 ``energy_delta``
     Energy dissipated by the contact per cycle vs delta, in contact and with
     separation.

@@ -143,7 +143,7 @@ def _legend_below(fig, ax, loops, colors, ncol=3):
 FIG2_AMPLITUDES = (0.1e-3, 0.5e-3)
 
 
-@register_figure("fig2", "Iwan hysteresis loops at constant normal load: microslip only and with macroslip", order=20)
+@register_figure("fig2", "Paper Fig 2: Iwan loops at constant normal load, amplitude varied (microslip only, with macroslip)", order=20)
 def fig2():
     return _cases(["iwan"], [0.0], 0.0, amplitudes=FIG2_AMPLITUDES)
 
@@ -238,7 +238,7 @@ def _plot_eta_family(tables, out_dir, name, delta_deg, paper_fig):
     return save_figure(fig, out_dir, name, dpi=150)
 
 
-@register_figure("fig3", "Loops under in-phase normal load (delta = 0), eta = 0 ... 1.2 (paper Fig 3)", order=30)
+@register_figure("fig3", "Paper Fig 3: loops, normal load in phase (delta = 0), eta = 0 ... 1.2 varied", order=30)
 def fig3():
     return _cases(["iwan"], ETAS, 0.0)
 
@@ -248,7 +248,7 @@ def _plot_fig3(tables, out_dir):
     return _plot_eta_family(tables, out_dir, "fig3", 0.0, 3)
 
 
-@register_figure("fig4", "Loops under out-of-phase normal load (delta = 90 deg), eta = 0 ... 1.2 (paper Fig 4)", order=40)
+@register_figure("fig4", "Paper Fig 4: loops, normal load 90 deg out of phase, eta = 0 ... 1.2 varied", order=40)
 def fig4():
     return _cases(["iwan"], ETAS, 90.0)
 
@@ -258,7 +258,7 @@ def _plot_fig4(tables, out_dir):
     return _plot_eta_family(tables, out_dir, "fig4", 90.0, 4)
 
 
-@register_figure("fig4_discrete", "Fig 4 cases: closed forms vs discrete Iwan (n = 1000) ground truth", order=41)
+@register_figure("fig4_discrete", "Paper Fig 4 cases, eta varied: closed forms vs the exact discrete Iwan model (n = 1000)", order=41)
 def fig4_discrete():
     return _cases(["iwan", "iwan-paper", "discrete"], ETAS, 90.0)
 
