@@ -123,7 +123,7 @@ def render(mach: dict, figs: dict | None, bench: dict | None, quick: bool) -> st
              f"on {mach['date (UTC)']} UTC.", "", "| machine | |", "|---|---|"]
     lines += [f"| {k} | {v} |" for k, v in mach.items() if k != "date (UTC)"]
     if figs:
-        lines += ["", "### `jointdyn figures`", "",
+        lines += ["", "## `jointdyn figures`", "",
                   "Each line is one fresh process. *Cold*: an empty Numba cache, so every kernel is compiled "
                   "first (the first run after installing). *Warm*: the cache filled by the cold run (every later "
                   "run). CPU time counts all processes of the run (sweeps use every core), so CPU time above wall "
@@ -134,7 +134,7 @@ def render(mach: dict, figs: dict | None, bench: dict | None, quick: bool) -> st
                          f"{r['load_after']:.2f} |")
     if bench:
         t = bench["timing"]
-        lines += ["", "### `benchmarks/run.py`", "",
+        lines += ["", "## `benchmarks/run.py`", "",
                   f"The whole benchmark took {t['wall_s']:.0f} s wall, {t['cpu_s']:.0f} s CPU (load "
                   f"{t['load_before']:.2f} before, {t['load_after']:.2f} after). Every result, as it printed it "
                   "(what each number means: the docstring of each `benchmarks/bench_*.py`):", "",
