@@ -26,24 +26,17 @@ import math
 from pathlib import Path
 
 from .. import config
+from ._law_args import add_law_arguments, law_params, model_help
 
 NAME = "loop"
 HELP = "quasi-static hysteresis loop of a contact law under prescribed tangential motion and normal load"
 
 
-def _law_choices():
+def add_arguments(p) -> None:
     from ..laws import law_names
 
-    return law_names()
-
-
-def add_arguments(p) -> None:
-    p.add_argument("--model", default="iwan", choices=_law_choices(),
-                   help="contact law: iwan (closed form, full Masing memory), iwan-paper (the paper's "
-                        "last-reversal rule), discrete (n Jenkins elements, ground truth), jenkins "
-                        "(default: iwan)")
-    p.add_argument("--n", type=int, default=config.LAW_DISCRETE_N,
-                   help=f"number of Jenkins elements of --model discrete (default {config.LAW_DISCRETE_N})")
+    p.add_argument("--model", default="iwan", choices=law_names(), help=model_help("iwan"))
+    add_law_arguments(p)
     p.add_argument("--kt", type=float, default=1e5, help="total tangential stiffness kt, N/m (default 1e5)")
     p.add_argument("--mu", type=float, default=0.1, help="friction coefficient mu (default 0.1)")
     p.add_argument("--n-ref", type=float, default=100.0, dest="n_ref",
@@ -71,7 +64,6 @@ def add_arguments(p) -> None:
 def _validate_args(args):
     from .. import _validate as V
 
-    V.positive_int("--n", args.n, 1)
     V.positive("--kt", args.kt)
     V.nonnegative("--mu", args.mu)
     V.positive("--n-ref", args.n_ref)
@@ -136,7 +128,8 @@ def run(args) -> int:
     from ..laws import make_law
 
     _validate_args(args)
-    law = make_law(args.model, kt=args.kt, mu=args.mu, n_ref=args.n_ref, n=args.n)
+    lp = law_params(args)
+    law = make_law(args.model, kt=args.kt, mu=args.mu, n_ref=args.n_ref, **lp)
     if args.input is not None:
         t, x, N = read_history_csv(args.input)
         period = args.period
@@ -150,8 +143,7 @@ def run(args) -> int:
     last = res.last_cycle()
 
     params = {"kt_N_per_m": args.kt, "mu": args.mu, "n_ref_N": args.n_ref, "fy_N": law.fy}
-    if args.model == "discrete":
-        params["n"] = args.n
+    params.update(lp)
     if args.input is not None:
         params.update(input=str(args.input), period_s=period)
     else:

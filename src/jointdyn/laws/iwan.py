@@ -41,10 +41,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from .. import _validate as V
 from .. import config
 from .._jit import jit
-from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, register
+from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, law_param, register
 
 __all__ = ["Iwan", "iwan_step", "iwan_step_jvp", "iwan_init", "iwan_init_jvp", "backbone"]
 
@@ -488,14 +487,15 @@ class Iwan(ContactLaw):
         innermost pair of reversal points is forgotten.
     """
 
-    memory: str = "full"
-    max_depth: int = config.IWAN_MAX_DEPTH
+    memory: str = law_param(
+        "full", choices=("full", "last"),
+        help="reversal memory: full (Masing's extended rules) or last (the paper's last-reversal rule)",
+    )
+    max_depth: int = law_param(
+        config.IWAN_MAX_DEPTH, low=2,
+        help="capacity of the reversal-point stack (the innermost pair is forgotten when full)",
+    )
     name: ClassVar[str] = "iwan"
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        V.choice("memory", self.memory, ("full", "last"))
-        object.__setattr__(self, "max_depth", V.positive_int("max_depth", self.max_depth, 2))
 
     @property
     def step(self):
@@ -523,14 +523,42 @@ class Iwan(ContactLaw):
     def init_jvp(self):
         return iwan_init_jvp
 
+    @property
+    def passive(self) -> bool:
+        """Full memory only: the last-reversal rule can create energy after
+        nested reversals (it forgets the outer loops)."""
+        return self.memory == "full"
 
-def _make_iwan(*, kt, mu, n_ref, **_):
-    return Iwan(kt=kt, mu=mu, n_ref=n_ref, memory="full")
+    @property
+    def x_slip(self) -> float:
+        """2 fy / kt (m): the virgin curve G_oa reaches macroslip at q = 2."""
+        return 2.0 * self.fy / self.kt
+
+    def _state_error(self, s):
+        """The head and the live reversal points finite, the depth an integer
+        in [0, max_depth], the base code and the direction valid (the stack
+        rows beyond the depth are never read and may hold anything)."""
+        head = s[:_HEAD]
+        if not np.all(np.isfinite(head)):
+            return f"entries 0..{_HEAD - 1} must be finite, got {head.tolist()}"
+        m = s[_M]
+        if not (m == int(m) and 0 <= m <= self.max_depth):
+            return f"entry {_M} (reversal-stack depth) must be an integer in [0, {self.max_depth}], got {float(m)!r}"
+        if s[_BASE] not in (_SEP, _VIRGIN, _SAT):
+            return f"entry {_BASE} (base curve) must be 0, 1 or 2, got {float(s[_BASE])!r}"
+        if s[_DIR] not in (-1.0, 0.0, 1.0):
+            return f"entry {_DIR} (direction) must be -1, 0 or 1, got {float(s[_DIR])!r}"
+        live = s[_HEAD : _HEAD + 3 * int(m)]
+        if not np.all(np.isfinite(live)):
+            return f"the {int(m)} live reversal points (entries {_HEAD}..{_HEAD + 3 * int(m) - 1}) must be finite"
+        return None
 
 
-def _make_iwan_paper(*, kt, mu, n_ref, **_):
-    return Iwan(kt=kt, mu=mu, n_ref=n_ref, memory="last")
-
-
-register("iwan", _make_iwan)
-register("iwan-paper", _make_iwan_paper)
+register(
+    "iwan", Iwan, fixed={"memory": "full"},
+    summary="closed-form Iwan with full Masing memory, exact at constant N for any history",
+)
+register(
+    "iwan-paper", Iwan, fixed={"memory": "last"},
+    summary="closed-form Iwan with the paper's last-reversal rule",
+)
