@@ -230,3 +230,21 @@ def test_iwan_state_beyond_the_stack_may_hold_anything():
     s[9:15] = np.nan  # two live reversal points that are not finite
     with pytest.raises(ValueError, match="live reversal points"):
         march(LAW, x, N, state=s)
+
+
+def test_register_refuses_a_taken_name_and_non_laws():
+    from dataclasses import dataclass
+
+    from jointdyn.laws import register
+
+    @dataclass(frozen=True)
+    class Other(Iwan):
+        """Another law."""
+
+    with pytest.raises(ValueError, match="already registered"):
+        register("iwan", Other)
+    with pytest.raises(ValueError, match="ContactLaw subclass"):
+        register("not-a-law", dict)
+    with pytest.raises(ValueError, match="fixed parameter"):
+        register("not-a-law", Iwan, fixed={"no_such": 1})
+    assert "not-a-law" not in law_names()

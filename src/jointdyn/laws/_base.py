@@ -459,7 +459,10 @@ def register(name: str, law: type, *, fixed: dict | None = None, summary: str | 
     if summary is None:
         summary = (law.__doc__ or law.__name__).strip().splitlines()[0].rstrip(".")
     old = _REGISTRY.get(name)
-    if old is not None and old.law.__qualname__ != law.__qualname__:
+    where = f"{law.__module__}.{law.__qualname__}"
+    if old is not None and f"{old.law.__module__}.{old.law.__qualname__}" != where:
+        # a module imported again (reload) registers the same class again; a
+        # different class under a taken name is an error
         raise ValueError(f"law name {name!r} is already registered by {old.law.__module__}.{old.law.__qualname__}")
     _REGISTRY[name] = _Entry(law=law, fixed=tuple(sorted(fixed.items())), summary=summary)
 
