@@ -34,7 +34,7 @@ def sep_fraction(eta):
 
 
 def law(name="iwan"):
-    return make_law(name, kt=KT, mu=MU, n_ref=N0, n=1000)
+    return make_law(name, kt=KT, mu=MU, n_ref=N0, **({"n": 1000} if name == "discrete" else {}))
 
 
 # --- histories ---------------------------------------------------------------

@@ -27,6 +27,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
+from ._law_args import add_law_arguments, law_params, model_help
 from ..systems import PAPER
 
 NAME = "frc"
@@ -46,9 +47,8 @@ def add_arguments(p) -> None:
     p.add_argument("--sweep", default=None,
                    help="time: up, down or both (default both); hb: refused (the continuation follows the "
                         "branch through its folds, which holds the states of both sweep directions)")
-    p.add_argument("--model", default="iwan", help="contact law: iwan, iwan-paper, discrete, jenkins (default iwan)")
-    p.add_argument("--n", type=int, default=config.LAW_DISCRETE_N,
-                   help=f"elements of the discrete law (default {config.LAW_DISCRETE_N})")
+    p.add_argument("--model", default="iwan", help=model_help("iwan"))
+    add_law_arguments(p)
     p.add_argument("--zeta", type=float, default=0.0, help="viscous damping ratio (default 0)")
     p.add_argument("--m", type=float, default=PAPER["m"], help=f"mass, kg (default {PAPER['m']:g})")
     p.add_argument("--k", type=float, default=PAPER["k"], help=f"stiffness, N/m (default {PAPER['k']:g})")
@@ -167,7 +167,7 @@ def _validate(args):
     else:
         args.beta = V.positive("--beta", 1.0 if args.beta is None else args.beta)
     V.finite("--delta", args.delta)
-    V.positive_int("--n", args.n)
+    args.law_params = law_params(args)
     V.nonnegative("--zeta", args.zeta)
     for key in ("m", "k", "kt", "kn", "mu", "n0"):
         V.positive(f"--{key}", getattr(args, key))
@@ -218,7 +218,7 @@ def _header(args) -> dict:
     else:
         head["beta"] = args.beta
         head["f1"] = args.mu * args.n0 / args.beta
-    head.update(delta_deg=args.delta, model=args.model, n=args.n, zeta=args.zeta,
+    head.update(delta_deg=args.delta, model=args.model, law_params=args.law_params, zeta=args.zeta,
                 m=args.m, k=args.k, kt=args.kt, kn=args.kn, mu=args.mu, n0=args.n0)
     return head
 
@@ -237,7 +237,7 @@ def _run_time(args, gammas):
             deltas=[args.delta],
             directions=directions,
             model=args.model,
-            n=args.n,
+            law_params=args.law_params,
             zeta=args.zeta,
             m=args.m, k=args.k, kt=args.kt, mu=args.mu, n0=args.n0,
             steps_per_period=args.steps_per_period,
@@ -299,7 +299,7 @@ def _run_hb(args, gammas):
         delta=math.radians(args.delta),
         model=args.model,
         zeta=args.zeta,
-        n=args.n,
+        law_params=args.law_params,
         m=args.m, k=args.k, kt=args.kt, mu=args.mu, n0=args.n0,
     )
     if gammas.size < 2:

@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import config
+from ._law_args import add_law_arguments, law_params, model_help
 
 NAME = "loop"
 HELP = "quasi-static hysteresis loop of a contact law under prescribed tangential motion and normal load"
@@ -54,19 +55,11 @@ _HARMONIC = {
 }
 
 
-def _law_choices():
+def add_arguments(p) -> None:
     from ..laws import law_names
 
-    return law_names()
-
-
-def add_arguments(p) -> None:
-    p.add_argument("--model", default="iwan", choices=_law_choices(),
-                   help="contact law: iwan (closed form, full Masing memory), iwan-paper (the paper's "
-                        "last-reversal rule), discrete (n Jenkins elements, ground truth), jenkins "
-                        "(default: iwan)")
-    p.add_argument("--n", type=int, default=config.LAW_DISCRETE_N,
-                   help=f"number of Jenkins elements of --model discrete (default {config.LAW_DISCRETE_N})")
+    p.add_argument("--model", default="iwan", choices=law_names(), help=model_help("iwan"))
+    add_law_arguments(p)
     p.add_argument("--kt", type=float, default=1e5, help="total tangential stiffness kt, N/m (default 1e5)")
     p.add_argument("--mu", type=float, default=0.1, help="friction coefficient mu (default 0.1)")
     p.add_argument("--n-ref", type=float, default=100.0, dest="n_ref",
@@ -147,7 +140,6 @@ def _validate_args(args):
     from .. import _validate as V
 
     _check_sources(args)
-    V.positive_int("--n", args.n, 1)
     V.positive("--kt", args.kt)
     V.nonnegative("--mu", args.mu)
     V.positive("--n-ref", args.n_ref)
@@ -240,11 +232,10 @@ def _notes(args, res, period) -> dict:
     return {"n_inserted": int(res.n_inserted), "remainder_s": remainder, "warnings": warnings}
 
 
-def _report(args, law, res, period) -> dict:
+def _report(args, law, res, period, lp) -> dict:
     last = res.last_cycle()
     params = {"kt_N_per_m": args.kt, "mu": args.mu, "n_ref_N": args.n_ref, "fy_N": law.fy}
-    if args.model == "discrete":
-        params["n"] = args.n
+    params.update(lp)
     if args.input is not None:
         params.update(input=str(args.input), period_s=period)
     else:
@@ -305,13 +296,14 @@ def run(args) -> int:
     from ..laws import make_law
 
     _validate_args(args)
-    law = make_law(args.model, kt=args.kt, mu=args.mu, n_ref=args.n_ref, n=args.n)
+    lp = law_params(args)
+    law = make_law(args.model, kt=args.kt, mu=args.mu, n_ref=args.n_ref, **lp)
     t, x, N, period = _history(args, law)
     res = quasistatic(law, t, x, N, period=period)
     if not np.all(np.isfinite(res.T)):
         raise ValueError("the parameters overflow double precision (the force T is not finite): "
                          "reduce --kt or --amplitude, or raise --mu x --n-ref")
-    report = _report(args, law, res, period)
+    report = _report(args, law, res, period, lp)
     text = json.dumps(report, allow_nan=False) if args.json else None
     # everything computed and serialised: now the files, each atomically
     if args.out is not None:

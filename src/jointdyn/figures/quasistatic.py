@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from ..drivers import harmonic_loop
-from ..laws import make_law
+from ..laws import law_parameters, make_law
 from ._registry import pyplot, register_figure, save_figure
 
 #: paper section 2.2 (Figs 3-4)
@@ -41,7 +41,8 @@ _MODEL_LABEL = {
 
 def _law(model):
     p = PAPER_QS
-    return make_law(model, kt=p["kt"], mu=p["mu"], n_ref=p["n0"], n=_N_DISCRETE)
+    extra = {"n": _N_DISCRETE} if "n" in {q.name for q in law_parameters(model)} else {}
+    return make_law(model, kt=p["kt"], mu=p["mu"], n_ref=p["n0"], **extra)
 
 
 def _last_cycle(model, amplitude, eta, delta_deg):
