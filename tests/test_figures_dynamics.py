@@ -36,7 +36,6 @@ def test_opening_drop_synthetic():
 def test_fig7_cases_differ_as_claimed():
     """Case a (delta 90) loses a load of several N when the contact opens;
     case b (delta 0) opens carrying almost none (real steady loops)."""
-    pytest.importorskip("jointdyn.dynamics")
     loops, info = F._loops(F.FIG7_CASES)
     a, b = info.iloc[0], info.iloc[1]
     assert a.status == "periodic" and b.status == "periodic"
