@@ -177,3 +177,17 @@ def test_paper_damper_phase_in_degrees():
     assert isinstance(c.normal, jd.HarmonicLoad) and c.phase_deg == 90.0
     kin = contact_kinematics(s)
     assert kin.normal_par[0, 2] == pytest.approx(math.pi / 2)
+
+
+def test_solvers_refuse_what_they_do_not_take_yet():
+    c = jd.Contact(_law(), dof=0, normal=jd.NormalSpring(kn=3e5, preload=100.0, dof=1))
+    s = jd.System(np.diag([10.0, 1.0]), None, np.diag([3.9e5, 1e3]), contacts=(c,), force=[25.0, 0.0])
+    with pytest.raises(ValueError, match="NormalSpring"):
+        jd.steady_state(s, 1.0)
+    c0 = jd.Contact(_law(), dof=0)
+    s2 = jd.System(np.diag([10.0, 1.0]), None, np.diag([3.9e5, 1e3]), contacts=(c0,), force=[25.0, 1.0],
+                   force_phase_deg=[0.0, 90.0])
+    with pytest.raises(ValueError, match="force_phase_deg"):
+        jd.steady_state(s2, 1.0)
+    with pytest.raises(ValueError, match="force_phase_deg"):
+        jd.frc_hb(s2, 0.8, 1.2)

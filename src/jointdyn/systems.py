@@ -237,6 +237,13 @@ class System:
         lam = eigh(self.K_reference, self.M, eigvals_only=True)
         return math.sqrt(max(lam[0], 0.0))
 
+    def require_in_phase_forcing(self, solver: str) -> None:
+        """ValueError naming ``force_phase_deg`` if a forcing phase is not 0
+        (for solvers that take the forcing as f sin(w t))."""
+        if np.any(self.force_phase_deg != 0.0):
+            raise ValueError(f"force_phase_deg: {solver} takes in-phase forcing only (all phases 0), "
+                             f"got {self.force_phase_deg.tolist()}")
+
     def forcing_coefficients(self) -> tuple[np.ndarray, np.ndarray]:
         """(cosine, sine) coefficients of the forcing, N: F = a cos(w t) + b sin(w t)."""
         phi = np.radians(self.force_phase_deg)

@@ -119,6 +119,7 @@ class HBProblem:
                  max_passes: int = config.HB_MAX_PASSES):
         if not isinstance(system, System):
             raise ValueError("system must be a jointdyn.System")
+        system.require_in_phase_forcing("harmonic balance")
         self.H = V.positive_int("harmonics", harmonics, 1)
         self.Ns = V.positive_int("samples", samples, 2 * self.H + 2)
         self.parameter = V.choice("parameter", parameter, PARAMETERS)
