@@ -19,8 +19,8 @@ K = np.array([[3.0e5, -1.0e5], [-1.0e5, 1.0e5]])         # N/m
 C = 2e-5 * K                                             # N s/m, light stiffness-proportional damping
 law = jd.DiscreteIwan(kt=5e4, mu=0.3, n_ref=200.0, n=100)
 contacts = (
-    jd.Contact(law=law, dof=0, n0=200.0, n1=60.0),        # against the ground, N = 200 + 60 sin(w t)
-    jd.Contact(law=law, dof=1, dof2=0, n0=150.0),         # between the two DOFs, constant 150 N
+    jd.Contact(law=law, dof=0, normal=jd.HarmonicLoad(200.0, 60.0)),  # against the ground, N = 200 + 60 sin(w t)
+    jd.Contact(law=law, dof=1, dof2=0, normal=jd.ConstantLoad(150.0)),  # between the two DOFs, constant 150 N
 )
 system = jd.System(M, C, K, contacts=contacts, force=[0.0, 30.0])
 print(f"w0 = {system.w0:.1f} rad/s (lowest mode of M, K without the contacts)")

@@ -10,7 +10,8 @@ from hypothesis import strategies as st
 import tolerances
 from jointdyn import config
 from jointdyn.drivers import march
-from jointdyn.laws import SEPARATION, HarmonicLoad, make_law
+from jointdyn.kinematics import ConstantLoad, HarmonicLoad
+from jointdyn.laws import SEPARATION, make_law
 from jointdyn.systems import PAPER, Contact, System
 from jointdyn.dynamics import (
     Restart,
@@ -56,7 +57,7 @@ def test_two_dof_contact_between_dofs_linear_limit():
     Kk = np.array([[3e5, -1e5], [-1e5, 1e5]])
     Cc = 1e-4 * Kk + 0.5 * Mm
     f = np.array([0.0, 0.02])
-    s = System(M=Mm, C=Cc, K=Kk, contacts=(Contact(law=law, dof=0, dof2=1, n0=100.0),), force=f)
+    s = System(M=Mm, C=Cc, K=Kk, contacts=(Contact(law=law, dof=0, dof2=1, normal=ConstantLoad(100.0)),), force=f)
     gamma = 0.7
     r = steady_state(s, gamma, response_dof=1)
     assert r.status == "periodic"
@@ -87,12 +88,12 @@ def test_two_dof_separating_contact_events_and_law():
     law = make_law("iwan", kt=2e5, mu=0.5, n_ref=100.0)
     Mm = np.diag([1.0, 2.0])
     Kk = np.array([[2e5, -1e5], [-1e5, 1.5e5]])
-    c = Contact(law=law, dof=1, n0=100.0, n1=150.0, delta=0.4)
+    c = Contact(law=law, dof=1, normal=HarmonicLoad(100.0, 150.0, math.degrees(0.4)))
     s = System(M=Mm, C=np.zeros((2, 2)), K=Kk, contacts=(c,), force=[20.0, 0.0])
     gamma = 1.2
     tr = integrate(s, gamma, periods=4)
     w = gamma * s.w0
-    ev = HarmonicLoad(c.n0, c.n1, w, c.delta).zero_crossings(0.0, tr.t[-1])
+    ev = c.normal.zero_crossings(w, 0.0, tr.t[-1])
     assert ev.size == 8
     for te in ev:
         assert np.min(np.abs(tr.t - te)) <= 1e-12 * tr.t[-1]
@@ -156,7 +157,7 @@ def test_den_hartog_unbounded_and_bounded():
     [
         (dict(eta=0.5, beta=2.0), 1.1),
         (dict(eta=1.5, beta=2.0), 0.8),
-        (dict(eta=1.5, beta=2.0, delta=1.0), 1.3),
+        (dict(eta=1.5, beta=2.0, delta_deg=math.degrees(1.0)), 1.3),
         (dict(eta=0.5, beta=5.0, zeta=0.02), 1.2),
     ],
 )
@@ -206,7 +207,7 @@ def test_property_law_in_integrator_equals_march(eta, delta, beta, gamma, model)
     # for any loads, the forces recorded by the integrator are those of the
     # law marched over the recorded displacement and normal-load samples,
     # every sample is finite and an open contact carries no force
-    s = System.paper_damper(eta=eta, beta=beta, delta=delta, model=model)
+    s = System.paper_damper(eta=eta, beta=beta, delta_deg=math.degrees(delta), model=model)
     tr = integrate(s, gamma, periods=3, steps_per_period=64)
     assert tr.status == "ok" and np.all(np.isfinite(tr.x)) and np.all(np.diff(tr.t) > 0)
     law = s.contacts[0].law
@@ -221,7 +222,7 @@ def test_separation_and_recontact_are_step_boundaries():
     tr = integrate(s, gamma, periods=3)
     w = gamma * s.w0
     c = s.contacts[0]
-    ev = HarmonicLoad(c.n0, c.n1, w, c.delta).zero_crossings(0.0, tr.t[-1])
+    ev = c.normal.zero_crossings(w, 0.0, tr.t[-1])
     assert ev.size == 6
     for te in ev:
         i = int(np.argmin(np.abs(tr.t - te)))
@@ -236,7 +237,7 @@ def test_separation_and_recontact_are_step_boundaries():
 @pytest.mark.parametrize("delta", [math.pi + math.asin(1 / 1.5), -math.asin(1 / 1.5)])
 def test_event_at_the_period_boundary(delta):
     # separation (first) or re-contact (second) exactly at w t = 0 mod 2 pi
-    s = System.paper_damper(eta=1.5, beta=2.0, delta=delta)
+    s = System.paper_damper(eta=1.5, beta=2.0, delta_deg=math.degrees(delta))
     tr = integrate(s, 1.1, periods=3)
     law = s.contacts[0].law
     T = march(law, tr.x[:, 0], tr.N[:, 0])[0]
@@ -269,7 +270,7 @@ def test_sampled_loads_match_harmonic_run():
     t = np.linspace(0.0, periods * 2 * math.pi / w, periods * 1024 + 1)
     F = s.force[0] * np.sin(w * t)
     c = s.contacts[0]
-    N = c.n0 + c.n1 * np.sin(w * t + c.delta)
+    N = c.normal.at(w * t)
     a = integrate_sampled(s, t, F[:, None], N[:, None])
     b = integrate(s, gamma, periods=periods, steps_per_period=1024)
     xa = np.interp(b.t, a.t, a.x[:, 0])

@@ -19,6 +19,7 @@ from jointdyn.hb import (
     hill_exponents,
     monodromy_multipliers,
 )
+from jointdyn.kinematics import HarmonicLoad
 from jointdyn.laws import Jenkins
 
 KT, FY, M, K, F1, ZETA = 3e5, 50.0, 10.0, 3.9e5, 20.0, 1e-3
@@ -75,7 +76,7 @@ def test_one_harmonic_equals_describing_function(gamma):
      ("iwan-paper", 0.5, "f1")],
 )
 def test_jacobian_matches_central_differences(model, eta, par):
-    sysm = System.paper_damper(eta=eta, beta=2.0, model=model, n=20 if model == "discrete" else None, delta=0.3,
+    sysm = System.paper_damper(eta=eta, beta=2.0, model=model, n=20 if model == "discrete" else None, delta_deg=math.degrees(0.3),
                                zeta=0.01)
     g = 1.1
     p = HBProblem(sysm, harmonics=4, samples=128, parameter=par, gamma=None if par == "gamma" else g)
@@ -226,7 +227,7 @@ def _damper(eta=0.1, delta=0.0, n0=100.0, f1=25.0):
     from jointdyn.laws import Iwan
 
     law = Iwan(kt=3e5, mu=0.5, n_ref=100.0)
-    return System.sdof(m=10.0, k=3.9e5, law=law, f1=f1, n0=n0, eta=eta, delta=delta)
+    return System.sdof(m=10.0, k=3.9e5, law=law, f1=f1, n0=n0, eta=eta, delta_deg=math.degrees(delta))
 
 
 def test_turning_points_ignore_jitter_within_the_band():
@@ -287,7 +288,7 @@ def test_two_dof_contact_between_masses_equals_time_integration():
     M = np.diag([10.0, 5.0])
     K = np.array([[5.9e5, -2e5], [-2e5, 2e5]])
     s = System(M=M, C=1e-4 * K, K=K, force=[40.0, 0.0],
-               contacts=(Contact(law=law, dof=0, dof2=1, n0=100.0, n1=30.0, delta=0.4),))
+               contacts=(Contact(law=law, dof=0, dof2=1, normal=HarmonicLoad(100.0, 30.0, math.degrees(0.4))),))
     for g in (1.0, 1.2):
         sol = harmonic_balance(s, g, harmonics=7, samples=256)
         ss = steady_state(s, g)

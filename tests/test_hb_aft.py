@@ -7,6 +7,8 @@ same sample; the rest of the pass is then copied) on stuck, slipping and
 separating orbits, with and without a parameter direction: the results
 agree to rounding."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -84,7 +86,7 @@ def _reference(p, X, lam):
 @pytest.mark.parametrize("model,kw", [("jenkins", {}), ("discrete", {"n": 4})])
 @pytest.mark.parametrize("eta,par", [(0.0, "gamma"), (0.5, "gamma"), (1.5, "gamma"), (0.5, "delta"), (1.5, "eta")])
 def test_compiled_evaluation_equals_plain_march(model, kw, eta, par):
-    s = System.paper_damper(eta=eta, beta=2.0, model=model, delta=0.3, zeta=0.01, **kw)
+    s = System.paper_damper(eta=eta, beta=2.0, model=model, delta_deg=math.degrees(0.3), zeta=0.01, **kw)
     p = HBProblem(s, harmonics=3, samples=32, parameter=par, gamma=None if par == "gamma" else 1.1)
     lam = {"gamma": 1.1, "delta": 0.3, "eta": eta}[par]
     X0 = p.linear_guess(lam)

@@ -19,6 +19,7 @@ from jointdyn._jit import jit
 from jointdyn.dynamics import integrate
 from jointdyn.dynamics._model import pack_system
 from jointdyn.laws import SEPARATION, STICK_SLIP, ContactLaw, law_names
+from jointdyn.kinematics import HarmonicLoad
 from jointdyn.systems import Contact, System
 from reference_dynamics import integrate_reference
 
@@ -75,7 +76,7 @@ def _system():
     M = np.diag([1.0, 0.5])
     K = np.array([[3e5, -1e5], [-1e5, 1e5]])
     C = 2e-5 * K + 0.5 * M
-    c = Contact(law=law, dof=0, dof2=1, n0=100.0, n1=30.0, delta=0.5)
+    c = Contact(law=law, dof=0, dof2=1, normal=HarmonicLoad(100.0, 30.0, math.degrees(0.5)))
     return System(M=M, C=C, K=K, contacts=(c,), force=[40.0, 25.0])
 
 
@@ -86,7 +87,7 @@ def _error(system, gamma, periods, spp):
     b = np.array([1.0, -1.0])
     xs = float(np.max(np.abs(tr.x)))
     xr, vr = integrate_reference(system.M, system.C, system.K, system.force, gamma * system.w0,
-                                 [(b, _tanh_force(c.law), c.n0, c.n1, c.delta)], tr.t, xscale=xs)  # fmt: skip
+                                 [(b, _tanh_force(c.law), c.n0, c.n1, c.normal.phase_rad)], tr.t, xscale=xs)  # fmt: skip
     return float(np.max(np.abs(xr - tr.x))) / xs, float(np.max(np.abs(vr - tr.v))) / float(np.max(np.abs(tr.v))), tr
 
 

@@ -9,7 +9,6 @@ off the discrete ground truth. The kernel now keeps the mismatch at the
 rejoin point as a force offset on the rejoined branch (zero at constant N).
 """
 
-import math
 
 import numpy as np
 import pytest
@@ -25,9 +24,9 @@ def _law(model):
     return make_law(model, kt=KT, mu=MU, n_ref=N0, **({"n": 1000} if model == "discrete" else {}))
 
 
-def _run(model, A=0.1e-3, eta=0.3, delta=0.0):
+def _run(model, A=0.1e-3, eta=0.3, delta_deg=0.0):
     law = _law(model)
-    return harmonic_loop(law, A, eta=eta, delta=delta, cycles=3, steps_per_cycle=2000)
+    return harmonic_loop(law, A, eta=eta, delta_deg=delta_deg, cycles=3, steps_per_cycle=2000)
 
 
 def _max_excess_jump(r):
@@ -67,7 +66,7 @@ def test_full_memory_rejoin_is_continuous_for_growing_amplitude():
 
 def test_full_memory_agrees_when_the_tie_is_not_hit():
     """Same case at delta = 90 deg: no jump (the rejoin is not triggered)."""
-    r = _run("iwan", delta=math.pi / 2)
+    r = _run("iwan", delta_deg=90.0)
     assert _max_excess_jump(r) < 1e-9 * FY
 
 

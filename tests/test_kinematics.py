@@ -19,14 +19,15 @@ from jointdyn.kinematics import (
     selection_matrix,
     tangential_history,
 )
-from jointdyn.laws import HarmonicLoad, make_law
+from jointdyn.kinematics import HarmonicLoad
+from jointdyn.laws import make_law
 from jointdyn.systems import Contact, System
 
 
 def _three_dof():
     law = make_law("jenkins", kt=1e5, mu=0.5, n_ref=100.0)
-    cs = (Contact(law=law, dof=2, dof2=0, n0=100.0, n1=40.0, delta=0.3),
-          Contact(law=law, dof=1, n0=80.0, n1=120.0, delta=-1.1))  # fmt: skip
+    cs = (Contact(law=law, dof=2, dof2=0, normal=HarmonicLoad(100.0, 40.0, math.degrees(0.3))),
+          Contact(law=law, dof=1, normal=HarmonicLoad(80.0, 120.0, math.degrees(-1.1))))  # fmt: skip
     return System(M=np.eye(3), C=np.zeros((3, 3)), K=np.eye(3) * 1e5, contacts=cs, force=[1.0, 0.0, 0.0])
 
 
@@ -82,11 +83,11 @@ def test_load_events_are_the_zero_crossings():
     # only the second contact (n1 > n0) opens: one separation, one re-contact
     assert sorted(c for _, c, _ in ev) == [1, 1]
     c = s.contacts[1]
-    want = HarmonicLoad(c.n0, c.n1, w, c.delta).zero_crossings(-1e-300, period) % period
+    want = c.normal.zero_crossings(w, -1e-300, period) % period
     np.testing.assert_allclose(sorted(t for t, _, _ in ev), np.sort(want), rtol=0, atol=1e-15)
     for te, ci, rising in ev:
         assert abs(normal_load_at(kin, ci, w, te)) <= 1e-12 * c.n0
-        slope = c.n1 * w * math.cos(w * te + c.delta)
+        slope = c.n1 * w * math.cos(w * te + c.normal.phase_rad)
         assert rising == (slope > 0.0)
 
 

@@ -9,6 +9,7 @@ from scipy.linalg import expm
 import tolerances
 from jointdyn.dynamics import fd_monodromy, monodromy_matrix
 from jointdyn.laws import make_law
+from jointdyn.kinematics import HarmonicLoad
 from jointdyn.systems import Contact, System
 
 
@@ -56,7 +57,7 @@ def test_stuck_contact_monodromy_is_the_stuck_linear_system():
     M = np.diag([2.0, 1.0])
     K = np.array([[3e5, -1e5], [-1e5, 1e5]])
     C = 1e-4 * K + 0.5 * M
-    s = System(M=M, C=C, K=K, contacts=(Contact(law=law, dof=0, dof2=1, n0=100.0, n1=30.0),), force=[5.0, 0.0])
+    s = System(M=M, C=C, K=K, contacts=(Contact(law=law, dof=0, dof2=1, normal=HarmonicLoad(100.0, 30.0)),), force=[5.0, 0.0])
     w = 1.2 * s.w0
     x, v = np.array([1e-5, -3e-5]), np.array([0.02, 0.0])
     S = law.initial_state(x[0] - x[1], 100.0)[None, :]

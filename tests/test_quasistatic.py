@@ -38,11 +38,11 @@ def law(name="iwan"):
 
 
 # --- histories ---------------------------------------------------------------
-@pytest.mark.parametrize("delta", [0.0, math.pi / 2, 2.0])
-def test_harmonic_history_inserts_exact_crossings(delta):
+@pytest.mark.parametrize("delta_deg", [0.0, 90.0, math.degrees(2.0)])
+def test_harmonic_history_inserts_exact_crossings(delta_deg):
     f, steps, cycles = 2.0, 100, 3
-    t, x, N = harmonic_history(0.5e-3, f, N0, eta=1.2, delta=delta, cycles=cycles, steps_per_cycle=steps)
-    tc = HarmonicLoad(N0, 1.2 * N0, 2 * math.pi * f, delta).zero_crossings(0.0, cycles / f)
+    t, x, N = harmonic_history(0.5e-3, f, N0, eta=1.2, delta_deg=delta_deg, cycles=cycles, steps_per_cycle=steps)
+    tc = HarmonicLoad(N0, 1.2 * N0, delta_deg).zero_crossings(2 * math.pi * f, 0.0, cycles / f)
     assert tc.size == 2 * cycles
     assert np.all(np.diff(t) > 0)
     assert t.size == cycles * steps + 1 + tc.size
@@ -55,7 +55,7 @@ def test_harmonic_history_inserts_exact_crossings(delta):
     assert set(np.arange(cycles + 1) / f) <= set(t.tolist())
     np.testing.assert_allclose(x, 0.5e-3 * np.sin(2 * math.pi * f * t), rtol=0, atol=1e-18)
     keep = N != 0.0
-    np.testing.assert_allclose(N[keep], N0 + 1.2 * N0 * np.sin(2 * math.pi * f * t[keep] + delta), rtol=1e-12)
+    np.testing.assert_allclose(N[keep], N0 + 1.2 * N0 * np.sin(2 * math.pi * f * t[keep] + math.radians(delta_deg)), rtol=1e-12)
 
 
 def test_harmonic_history_crossing_on_grid_point_is_not_duplicated():
@@ -69,7 +69,7 @@ def test_harmonic_history_crossing_on_grid_point_is_not_duplicated():
 
 
 def test_harmonic_history_no_crossings_when_in_contact():
-    t, x, N = harmonic_history(1e-4, 1.0, N0, eta=0.9, delta=1.0, cycles=2, steps_per_cycle=40, x_offset=1e-4)
+    t, x, N = harmonic_history(1e-4, 1.0, N0, eta=0.9, delta_deg=math.degrees(1.0), cycles=2, steps_per_cycle=40, x_offset=1e-4)
     assert t.size == 81 and np.all(N > 0)
     assert np.isclose(x.mean(), 1e-4, atol=2e-6)
 
@@ -94,7 +94,7 @@ def test_unilateral_spring_history_clips_only_in_separation():
         (dict(frequency=math.nan), "frequency"),
         (dict(n0=-1.0), "n0"),
         (dict(eta=-0.1), "eta"),
-        (dict(delta=math.inf), "delta"),
+        (dict(delta_deg=math.inf), "delta_deg"),
         (dict(cycles=0), "cycles"),
         (dict(cycles=1.5), "cycles"),
         (dict(steps_per_cycle=3), "steps_per_cycle"),
@@ -156,7 +156,7 @@ def test_first_cycle_is_work_not_loop_area():
 @pytest.mark.parametrize("eta", [0.0, 0.6, 1.0, 1.2, 2.5])
 @pytest.mark.parametrize("name", ["iwan", "discrete"])
 def test_state_fractions(eta, delta_deg, name):
-    r = harmonic_loop(law(name), 0.5e-3, eta=eta, delta=math.radians(delta_deg), cycles=2, steps_per_cycle=400)
+    r = harmonic_loop(law(name), 0.5e-3, eta=eta, delta_deg=delta_deg, cycles=2, steps_per_cycle=400)
     for _, row in r.cycles.iterrows():
         s = row["stick_slip_fraction"] + row["macroslip_fraction"] + row["separation_fraction"]
         assert s == pytest.approx(1.0, abs=1e-12)
@@ -172,7 +172,7 @@ def test_state_fractions(eta, delta_deg, name):
 
 def test_recontact_starts_virgin_curve_at_exact_instant():
     """After re-contact at x_c the closed form follows G_oa(q - q_c; alpha)."""
-    r = harmonic_loop(law("iwan"), 0.5e-3, eta=1.2, delta=0.0, cycles=2, steps_per_cycle=2000)
+    r = harmonic_loop(law("iwan"), 0.5e-3, eta=1.2, delta_deg=0.0, cycles=2, steps_per_cycle=2000)
     rec = np.flatnonzero((r.N[:-1] == 0) & (r.N[1:] > 0))
     assert rec.size == 2
     for i in rec:
@@ -204,7 +204,7 @@ def test_separation_converges_with_step(name, delta_deg, rtol):
     step barely moves the energy (a separation smeared over a step would move
     it at O(dt))."""
     E = [
-        harmonic_loop(law(name), 0.5e-3, eta=1.2, delta=math.radians(delta_deg), steps_per_cycle=s)
+        harmonic_loop(law(name), 0.5e-3, eta=1.2, delta_deg=delta_deg, steps_per_cycle=s)
         .last_cycle()["energy_per_cycle_J"]
         for s in (500, 1000)
     ]
@@ -342,7 +342,7 @@ def test_paper_trends_of_state_regions(delta_deg, sign):
     unloading branch grows and that of the loading branch shrinks (macroslip
     the other way round); out of phase (90 deg) the reverse."""
     fr = np.array([
-        _branch_microslip_fractions(harmonic_loop(law("iwan"), 0.5e-3, eta=eta, delta=math.radians(delta_deg),
+        _branch_microslip_fractions(harmonic_loop(law("iwan"), 0.5e-3, eta=eta, delta_deg=delta_deg,
                                                   steps_per_cycle=1000))
         for eta in (0.0, 0.3, 0.6, 0.9)
     ])

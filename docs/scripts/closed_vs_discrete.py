@@ -43,7 +43,7 @@ MARKERS = {A_PAPER: "table", A_SMALL: "table-small"}
 
 def last_cycle(model, A, eta, delta_deg, n=1000):
     law = make_law(model, kt=KT, mu=MU, n_ref=N0, n=n)
-    r = harmonic_loop(law, A, 1.0, N0, eta=eta, delta=math.radians(delta_deg), cycles=CYCLES,
+    r = harmonic_loop(law, A, 1.0, N0, eta=eta, delta_deg=delta_deg, cycles=CYCLES,
                       steps_per_cycle=STEPS)
     sl = r.cycle_slice(-1)
     return r.last_cycle(), r.t[sl], r.T[sl]

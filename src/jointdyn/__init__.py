@@ -21,18 +21,16 @@ from .laws import (
     STICK_SLIP,
     ContactLaw,
     DiscreteIwan,
-    HarmonicLoad,
     Iwan,
     Jenkins,
-    SampledLoad,
-    UnilateralSpring,
     backbone,
     law_names,
     law_parameters,
     make_law,
 )
 from .drivers import LoopResult, harmonic_history, harmonic_loop, march, quasistatic, read_history_csv
-from .systems import PAPER, Contact, System
+from .kinematics import ConstantLoad, HarmonicLoad, NormalSpring, SampledLoad
+from .systems import PAPER, Contact, System, modal_damping
 
 __version__ = "0.1.0"
 
@@ -79,9 +77,10 @@ __all__ = [
     "make_law",
     "law_names",
     "law_parameters",
+    "ConstantLoad",
     "HarmonicLoad",
     "SampledLoad",
-    "UnilateralSpring",
+    "NormalSpring",
     "march",
     "quasistatic",
     "harmonic_loop",
@@ -91,5 +90,6 @@ __all__ = [
     "System",
     "Contact",
     "PAPER",
+    "modal_damping",
     *_LAZY,
 ]

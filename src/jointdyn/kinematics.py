@@ -41,13 +41,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
+from . import _validate as V
 from ._cache import by_identity
 from ._jit import jit
 
 __all__ = [
+    "NormalLoad",
+    "ConstantLoad",
+    "HarmonicLoad",
+    "SampledLoad",
+    "NormalSpring",
     "NORMAL_HARMONIC",
     "ContactKinematics",
     "contact_kinematics",
@@ -72,6 +79,187 @@ __all__ = [
 
 #: normal load prescribed as n0 + n1 sin(phase + delta), phase = w t
 NORMAL_HARMONIC = 0
+
+
+# --- normal loads (what users write) ------------------------------------------------
+
+
+class NormalLoad:
+    """Base of the normal-load descriptions of a contact.
+
+    ``autonomous`` is True for loads that do not depend on a forcing
+    frequency (a constant load, a normal spring): only those have a place in
+    a free vibration (nonlinear modes). ``prescribed`` is True for loads
+    given as a function of time (they ignore the motion).
+
+    Every kind has ``n0``, the static part of the load (N): the constant or
+    mean load, or the preload of a spring.
+    """
+
+    autonomous: ClassVar[bool] = False
+    prescribed: ClassVar[bool] = True
+
+
+@dataclass(frozen=True)
+class ConstantLoad(NormalLoad):
+    """N(t) = n0 (N, > 0): a constant normal load."""
+
+    n0: float
+    autonomous: ClassVar[bool] = True
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "n0", V.positive("n0", self.n0))
+
+    def at(self, phase):
+        """Normal load (N) at forcing phases w t (rad)."""
+        return np.full(np.shape(phase), self.n0)
+
+
+@dataclass(frozen=True)
+class HarmonicLoad(NormalLoad):
+    """N(t) = n0 + n1 sin(w t + phase), prescribed at the excitation frequency w.
+
+    Parameters
+    ----------
+    n0 : float
+        Static part N0, N (> 0).
+    n1 : float
+        Amplitude N1, N (>= 0); eta = n1 / n0, the contact opens during part
+        of the period when eta > 1.
+    phase_deg : float
+        Phase of the load relative to the forcing sin(w t), degrees.
+    """
+
+    n0: float
+    n1: float = 0.0
+    phase_deg: float = 0.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "n0", V.positive("n0", self.n0))
+        object.__setattr__(self, "n1", V.nonnegative("n1", self.n1))
+        object.__setattr__(self, "phase_deg", V.finite("phase_deg", self.phase_deg))
+        V.derived("n1 / n0", self.n1 / self.n0)
+
+    @property
+    def eta(self) -> float:
+        """N1 / N0."""
+        return self.n1 / self.n0
+
+    @property
+    def phase_rad(self) -> float:
+        """The phase in radians."""
+        return math.radians(self.phase_deg)
+
+    def at(self, phase):
+        """Normal load (N) at forcing phases w t (rad)."""
+        return harmonic_load_samples(self.n0, self.n1, self.phase_rad, np.asarray(phase, dtype=np.float64))
+
+    def zero_crossings(self, w: float, t0: float, t1: float) -> np.ndarray:
+        """Instants in (t0, t1) (s) where N changes sign (separation / re-contact), w in rad/s."""
+        if self.n1 <= self.n0 or w == 0.0:
+            return np.empty(0)
+        return np.array(_crossings(self.n0, self.n1, self.phase_rad, w, t0, t1))
+
+
+@dataclass(frozen=True)
+class SampledLoad(NormalLoad):
+    """A periodic normal load sampled over one forcing period.
+
+    Parameters
+    ----------
+    values : array_like
+        N at the phases w t = 2 pi j / m, j = 0..m-1 (m >= 2 samples, finite,
+        N); linear between samples, periodic.
+    """
+
+    values: np.ndarray
+
+    def __post_init__(self) -> None:
+        v = V.finite_array("values", self.values)
+        if v.size < 2:
+            raise ValueError(f"values must have at least 2 samples per period, got {v.size}")
+        object.__setattr__(self, "values", v)
+
+    @property
+    def n0(self) -> float:
+        """Mean of the samples, N."""
+        return float(np.mean(self.values))
+
+    def at(self, phase):
+        """Normal load (N) at forcing phases w t (rad): periodic linear interpolation."""
+        m = self.values.size
+        grid = 2.0 * np.pi * np.arange(m + 1) / m
+        ph = np.mod(np.asarray(phase, dtype=np.float64), 2.0 * np.pi)
+        return np.interp(ph, grid, np.append(self.values, self.values[0]))
+
+
+@dataclass(frozen=True)
+class NormalSpring(NormalLoad):
+    """Normal load produced by the structure: N = max(0, preload + kn g).
+
+    g is the normal approach of the two sides (m, positive closes the
+    contact): ``x[dof] - x[dof2]`` (``dof2 = -1``: against ground) or
+    ``direction . x``. The contact pushes the sides apart with N and the
+    preload is a static force P pressing them together, so the structure
+    feels ``Bn (N - P)``: at rest g = 0 and N = P; while closed the spring
+    is linear (stiffness kn), while open only the structure holds the
+    normal DOFs.
+
+    Parameters
+    ----------
+    kn : float
+        Normal contact stiffness, N/m (> 0).
+    preload : float
+        Normal load at g = 0, N (> 0).
+    dof, dof2 : int
+        Normal DOF pair (dof2 = -1: ground).
+    direction : array_like, optional
+        Selection vector over the DOFs instead of ``dof``/``dof2``.
+    """
+
+    kn: float
+    preload: float
+    dof: int = 0
+    dof2: int = -1
+    direction: np.ndarray | None = None
+
+    autonomous: ClassVar[bool] = True
+    prescribed: ClassVar[bool] = False
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "kn", V.positive("kn", self.kn))
+        object.__setattr__(self, "preload", V.positive("preload", self.preload))
+        dof, dof2, direction = _selection("normal", self.dof, self.dof2, self.direction)
+        object.__setattr__(self, "dof", dof)
+        object.__setattr__(self, "dof2", dof2)
+        object.__setattr__(self, "direction", direction)
+        V.derived("preload / kn (opening displacement, m)", self.preload / self.kn)
+
+    @property
+    def n0(self) -> float:
+        """The preload, N."""
+        return self.preload
+
+    def load(self, g):
+        """Normal load (N) for normal approach ``g`` (m, positive closes)."""
+        return np.maximum(0.0, self.preload + self.kn * np.asarray(g, dtype=np.float64))
+
+
+def _selection(what: str, dof, dof2, direction):
+    """Validated (dof, dof2, direction) of a tangential or normal selection."""
+    if direction is not None:
+        if dof not in (0, None) or dof2 not in (-1, None):
+            raise ValueError(f"{what} selection: give either dof/dof2 or direction, not both")
+        d = V.finite_array(f"{what} direction", direction)
+        if not np.any(d != 0.0):
+            raise ValueError(f"{what} direction must have a non-zero entry")
+        return 0, -1, d
+    dof = V.positive_int(f"{what} dof", dof, 0)
+    if dof2 != -1:
+        dof2 = V.positive_int(f"{what} dof2", dof2, 0)
+        if dof2 == dof:
+            raise ValueError(f"{what} dof2 must differ from dof ({dof}); use -1 for ground")
+    return dof, dof2, None
 
 
 @dataclass(frozen=True)
@@ -111,22 +299,41 @@ def contact_kinematics(system) -> ContactKinematics:
     """Pack the contacts of ``system`` (a :class:`~jointdyn.System`), cached per object.
 
     Each contact gives its tangential selection from ``(dof, dof2)``
-    (``u = x[dof] - x[dof2]``, or ``x[dof]`` against ground) and its
-    harmonic normal load ``(n0, n1, delta)``.
+    (``u = x[dof] - x[dof2]``, or ``x[dof]`` against ground) or from its
+    selection vector ``direction`` (the non-zero entries), and its normal
+    load (constant and harmonic loads as ``(n0, n1, delta rad)``).
     """
     cs = system.contacts
     nc = len(cs)
-    idx = np.full((nc, 2), -1, dtype=np.int64)
-    wts = np.zeros((nc, 2))
-    for i, c in enumerate(cs):
-        idx[i, 0] = c.dof
-        wts[i, 0] = 1.0
-        if c.dof2 >= 0:
-            idx[i, 1] = c.dof2
-            wts[i, 1] = -1.0
+    sel = [_sparse_selection(c.dof, c.dof2, c.direction) for c in cs]
+    width = max([len(i) for i, _ in sel], default=2)
+    idx = np.full((nc, max(width, 2)), -1, dtype=np.int64)
+    wts = np.zeros((nc, max(width, 2)))
+    for i, (ii, ww) in enumerate(sel):
+        idx[i, : len(ii)] = ii
+        wts[i, : len(ww)] = ww
     kind = np.full(nc, NORMAL_HARMONIC, dtype=np.int64)
-    par = np.array([[c.n0, c.n1, c.delta] for c in cs], dtype=np.float64).reshape(nc, 3)
+    par = np.zeros((nc, 3))
+    for i, c in enumerate(cs):
+        load = c.normal
+        if isinstance(load, HarmonicLoad):
+            par[i] = (load.n0, load.n1, load.phase_rad)
+        elif isinstance(load, ConstantLoad):
+            par[i] = (load.n0, 0.0, 0.0)
+        else:
+            raise ValueError(f"contact {i}: a normal load of type {type(load).__name__} is not supported by "
+                             "this solver (constant and harmonic loads are)")
     return ContactKinematics(idx, wts, kind, par)
+
+
+def _sparse_selection(dof, dof2, direction):
+    """(DOF indices, weights) of a selection: (dof, dof2) as (1, -1), or the non-zero entries of direction."""
+    if direction is not None:
+        nz = np.flatnonzero(direction)
+        return nz.astype(np.int64), direction[nz].astype(np.float64)
+    if dof2 >= 0:
+        return np.array([dof, dof2], dtype=np.int64), np.array([1.0, -1.0])
+    return np.array([dof], dtype=np.int64), np.array([1.0])
 
 
 def selection_matrix(kin: ContactKinematics, ndof: int) -> np.ndarray:
@@ -249,18 +456,32 @@ def load_events(kin: ContactKinematics, w: float, period: float):
     re-contact (N turns positive), False at a separation. Contacts whose load
     never turns tensile (n1 <= n0) have none.
     """
-    from .laws.normal import HarmonicLoad
-
     events = []
     for c in range(kin.ncontacts):
         if kin.normal_kind[c] != NORMAL_HARMONIC:
             continue
         n0, n1, delta = (float(v) for v in kin.normal_par[c])
         if n1 > n0:
-            for te in HarmonicLoad(n0, n1, w, delta).zero_crossings(-1e-300, period):
+            for te in _crossings(n0, n1, delta, w, -1e-300, period):
                 te = float(te) % period
                 events.append((te, c, math.cos(w * te + delta) > 0.0))
     return events
+
+
+def _crossings(n0, n1, delta, w, t0, t1):
+    """Zero crossings in (t0, t1) of n0 + n1 sin(w t + delta) (delta in rad)."""
+    r = -n0 / n1
+    out = []
+    for b in (math.asin(r), math.pi - math.asin(r)):
+        k = math.floor((w * t0 + delta - b) / (2 * math.pi))
+        while True:
+            t = (b + 2 * math.pi * k - delta) / w
+            if t >= t1:
+                break
+            if t > t0:
+                out.append(t)
+            k += 1
+    return sorted(out)
 
 
 def sampled_load_grid(t, F, N, recontact_alpha: float):

@@ -1,17 +1,18 @@
-"""What the system is: mass, damping and stiffness, contacts, harmonic loads.
+"""What the system is: mass, damping and stiffness, contacts, forcing.
 
-MODEL.md section 6::
+docs/model.md sections 6 and 8::
 
-    M x'' + C x' + K x = f sin(w t) - sum_c B_c T_c(u_c, N_c(t)),
-    u_c = x[dof] - x[dof2] (or x[dof] against ground),
-    N_c(t) = n0 + n1 sin(w t + delta).
+    M x'' + C x' + K x + sum_c [Bt_c T_c(u_c, N_c) + Bn_c (N_c - P_c)] = F(t),
+    u_c = Bt_c . x,   F_i(t) = f_i sin(w t + phi_i),
+
+with the normal load N_c of each contact either prescribed (constant,
+harmonic at the excitation frequency, or a sampled periodic signal) or
+produced by the structure through a unilateral normal spring
+N_c = max(0, P_c + kn_c Bn_c . x) (:mod:`jointdyn.kinematics`, the one home
+of contact selections and normal loads; a prescribed load has no Bn term).
 
 The excitation frequency w is not part of the system: solvers take it (or
-gamma = w / w0) as an argument, so one System serves a whole sweep. The
-contact selection and the normal loads are packed for the solvers by
-:func:`jointdyn.kinematics.contact_kinematics`, their one home.
-All contacts of one system use the same contact-law class (one compiled
-kernel); their parameters may differ.
+gamma = w / w0) as an argument, so one System serves a whole sweep.
 """
 
 from __future__ import annotations
@@ -23,60 +24,113 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _validate as V
-from .kinematics import harmonic_load_samples
+from .kinematics import ConstantLoad, HarmonicLoad, NormalLoad, NormalSpring, _selection
 from .laws import ContactLaw, make_law
 
-__all__ = ["Contact", "System", "PAPER"]
+__all__ = ["Contact", "System", "PAPER", "modal_damping"]
 
-#: the paper's section-3 damper (MODEL.md section 6)
+#: the paper's section-3 damper (docs/model.md section 6)
 PAPER = dict(m=10.0, k=3.9e5, kt=3.0e5, kn=3.0e5, mu=0.5, n0=100.0)
 
 
 @dataclass(frozen=True)
 class Contact:
-    """One frictional contact.
+    """One frictional contact: a tangential law, where it acts, its normal load.
 
     Parameters
     ----------
     law : ContactLaw
-        Tangential law; its ``n_ref`` is the reference load for alpha = N / n_ref.
-    dof : int
-        DOF whose displacement is the tangential slip (index into x).
-    dof2 : int
-        Second DOF (relative slip x[dof] - x[dof2]); -1 means ground.
-    n0 : float
-        Static normal load N0, N (> 0).
-    n1 : float
-        Amplitude N1 of the normal-load oscillation, N (>= 0); eta = n1 / n0.
-    delta : float
-        Phase of the normal load relative to the forcing, rad.
+        Tangential law; its ``n_ref`` is the reference load of alpha = N / n_ref.
+    dof, dof2 : int
+        Tangential relative displacement u = x[dof] - x[dof2]; ``dof2 = -1``
+        means against ground.
+    normal : NormalLoad, optional
+        :class:`~jointdyn.ConstantLoad`, :class:`~jointdyn.HarmonicLoad`,
+        :class:`~jointdyn.SampledLoad` or :class:`~jointdyn.NormalSpring`;
+        default ``ConstantLoad(law.n_ref)``.
+    direction : array_like, optional
+        Tangential selection vector over the DOFs (u = direction . x), instead
+        of ``dof``/``dof2`` (e.g. for reduced models).
     """
 
     law: ContactLaw
     dof: int = 0
     dof2: int = -1
-    n0: float = 100.0
-    n1: float = 0.0
-    delta: float = 0.0
+    normal: NormalLoad | None = None
+    direction: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.law, ContactLaw):
-            raise ValueError(f"law must be a ContactLaw, got {type(self.law).__name__}")
-        object.__setattr__(self, "dof", V.positive_int("dof", self.dof, 0))
-        if self.dof2 != -1:
-            object.__setattr__(self, "dof2", V.positive_int("dof2", self.dof2, 0))
-        object.__setattr__(self, "n0", V.positive("n0", self.n0))
-        object.__setattr__(self, "n1", V.nonnegative("n1", self.n1))
-        object.__setattr__(self, "delta", V.finite("delta", self.delta))
+            raise ValueError(f"law must be a ContactLaw (see jointdyn.make_law), got {type(self.law).__name__}")
+        dof, dof2, direction = _selection("tangential", self.dof, self.dof2, self.direction)
+        object.__setattr__(self, "dof", dof)
+        object.__setattr__(self, "dof2", dof2)
+        object.__setattr__(self, "direction", direction)
+        normal = ConstantLoad(self.law.n_ref) if self.normal is None else self.normal
+        if not isinstance(normal, NormalLoad):
+            raise ValueError("normal must be a ConstantLoad, HarmonicLoad, SampledLoad or NormalSpring, "
+                             f"got {type(normal).__name__}")
+        object.__setattr__(self, "normal", normal)
+
+    @property
+    def n0(self) -> float:
+        """Static part of the normal load (constant or mean load, or preload), N."""
+        return self.normal.n0
+
+    @property
+    def n1(self) -> float:
+        """Amplitude of a harmonic normal load, N (0 for the other kinds)."""
+        return self.normal.n1 if isinstance(self.normal, HarmonicLoad) else 0.0
 
     @property
     def eta(self) -> float:
-        """N1 / N0."""
+        """N1 / N0 of a harmonic normal load (0 for the other kinds)."""
         return self.n1 / self.n0
 
+    @property
+    def phase_deg(self) -> float:
+        """Phase of a harmonic normal load relative to the forcing, degrees (0 otherwise)."""
+        return self.normal.phase_deg if isinstance(self.normal, HarmonicLoad) else 0.0
+
     def normal_load(self, w: float, t):
-        """N(t) = n0 + n1 sin(w t + delta), N (:func:`jointdyn.kinematics.harmonic_load`)."""
-        return harmonic_load_samples(self.n0, self.n1, self.delta, w * np.asarray(t, dtype=float))
+        """Prescribed normal load N(t) (N) at times t (s), forcing frequency w (rad/s)."""
+        if not self.normal.prescribed:
+            raise ValueError("a normal spring's load depends on the motion: it has no N(t) of its own")
+        return self.normal.at(w * np.asarray(t, dtype=np.float64))
+
+
+def _square(name: str, A, n: int) -> np.ndarray:
+    A = V.finite_array(name, np.atleast_2d(A), 2)
+    if A.shape != (n, n):
+        raise ValueError(f"{name} must be {n} x {n}, got shape {A.shape}")
+    return A
+
+
+def _symmetric(name: str, A: np.ndarray) -> None:
+    scale = float(np.max(np.abs(A))) if A.size else 0.0
+    if np.max(np.abs(A - A.T), initial=0.0) > 1e-10 * scale:
+        i, j = np.unravel_index(int(np.argmax(np.abs(A - A.T))), A.shape)
+        raise ValueError(f"{name} must be symmetric ({name}[{i},{j}] = {A[i, j]!r} but "
+                         f"{name}[{j},{i}] = {A[j, i]!r})")
+
+
+def _check_selection(what: str, dof: int, dof2: int, direction, n: int) -> None:
+    if direction is not None:
+        if direction.shape != (n,):
+            raise ValueError(f"{what} direction must have length {n} (one entry per DOF), got {direction.size}")
+        return
+    for d in (dof, dof2):
+        if d >= n:
+            raise ValueError(f"{what} dof must be in [0, {n - 1}] (or -1 for ground), got {d}")
+
+
+def _vector(name: str, values, n: int, default: float) -> np.ndarray:
+    if values is None:
+        return np.full(n, default)
+    v = V.finite_array(name, np.atleast_1d(values))
+    if v.shape != (n,):
+        raise ValueError(f"{name} must have length {n} (one entry per DOF), got {v.size}")
+    return v
 
 
 @dataclass(frozen=True)
@@ -86,11 +140,19 @@ class System:
     Parameters
     ----------
     M, C, K : array_like
-        Mass (kg), viscous damping (N s/m) and stiffness (N/m) matrices, n x n.
+        Mass (kg, symmetric positive definite), viscous damping (N s/m; None
+        for none; :func:`modal_damping` builds one from modal ratios) and
+        stiffness (N/m, symmetric) matrices, n x n.
     contacts : tuple of Contact
-        Contacts (all with the same law class).
+        The frictional contacts (each with its own law and normal load).
     force : array_like
-        Forcing amplitudes f (N) per DOF: F(t) = f sin(w t).
+        Forcing amplitudes f (N) per DOF.
+    force_phase_deg : array_like, optional
+        Forcing phases phi (degrees) per DOF: F_i(t) = f_i sin(w t + phi_i).
+    w0_rad_s : float, optional
+        Reference frequency of gamma = w / w0, rad/s (default: see :attr:`w0`).
+    output_dof : int, optional
+        DOF whose response is reported (default: :attr:`response_dof`).
     """
 
     M: np.ndarray
@@ -98,49 +160,94 @@ class System:
     K: np.ndarray
     contacts: tuple = field(default_factory=tuple)
     force: np.ndarray = None
+    force_phase_deg: np.ndarray = None
+    w0_rad_s: float | None = None
+    output_dof: int | None = None
 
     def __post_init__(self) -> None:
         M = V.finite_array("M", np.atleast_2d(self.M), 2)
         n = M.shape[0]
-        C = V.finite_array("C", np.atleast_2d(self.C), 2)
-        K = V.finite_array("K", np.atleast_2d(self.K), 2)
-        for name, A in (("M", M), ("C", C), ("K", K)):
-            if A.shape != (n, n):
-                raise ValueError(f"{name} must be {n} x {n}, got shape {A.shape}")
-        if np.any(np.linalg.eigvalsh(0.5 * (M + M.T)) <= 0):
+        if M.shape != (n, n):
+            raise ValueError(f"M must be square, got shape {M.shape}")
+        _symmetric("M", M)
+        if np.any(np.linalg.eigvalsh(M) <= 0):
             raise ValueError("M must be symmetric positive definite (eigenvalues in (0, inf))")
-        f = np.zeros(n) if self.force is None else V.finite_array("force", np.atleast_1d(self.force))
-        if f.shape != (n,):
-            raise ValueError(f"force must have length {n}, got {f.shape[0]}")
+        K = _square("K", self.K, n)
+        _symmetric("K", K)
+        C = np.zeros((n, n)) if self.C is None else _square("C", self.C, n)
         contacts = tuple(self.contacts)
-        for c in contacts:
+        for i, c in enumerate(contacts):
             if not isinstance(c, Contact):
-                raise ValueError("contacts must be Contact instances")
-            for d in (c.dof, c.dof2):
-                if d >= n:
-                    raise ValueError(f"contact dof must be in [0, {n - 1}] (or -1 for ground), got {d}")
+                raise ValueError(f"contacts must be Contact instances (contact {i} is a {type(c).__name__})")
+            _check_selection(f"contact {i} tangential", c.dof, c.dof2, c.direction, n)
+            if isinstance(c.normal, NormalSpring):
+                _check_selection(f"contact {i} normal", c.normal.dof, c.normal.dof2, c.normal.direction, n)
         if len({type(c.law) for c in contacts}) > 1:
             raise ValueError("all contacts of one System must use the same contact-law class")
-        object.__setattr__(self, "M", M)
-        object.__setattr__(self, "C", C)
-        object.__setattr__(self, "K", K)
-        object.__setattr__(self, "force", f)
-        object.__setattr__(self, "contacts", contacts)
+        for name, value in (("M", M), ("C", C), ("K", K), ("contacts", contacts),
+                            ("force", _vector("force", self.force, n, 0.0)),
+                            ("force_phase_deg", _vector("force_phase_deg", self.force_phase_deg, n, 0.0))):
+            object.__setattr__(self, name, value)
+        if self.w0_rad_s is not None:
+            object.__setattr__(self, "w0_rad_s", V.positive("w0_rad_s", self.w0_rad_s))
+        if self.output_dof is not None:
+            d = V.positive_int("output_dof", self.output_dof, 0)
+            if d >= n:
+                raise ValueError(f"output_dof must be in [0, {n - 1}], got {d}")
+            object.__setattr__(self, "output_dof", d)
 
     @property
     def ndof(self) -> int:
+        """Number of degrees of freedom."""
         return self.M.shape[0]
+
+    @property
+    def response_dof(self) -> int:
+        """DOF whose response is reported: ``output_dof``, else the first
+        contact's tangential DOF (its largest selection entry), else 0."""
+        if self.output_dof is not None:
+            return self.output_dof
+        if self.contacts:
+            c = self.contacts[0]
+            return int(np.argmax(np.abs(c.direction))) if c.direction is not None else c.dof
+        return 0
+
+    @property
+    def K_reference(self) -> np.ndarray:
+        """K with the normal springs in place (closed) and the tangential contacts free, N/m."""
+        K = self.K.copy()
+        for c in self.contacts:
+            if isinstance(c.normal, NormalSpring):
+                b = _dense(c.normal.dof, c.normal.dof2, c.normal.direction, self.ndof)
+                K += c.normal.kn * np.outer(b, b)
+        return K
 
     @functools.cached_property
     def w0(self) -> float:
-        """Lowest natural angular frequency of (M, K) without contacts, rad/s.
+        """Reference frequency of gamma = w / w0, rad/s.
 
-        For the single-DOF damper w0 = sqrt(k/m), the paper's reference for gamma.
+        ``w0_rad_s`` when given; else the lowest natural frequency of
+        (M, :attr:`K_reference`): normal springs in place, tangential contacts
+        free. For the single-DOF damper w0 = sqrt(k/m), the paper's reference.
         """
+        if self.w0_rad_s is not None:
+            return self.w0_rad_s
         from scipy.linalg import eigh
 
-        lam = eigh(self.K, self.M, eigvals_only=True)
+        lam = eigh(self.K_reference, self.M, eigvals_only=True)
         return math.sqrt(max(lam[0], 0.0))
+
+    def require_in_phase_forcing(self, solver: str) -> None:
+        """ValueError naming ``force_phase_deg`` if a forcing phase is not 0
+        (for solvers that take the forcing as f sin(w t))."""
+        if np.any(self.force_phase_deg != 0.0):
+            raise ValueError(f"force_phase_deg: {solver} takes in-phase forcing only (all phases 0), "
+                             f"got {self.force_phase_deg.tolist()}")
+
+    def forcing_coefficients(self) -> tuple[np.ndarray, np.ndarray]:
+        """(cosine, sine) coefficients of the forcing, N: F = a cos(w t) + b sin(w t)."""
+        phi = np.radians(self.force_phase_deg)
+        return self.force * np.sin(phi), self.force * np.cos(phi)
 
     @classmethod
     def sdof(
@@ -154,7 +261,7 @@ class System:
         zeta: float | None = None,
         n0: float | None = None,
         eta: float = 0.0,
-        delta: float = 0.0,
+        delta_deg: float = 0.0,
     ) -> "System":
         """Single-DOF oscillator with one contact between mass and ground.
 
@@ -173,9 +280,9 @@ class System:
         n0 : float, optional
             Static normal load, N; default ``law.n_ref``.
         eta : float
-            N1 / N0 (>= 0).
-        delta : float
-            Normal-load phase, rad.
+            N1 / N0 (>= 0): N(t) = n0 (1 + eta sin(w t + delta)).
+        delta_deg : float
+            Normal-load phase relative to the forcing, degrees.
         """
         m = V.positive("m", m)
         k = V.positive("k", k)
@@ -188,7 +295,8 @@ class System:
         if law is not None:
             n0 = law.n_ref if n0 is None else n0
             eta = V.nonnegative("eta", eta)
-            contacts = (Contact(law=law, dof=0, n0=n0, n1=eta * float(n0), delta=delta),)
+            normal = HarmonicLoad(n0=n0, n1=eta * float(n0), phase_deg=delta_deg)
+            contacts = (Contact(law=law, dof=0, normal=normal),)
         return cls(M=[[m]], C=[[c]], K=[[k]], contacts=contacts, force=[V.finite("f1", f1)])
 
     @classmethod
@@ -197,7 +305,7 @@ class System:
         *,
         eta: float = 0.5,
         beta: float = 1.0,
-        delta: float = 0.0,
+        delta_deg: float = 0.0,
         model: str = "iwan",
         zeta: float = 0.0,
         f1: float | None = None,
@@ -213,8 +321,8 @@ class System:
             N1 / N0 (>= 0).
         beta : float
             mu N0 / F1 (> 0); ignored when ``f1`` is given.
-        delta : float
-            Normal-load phase, rad.
+        delta_deg : float
+            Normal-load phase relative to the forcing, degrees.
         model : str
             Contact-law name (``iwan``, ``iwan-paper``, ``discrete``, ``jenkins``).
         zeta : float
@@ -243,4 +351,50 @@ class System:
         law = make_law(model, kt=p["kt"], mu=p["mu"], n_ref=p["n0"], **law_params)
         if f1 is None:
             f1 = law.fy / V.positive("beta", beta)
-        return cls.sdof(m=p["m"], k=p["k"], law=law, f1=f1, zeta=zeta, n0=p["n0"], eta=eta, delta=delta)
+        return cls.sdof(m=p["m"], k=p["k"], law=law, f1=f1, zeta=zeta, n0=p["n0"], eta=eta, delta_deg=delta_deg)
+
+
+def _dense(dof: int, dof2: int, direction, n: int) -> np.ndarray:
+    """Selection vector (n,) of (dof, dof2) or ``direction``."""
+    if direction is not None:
+        return np.asarray(direction, dtype=np.float64).copy()
+    b = np.zeros(n)
+    b[dof] += 1.0
+    if dof2 >= 0:
+        b[dof2] -= 1.0
+    return b
+
+
+def modal_damping(M, K, zeta) -> np.ndarray:
+    """Viscous damping matrix with modal damping ratios, N s/m.
+
+    ``C = M Phi diag(2 zeta_r w_r) Phi^T M`` with the mass-normalised modes
+    Phi and natural frequencies w_r (rad/s) of (M, K), so that mode r of the
+    undamped structure has damping ratio zeta_r. Pass the stiffness the
+    ratios refer to (e.g. ``System.K_reference``, with the normal springs).
+
+    Parameters
+    ----------
+    M, K : array_like (n, n)
+        Mass (kg, symmetric positive definite) and stiffness (N/m, symmetric).
+    zeta : float or array_like (n,)
+        Damping ratio of every mode, or one per mode in increasing frequency
+        (>= 0). Rigid-body modes (w_r = 0) get no damping.
+    """
+    from scipy.linalg import eigh
+
+    M = V.finite_array("M", np.atleast_2d(M), 2)
+    K = V.finite_array("K", np.atleast_2d(K), 2)
+    n = M.shape[0]
+    _square("K", K, n)
+    _symmetric("M", M)
+    _symmetric("K", K)
+    z = np.atleast_1d(np.asarray(zeta, dtype=np.float64))
+    if z.size == 1:
+        z = np.full(n, float(z[0]))
+    if z.shape != (n,) or not np.all(np.isfinite(z)) or np.any(z < 0):
+        raise ValueError(f"zeta must be a number >= 0 or {n} numbers >= 0 (one per mode), got {zeta!r}")
+    lam, phi = eigh(K, M)
+    w = np.sqrt(np.maximum(lam, 0.0))
+    MP = M @ phi
+    return (MP * (2.0 * z * w)) @ MP.T

@@ -296,7 +296,7 @@ def _run_hb(args, gammas):
         eta=args.eta,
         beta=args.beta if args.f1 is None else 1.0,
         f1=args.f1,
-        delta=math.radians(args.delta),
+        delta_deg=args.delta,
         model=args.model,
         zeta=args.zeta,
         law_params=args.law_params,

@@ -202,7 +202,7 @@ def _history(args, law):
 
     if args.input is None:
         t, x, N = harmonic_history(
-            args.amplitude, args.frequency, args.n_ref, eta=args.eta, delta=math.radians(args.delta),
+            args.amplitude, args.frequency, args.n_ref, eta=args.eta, delta_deg=args.delta,
             cycles=args.cycles, steps_per_cycle=args.steps_per_cycle, kn=args.kn,
         )
         return t, x, N, 1.0 / args.frequency

@@ -24,7 +24,8 @@ import pandas as pd
 
 from .. import _validate as V
 from .. import config
-from ..laws import MACROSLIP, SEPARATION, STATE_NAMES, STICK_SLIP, ContactLaw, HarmonicLoad, UnilateralSpring
+from ..kinematics import HarmonicLoad, NormalSpring
+from ..laws import MACROSLIP, SEPARATION, STATE_NAMES, STICK_SLIP, ContactLaw
 from ._csv import read_history_csv
 from ._march import march
 
@@ -64,7 +65,7 @@ def harmonic_history(
     frequency,
     n0,
     eta=0.0,
-    delta=0.0,
+    delta_deg=0.0,
     cycles=config.QS_CYCLES,
     steps_per_cycle=config.QS_STEPS_PER_CYCLE,
     x_offset=0.0,
@@ -90,8 +91,8 @@ def harmonic_history(
     eta : float
         Normal-load ratio N1 / N0 (>= 0); the interface separates during part
         of the cycle iff eta > 1.
-    delta : float
-        Phase of the normal load relative to x, **radians** (finite).
+    delta_deg : float
+        Phase delta of the normal load relative to x, degrees (finite).
     cycles : int
         Number of periods (>= 1).
     steps_per_cycle : int
@@ -121,7 +122,7 @@ def harmonic_history(
     f = V.positive("frequency", frequency)
     n0 = V.positive("n0", n0)
     eta = V.nonnegative("eta", eta)
-    delta = V.finite("delta", delta)
+    delta_deg = V.finite("delta_deg", delta_deg)
     cycles = V.positive_int("cycles", cycles, 1)
     steps = V.positive_int("steps_per_cycle", steps_per_cycle, 4)
     x_offset = V.finite("x_offset", x_offset)
@@ -135,8 +136,8 @@ def harmonic_history(
     # t_i = (i / steps) / f: the period boundaries k / f are exact samples
     t = (np.arange(cycles * steps + 1) / steps) / f
     t_end = t[-1]
-    load = HarmonicLoad(n0=n0, n1=eta * n0, omega=w, delta=delta)
-    tc = load.zero_crossings(0.0, t_end)
+    load = HarmonicLoad(n0=n0, n1=eta * n0, phase_deg=delta_deg)
+    tc = load.zero_crossings(w, 0.0, t_end)
     dt = 1.0 / (steps * f)
     snap = config.QS_SNAP_RTOL * dt
     crossing = np.zeros(t.size, dtype=bool)
@@ -158,10 +159,10 @@ def harmonic_history(
     phase = w * t
     x = x_offset + A * np.sin(phase)
     if kn is None:
-        N = load(t)
+        N = load.at(phase)
     else:
-        v = (eta * n0 / kn) * np.sin(phase + delta)
-        N = UnilateralSpring(n_ref=n0, kn=kn).load(v)
+        v = (eta * n0 / kn) * np.sin(phase + load.phase_rad)
+        N = NormalSpring(kn=kn, preload=n0).load(v)
     N[crossing] = 0.0
     return t, x, N
 
@@ -549,7 +550,7 @@ def harmonic_loop(
     frequency=1.0,
     n0=None,
     eta=0.0,
-    delta=0.0,
+    delta_deg=0.0,
     cycles=config.QS_CYCLES,
     steps_per_cycle=config.QS_STEPS_PER_CYCLE,
     x_offset=0.0,
@@ -558,10 +559,10 @@ def harmonic_loop(
     """:func:`quasistatic` over :func:`harmonic_history`, period 1 / frequency.
 
     ``n0`` defaults to the law's ``n_ref`` (the paper's N_ref = N0); the other
-    parameters are those of :func:`harmonic_history` (``delta`` in radians).
+    parameters are those of :func:`harmonic_history` (``delta_deg`` in degrees).
     """
     if not isinstance(law, ContactLaw):
         raise ValueError(f"law must be a ContactLaw (see jointdyn.make_law), got {type(law).__name__}")
     n0 = law.n_ref if n0 is None else n0
-    t, x, N = harmonic_history(amplitude, frequency, n0, eta, delta, cycles, steps_per_cycle, x_offset, kn)
+    t, x, N = harmonic_history(amplitude, frequency, n0, eta, delta_deg, cycles, steps_per_cycle, x_offset, kn)
     return quasistatic(law, t, x, N, period=1.0 / float(frequency))

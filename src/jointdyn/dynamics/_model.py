@@ -80,6 +80,7 @@ def pack_system(system) -> PackedSystem:
     """The :class:`PackedSystem` of ``system`` (cached per System object)."""
     n = system.ndof
     cs = system.contacts
+    system.require_in_phase_forcing("the time integrator")
     kin = contact_kinematics(system)
     M = np.ascontiguousarray(system.M, dtype=np.float64)
     Minv = np.ascontiguousarray(np.linalg.inv(system.M))

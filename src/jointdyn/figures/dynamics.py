@@ -174,7 +174,7 @@ def steady_loop(eta, beta, gamma, delta_deg, *, model="iwan", **kw):
     from ..dynamics import steady_state
     from ..systems import System
 
-    system = System.paper_damper(eta=eta, beta=beta, delta=math.radians(delta_deg), model=model)
+    system = System.paper_damper(eta=eta, beta=beta, delta_deg=delta_deg, model=model)
     res = steady_state(system, gamma, keep_loop=True, **kw)
     lp = res.loop
     df = pd.DataFrame({

@@ -17,7 +17,6 @@ tabulated and plotted. Tables are long format (one row per sample).
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pandas as pd
@@ -49,7 +48,7 @@ def _last_cycle(model, amplitude, eta, delta_deg):
     """Long table of the last cycle and a one-row metrics dict."""
     res = harmonic_loop(
         _law(model), amplitude, PAPER_QS["frequency"], PAPER_QS["n0"], eta=eta,
-        delta=math.radians(delta_deg), cycles=_CYCLES, steps_per_cycle=_STEPS,
+        delta_deg=delta_deg, cycles=_CYCLES, steps_per_cycle=_STEPS,
     )
     sl = res.cycle_slice(-1)
     df = pd.DataFrame(

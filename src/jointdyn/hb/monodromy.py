@@ -13,13 +13,14 @@ displacement.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
 from .. import _validate as V
 from .. import config
 from ..drivers import march
-from ..kinematics import contact_kinematics, normal_load_samples, tangential_history
+from ..kinematics import HarmonicLoad, contact_kinematics, normal_load_samples, tangential_history
 from ..laws import MACROSLIP, SEPARATION
 from ..systems import System
 from .stability import derivative_matrix
@@ -39,7 +40,7 @@ def _basis(tau, H):
 def _system_at(problem, f, loads) -> System:
     """The problem's System with the forcing f and contact loads (n0, n1, delta) of a parameter value."""
     s = problem.system
-    contacts = tuple(dataclasses.replace(c, n0=n0, n1=n1, delta=dl)
+    contacts = tuple(dataclasses.replace(c, normal=HarmonicLoad(n0, n1, math.degrees(dl)))
                      for c, (n0, n1, dl, _) in zip(problem.contacts, loads))  # fmt: skip
     return System(M=s.M, C=s.C, K=s.K, contacts=contacts, force=f)
 

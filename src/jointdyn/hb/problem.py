@@ -119,6 +119,7 @@ class HBProblem:
                  max_passes: int = config.HB_MAX_PASSES):
         if not isinstance(system, System):
             raise ValueError("system must be a jointdyn.System")
+        system.require_in_phase_forcing("harmonic balance")
         self.H = V.positive_int("harmonics", harmonics, 1)
         self.Ns = V.positive_int("samples", samples, 2 * self.H + 2)
         self.parameter = V.choice("parameter", parameter, PARAMETERS)
@@ -175,7 +176,7 @@ class HBProblem:
         if p == "f1":
             return self.f1_ref
         c = self.contacts[0]
-        return {"eta": c.eta, "n0": c.n0, "delta": c.delta}[p]
+        return {"eta": c.eta, "n0": c.n0, "delta": c.normal.phase_rad}[p]
 
     def _split(self, p):
         """(w, f, contact loads [(n0, n1, delta)], dN/dp per contact or None)."""
@@ -185,7 +186,7 @@ class HBProblem:
         f = self.f_dir * (p if par == "f1" else self.f1_ref)
         loads = []
         for c in self.contacts:
-            n0, n1, dl = c.n0, c.n1, c.delta
+            n0, n1, dl = c.n0, c.n1, math.radians(c.phase_deg)
             dn = None
             if par == "eta":
                 n1 = p * n0

@@ -31,7 +31,6 @@ for _module in _pkgutil.iter_modules(__path__):
 
 from .discrete import DiscreteIwan, Jenkins  # noqa: E402
 from .iwan import Iwan, backbone  # noqa: E402
-from .normal import HarmonicLoad, NormalLoad, SampledLoad, UnilateralSpring  # noqa: E402
 
 __all__ = [
     "STICK_SLIP",
@@ -51,8 +50,4 @@ __all__ = [
     "law_parameters",
     "law_summary",
     "canonical_law_params",
-    "NormalLoad",
-    "HarmonicLoad",
-    "SampledLoad",
-    "UnilateralSpring",
 ]

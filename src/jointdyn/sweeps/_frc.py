@@ -159,7 +159,7 @@ class LineSpec:
             eta=self.eta,
             beta=1.0 if self.beta is None else self.beta,
             f1=self.f1,
-            delta=math.radians(self.delta_deg),
+            delta_deg=self.delta_deg,
             model=self.model,
             zeta=self.zeta,
             law_params=dict(self.law_params),
