@@ -17,6 +17,10 @@ IWAN_MAX_DEPTH = 64
 #: displacement kt x / fy) has reached it (Masing rejoin); the force error
 #: is of the same order in units of fy
 IWAN_WIPE_TOL = 1e-9
+#: linear pieces kept by the exact Iwan law (``iwan-exact``) after a step;
+#: beyond, the pair whose chord changes the state least is merged
+#: (accuracy study: docs/exact-iwan.md)
+IWAN_EXACT_CAPACITY = 32
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history

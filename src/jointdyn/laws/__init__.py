@@ -15,6 +15,7 @@ from ._base import (
     register,
 )
 from .discrete import DiscreteIwan, Jenkins
+from .exact import ExactIwan  # noqa: F401 - registers "iwan-exact"
 from .iwan import Iwan, backbone
 from .normal import HarmonicLoad, NormalLoad, SampledLoad, UnilateralSpring
 
