@@ -37,13 +37,13 @@ the rest of the history.
 
 Kernel layouts
 --------------
-``params = [kt (N/m), fy (N), N_ref (N), K, room]`` with ``room = 2 K``
-(pieces a step may hold before its closing merges).
+``params = [kt (N/m), fy (N), N_ref (N), K, kt / fy (1/m), 1 / N_ref (1/N)]``.
 
-``state = [x_prev (m), m, (hi_k, a_k, b_k) for k < room]``: ``m`` pieces
+``state = [x_prev (m), m, (hi_k, a_k, b_k) for k < 3 K]``: ``m`` pieces
 in increasing u; piece k covers [hi_(k-1), hi_k] (hi_(-1) = 0,
 hi_(m-1) = 2) with P(u) = a_k + b_k u (units of fy). Rows beyond the live
-pieces are not written by ``step``.
+pieces are not written by ``step``. A step writes at most three pieces per
+committed piece before it merges down to K, hence room for 3 K.
 
 Derivatives (``step_jvp``): rows a_k, b_k carry da_k, db_k; the breakpoint
 rows carry zero. Breakpoints need none: P is continuous in u, so moving a
@@ -84,65 +84,76 @@ U_MAX = 2.0
 _X, _M = 0, 1
 _HEAD = 2
 # params rows
-_P_KT, _P_FY, _P_NREF, _P_CAP, _P_ROOM = 0, 1, 2, 3, 4
+_P_KT, _P_FY, _P_NREF, _P_CAP, _P_QS, _P_INV_NREF = 0, 1, 2, 3, 4, 5
 #: smallest capacity: one piece may split into three in a step
 MIN_CAPACITY = 3
+# kinds of an element (or segment) after a trial shift: above the upper clip
+# line, inside the limits, below the lower line
+_ABOVE, _STUCK, _BELOW = 1, 0, -1
+# kind of a piece whose derivative rows are zero (separation)
+_ZERO = 2
 
 
 @jit(inline="always")
-def _on_line(a, b, alpha):
-    """True if a + b u is a clip line +-alpha u (the piece slips)."""
-    return a == 0.0 and (b == alpha or b == -alpha)
-
-
-@jit(inline="always")
-def _cut(g_lo, g_hi, a, slope, lo, hi):
-    """Crossing of a + slope u with zero inside [lo, hi] (``hi`` if none).
-
-    A crossing exists when the sign test ``g > 0`` differs at the two ends
-    (``g_lo``, ``g_hi`` the values there); it is dropped (``hi`` returned)
-    when it lies within :data:`SNAP` of an end.
-    """
-    if (g_lo > 0.0) == (g_hi > 0.0):
-        return hi
-    c = -a / slope
-    if c - lo <= SNAP or hi - c <= SNAP:
+def _snap(c, lo, hi):
+    """Cut position ``c`` clamped to [lo, hi]; within :data:`SNAP` of an
+    end it moves onto that end (the cut is dropped)."""
+    if c - lo <= SNAP:
+        return lo
+    if hi - c <= SNAP:
         return hi
     return c
 
 
 @jit(inline="always")
-def _cuts(lo, hi, a, b, alpha):
-    """Cuts of the piece a + b u on [lo, hi] by the clip lines, sorted.
+def _split(lo, hi, a, b, alpha, k_lo, k_hi):
+    """Cuts of the piece a + b u on [lo, hi] whose ends have different kinds.
 
-    Returns ``c1 <= c2`` in [lo, hi]; a missing cut is ``hi``, so the
-    segments [lo, c1], [c1, c2], [c2, hi] (empty ones skipped) partition
-    the piece into regions of one kind each (above, stuck, below).
+    ``k_lo``, ``k_hi``: kind (:data:`_ABOVE`, :data:`_STUCK`, :data:`_BELOW`)
+    at each end. Returns ``c1 <= c2``: the segments [lo, c1] (kind k_lo),
+    [c1, c2] (stuck) and [c2, hi] (kind k_hi) partition the piece (empty
+    ones are skipped); an end whose kind is stuck has no cut of its own.
     """
-    su = b - alpha  # a + su u > 0: above the upper line
-    sl = b + alpha  # a + sl u < 0: below the lower line
-    cu = _cut(a + su * lo, a + su * hi, a, su, lo, hi)
-    cl = _cut(a + sl * lo, a + sl * hi, a, sl, lo, hi)
-    if cl < cu:
-        return cl, cu
-    return cu, cl
+    c1 = lo
+    c2 = hi
+    if k_lo == _ABOVE:
+        c1 = _snap(-a / (b - alpha), lo, hi)
+    elif k_lo == _BELOW:
+        c1 = _snap(-a / (b + alpha), lo, hi)
+    if k_hi == _ABOVE:
+        c2 = _snap(-a / (b - alpha), lo, hi)
+    elif k_hi == _BELOW:
+        c2 = _snap(-a / (b + alpha), lo, hi)
+    if c2 < c1:
+        c2 = c1
+    return c1, c2
 
 
 @jit(inline="always")
-def _kind(lo, hi, a, b, alpha):
-    """Coefficients of a segment after the clip, decided at its midpoint.
+def _end_kind(p, lim):
+    """Kind of an element whose trial force is ``p`` and limit ``lim``."""
+    if p > lim:
+        return _ABOVE
+    if p < -lim:
+        return _BELOW
+    return _STUCK
 
-    Returns ``(a', b', stuck)``: ``(0, +-alpha, False)`` on a clip line,
-    ``(a, b, True)`` inside the limits.
+
+@jit(inline="always")
+def _coeffs(kind, a, b, alpha):
+    """Coefficients and kind of a segment of kind ``kind`` after the clip.
+
+    Clipped: ``(0, +-alpha)``; stuck: ``(a, b)``, whose kind becomes a clip
+    kind when the line a + b u is a clip line (no stiffness, and joinable
+    with a clipped neighbour).
     """
-    mid = 0.5 * (lo + hi)
-    v = a + b * mid
-    lim = alpha * mid
-    if v > lim:
-        return 0.0, alpha, False
-    if v < -lim:
-        return 0.0, -alpha, False
-    return a, b, True
+    if kind == _ABOVE:
+        return 0.0, alpha, _ABOVE
+    if kind == _BELOW:
+        return 0.0, -alpha, _BELOW
+    if a == 0.0 and (b == alpha or b == -alpha):
+        return a, b, (_ABOVE if b > 0.0 else _BELOW)
+    return a, b, _STUCK
 
 
 @jit(inline="always")
@@ -151,158 +162,106 @@ def _integral(lo, hi, a, b):
     return (hi - lo) * (a + 0.5 * b * (hi + lo))
 
 
-@jit(inline="always")
-def _lo_of(s, k):
-    """Lower end of piece k."""
-    if k == 0:
-        return 0.0
-    return s[_HEAD + 3 * (k - 1)]
+# Helpers that take arrays are straight-line code: Numba keeps the
+# reference-count updates of an array argument of an inlined function with
+# branches inside the caller's loop (two atomic operations per array and
+# call, which cost more than the whole step); decisions are taken by the
+# scalar helpers above and by the core.
 
 
 @jit(inline="always")
-def _merge_cost(s, k):
-    """Twice the area between pieces k, k+1 and the chord through their
-    outer ends, ``|b_k - b_(k+1)| (mid - lo)(hi - mid)`` for a continuous P
-    (the integral of |P - chord| du a merge would add is half of it).
-    """
+def _write(s, k, hi, a, b):
+    """Piece k of state ``s`` := (hi, a, b)."""
     r = _HEAD + 3 * k
-    lo = _lo_of(s, k)
-    mid = s[r]
-    hi = s[r + 3]
-    return abs(s[r + 2] - s[r + 5]) * (mid - lo) * (hi - mid)
-
-
-@jit(inline="always")
-def _merge_pair(s, ds, k, m, alpha):
-    """Replace pieces k, k+1 by the chord through P at their outer ends.
-
-    Shifts the pieces above down by one. ``ds`` (or None) gets the chord of
-    the derivatives at fixed breakpoints. Returns the change of the
-    integral of P and of the stuck measure.
-    """
-    r = _HEAD + 3 * k
-    lo = _lo_of(s, k)
-    mid = s[r]
-    hi = s[r + 3]
-    aL, bL, aR, bR = s[r + 1], s[r + 2], s[r + 4], s[r + 5]
-    pl = aL + bL * lo
-    ph = aR + bR * hi
-    b = (ph - pl) / (hi - lo)
-    a = pl - b * lo
-    d_int = _integral(lo, hi, a, b) - _integral(lo, mid, aL, bL) - _integral(mid, hi, aR, bR)
-    d_stuck = 0.0
-    if not _on_line(a, b, alpha):
-        d_stuck += hi - lo
-    if not _on_line(aL, bL, alpha):
-        d_stuck -= mid - lo
-    if not _on_line(aR, bR, alpha):
-        d_stuck -= hi - mid
     s[r] = hi
     s[r + 1] = a
     s[r + 2] = b
-    if ds is not None:
-        for j in range(ds.shape[1]):
-            dl = ds[r + 1, j] + ds[r + 2, j] * lo
-            dh = ds[r + 4, j] + ds[r + 5, j] * hi
-            db = (dh - dl) / (hi - lo)
-            ds[r + 1, j] = dl - db * lo
-            ds[r + 2, j] = db
-    for rr in range(r + 3, _HEAD + 3 * (m - 1)):
-        s[rr] = s[rr + 3]
-        if ds is not None:
-            for j in range(ds.shape[1]):
-                ds[rr, j] = ds[rr + 3, j]
-    return d_int, d_stuck
 
 
 @jit(inline="always")
-def _merge_least(s, ds, m, alpha):
-    """Chord-merge the adjacent pair of least cost (first on ties); see
-    :func:`_merge_pair` for the returns."""
+def _write_jvp(ds, ds_old, dx, dN, k, r_old, kind, qs, ia):
+    """Derivative rows of piece k: stuck, those of the old piece (row
+    ``r_old``) plus dq = (kt/fy)(dx - dx_prev) on a; clipped (kind +-1),
+    (0, +-dalpha); :data:`_ZERO`, zero. The breakpoint row gets zero."""
+    r = _HEAD + 3 * k
+    w = 1.0 if kind == _STUCK else 0.0
+    sg = float(kind) * ia if kind != _ZERO else 0.0
+    for j in range(ds.shape[1]):
+        ds[r, j] = 0.0
+        ds[r + 1, j] = w * (ds_old[r_old + 1, j] + qs * (dx[j] - ds_old[_X, j]))
+        ds[r + 2, j] = w * ds_old[r_old + 2, j] + sg * dN[j]
+
+
+@jit(inline="always")
+def _pair_cost(lo, mid, hi, bl, br):
+    """Twice the area between two adjacent pieces (slopes bl, br, meeting at
+    mid) and the chord through their outer ends: |bl - br| (mid - lo)(hi - mid)
+    for a continuous P. The integral of |P - chord| du a merge adds is half
+    of it."""
+    return abs(bl - br) * (mid - lo) * (hi - mid)
+
+
+@jit(inline="always")
+def _least_pair(s, m):
+    """Index k of the adjacent pair (k, k+1) of least merge cost (first on ties)."""
     best = 0
-    cbest = _merge_cost(s, 0)
-    for k in range(1, m - 1):
-        c = _merge_cost(s, k)
+    cbest = np.inf
+    lo = 0.0
+    for k in range(m - 1):
+        r = _HEAD + 3 * k
+        c = _pair_cost(lo, s[r], s[r + 3], s[r + 2], s[r + 5])
         if c < cbest:
             cbest = c
             best = k
-    return _merge_pair(s, ds, best, m, alpha)
+        lo = s[r]
+    return best
 
 
 @jit(inline="always")
-def _emit(s, ds, ds_old, dx, dN, qs, ia, m, room, lo, hi, a, b, alpha, r_old):
-    """Append the clipped segment [lo, hi] of the shifted old piece (row
-    ``r_old``, coefficients ``a``, ``b`` after the shift) to the new state.
+def _chord(lo, mid, hi, al, bl, ar, br):
+    """Chord through P at the outer ends of two adjacent pieces.
 
-    A segment with the coefficients of the last piece extends it. When the
-    state is full (``room`` pieces) the least-cost pair is chord-merged
-    first. ``ds`` (or None) receives the derivative rows: stuck, the old
-    piece's plus dq = (kt/fy)(dx - dx_prev) on a; clipped, (0, +-dalpha).
-    Returns the new piece count, the integral of P over the segment (plus
-    the change of a merge) and the stuck measure added.
+    Returns its coefficients ``(a, b)`` and the change of the integral of
+    P over [lo, hi] when the two pieces are replaced by it.
     """
-    a2, b2, stuck = _kind(lo, hi, a, b, alpha)
-    d_int = _integral(lo, hi, a2, b2)
-    d_stuck = 0.0 if _on_line(a2, b2, alpha) else hi - lo
-    if m > 0:
-        rp = _HEAD + 3 * (m - 1)
-        if s[rp + 1] == a2 and s[rp + 2] == b2:
-            s[rp] = hi
-            return m, d_int, d_stuck
-    if m == room:
-        di, dst = _merge_least(s, ds, m, alpha)
-        m -= 1
-        d_int += di
-        d_stuck += dst
-    r = _HEAD + 3 * m
-    s[r] = hi
-    s[r + 1] = a2
-    s[r + 2] = b2
-    if ds is not None:
-        sg = 1.0 if b2 > 0.0 else -1.0
-        for j in range(ds.shape[1]):
-            ds[r, j] = 0.0
-            if stuck:
-                ds[r + 1, j] = ds_old[r_old + 1, j] + qs * (dx[j] - ds_old[_X, j])
-                ds[r + 2, j] = ds_old[r_old + 2, j]
-            else:
-                ds[r + 1, j] = 0.0
-                ds[r + 2, j] = sg * ia * dN[j]
-    return m + 1, d_int, d_stuck
+    pl = al + bl * lo
+    ph = ar + br * hi
+    b = (ph - pl) / (hi - lo)
+    a = pl - b * lo
+    d_int = _integral(lo, hi, a, b) - _integral(lo, mid, al, bl) - _integral(mid, hi, ar, br)
+    return a, b, d_int
 
 
 @jit(inline="always")
-def _reset(s, ds, x, dx):
-    """Virgin state at x: one piece P = 0 on [0, 2], x_prev = x (``ds``, or
-    None: d(x_prev) = dx, zero elsewhere). Rows beyond the piece are
-    zeroed too (written in full)."""
-    s[:] = 0.0
-    s[_X] = x
-    s[_M] = 1.0
-    s[_HEAD] = U_MAX
+def _shift_down(s, ds, k, m):
+    """Drop piece k + 1 of ``m``: pieces above move down one slot (``ds`` too, unless None)."""
+    for rr in range(_HEAD + 3 * (k + 1), _HEAD + 3 * (m - 1)):
+        s[rr] = s[rr + 3]
     if ds is not None:
-        for r in range(ds.shape[0]):
+        for rr in range(_HEAD + 3 * (k + 1), _HEAD + 3 * (m - 1)):
             for j in range(ds.shape[1]):
-                ds[r, j] = 0.0
-        for j in range(ds.shape[1]):
-            ds[_X, j] = dx[j]
+                ds[rr, j] = ds[rr + 3, j]
 
 
 @jit(inline="always")
-def _reset_live(s, ds, x, dx):
-    """:func:`_reset` writing only the rows of the one live piece (steps)."""
+def _chord_jvp(ds, k, lo, hi):
+    """Derivative rows of the chord replacing pieces k, k+1: the chord of
+    the derivatives at fixed breakpoints."""
+    r = _HEAD + 3 * k
+    for j in range(ds.shape[1]):
+        dl = ds[r + 1, j] + ds[r + 2, j] * lo
+        dh = ds[r + 4, j] + ds[r + 5, j] * hi
+        db = (dh - dl) / (hi - lo)
+        ds[r + 1, j] = dl - db * lo
+        ds[r + 2, j] = db
+
+
+@jit(inline="always")
+def _reset_live(s, x):
+    """Virgin state at x written into its live rows: one piece P = 0 on [0, 2]."""
     s[_X] = x
     s[_M] = 1.0
-    s[_HEAD] = U_MAX
-    s[_HEAD + 1] = 0.0
-    s[_HEAD + 2] = 0.0
-    if ds is not None:
-        for j in range(ds.shape[1]):
-            ds[_X, j] = dx[j]
-            ds[_M, j] = 0.0
-            ds[_HEAD, j] = 0.0
-            ds[_HEAD + 1, j] = 0.0
-            ds[_HEAD + 2, j] = 0.0
+    _write(s, 0, U_MAX, 0.0, 0.0)
 
 
 @jit(inline="always")
@@ -321,62 +280,116 @@ def _jvp_force(s, ds, m, fy, dT):
 
 @jit(inline="always")
 def _exact_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
-    # derivative arguments are all arrays or all None (pruned at compile time)
-    kt = params[_P_KT]
+    # Derivative arguments are all arrays or all None (pruned at compile
+    # time). One exit and no call that is not inlined: either keeps Numba's
+    # reference-count updates of the arrays inside the caller's loop.
     fy = params[_P_FY]
-    n_ref = params[_P_NREF]
-    cap = int(params[_P_CAP])
-    room = int(params[_P_ROOM])
-    alpha = N / n_ref
-    if alpha <= 0.0 or fy <= 0.0:
-        _reset_live(s_new, ds_new, x, dx)
-        if dT is not None:
-            dT[:] = 0.0
-        return 0.0, 0.0, (SEPARATION if alpha <= 0.0 else MACROSLIP)
-    qs = kt / fy
-    ia = 1.0 / n_ref
-    inc = qs * (x - s_old[_X])
-    m_old = int(s_old[_M])
+    alpha = N * params[_P_INV_NREF]
+    contact = alpha > 0.0 and fy > 0.0
+    inc = params[_P_QS] * (x - s_old[_X])
     m = 0
     total = 0.0  # integral of P over [0, 2]
     stuck = 0.0  # measure of the stuck slip strengths
+    pa = pb = np.nan  # coefficients of the last piece written
     lo = 0.0
-    for k in range(m_old):
+    # kind at each breakpoint from the trial force there (one evaluation per
+    # breakpoint, shared by the two pieces meeting there); the limit is 0 at u = 0
+    k_lo = _end_kind(s_old[_HEAD + 1] + inc, 0.0)
+    for k in range(int(s_old[_M]) if contact else 0):
         r = _HEAD + 3 * k
         hi = s_old[r]
         a = s_old[r + 1] + inc
         b = s_old[r + 2]
-        c1, c2 = _cuts(lo, hi, a, b, alpha)
-        if c1 > lo:
-            m, di, dst = _emit(s_new, ds_new, ds_old, dx, dN, qs, ia, m, room, lo, c1, a, b, alpha, r)
-            total += di
-            stuck += dst
-        if c2 > c1:
-            m, di, dst = _emit(s_new, ds_new, ds_old, dx, dN, qs, ia, m, room, c1, c2, a, b, alpha, r)
-            total += di
-            stuck += dst
-        if hi > c2:
-            m, di, dst = _emit(s_new, ds_new, ds_old, dx, dN, qs, ia, m, room, c2, hi, a, b, alpha, r)
-            total += di
-            stuck += dst
+        k_hi = _end_kind(a + b * hi, alpha * hi)
+        c1 = c2 = hi  # one kind over the whole piece (a + b u is straight)
+        if k_lo != k_hi:
+            c1, c2 = _split(lo, hi, a, b, alpha, k_lo, k_hi)
+        # segments [lo, c1] (kind k_lo), [c1, c2] (stuck), [c2, hi] (kind k_hi)
+        left = lo
+        for seg in range(3):
+            right, kind = _segment(seg, c1, c2, hi, k_lo, k_hi)
+            if right > left:
+                a2, b2, kind = _coeffs(kind, a, b, alpha)
+                # a clipped segment on the line of the last piece extends it
+                if kind == _STUCK or a2 != pa or b2 != pb:
+                    m += 1
+                _write(s_new, m - 1, right, a2, b2)
+                if ds_new is not None:
+                    _write_jvp(ds_new, ds_old, dx, dN, m - 1, r, kind, params[_P_QS], params[_P_INV_NREF])
+                total += _integral(left, right, a2, b2)
+                if kind == _STUCK:
+                    stuck += right - left
+                pa = a2
+                pb = b2
+                left = right
         lo = hi
-    while m > cap:
-        di, dst = _merge_least(s_new, ds_new, m, alpha)
-        m -= 1
-        total += di
-        stuck += dst
+        k_lo = k_hi
+    if m > int(params[_P_CAP]):
+        m, total, stuck = _enforce_capacity(s_new, ds_new, m, int(params[_P_CAP]), alpha, total, stuck)
+    if not contact:  # separation (or no friction): P = 0
+        _write(s_new, 0, U_MAX, 0.0, 0.0)
+        m = 1
     s_new[_X] = x
     s_new[_M] = m
     if ds_new is not None:
+        if not contact:
+            _write_jvp(ds_new, ds_old, dx, dN, 0, _HEAD, _ZERO, 0.0, 0.0)
+        _jvp_force(s_new, ds_new, m, fy, dT)
         for j in range(dx.shape[0]):
             ds_new[_X, j] = dx[j]
             ds_new[_M, j] = 0.0
-        _jvp_force(s_new, ds_new, m, fy, dT)
     code = STICK_SLIP if stuck > 0.0 else MACROSLIP
-    return 0.5 * fy * total, 0.5 * kt * stuck, code
+    if alpha <= 0.0:
+        code = SEPARATION
+    return 0.5 * fy * total, 0.5 * params[_P_KT] * stuck, code
 
 
-@jit
+@jit(inline="always")
+def _segment(seg, c1, c2, hi, k_lo, k_hi):
+    """Right end and kind of segment ``seg`` (0, 1, 2) of a split piece."""
+    if seg == 0:
+        return c1, k_lo
+    if seg == 1:
+        return c2, _STUCK
+    return hi, k_hi
+
+
+@jit(inline="always")
+def _enforce_capacity(s, ds, m, cap, alpha, total, stuck):
+    """Chord-merge least-cost pairs until at most ``cap`` pieces remain.
+
+    Returns the piece count and the integral of P and stuck measure
+    updated for the merges.
+    """
+    while m > cap:
+        k = _least_pair(s, m)
+        r = _HEAD + 3 * k
+        lo = 0.0 if k == 0 else s[r - 3]
+        mid = s[r]
+        hi = s[r + 3]
+        al, bl, ar, br = s[r + 1], s[r + 2], s[r + 4], s[r + 5]
+        a, b, d_int = _chord(lo, mid, hi, al, bl, ar, br)
+        total += d_int
+        stuck += _stuck_part(lo, hi, a, b, alpha) - _stuck_part(lo, mid, al, bl, alpha) - _stuck_part(mid, hi, ar, br, alpha)
+        if ds is not None:
+            _chord_jvp(ds, k, lo, hi)
+        _write(s, k, hi, a, b)
+        _shift_down(s, ds, k, m)
+        m -= 1
+    return m, total, stuck
+
+
+@jit(inline="always")
+def _stuck_part(lo, hi, a, b, alpha):
+    """Measure of [lo, hi] if a + b u is not a clip line, else 0."""
+    if a == 0.0 and (b == alpha or b == -alpha):
+        return 0.0
+    return hi - lo
+
+
+# inline="always": inlined into the caller's compiled loop (march,
+# integrators), where a call passing three arrays costs as much as the law
+@jit(inline="always")
 def exact_step(params, s_old, s_new, x, N):
     """Trial step of the exact Iwan law (see module docstring).
 
@@ -415,15 +428,20 @@ def exact_step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT):
 @jit
 def exact_init(params, x0, n0, s):
     """Virgin committed state at displacement ``x0`` (m): P = 0 for every
-    slip strength (one piece), x_prev = x0; ``n0`` does not enter."""
-    _reset(s, None, x0, None)
+    slip strength (one piece), x_prev = x0, every row written; ``n0`` does
+    not enter."""
+    s[:] = 0.0
+    _reset_live(s, x0)
 
 
 @jit
 def exact_init_jvp(params, x0, dx0, n0, dn0, s, ds):
     """:func:`exact_init` and its derivative: d(x_prev) = dx0, zero elsewhere
     (``ds`` is (state size, directions))."""
-    _reset(s, ds, x0, dx0)
+    exact_init(params, x0, n0, s)
+    ds[:, :] = 0.0
+    for j in range(ds.shape[1]):
+        ds[_X, j] = dx0[j]
 
 
 @dataclass(frozen=True)
@@ -466,12 +484,14 @@ class ExactIwan(ContactLaw):
 
     @property
     def params(self) -> np.ndarray:
-        return np.array([self.kt, self.fy, self.n_ref, float(self.capacity), float(self.room)])
+        qs = self.kt / self.fy if self.fy > 0.0 else 0.0
+        return np.array([self.kt, self.fy, self.n_ref, float(self.capacity), qs, 1.0 / self.n_ref])
 
     @property
     def room(self) -> int:
-        """Pieces a step may hold before its closing merges (2 capacity)."""
-        return 2 * self.capacity
+        """Pieces a step may hold before its closing merges: 3 capacity (each
+        piece splits into at most three)."""
+        return 3 * self.capacity
 
     @property
     def state_size(self) -> int:
