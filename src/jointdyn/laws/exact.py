@@ -218,16 +218,21 @@ def _least_pair(s, m):
 
 
 @jit(inline="always")
-def _chord(lo, mid, hi, al, bl, ar, br):
+def _chord(lo, mid, hi, al, bl, ar, br, alpha):
     """Chord through P at the outer ends of two adjacent pieces.
 
     Returns its coefficients ``(a, b)`` and the change of the integral of
-    P over [lo, hi] when the two pieces are replaced by it.
+    P over [lo, hi] when the two pieces are replaced by it. A chord within
+    ``SNAP alpha`` of a clip line on [0, hi] is put on it (the merge of a
+    clipped piece and a nearly clipped one: it slips, like its parts).
     """
     pl = al + bl * lo
     ph = ar + br * hi
     b = (ph - pl) / (hi - lo)
     a = pl - b * lo
+    if abs(a) + abs(abs(b) - alpha) * hi <= SNAP * alpha:
+        a = 0.0
+        b = alpha if b > 0.0 else -alpha
     d_int = _integral(lo, hi, a, b) - _integral(lo, mid, al, bl) - _integral(mid, hi, ar, br)
     return a, b, d_int
 
@@ -368,7 +373,7 @@ def _enforce_capacity(s, ds, m, cap, alpha, total, stuck):
         mid = s[r]
         hi = s[r + 3]
         al, bl, ar, br = s[r + 1], s[r + 2], s[r + 4], s[r + 5]
-        a, b, d_int = _chord(lo, mid, hi, al, bl, ar, br)
+        a, b, d_int = _chord(lo, mid, hi, al, bl, ar, br, alpha)
         total += d_int
         stuck += _stuck_part(lo, hi, a, b, alpha) - _stuck_part(lo, mid, al, bl, alpha) - _stuck_part(mid, hi, ar, br, alpha)
         if ds is not None:

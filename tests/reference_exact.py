@@ -1,0 +1,131 @@
+"""Plain-Python reference of the exact Iwan law (``iwan-exact``).
+
+Written from the algorithm of ``jointdyn.laws.exact`` (module docstring) and
+MODEL.md sections 2, 3 and 5, without its state vector, its kernels or
+numpy: the state is a Python list of pieces ``[lo, hi, a, b]`` (P(u) = a +
+b u on [lo, hi], u the slip strength in units of fy, P in units of fy), and
+each step is done the straightforward way:
+
+1. separation (N <= 0) or no friction: P = 0 (one piece), T = 0;
+2. every element gets dq = (kt / fy)(x - x_prev);
+3. each piece is cut where it crosses a clip line +-alpha u (a cut closer
+   than ``SNAP`` to an end of the piece is dropped) and each segment is
+   classified at its midpoint: above the upper line (P = alpha u), below the
+   lower line (P = -alpha u) or stuck (unchanged);
+4. adjacent pieces with identical coefficients are joined;
+5. while there are more than ``capacity`` pieces, the adjacent pair with the
+   least |b_left - b_right| (mid - lo)(hi - mid) (twice the area between
+   the pair and the chord through its outer ends; first on ties) is
+   replaced by that chord (put on a clip line when it lies within
+   SNAP * alpha of it over [0, hi]);
+6. T = fy / 2 * integral of P over [0, 2], kT = kt / 2 * (measure of the
+   pieces that are not on a clip line).
+
+The object commits on every :meth:`ExactIwanRef.step`; ``march_ref`` of
+``tests/reference.py`` marches it like the other references.
+"""
+
+from __future__ import annotations
+
+STICK_SLIP, MACROSLIP, SEPARATION = 0, 1, 2
+
+#: cuts closer than this to an end of a piece are dropped (units of u), the
+#: tolerance documented in laws/exact.py
+SNAP = 1e-9
+U_MAX = 2.0
+
+
+def _on_line(a, b, alpha):
+    return a == 0.0 and (b == alpha or b == -alpha)
+
+
+class ExactIwanRef:
+    """The exact Iwan law, one piece at a time (module docstring).
+
+    Parameters: kt (N/m), mu, n_ref (N), capacity (pieces), and the virgin
+    state's displacement x0 (m); the load ``n0`` does not enter the virgin
+    state.
+    """
+
+    def __init__(self, kt, mu, n_ref, capacity, x0=0.0, n0=None):
+        self.kt = float(kt)
+        self.fy = float(mu) * float(n_ref)
+        self.n_ref = float(n_ref)
+        self.capacity = int(capacity)
+        self.x_prev = float(x0)
+        self.pieces = [[0.0, U_MAX, 0.0, 0.0]]
+
+    # --- one step ---------------------------------------------------------
+    def step(self, x, N):
+        alpha = N / self.n_ref
+        if alpha <= 0.0 or self.fy <= 0.0:
+            self.pieces = [[0.0, U_MAX, 0.0, 0.0]]
+            self.x_prev = x
+            return 0.0, 0.0, (SEPARATION if alpha <= 0.0 else MACROSLIP)
+        dq = self.kt / self.fy * (x - self.x_prev)
+        self.x_prev = x
+        new = []
+        for lo, hi, a, b in self.pieces:
+            for seg in self._clip(lo, hi, a + dq, b, alpha):
+                if new and new[-1][2] == seg[2] and new[-1][3] == seg[3]:
+                    new[-1][1] = seg[1]
+                else:
+                    new.append(seg)
+        while len(new) > self.capacity:
+            self._merge_least(new, alpha)
+        self.pieces = new
+        return self._outputs(alpha)
+
+    @staticmethod
+    def _clip(lo, hi, a, b, alpha):
+        """Segments of a + b u on [lo, hi] after the clip to [-alpha u, alpha u]."""
+        cuts = [lo, hi]
+        for slope in (b - alpha, b + alpha):  # a + slope u = 0 on a clip line
+            if slope != 0.0:
+                c = -a / slope
+                if lo + SNAP < c < hi - SNAP:
+                    cuts.append(c)
+        cuts.sort()
+        out = []
+        for l, h in zip(cuts[:-1], cuts[1:]):
+            if h <= l:
+                continue
+            mid = 0.5 * (l + h)
+            v = a + b * mid
+            if v > alpha * mid:
+                out.append([l, h, 0.0, alpha])
+            elif v < -alpha * mid:
+                out.append([l, h, 0.0, -alpha])
+            else:
+                out.append([l, h, a, b])
+        return out
+
+    @staticmethod
+    def _merge_least(pieces, alpha):
+        """Replace the least-cost adjacent pair by its chord (in place)."""
+        best, cost = 0, None
+        for k in range(len(pieces) - 1):
+            lo, mid, _, bl = pieces[k]
+            _, hi, _, br = pieces[k + 1]
+            c = abs(bl - br) * (mid - lo) * (hi - mid)
+            if cost is None or c < cost:
+                best, cost = k, c
+        lo, _, al, bl = pieces[best]
+        _, hi, ar, br = pieces[best + 1]
+        p_lo = al + bl * lo
+        p_hi = ar + br * hi
+        b = (p_hi - p_lo) / (hi - lo)
+        a = p_lo - b * lo
+        if abs(a) + abs(abs(b) - alpha) * hi <= SNAP * alpha:  # on a clip line
+            a, b = 0.0, (alpha if b > 0.0 else -alpha)
+        pieces[best : best + 2] = [[lo, hi, a, b]]
+
+    def _outputs(self, alpha):
+        total = 0.0
+        stuck = 0.0
+        for lo, hi, a, b in self.pieces:
+            total += a * (hi - lo) + 0.5 * b * (hi * hi - lo * lo)
+            if not _on_line(a, b, alpha):
+                stuck += hi - lo
+        code = STICK_SLIP if stuck > 0.0 else MACROSLIP
+        return 0.5 * self.fy * total, 0.5 * self.kt * stuck, code
