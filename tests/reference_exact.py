@@ -13,11 +13,12 @@ each step is done the straightforward way:
    classified at its midpoint: above the upper line (P = alpha u), below the
    lower line (P = -alpha u) or stuck (unchanged);
 4. adjacent pieces with identical coefficients are joined;
-5. while there are more than ``capacity`` pieces, the adjacent pair with the
-   least |b_left - b_right| (mid - lo)(hi - mid) (twice the area between
-   the pair and the chord through its outer ends; first on ties) is
-   replaced by that chord (put on a clip line when it lies within
-   SNAP * alpha of it over [0, hi]);
+5. while there are more than ``capacity`` pieces, three adjacent pieces
+   j-1, j, j+1 (vertices (u0, p0) .. (u3, p3)) are replaced by two through
+   a new vertex at uw = (u1 + u2) / 2 whose value keeps the integral of P
+   over [u0, u3]; the j chosen is the first with the least
+   (|change of P at u1| + |change of P at u2|) (u3 - u0); a new piece
+   within SNAP * alpha of a clip line over [0, its upper end] is put on it;
 6. T = fy / 2 * integral of P over [0, 2], kT = kt / 2 * (measure of the
    pieces that are not on a clip line).
 
@@ -33,6 +34,16 @@ STICK_SLIP, MACROSLIP, SEPARATION = 0, 1, 2
 #: tolerance documented in laws/exact.py
 SNAP = 1e-9
 U_MAX = 2.0
+
+
+def _line(u0, p0, u1, p1, alpha):
+    """Piece [u0, u1] through (u0, p0), (u1, p1), put on a clip line when it
+    lies within SNAP * alpha of it over [0, u1]."""
+    b = (p1 - p0) / (u1 - u0)
+    a = p0 - b * u0
+    if abs(a) + abs(abs(b) - alpha) * u1 <= SNAP * alpha:
+        a, b = 0.0, (alpha if b > 0.0 else -alpha)
+    return [u0, u1, a, b]
 
 
 def _on_line(a, b, alpha):
@@ -57,7 +68,7 @@ class ExactIwanRef:
 
     # --- one step ---------------------------------------------------------
     def step(self, x, N):
-        alpha = N / self.n_ref
+        alpha = N * (1.0 / self.n_ref)  # the kernel's rounding of alpha
         if alpha <= 0.0 or self.fy <= 0.0:
             self.pieces = [[0.0, U_MAX, 0.0, 0.0]]
             self.x_prev = x
@@ -102,23 +113,36 @@ class ExactIwanRef:
 
     @staticmethod
     def _merge_least(pieces, alpha):
-        """Replace the least-cost adjacent pair by its chord (in place)."""
-        best, cost = 0, None
-        for k in range(len(pieces) - 1):
-            lo, mid, _, bl = pieces[k]
-            _, hi, _, br = pieces[k + 1]
-            c = abs(bl - br) * (mid - lo) * (hi - mid)
-            if cost is None or c < cost:
-                best, cost = k, c
-        lo, _, al, bl = pieces[best]
-        _, hi, ar, br = pieces[best + 1]
-        p_lo = al + bl * lo
-        p_hi = ar + br * hi
-        b = (p_hi - p_lo) / (hi - lo)
-        a = p_lo - b * lo
-        if abs(a) + abs(abs(b) - alpha) * hi <= SNAP * alpha:  # on a clip line
-            a, b = 0.0, (alpha if b > 0.0 else -alpha)
-        pieces[best : best + 2] = [[lo, hi, a, b]]
+        """Merge the least-cost three adjacent pieces into two (in place)."""
+
+        def value(piece, u):
+            return piece[2] + piece[3] * u
+
+        def integral(piece):
+            lo, hi, a, b = piece
+            return (hi - lo) * (a + 0.5 * b * (hi + lo))
+
+        best = None
+        for j in range(1, len(pieces) - 1):
+            left, mid, right = pieces[j - 1], pieces[j], pieces[j + 1]
+            u0, u1, u2, u3 = left[0], left[1], mid[1], right[1]
+            p0, p1, p2, p3 = value(left, u0), value(left, u1), value(mid, u2), value(right, u3)
+            area2 = 2.0 * (integral(left) + integral(mid) + integral(right))
+            uw = 0.5 * (u1 + u2)
+            # trapezoids u0 -> uw -> u3 with the same area, written with the
+            # kernel's operations (one reciprocal): the cost decides between
+            # near-equal candidates and the line snap is a threshold, so both
+            # implementations must round alike
+            d, wl, wr = u3 - u0, uw - u0, u3 - uw
+            inv = 1.0 / (d * wl * wr)
+            pw = (area2 - wl * p0 - wr * p3) * (wl * wr) * inv
+            new1 = p0 + (pw - p0) * (u1 - u0) * (d * wr) * inv
+            new2 = pw + (p3 - pw) * (u2 - uw) * (d * wl) * inv
+            cost = (abs(new1 - p1) + abs(new2 - p2)) * d
+            if best is None or cost < best[0]:
+                best = (cost, j, u0, uw, u3, p0, pw, p3)
+        _, j, u0, uw, u3, p0, pw, p3 = best
+        pieces[j - 1 : j + 2] = [_line(u0, p0, uw, pw, alpha), _line(uw, pw, u3, p3, alpha)]
 
     def _outputs(self, alpha):
         total = 0.0

@@ -2,7 +2,7 @@
 
 * the plain-Python reference ``tests/reference_exact.py`` (same algorithm,
   lists of pieces): same force, tangent and motion state to rounding, with
-  and without chord merges (small capacities);
+  and without merges (small capacities);
 * the full-memory closed form at constant normal load (both exact there):
   nested, growing, decaying and random histories, several load ratios;
 * the discrete model under varying load with separation: its error against
@@ -80,7 +80,7 @@ def test_kernel_matches_reference(capacity, x, N):
 def test_reference_cases_merge_and_separate():
     """Guard of the test above: its cases reach all three motion states, and
     the out-of-phase case needs more pieces than the small capacities (so
-    chord merges are compared too)."""
+    merges are compared too)."""
     seen = set()
     for p in _reference_cases():
         x, N = p.values
@@ -119,7 +119,7 @@ def _constant_load_histories():
 def test_equals_full_memory_closed_form_at_constant_load(alpha, x):
     law = ExactIwan(kt=KT, mu=MU, n_ref=NREF)
     N = np.full(x.size, alpha * NREF)
-    # no chord merge: the exact law is exact here
+    # no merge: the exact law is exact here
     assert _pieces(law, x, N).max() < law.capacity
     T, kT, code, _ = march(law, x, N)
     Tc, kTc, cc, _ = march(Iwan(kt=KT, mu=MU, n_ref=NREF, memory="full"), x, N)
@@ -187,7 +187,7 @@ def _jvp_case(seed, eta):
 def test_jvp_equals_finite_differences(seed, eta):
     law = ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=500)
     x, N, dx, dN = _jvp_case(seed, eta)
-    assert _pieces(law, x, N).max() < law.capacity  # no chord merge: exact derivatives
+    assert _pieces(law, x, N).max() < law.capacity  # no merge: exact derivatives
     s0 = np.empty(law.state_size)
     ds0 = np.empty((law.state_size, dx.shape[1]))
     law.init_jvp(law.params, x[0], dx[0], N[0], dN[0], s0, ds0)
@@ -211,14 +211,16 @@ def test_jvp_equals_finite_differences(seed, eta):
         np.testing.assert_allclose(dT[:, j], fd, rtol=0, atol=C.TEST_JVP_RTOL * scale)
 
 
-def test_jvp_after_chord_merges_is_close():
-    """Where chord merges happen the derivative is that of the merged state at
-    fixed breakpoints: not exact, but close (to the merge error's order)."""
-    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=6)
-    t = np.linspace(0.0, 2.0, 2 * 200 + 1)
-    x = 1.2 * XS * np.sin(2 * np.pi * t)
-    N = NREF * (1 + 0.8 * np.cos(2 * np.pi * t))
-    assert _pieces(law, x, N).max() == law.capacity
+def test_jvp_with_merges_is_close():
+    """Where merges happen the derivative is merged at fixed breakpoints: not
+    exact (the merged vertex moves with the breakpoints), but close: within
+    1 % of the largest derivative at the default capacity on a history that
+    needs about twice as many pieces (measured 0.03 % and 0.05 %)."""
+    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF)
+    t = np.linspace(0.0, 2.0, 2 * 1000 + 1)
+    x = 2.5 * XS * np.sin(2 * np.pi * t)
+    N = NREF * (1 + 0.9 * np.cos(2 * np.pi * t))
+    assert _pieces(ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=1000), x, N).max() > 1.5 * law.capacity
     dx = np.zeros((x.size, 2))
     dN = np.zeros_like(dx)
     dx[1:, 0] = XS * np.cos(2 * np.pi * t[1:])
@@ -228,7 +230,7 @@ def test_jvp_after_chord_merges_is_close():
     h = C.TEST_JVP_FD_STEP
     for j in range(2):
         fd = (march(law, x + h * dx[:, j], N + h * dN[:, j])[0] - march(law, x - h * dx[:, j], N - h * dN[:, j])[0]) / (2 * h)
-        assert np.max(np.abs(dT[:, j] - fd)) <= 0.05 * np.max(np.abs(fd))
+        assert np.max(np.abs(dT[:, j] - fd)) <= 0.01 * np.max(np.abs(fd))
 
 
 # --- describing-function energy ----------------------------------------------------------

@@ -28,12 +28,16 @@ closer than :data:`SNAP` (units of u) to the end of its piece is dropped
 O(SNAP^2) fy). The number of pieces is small for loads in phase with the
 motion, but grows by about one per step while the contact slips with alpha
 rising (the exact P is then a curve that the steps sample). Above the
-capacity K the two adjacent pieces whose replacement by the chord through
-their outer ends changes integral |P| du least are joined (chord merge): this
-is the only approximation. Clipping and shifting never enlarge a difference
+capacity K, three adjacent pieces are merged into two: their two inner
+breakpoints u1, u2 are replaced by one vertex at (u1 + u2) / 2 whose value
+keeps the integral of P over the three pieces, so a merge leaves T
+unchanged; the merge chosen is the one that moves P least at u1 and u2
+(sum of the two changes times the width of the three pieces). This is the
+only approximation. Clipping and shifting never enlarge a difference
 between two states (both are non-expansive, element by element), so the
-force error after a merge stays below fy / 2 times the area it removed, for
-the rest of the history.
+force error at any later time is at most fy / 2 times the sum of the
+integrals of |change of P| of the merges before it; in practice it is far
+smaller, because slip erases the merged parts (docs/exact-iwan.md).
 
 Kernel layouts
 --------------
@@ -48,9 +52,10 @@ committed piece before it merges down to K, hence room for 3 K.
 Derivatives (``step_jvp``): rows a_k, b_k carry da_k, db_k; the breakpoint
 rows carry zero. Breakpoints need none: P is continuous in u, so moving a
 breakpoint does not change the integral, and the element-wise derivative
-dP(u) (stuck: dP + dq; clipped: +-dalpha u) is linear on each piece. Where
-a chord merge joins two pieces, the derivative is the chord of the
-derivatives at fixed breakpoints (the only step at which it is not exact).
+dP(u) (stuck: dP + dq; clipped: +-dalpha u) is linear on each piece. At
+a merge the derivative is merged the same way at fixed breakpoints (through
+the derivatives at the outer ends, keeping the integral of the derivative,
+so dT is unchanged by it); it is exact except at the steps with merges.
 """
 
 from __future__ import annotations
@@ -193,48 +198,95 @@ def _write_jvp(ds, ds_old, dx, dN, k, r_old, kind, qs, ia):
 
 
 @jit(inline="always")
-def _pair_cost(lo, mid, hi, bl, br):
-    """Twice the area between two adjacent pieces (slopes bl, br, meeting at
-    mid) and the chord through their outer ends: |bl - br| (mid - lo)(hi - mid)
-    for a continuous P. The integral of |P - chord| du a merge adds is half
-    of it."""
-    return abs(bl - br) * (mid - lo) * (hi - mid)
+def _removal(u0, u1, u2, u3, p0, p1, p2, p3, area2):
+    """Vertex replacing the breakpoints u1, u2 of three adjacent pieces.
+
+    The pieces run through the vertices (u0, p0) .. (u3, p3) (u in fy,
+    P in fy), ``area2`` is twice their integral. The new vertex is at
+    uw = (u1 + u2) / 2, with the value pw that keeps the integral over
+    [u0, u3]; ``cost`` = (|change at u1| + |change at u2|)(u3 - u0).
+    One division.
+    """
+    uw = 0.5 * (u1 + u2)
+    d = u3 - u0
+    left = uw - u0
+    right = u3 - uw
+    inv = 1.0 / (d * left * right)
+    pw = (area2 - left * p0 - right * p3) * (left * right) * inv
+    n1 = p0 + (pw - p0) * (u1 - u0) * (d * right) * inv
+    n2 = pw + (p3 - pw) * (u2 - uw) * (d * left) * inv
+    return uw, pw, (abs(n1 - p1) + abs(n2 - p2)) * d
 
 
 @jit(inline="always")
-def _least_pair(s, m):
-    """Index k of the adjacent pair (k, k+1) of least merge cost (first on ties)."""
-    best = 0
+def _triple(s, j):
+    """Vertices and twice the integral of pieces j-1, j, j+1 (j >= 1)."""
+    r = _HEAD + 3 * (j - 1)
+    u0 = 0.0 if j == 1 else s[r - 3]
+    u1 = s[r]
+    u2 = s[r + 3]
+    u3 = s[r + 6]
+    a0, b0, a1, b1, a2, b2 = s[r + 1], s[r + 2], s[r + 4], s[r + 5], s[r + 7], s[r + 8]
+    area2 = 2.0 * (_integral(u0, u1, a0, b0) + _integral(u1, u2, a1, b1) + _integral(u2, u3, a2, b2))
+    return u0, u1, u2, u3, a0 + b0 * u0, a0 + b0 * u1, a1 + b1 * u2, a2 + b2 * u3, area2
+
+
+@jit(inline="always")
+def _least_triple(s, m):
+    """j of the three adjacent pieces j-1, j, j+1 whose merge into two
+    (:func:`_removal`) costs least (first on ties)."""
+    best = 1
     cbest = np.inf
-    lo = 0.0
-    for k in range(m - 1):
-        r = _HEAD + 3 * k
-        c = _pair_cost(lo, s[r], s[r + 3], s[r + 2], s[r + 5])
+    for j in range(1, m - 1):
+        u0, u1, u2, u3, p0, p1, p2, p3, area2 = _triple(s, j)
+        c = _removal(u0, u1, u2, u3, p0, p1, p2, p3, area2)[2]
         if c < cbest:
             cbest = c
-            best = k
-        lo = s[r]
+            best = j
     return best
 
 
 @jit(inline="always")
-def _chord(lo, mid, hi, al, bl, ar, br, alpha):
-    """Chord through P at the outer ends of two adjacent pieces.
+def _line(u0, p0, u1, p1, alpha):
+    """Coefficients of the line through (u0, p0), (u1, p1); a line within
+    ``SNAP alpha`` of a clip line on [0, u1] is put on it (a merged piece
+    that slips like its parts)."""
+    b = (p1 - p0) / (u1 - u0)
+    a = p0 - b * u0
+    if abs(a) + abs(abs(b) - alpha) * u1 <= SNAP * alpha:
+        return 0.0, (alpha if b > 0.0 else -alpha)
+    return a, b
 
-    Returns its coefficients ``(a, b)`` and the change of the integral of
-    P over [lo, hi] when the two pieces are replaced by it. A chord within
-    ``SNAP alpha`` of a clip line on [0, hi] is put on it (the merge of a
-    clipped piece and a nearly clipped one: it slips, like its parts).
-    """
-    pl = al + bl * lo
-    ph = ar + br * hi
-    b = (ph - pl) / (hi - lo)
-    a = pl - b * lo
-    if abs(a) + abs(abs(b) - alpha) * hi <= SNAP * alpha:
-        a = 0.0
-        b = alpha if b > 0.0 else -alpha
-    d_int = _integral(lo, hi, a, b) - _integral(lo, mid, al, bl) - _integral(mid, hi, ar, br)
-    return a, b, d_int
+
+@jit(inline="always")
+def _stuck_part(lo, hi, a, b, alpha):
+    """Measure of [lo, hi] if a + b u is not a clip line, else 0."""
+    if a == 0.0 and (b == alpha or b == -alpha):
+        return 0.0
+    return hi - lo
+
+
+@jit(inline="always")
+def _merge_jvp(ds, j, u0, u1, u2, u3, uw):
+    """Derivative rows of the two pieces replacing j-1, j, j+1: through the
+    derivatives at u0 and u3 and the vertex derivative that keeps the
+    integral of the derivative (fixed breakpoints)."""
+    r = _HEAD + 3 * (j - 1)
+    d = u3 - u0
+    left = uw - u0
+    right = u3 - uw
+    for k in range(ds.shape[1]):
+        da0, db0, da1, db1, da2, db2 = ds[r + 1, k], ds[r + 2, k], ds[r + 4, k], ds[r + 5, k], ds[r + 7, k], ds[r + 8, k]
+        area2 = 2.0 * (_integral(u0, u1, da0, db0) + _integral(u1, u2, da1, db1) + _integral(u2, u3, da2, db2))
+        dp0 = da0 + db0 * u0
+        dp3 = da2 + db2 * u3
+        dpw = (area2 - left * dp0 - right * dp3) / d
+        ds[r, k] = 0.0
+        ds[r + 2, k] = (dpw - dp0) / left
+        ds[r + 1, k] = dp0 - ds[r + 2, k] * u0
+        ds[r + 3, k] = 0.0
+        ds[r + 5, k] = (dp3 - dpw) / right
+        ds[r + 4, k] = dpw - ds[r + 5, k] * uw
 
 
 @jit(inline="always")
@@ -246,19 +298,6 @@ def _shift_down(s, ds, k, m):
         for rr in range(_HEAD + 3 * (k + 1), _HEAD + 3 * (m - 1)):
             for j in range(ds.shape[1]):
                 ds[rr, j] = ds[rr + 3, j]
-
-
-@jit(inline="always")
-def _chord_jvp(ds, k, lo, hi):
-    """Derivative rows of the chord replacing pieces k, k+1: the chord of
-    the derivatives at fixed breakpoints."""
-    r = _HEAD + 3 * k
-    for j in range(ds.shape[1]):
-        dl = ds[r + 1, j] + ds[r + 2, j] * lo
-        dh = ds[r + 4, j] + ds[r + 5, j] * hi
-        db = (dh - dl) / (hi - lo)
-        ds[r + 1, j] = dl - db * lo
-        ds[r + 2, j] = db
 
 
 @jit(inline="always")
@@ -361,35 +400,33 @@ def _segment(seg, c1, c2, hi, k_lo, k_hi):
 
 @jit(inline="always")
 def _enforce_capacity(s, ds, m, cap, alpha, total, stuck):
-    """Chord-merge least-cost pairs until at most ``cap`` pieces remain.
+    """Merge three adjacent pieces into two (:func:`_removal`, least cost
+    first) until at most ``cap`` pieces remain.
 
-    Returns the piece count and the integral of P and stuck measure
-    updated for the merges.
+    Returns the piece count and the integral of P (unchanged up to
+    rounding) and the stuck measure, updated for the merges.
     """
     while m > cap:
-        k = _least_pair(s, m)
-        r = _HEAD + 3 * k
-        lo = 0.0 if k == 0 else s[r - 3]
-        mid = s[r]
-        hi = s[r + 3]
-        al, bl, ar, br = s[r + 1], s[r + 2], s[r + 4], s[r + 5]
-        a, b, d_int = _chord(lo, mid, hi, al, bl, ar, br, alpha)
-        total += d_int
-        stuck += _stuck_part(lo, hi, a, b, alpha) - _stuck_part(lo, mid, al, bl, alpha) - _stuck_part(mid, hi, ar, br, alpha)
+        j = _least_triple(s, m)
+        u0, u1, u2, u3, p0, p1, p2, p3, area2 = _triple(s, j)
+        uw, pw, _ = _removal(u0, u1, u2, u3, p0, p1, p2, p3, area2)
+        r = _HEAD + 3 * (j - 1)
+        for q in range(3):
+            a, b = s[r + 3 * q + 1], s[r + 3 * q + 2]
+            lo = u0 if q == 0 else s[r + 3 * q - 3]
+            total -= _integral(lo, s[r + 3 * q], a, b)
+            stuck -= _stuck_part(lo, s[r + 3 * q], a, b, alpha)
+        a1, b1 = _line(u0, p0, uw, pw, alpha)
+        a2, b2 = _line(uw, pw, u3, p3, alpha)
+        total += _integral(u0, uw, a1, b1) + _integral(uw, u3, a2, b2)
+        stuck += _stuck_part(u0, uw, a1, b1, alpha) + _stuck_part(uw, u3, a2, b2, alpha)
         if ds is not None:
-            _chord_jvp(ds, k, lo, hi)
-        _write(s, k, hi, a, b)
-        _shift_down(s, ds, k, m)
+            _merge_jvp(ds, j, u0, u1, u2, u3, uw)
+        _write(s, j - 1, uw, a1, b1)
+        _write(s, j, u3, a2, b2)
+        _shift_down(s, ds, j, m)
         m -= 1
     return m, total, stuck
-
-
-@jit(inline="always")
-def _stuck_part(lo, hi, a, b, alpha):
-    """Measure of [lo, hi] if a + b u is not a clip line, else 0."""
-    if a == 0.0 and (b == alpha or b == -alpha):
-        return 0.0
-    return hi - lo
 
 
 # inline="always": inlined into the caller's compiled loop (march,
@@ -468,8 +505,8 @@ class ExactIwan(ContactLaw):
         Reference normal load N_ref, N.
     capacity : int
         Largest number of linear pieces kept after a step (>= 3); above it
-        pieces are chord-merged (the only approximation, see module
-        docstring and docs/exact-iwan.md for its error).
+        three adjacent pieces are merged into two (the only approximation,
+        see the module docstring and docs/exact-iwan.md for its error).
     """
 
     capacity: int = config.IWAN_EXACT_CAPACITY
