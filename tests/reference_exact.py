@@ -129,19 +129,18 @@ class ExactIwanRef:
             p0, p1, p2, p3 = value(left, u0), value(left, u1), value(mid, u2), value(right, u3)
             area2 = 2.0 * (integral(left) + integral(mid) + integral(right))
             uw = 0.5 * (u1 + u2)
-            # trapezoids u0 -> uw -> u3 with the same area, written with the
-            # kernel's operations (one reciprocal): the cost decides between
-            # near-equal candidates and the line snap is a threshold, so both
-            # implementations must round alike
+            # trapezoids u0 -> uw -> u3 with the same area; the cost is
+            # compared as a fraction num / den, written with the kernel's
+            # operations: it decides between near-equal candidates and the
+            # line snap is a threshold, so both implementations round alike
             d, wl, wr = u3 - u0, uw - u0, u3 - uw
-            inv = 1.0 / (d * wl * wr)
-            pw = (area2 - wl * p0 - wr * p3) * (wl * wr) * inv
-            new1 = p0 + (pw - p0) * (u1 - u0) * (d * wr) * inv
-            new2 = pw + (p3 - pw) * (u2 - uw) * (d * wl) * inv
-            cost = (abs(new1 - p1) + abs(new2 - p2)) * d
-            if best is None or cost < best[0]:
-                best = (cost, j, u0, uw, u3, p0, pw, p3)
-        _, j, u0, uw, u3, p0, pw, p3 = best
+            pwd = area2 - wl * p0 - wr * p3  # pw * d
+            e1 = (p0 - p1) * wl * d + (pwd - p0 * d) * (u1 - u0)  # (change at u1) wl d
+            e2 = (pwd - p2 * d) * wr + (p3 * d - pwd) * (u2 - uw)  # (change at u2) wr d
+            num, den = abs(e1) * wr + abs(e2) * wl, wl * wr
+            if best is None or num * best[1] < best[0] * den:
+                best = (num, den, j, u0, uw, u3, p0, pwd / d, p3)
+        _, _, j, u0, uw, u3, p0, pw, p3 = best
         pieces[j - 1 : j + 2] = [_line(u0, p0, uw, pw, alpha), _line(uw, pw, u3, p3, alpha)]
 
     def _outputs(self, alpha):

@@ -198,24 +198,30 @@ def _write_jvp(ds, ds_old, dx, dN, k, r_old, kind, qs, ia):
 
 
 @jit(inline="always")
-def _removal(u0, u1, u2, u3, p0, p1, p2, p3, area2):
-    """Vertex replacing the breakpoints u1, u2 of three adjacent pieces.
+def _removal_cost(u0, u1, u2, u3, p0, p1, p2, p3, area2):
+    """Cost of replacing the breakpoints u1, u2 of three adjacent pieces by
+    one vertex, as a fraction ``num / den`` (no division).
 
-    The pieces run through the vertices (u0, p0) .. (u3, p3) (u in fy,
-    P in fy), ``area2`` is twice their integral. The new vertex is at
-    uw = (u1 + u2) / 2, with the value pw that keeps the integral over
-    [u0, u3]; ``cost`` = (|change at u1| + |change at u2|)(u3 - u0).
-    One division.
+    The pieces run through the vertices (u0, p0) .. (u3, p3) (u in fy, P in
+    fy), ``area2`` is twice their integral. The new vertex is at
+    uw = (u1 + u2) / 2 with the value pw that keeps the integral over
+    [u0, u3]; the cost is (|change of P at u1| + |change at u2|)(u3 - u0).
     """
     uw = 0.5 * (u1 + u2)
     d = u3 - u0
     left = uw - u0
     right = u3 - uw
-    inv = 1.0 / (d * left * right)
-    pw = (area2 - left * p0 - right * p3) * (left * right) * inv
-    n1 = p0 + (pw - p0) * (u1 - u0) * (d * right) * inv
-    n2 = pw + (p3 - pw) * (u2 - uw) * (d * left) * inv
-    return uw, pw, (abs(n1 - p1) + abs(n2 - p2)) * d
+    pwd = area2 - left * p0 - right * p3  # pw (u3 - u0)
+    e1 = (p0 - p1) * left * d + (pwd - p0 * d) * (u1 - u0)  # (change at u1) (uw - u0) d
+    e2 = (pwd - p2 * d) * right + (p3 * d - pwd) * (u2 - uw)  # (change at u2) (u3 - uw) d
+    return abs(e1) * right + abs(e2) * left, left * right
+
+
+@jit(inline="always")
+def _vertex(u0, u1, u2, u3, p0, p3, area2):
+    """The vertex (uw, pw) of :func:`_removal_cost`."""
+    uw = 0.5 * (u1 + u2)
+    return uw, (area2 - (uw - u0) * p0 - (u3 - uw) * p3) / (u3 - u0)
 
 
 @jit(inline="always")
@@ -234,15 +240,32 @@ def _triple(s, j):
 @jit(inline="always")
 def _least_triple(s, m):
     """j of the three adjacent pieces j-1, j, j+1 whose merge into two
-    (:func:`_removal`) costs least (first on ties)."""
+    (:func:`_removal_cost`) costs least (first on ties); the window of
+    three pieces slides along, each integral computed once."""
     best = 1
-    cbest = np.inf
+    b_num = np.inf
+    b_den = 1.0
+    u0 = 0.0
+    u1 = s[_HEAD]
+    u2 = s[_HEAD + 3]
+    a0, b0, a1, b1 = s[_HEAD + 1], s[_HEAD + 2], s[_HEAD + 4], s[_HEAD + 5]
+    i0 = _integral(u0, u1, a0, b0)
+    i1 = _integral(u1, u2, a1, b1)
     for j in range(1, m - 1):
-        u0, u1, u2, u3, p0, p1, p2, p3, area2 = _triple(s, j)
-        c = _removal(u0, u1, u2, u3, p0, p1, p2, p3, area2)[2]
-        if c < cbest:
-            cbest = c
+        r = _HEAD + 3 * (j + 1)
+        u3 = s[r]
+        a2 = s[r + 1]
+        b2 = s[r + 2]
+        i2 = _integral(u2, u3, a2, b2)
+        num, den = _removal_cost(u0, u1, u2, u3, a0 + b0 * u0, a0 + b0 * u1, a1 + b1 * u2, a2 + b2 * u3,
+                                 2.0 * (i0 + i1 + i2))
+        if num * b_den < b_num * den:
             best = j
+            b_num = num
+            b_den = den
+        u0, u1, u2 = u1, u2, u3
+        a0, b0, a1, b1 = a1, b1, a2, b2
+        i0, i1 = i1, i2
     return best
 
 
@@ -350,7 +373,7 @@ def _exact_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
             c1, c2 = _split(lo, hi, a, b, alpha, k_lo, k_hi)
         # segments [lo, c1] (kind k_lo), [c1, c2] (stuck), [c2, hi] (kind k_hi)
         left = lo
-        for seg in range(3):
+        for seg in range(1 if k_lo == k_hi else 3):
             right, kind = _segment(seg, c1, c2, hi, k_lo, k_hi)
             if right > left:
                 a2, b2, kind = _coeffs(kind, a, b, alpha)
@@ -400,8 +423,8 @@ def _segment(seg, c1, c2, hi, k_lo, k_hi):
 
 @jit(inline="always")
 def _enforce_capacity(s, ds, m, cap, alpha, total, stuck):
-    """Merge three adjacent pieces into two (:func:`_removal`, least cost
-    first) until at most ``cap`` pieces remain.
+    """Merge three adjacent pieces into two (:func:`_removal_cost`, least
+    cost first) until at most ``cap`` pieces remain.
 
     Returns the piece count and the integral of P (unchanged up to
     rounding) and the stuck measure, updated for the merges.
@@ -409,7 +432,7 @@ def _enforce_capacity(s, ds, m, cap, alpha, total, stuck):
     while m > cap:
         j = _least_triple(s, m)
         u0, u1, u2, u3, p0, p1, p2, p3, area2 = _triple(s, j)
-        uw, pw, _ = _removal(u0, u1, u2, u3, p0, p1, p2, p3, area2)
+        uw, pw = _vertex(u0, u1, u2, u3, p0, p3, area2)
         r = _HEAD + 3 * (j - 1)
         for q in range(3):
             a, b = s[r + 3 * q + 1], s[r + 3 * q + 2]
