@@ -461,10 +461,10 @@ def exact_step(params, s_old, s_new, x, N):
     Parameters
     ----------
     params : float64[:]
-        ``[kt (N/m), fy (N), N_ref (N), K, room]``.
+        ``[kt (N/m), fy (N), N_ref (N), K, kt / fy (1/m), 1 / N_ref (1/N)]``.
     s_old, s_new : float64[:]
         Committed (not written) and trial state, ``[x_prev (m), m,
-        (hi_k, a_k, b_k) * room]``.
+        (hi_k, a_k, b_k) * 3 K]`` (module docstring).
     x : float
         Tangential displacement, m.
     N : float
