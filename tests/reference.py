@@ -268,16 +268,26 @@ class IwanPaperRef:
         return self.fy * G, self.kt * slope, code
 
 
-def reference_for(law, x0=0.0, n0=None):
-    """The reference object equivalent to a ``jointdyn`` law, at ``(x0, n0)``."""
-    name = type(law).__name__
-    if name == "Iwan":
-        if law.memory == "last":
-            return IwanPaperRef(law.kt, law.mu, law.n_ref, x0, n0)
-        return IwanRef(law.kt, law.mu, law.n_ref, x0, n0, max_depth=law.max_depth)
-    if name in ("DiscreteIwan", "Jenkins"):
-        return DiscreteIwanRef(law.kt, law.mu, law.n_ref, law.n, x0, n0)
-    raise TypeError(f"no reference for {name}")
+#: registered law name -> factory(law, x0, n0) of its plain-Python reference;
+#: every law in ``jointdyn.laws.law_names()`` needs an entry (the reference
+#: comparison fails for a law without one)
+REFERENCES = {
+    "iwan": lambda law, x0, n0: IwanRef(law.kt, law.mu, law.n_ref, x0, n0, max_depth=law.max_depth),
+    "iwan-paper": lambda law, x0, n0: IwanPaperRef(law.kt, law.mu, law.n_ref, x0, n0),
+    "discrete": lambda law, x0, n0: DiscreteIwanRef(law.kt, law.mu, law.n_ref, law.n, x0, n0),
+    "jenkins": lambda law, x0, n0: DiscreteIwanRef(law.kt, law.mu, law.n_ref, 1, x0, n0),
+}
+
+
+def reference_for(name, law, x0=0.0, n0=None):
+    """The reference object equivalent to the registered law ``name`` (instance
+    ``law``), in its virgin state at ``(x0, n0)``."""
+    if name not in REFERENCES:
+        raise LookupError(
+            f"no plain-Python reference for the registered law {name!r}: write one in tests/reference.py "
+            "(from the law's specification, not from its kernels) and add it to REFERENCES"
+        )
+    return REFERENCES[name](law, x0, n0)
 
 
 def march_ref(ref, x, N):

@@ -134,3 +134,20 @@ def test_scheduler_address(fake, capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["directions"]["up"]["status"] == ["periodic", "periodic"]
     assert len(fake.calls) == 2  # ran on the cluster's in-process workers
+
+
+def test_table_prints_distinct_gammas_distinctly(fake, capsys):
+    """Points 1e-4 apart near 1.79 used to print as '1.79' three times."""
+    rc = main(["frc", "--gamma", "1.79:1.7902:0.0001", "--sweep", "up", "--workers", "1"])
+    assert rc == 0
+    rows = capsys.readouterr().out.strip().splitlines()[1:]
+    assert [r.split()[0] for r in rows] == ["1.79", "1.7901", "1.7902"]
+
+
+def test_table_digits():
+    from jointdyn.commands.frc import _digits
+
+    assert _digits([0.6, 0.61, 1.8]) == 4
+    assert _digits([1.79, 1.7901]) == 5
+    assert _digits([1.0, 1.0 + 2**-52]) == 17
+    assert _digits([1.0, 1.0]) == 4  # equal values need no digits to differ

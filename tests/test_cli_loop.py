@@ -40,7 +40,8 @@ def run_cli(argv):
 
 
 def loop_json(capsys, *args):
-    rc = run_cli(["loop", "--json", "--steps-per-cycle", "400", *args])
+    grid = [] if "--input" in args else ["--steps-per-cycle", "400"]  # the grid is refused with --input
+    rc = run_cli(["loop", "--json", *grid, *args])
     out = capsys.readouterr().out
     assert rc == 0
     assert len(out.strip().splitlines()) == 1
@@ -64,7 +65,8 @@ def test_json_default_matches_closed_form(capsys):
 
 @pytest.mark.parametrize("model", ["iwan", "iwan-paper", "discrete", "jenkins"])
 def test_json_separation(capsys, model):
-    d = loop_json(capsys, "--model", model, "--eta", "1.2", "--delta", "90", "--n", "200")
+    n = ("--n", "200") if model == "discrete" else ()
+    d = loop_json(capsys, "--model", model, "--eta", "1.2", "--delta", "90", *n)
     expected = (math.pi - 2 * math.asin(1 / 1.2)) / (2 * math.pi)
     assert d["separation_fraction"] == pytest.approx(expected, abs=TEST_QS_FRACTION_ATOL)
     assert d["parameters"]["delta_deg"] == 90.0
@@ -89,7 +91,8 @@ def test_out_writes_csv_and_png(tmp_path, capsys):
     assert rc == 0 and "energy per cycle" in text
     assert sorted(p.name for p in out.iterdir()) == ["loop.csv", "loop.png"]
     df = pd.read_csv(out / "loop.csv")
-    assert list(df.columns) == ["t", "x", "N", "T", "state"]
+    assert list(df.columns) == ["t", "x", "N", "T", "state", "inserted"]
+    assert not df["inserted"].any()  # the harmonic grid already holds the crossing instants
     assert set(df["state"]) == {"stick-slip", "macroslip", "separation"}
     assert np.all(df.loc[df["state"] == "separation", "T"] == 0.0)
     assert np.all(df.loc[df["N"] <= 0, "state"] == "separation")
@@ -135,7 +138,7 @@ BAD = [
     (["--kn", "-1"], "--kn"),
     (["--model", "coulomb"], "--model"),
     (["--period", "1"], "--period"),
-    (["--input", "does-not-exist.csv"], "CSV"),
+    (["--input", "does-not-exist.csv"], "--input"),
 ]
 
 
@@ -155,13 +158,13 @@ def test_bad_input_exit_2_no_file(tmp_path, capsys, args, name):
 
 
 BAD_CSV = [
-    ("t,x,N\n0,0,100\n1,1e-5,100\n2,2e-5\n", "same length"),
-    ("t,x,N\n0,0,100\n1,1e-5,\n2,2e-5,\n", "same length"),
-    ("t,x,N\n0,0,100\n2,1e-5,100\n1,2e-5,100\n", "strictly increasing"),
-    ("t,x\n0,0\n1,1e-5\n", "missing N"),
-    ("time,x,N\n0,0,100\n1,1e-5,100\n", "missing t"),
-    ("t,x,N\n0,0,100\n1,nan,100\n", "finite"),
-    ("t,x,N\n0,0,100\n1,inf,100\n", "finite"),
+    ("t,x,N\n0,0,100\n1,1e-5,100\n2,2e-5\n", "line 4: expected 3 fields"),
+    ("t,x,N\n0,0,100\n1,1e-5,\n2,2e-5,\n", "line 3: N is empty"),
+    ("t,x,N\n0,0,100\n2,1e-5,100\n1,2e-5,100\n", "line 4: t must be strictly increasing"),
+    ("t,x\n0,0\n1,1e-5\n", "missing column N"),
+    ("T,x,N\n0,0,100\n1,1e-5,100\n", "missing column t"),
+    ("t,x,N\n0,0,100\n1,nan,100\n", "line 3: x = 'nan' is not finite"),
+    ("t,x,N\n0,0,100\n1,inf,100\n", "line 3: x = 'inf' is not finite"),
 ]
 
 
@@ -203,3 +206,61 @@ def test_subprocess_json():
     d = json.loads(r.stdout)
     assert KEYS <= set(d) and d["parameters"]["eta"] == 0.6
     assert d["separation_fraction"] == 0.0 and d["force_max_N"] == pytest.approx(1.6 * FY)
+
+
+# --- what --input changes in the history, said out loud ----------------------------
+def _sampled_history(path, rows=801, n_offset=100.0, n_amp=120.0):
+    """Two 1-s cycles sampled off the crossing instants (they get inserted)."""
+    t = np.linspace(0.0, 2.0, rows)
+    x = A * np.sin(2 * np.pi * t)
+    N = n_offset + n_amp * np.sin(2 * np.pi * t + 1.0)
+    pd.DataFrame({"t": t, "x": x, "N": N}).to_csv(path, index=False, float_format="%.17g")
+    return t, x, N
+
+
+def test_input_inserted_rows_are_marked(tmp_path, capsys):
+    p = tmp_path / "h.csv"
+    t, x, N = _sampled_history(p)
+    out = tmp_path / "o"
+    d = loop_json(capsys, "--input", str(p), "--period", "1", "--out", str(out))
+    df = pd.read_csv(out / "loop.csv")
+    assert df["inserted"].dtype == bool
+    assert d["n_inserted"] == int(df["inserted"].sum()) == len(df) - len(t) == 4
+    # the rows not inserted are exactly the input, in order
+    kept = df.loc[~df["inserted"]]
+    np.testing.assert_array_equal(kept["t"].to_numpy(), t)
+    np.testing.assert_array_equal(kept["x"].to_numpy(), x)
+    np.testing.assert_array_equal(kept["N"].to_numpy(), N)
+    assert np.all(df.loc[df["inserted"], "N"] == 0.0)
+    assert d["remainder_s"] == 0.0 and d["warnings"] == []
+    rc = run_cli(["loop", "--input", str(p), "--period", "1"])
+    text = capsys.readouterr().out
+    assert rc == 0 and "801 from --input + 4 inserted" in text
+
+
+def test_input_period_remainder_is_reported(tmp_path, capsys):
+    p = tmp_path / "h.csv"
+    _sampled_history(p)
+    d = loop_json(capsys, "--input", str(p), "--period", "0.75")
+    assert d["n_cycles"] == 2 and d["t_end_s"] == pytest.approx(1.5)
+    assert d["remainder_s"] == pytest.approx(0.5)
+    rc = run_cli(["loop", "--input", str(p), "--period", "0.75"])
+    text = capsys.readouterr().out
+    assert rc == 0 and "not analysed       the last 0.5 s (after t = 1.5 s)" in text
+
+
+def test_contact_never_closes_is_a_warning(tmp_path, capsys):
+    p = tmp_path / "h.csv"
+    _sampled_history(p, n_offset=-5.0, n_amp=1.0)
+    rc = run_cli(["loop", "--input", str(p), "--json"])
+    cap = capsys.readouterr()
+    d = json.loads(cap.out)
+    assert rc == 0
+    assert d["energy_per_cycle_J"] == 0.0 and d["secant_stiffness_N_per_m"] == 0.0  # the result stays
+    assert len(d["warnings"]) == 1 and "never closes" in d["warnings"][0]
+    assert cap.err.strip().splitlines() == [f"jointdyn loop: warning: {d['warnings'][0]}"]
+
+
+def test_harmonic_report_fields(capsys):
+    d = loop_json(capsys, "--eta", "1.2")
+    assert d["n_inserted"] == 0 and d["remainder_s"] == 0.0 and d["warnings"] == []

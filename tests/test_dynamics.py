@@ -181,7 +181,7 @@ def test_step_halving_changes_amplitude_little(eta, gamma):
 
 @pytest.mark.parametrize("model,eta", [("iwan", 0.5), ("iwan", 1.5), ("discrete", 1.5), ("iwan-paper", 0.8)])
 def test_integrator_law_agrees_with_march(model, eta):
-    s = System.paper_damper(eta=eta, beta=1.5, model=model, n=40)
+    s = System.paper_damper(eta=eta, beta=1.5, model=model, n=40 if model == "discrete" else None)
     tr = integrate(s, 1.05, periods=6)
     assert isinstance(tr, Trajectory) and tr.status == "ok"
     law = s.contacts[0].law

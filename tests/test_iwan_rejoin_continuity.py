@@ -21,8 +21,12 @@ KT, MU, N0 = 1e5, 0.1, 100.0
 FY = MU * N0
 
 
+def _law(model):
+    return make_law(model, kt=KT, mu=MU, n_ref=N0, **({"n": 1000} if model == "discrete" else {}))
+
+
 def _run(model, A=0.1e-3, eta=0.3, delta=0.0):
-    law = make_law(model, kt=KT, mu=MU, n_ref=N0, n=1000)
+    law = _law(model)
     return harmonic_loop(law, A, eta=eta, delta=delta, cycles=3, steps_per_cycle=2000)
 
 
@@ -57,7 +61,7 @@ def test_full_memory_rejoin_is_continuous_for_growing_amplitude():
     x = 0.1e-3 * (1 + 0.05 * t) * np.sin(2 * np.pi * t)
     N = N0 * (1 + 0.3 * np.sin(2 * np.pi * t))
     for model in ("discrete", "iwan-paper", "iwan"):
-        r = quasistatic(make_law(model, kt=KT, mu=MU, n_ref=N0, n=1000), t, x, N)
+        r = quasistatic(_law(model), t, x, N)
         assert _max_excess_jump(r) < 1e-3 * FY, model
 
 

@@ -6,7 +6,10 @@ history and/or the normal-load history, propagated through the state by
 (to ``TEST_JVP_RTOL`` of the largest derivative) for histories with
 reversals, macroslip, varying load and separation, as long as no sample sits
 at a state transition (the perturbed marches must pass through the same
-motion states, which the test checks). The primal outputs of ``step_jvp``
+motion states, which the test checks). The laws are built with few elements
+(``law_cases.variants(small=True)``): with many, one of them changes between
+stick and slip within the difference step at a large share of the samples,
+and its memory keeps the two perturbed marches on different sides. The primal outputs of ``step_jvp``
 must be ``step``'s bit for bit.
 """
 
@@ -15,7 +18,10 @@ import pytest
 
 import law_histories as H
 
-from jointdyn import DiscreteIwan, Iwan, Jenkins, march
+from law_cases import registry_laws
+
+from jointdyn import Iwan, march
+from jointdyn.laws import law_names, make_law
 import tolerances as C
 from jointdyn._jit import specialize
 
@@ -47,12 +53,9 @@ def march_jvp(law, x, dx, N, dN, state):
     return T, kT, code, dT
 
 
-LAWS = {
-    "iwan-full": Iwan(kt=KT, mu=MU, n_ref=NREF),
-    "iwan-last": Iwan(kt=KT, mu=MU, n_ref=NREF, memory="last"),
-    "discrete-7": DiscreteIwan(kt=KT, mu=MU, n_ref=NREF, n=7),
-    "jenkins": Jenkins(kt=KT, mu=MU, n_ref=NREF),
-}
+#: every registered law with every parameter set of law_cases.variants (few elements)
+LAWS = {case: law for case, _, law in registry_laws(KT, MU, NREF, small=True)}
+FULL = Iwan(kt=KT, mu=MU, n_ref=NREF)
 
 
 def _case(seed, eta):
@@ -101,14 +104,14 @@ def test_jvp_cases_cover_every_state():
     seen = set()
     for seed, eta in [(1, 0.0), (4, 1.3)]:
         x, N, dx, dN = _case(seed, eta)
-        seen.update(np.unique(march(LAWS["iwan-full"], x, N)[2]).tolist())
+        seen.update(np.unique(march(FULL, x, N)[2]).tolist())
     assert seen == {0, 1, 2}
 
 
 def test_jvp_of_constant_load_branch_closed_form():
     """d T / d x along a Masing branch: kT of the branch, by hand: after a
     reversal at q0 the slope is kt (1 - (q0 - q)/(4 alpha)) (c = 2)."""
-    law = LAWS["iwan-full"]
+    law = FULL
     x = np.concatenate([np.linspace(0, 0.8 * XS, 20), np.linspace(0.8 * XS, 0.0, 21)[1:]])
     N = np.full(x.size, NREF)
     dx = np.zeros((x.size, 1))
@@ -118,3 +121,26 @@ def test_jvp_of_constant_load_branch_closed_form():
     q0, q = 1.6, 0.0
     assert dT[-1, 0] == pytest.approx(KT * (1 - (q0 - q) / 4.0), rel=1e-12)
     assert kT[-1] == pytest.approx(KT * (1 - (q0 - q) / 4.0), rel=1e-12)
+
+
+@pytest.mark.parametrize("name", law_names())
+def test_init_jvp_is_the_exact_derivative_of_the_virgin_state(name):
+    """init_jvp writes init's state and its derivative along dx0, dn0: equal
+    to central differences of initial_state (the virgin state is smooth on
+    each side of n0 = 0), on both sides of separation, for several
+    directions at once."""
+    rng = np.random.default_rng(11)
+    law = make_law(name, kt=KT, mu=MU, n_ref=NREF)
+    for x0, n0 in ((0.0, NREF), (3.1 * XS, 0.4 * NREF), (-1.7 * XS, -0.5 * NREF)):
+        dx0 = rng.normal(size=3) * XS
+        dn0 = rng.normal(size=3) * NREF
+        s = np.full(law.state_size, np.nan)
+        ds = np.full((law.state_size, 3), np.nan)
+        law.init_jvp(law.params, x0, dx0, n0, dn0, s, ds)
+        np.testing.assert_array_equal(s, law.initial_state(x0, n0))
+        h = C.TEST_JVP_FD_STEP
+        for j in range(3):
+            fd = (law.initial_state(x0 + h * dx0[j], n0 + h * dn0[j])
+                  - law.initial_state(x0 - h * dx0[j], n0 - h * dn0[j])) / (2 * h)
+            scale = max(np.max(np.abs(fd)), np.max(np.abs(ds[:, j])), 1e-300)
+            np.testing.assert_allclose(ds[:, j], fd, rtol=0, atol=C.TEST_JVP_RTOL * scale)

@@ -34,7 +34,7 @@ def sep_fraction(eta):
 
 
 def law(name="iwan"):
-    return make_law(name, kt=KT, mu=MU, n_ref=N0, n=1000)
+    return make_law(name, kt=KT, mu=MU, n_ref=N0, **({"n": 1000} if name == "discrete" else {}))
 
 
 # --- histories ---------------------------------------------------------------
@@ -301,14 +301,14 @@ def test_read_history_csv_roundtrip(tmp_path):
 @pytest.mark.parametrize(
     "text, name",
     [
-        ("t,x\n0,0\n1,1e-5\n", "N"),
-        ("t,x,N\n0,0,1\n1,1e-5,1\n2,,\n", "same length"),
-        ("t,x,N\n0,0,1\n1,,1\n2,0,1\n", "empty cell"),
-        ("t,x,N\n0,0,1\n0,1e-5,1\n", "t must be strictly increasing"),
-        ("t,x,N\n0,0,1\n1,nan,1\n", "x must be finite"),
-        ("t,x,N\n0,0,1\n1,abc,1\n", "numeric"),
+        ("t,x\n0,0\n1,1e-5\n", "missing column N"),
+        ("t,x,N\n0,0,1\n1,1e-5,1\n2,,\n", "line 4: x is empty"),
+        ("t,x,N\n0,0,1\n1,,1\n2,0,1\n", "line 3: x is empty"),
+        ("t,x,N\n0,0,1\n0,1e-5,1\n", "line 3: t must be strictly increasing"),
+        ("t,x,N\n0,0,1\n1,nan,1\n", "line 3: x = 'nan' is not finite"),
+        ("t,x,N\n0,0,1\n1,abc,1\n", "line 3: x = 'abc' is not a number"),
         ("t,x,N\n0,0,1\n", "at least 2"),
-        ("", "CSV"),
+        ("", "no data"),
     ],
 )
 def test_read_history_csv_validates(tmp_path, text, name):
@@ -319,7 +319,7 @@ def test_read_history_csv_validates(tmp_path, text, name):
 
 
 def test_read_history_csv_missing_file(tmp_path):
-    with pytest.raises(ValueError, match="existing CSV"):
+    with pytest.raises(ValueError, match="path must be an existing file"):
         read_history_csv(tmp_path / "nope.csv")
 
 

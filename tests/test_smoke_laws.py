@@ -30,10 +30,11 @@ def test_init_kernel_writes_the_whole_virgin_state():
     full (a buffer full of NaN comes back finite), is what initial_state
     returns, and the law is at rest there (T = 0 at x0, stick-slip for
     n0 > 0, separation for n0 <= 0)."""
-    from jointdyn.laws import SEPARATION, STICK_SLIP, law_names, make_law
+    from law_cases import registry_laws
 
-    for name in law_names():
-        law = make_law(name, kt=2e5, mu=0.4, n_ref=120.0, n=50)
+    from jointdyn.laws import SEPARATION, STICK_SLIP
+
+    for name, _, law in registry_laws(kt=2e5, mu=0.4, n_ref=120.0):
         for x0, n0 in ((0.0, 120.0), (3.7e-4, 60.0), (-2e-3, 0.0)):
             s = np.full(law.state_size, np.nan)
             law.init(law.params, x0, n0, s)

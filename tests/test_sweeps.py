@@ -281,7 +281,7 @@ def test_line_keys_distinct_and_stable():
     base = dict(eta=0.5, beta=2.0, f1=None, delta_deg=0.0, direction="up", gammas=(0.9, 1.0))
     variants = [
         {}, {"eta": 0.5000001}, {"beta": None, "f1": 2.0}, {"delta_deg": 90.0}, {"direction": "down"},
-        {"gammas": (0.9, 1.0, 1.1)}, {"model": "discrete"}, {"n": 200}, {"zeta": 0.01},
+        {"gammas": (0.9, 1.0, 1.1)}, {"model": "discrete"}, {"law_params": (("n", 200),)}, {"zeta": 0.01},
         {"overrides": (("m", 11.0),)}, {"steps_per_period": 512},
     ]
     keys = [LineSpec(**{**base, **v}).key for v in variants]

@@ -7,14 +7,14 @@ for a microslip-only amplitude of 0.1 mm), computed here:
 
     PYTHONPATH=src python docs/scripts/closed_vs_discrete.py
 
-Cases (paper section 2.2, MODEL.md section 6): kt = 100 kN/m, mu = 0.1,
+Cases (paper section 2.2, docs/model.md section 6): kt = 100 kN/m, mu = 0.1,
 N0 = N_ref = 100 N (fy = 10 N), x = 0.5 mm sin(2 pi t),
 N = N0 (1 + eta sin(2 pi t + delta)), delta in {0, 90} deg,
 eta in {0, 0.3, 0.6, 0.9, 1.2}; 2 cycles from the virgin state, 2000 steps per
 cycle (plus the exact separation / re-contact instants), metrics of the
 last cycle. Models: ``iwan`` (closed form, Masing's extended memory),
 ``iwan-paper`` (closed form, the paper's last-reversal rule), ``discrete``
-(n = 1000 Jenkins elements, MODEL.md section 5) and, to show that the ground
+(n = 1000 Jenkins elements, docs/model.md section 5) and, to show that the ground
 truth is converged in n, ``discrete`` with n = 4000.
 """
 

@@ -1,6 +1,6 @@
 """Convergence study of the time integrator (docs/time-integration.md).
 
-Steady-state half peak-to-peak amplitude of the paper damper (MODEL.md
+Steady-state half peak-to-peak amplitude of the paper damper (docs/model.md
 section 6, closed-form Iwan law, beta = 2) against the number of RK4 steps
 per forcing period, for a case that stays in contact (eta = 0.5) and one
 that separates twice per period (eta = 1.5), with the event handling of

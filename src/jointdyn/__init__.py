@@ -3,7 +3,7 @@
 Public API (everything else is private):
 
 - contact laws: :class:`Iwan`, :class:`DiscreteIwan`, :class:`Jenkins`,
-  :func:`make_law`, normal loads;
+  :func:`make_law` (:func:`law_names`, :func:`law_parameters`), normal loads;
 - drivers: :func:`march`, :func:`quasistatic`, :func:`harmonic_loop`;
 - systems: :class:`System`, :class:`Contact`;
 - time integration: :func:`integrate`, :func:`steady_state`;
@@ -28,6 +28,7 @@ from .laws import (
     UnilateralSpring,
     backbone,
     law_names,
+    law_parameters,
     make_law,
 )
 from .drivers import LoopResult, harmonic_history, harmonic_loop, march, quasistatic, read_history_csv
@@ -77,6 +78,7 @@ __all__ = [
     "backbone",
     "make_law",
     "law_names",
+    "law_parameters",
     "HarmonicLoad",
     "SampledLoad",
     "UnilateralSpring",

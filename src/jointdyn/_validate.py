@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import math
+import os
+import tempfile
+from pathlib import Path
 
 import numpy as np
 
@@ -16,6 +19,10 @@ __all__ = [
     "same_length",
     "choice",
     "in_range",
+    "derived",
+    "count_at_most",
+    "output_dir",
+    "input_file",
 ]
 
 
@@ -114,3 +121,96 @@ def choice(name: str, value, allowed) -> str:
     if value not in allowed:
         raise ValueError(f"{name} must be one of {', '.join(map(str, allowed))}; got {value!r}")
     return value
+
+
+def derived(label: str, value: float, *, positive: bool = False) -> float:
+    """A quantity computed from several inputs: finite (and > 0 if asked).
+
+    ``label`` names the quantity and the inputs it comes from, e.g.
+    ``"fy = --mu x --n-ref"``, so that an overflow or underflow points at
+    the parameters to change.
+    """
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"{label} must be finite (overflow), got {v!r}")
+    if positive and not v > 0.0:
+        raise ValueError(f"{label} must be > 0 (underflow), got {v!r}")
+    return v
+
+
+def count_at_most(label: str, count: float, limit: int, unit: str) -> int:
+    """A size computed from several inputs, bounded before anything is allocated.
+
+    ``count`` may be a float (inf, NaN or huge when the inputs are extreme);
+    it is compared as a float and converted to int only when in range.
+    """
+    c = float(count)
+    if not c <= limit:  # also catches NaN and inf
+        raise ValueError(f"{label} must be at most {limit} {unit}, got {c:.4g}")
+    return int(c)
+
+
+def _probe_writable(directory: str) -> bool:
+    """True when a file can really be created in ``directory`` (the
+    permission bits do not stop root, a read-only mount or /proc does)."""
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".jointdyn-probe-", dir=directory)
+    except OSError:
+        return False
+    os.close(fd)
+    os.unlink(probe)
+    return True
+
+
+def _path(name: str, path) -> Path:
+    if not isinstance(path, (str, os.PathLike)) or not str(path):
+        raise ValueError(f"{name} must be a file-system path (str or os.PathLike), got {path!r:.80}")
+    return Path(path)
+
+
+def output_dir(name: str, path, files=(), subdirs=()) -> Path:
+    """A directory that exists and is writable, or can be created.
+
+    Checked before any computing, so that no work is lost to an output that
+    cannot be written: ``path`` is a directory or does not exist yet; its
+    nearest existing ancestor is a directory in which files can be created
+    (permissions and a probe file, removed at once); the ``files`` to be
+    written into it are not existing directories; the ``subdirs`` are not
+    existing files. Nothing is created.
+    """
+    p = _path(name, path)
+    s = str(p)
+    if os.path.lexists(s) and not os.path.isdir(s):
+        raise ValueError(f"{name} must be a directory, got existing file {s!r}")
+    anc = os.path.abspath(s)
+    while not os.path.lexists(anc):
+        anc = os.path.dirname(anc)
+    if not os.path.isdir(anc):
+        raise ValueError(f"{name} {s!r} cannot be created: {anc!r} is a file, not a directory")
+    if not (os.access(anc, os.W_OK | os.X_OK) and _probe_writable(anc)):
+        raise ValueError(f"{name} {s!r} is not writable: files cannot be created in {anc!r}")
+    for f in files:
+        if os.path.isdir(os.path.join(s, f)):
+            raise ValueError(f"{name} {s!r} holds a directory named {f!r} where a file is to be written")
+    for d in subdirs:
+        q = os.path.join(s, d)
+        if os.path.lexists(q) and not os.path.isdir(q):
+            raise ValueError(f"{name} {s!r} holds a file named {d!r} where a directory is to be created")
+        if os.path.isdir(q) and not (os.access(q, os.W_OK | os.X_OK) and _probe_writable(q)):
+            raise ValueError(f"{name} {s!r} is not writable: files cannot be created in {q!r}")
+    return p
+
+
+def input_file(name: str, path) -> Path:
+    """An existing regular file that can be opened and read."""
+    p = _path(name, path)
+    s = str(p)
+    if not os.path.isfile(s):
+        what = "a directory" if os.path.isdir(s) else "not a regular file" if os.path.lexists(s) else "no such file"
+        raise ValueError(f"{name} must be an existing file, got {s!r} ({what})")
+    try:
+        with open(s, "rb") as fh:
+            fh.read(1)
+    except OSError as exc:
+        raise ValueError(f"{name} {s!r} cannot be read: {exc.strerror or exc}") from None
+    return p

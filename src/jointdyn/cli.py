@@ -2,24 +2,43 @@
 
 The CLI only dispatches. Every module in :mod:`jointdyn.commands` that
 defines ``NAME``, ``HELP``, ``add_arguments(parser)`` and ``run(args)`` is a
-subcommand. Bad input (``ValueError``) prints one line on stderr and exits
-with status 2; commands write their files only after all computing is done,
-and atomically.
+subcommand. Commands validate everything (options, input files, the
+writability of ``--out``, sizes and derived quantities) before computing,
+and write their files only after all computing is done, each atomically.
+
+Exit status
+-----------
+- 0: success.
+- 2: bad input (a ``ValueError`` from validation, or an argparse usage
+  error): one line on stderr naming the parameter, no file written.
+- 1: an operating-system error during the run, after validation (e.g. a
+  full disk while writing the results): one line on stderr.
+- 130: interrupted (Ctrl-C).
+- 141 (128 + SIGPIPE): the reader of stdout went away (``jointdyn ... |
+  head``); the command stops quietly, as Unix tools do, and the shell's
+  ``pipefail`` sees the same status as for a tool killed by SIGPIPE.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import pkgutil
 import sys
 
 __all__ = ["main"]
 
+#: exit status when stdout's reader went away (128 + SIGPIPE)
+EXIT_BROKEN_PIPE = 141
+EXIT_BAD_INPUT = 2
+EXIT_OS_ERROR = 1
+EXIT_INTERRUPTED = 130
+
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line, exit 2 (argparse prints usage too)
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
 
 
 def _commands():
@@ -36,7 +55,10 @@ def _commands():
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from . import __version__
+
     parser = _Parser(prog="jointdyn", description="Dynamics of frictional joints with varying normal load.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for name, mod in _commands().items():
         p = sub.add_parser(name, help=getattr(mod, "HELP", None), description=getattr(mod, "HELP", None))
@@ -45,19 +67,55 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv=None) -> int:
+def _quiet_stdout() -> None:
+    """Point stdout at /dev/null so that the interpreter's final flush does
+    not raise BrokenPipeError again (Python's documented SIGPIPE recipe)."""
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):  # no real file (e.g. captured by a test)
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, fd)
+    os.close(devnull)
+
+
+def _dispatch(argv) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit:
+        sys.stdout.flush()  # --help, --version: a closed pipe shows here, not at exit
+        raise
+    prog = f"jointdyn {args.command}"
     try:
         rc = args._run(args)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        raise
     except ValueError as exc:
         msg = " ".join(str(exc).split())
-        print(f"jointdyn {args.command}: error: {msg}", file=sys.stderr)
-        return 2
+        print(f"{prog}: error: {msg}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except OSError as exc:  # after validation: the environment failed during the run
+        where = f": {exc.filename!r}" if getattr(exc, "filename", None) else ""
+        msg = " ".join(str(exc.strerror or exc).split())
+        print(f"{prog}: error: {msg}{where}", file=sys.stderr)
+        return EXIT_OS_ERROR
     except KeyboardInterrupt:
-        print(f"jointdyn {args.command}: interrupted (finished results are kept)", file=sys.stderr)
-        return 130
+        print(f"{prog}: interrupted (finished results are kept)", file=sys.stderr)
+        return EXIT_INTERRUPTED
     return int(rc or 0)
+
+
+def main(argv=None) -> int:
+    """Run ``jointdyn`` with ``argv`` (default: ``sys.argv[1:]``); returns
+    the exit status (see the module docstring). Usage errors, ``--help``
+    and ``--version`` raise ``SystemExit`` as argparse does."""
+    try:
+        return _dispatch(argv)
+    except BrokenPipeError:
+        _quiet_stdout()
+        return EXIT_BROKEN_PIPE
 
 
 if __name__ == "__main__":  # pragma: no cover

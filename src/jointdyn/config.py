@@ -27,6 +27,12 @@ IWAN_EXACT_CAPACITY = 32
 QS_STEPS_PER_CYCLE = 2000
 #: cycles of the harmonic history
 QS_CYCLES = 2
+#: most samples of a harmonic history (cycles x steps per cycle); bounds the
+#: memory of one loop (about 100 bytes per sample with its CSV output)
+QS_MAX_SAMPLES = 10_000_000
+#: a cycle of a sampled history spans at least this many sample intervals on
+#: average (fewer is not a sampled loop); bounds the cycles of --period
+QS_MIN_INTERVALS_PER_CYCLE = 2
 #: a time within this fraction of a step (harmonic grid) or of the history
 #: duration (cycle windows) is the same instant: crossing instants and cycle
 #: boundaries snap onto existing samples instead of creating tiny steps
@@ -119,6 +125,10 @@ SS_UNBOUNDED_Q = 20.0
 # --- sweeps --------------------------------------------------------------------------
 #: gamma grid START:STOP:STEP (the paper's Fig 6 range)
 SWEEP_GAMMA_DEFAULT = (0.6, 1.8, 0.01)
+#: most points of a gamma grid given as START:STOP:STEP
+SWEEP_MAX_GAMMA_POINTS = 100_000
+#: seconds to wait for a Dask scheduler to answer (--scheduler)
+SWEEP_SCHEDULER_TIMEOUT_S = 5.0
 #: local pool for sweep lines when no Dask client is given: "process" or
 #: "thread" (the compiled kernels release the GIL)
 SWEEP_POOL = "process"

@@ -21,7 +21,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _validate as V
-from . import config
 from .laws import ContactLaw, make_law
 
 __all__ = ["Contact", "System", "PAPER"]
@@ -199,7 +198,8 @@ class System:
         model: str = "iwan",
         zeta: float = 0.0,
         f1: float | None = None,
-        n: int = config.LAW_DISCRETE_N,
+        law_params: dict | None = None,
+        n: int | None = None,
         **overrides,
     ) -> "System":
         """The paper's friction damper (MODEL.md section 6) in its groups.
@@ -218,8 +218,12 @@ class System:
             Viscous damping ratio (paper: 0).
         f1 : float, optional
             Forcing amplitude, N (instead of beta).
-        n : int
-            Elements of the discrete model.
+        law_params : dict, optional
+            Law-specific parameters of ``model``
+            (:func:`jointdyn.laws.law_parameters`), e.g. ``{"n": 200}``.
+        n : int, optional
+            Shorthand for ``law_params={"n": n}`` (elements of ``discrete``);
+            a model without that parameter refuses it.
         **overrides
             Any of ``m, k, kt, mu, n0`` (paper values by default).
         """
@@ -228,7 +232,12 @@ class System:
             if key not in p:
                 raise ValueError(f"unknown parameter {key!r}; allowed: {', '.join(p)}")
             p[key] = val
-        law = make_law(model, kt=p["kt"], mu=p["mu"], n_ref=p["n0"], n=n)
+        law_params = dict(law_params or {})
+        if n is not None:
+            if "n" in law_params:
+                raise ValueError("n is given twice: as n and in law_params; give it once")
+            law_params["n"] = n
+        law = make_law(model, kt=p["kt"], mu=p["mu"], n_ref=p["n0"], **law_params)
         if f1 is None:
             f1 = law.fy / V.positive("beta", beta)
         return cls.sdof(m=p["m"], k=p["k"], law=law, f1=f1, zeta=zeta, n0=p["n0"], eta=eta, delta=delta)

@@ -3,10 +3,18 @@
 Time domain (``--method time``, default): steady states swept up and/or down
 in gamma with warm starts (:func:`jointdyn.sweeps.frc_sweep`). Harmonic
 balance (``--method hb``): :func:`jointdyn.hb.frc_hb` continuation.
-Everything is validated before computing; ``--out`` files (``frc.nc``,
-``frc.csv``, ``frc.png``) are written atomically after computing (time-domain
-sweep lines are also saved one by one under ``OUT/lines`` so that an
-interrupted run resumes).
+Options of one method are refused with the other (one line, exit 2):
+``--sweep``, ``--steps-per-period``, ``--scheduler`` and ``--workers`` are
+time-domain options (the continuation follows the branch through its folds,
+which holds the states of both sweep directions, along one sequential path);
+``--harmonics`` and ``--samples`` are harmonic-balance options.
+
+Everything is validated before computing (including the writability of
+``--out``, derived quantities such as fy = mu N0 and the grid size, and the
+connection to ``--scheduler``); ``--out`` files (``frc.nc``, ``frc.csv``,
+``frc.png``) are written atomically after computing (time-domain sweep lines
+are also saved one by one under ``OUT/lines`` so that an interrupted run
+resumes). The table prints gamma with as many digits as distinct points need.
 """
 
 from __future__ import annotations
@@ -19,6 +27,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
+from ._law_args import add_law_arguments, law_params, model_help
 from ..systems import PAPER
 
 NAME = "frc"
@@ -35,10 +44,11 @@ def add_arguments(p) -> None:
     p.add_argument("--gamma", default=g0, metavar="START:STOP:STEP",
                    help=f"frequency-ratio grid gamma = w/w0 (default {g0})")
     p.add_argument("--delta", type=float, default=0.0, help="normal-load phase, degrees (default 0)")
-    p.add_argument("--sweep", default="both", help="up, down or both (default both)")
-    p.add_argument("--model", default="iwan", help="contact law: iwan, iwan-paper, discrete, jenkins (default iwan)")
-    p.add_argument("--n", type=int, default=config.LAW_DISCRETE_N,
-                   help=f"elements of the discrete law (default {config.LAW_DISCRETE_N})")
+    p.add_argument("--sweep", default=None,
+                   help="time: up, down or both (default both); hb: refused (the continuation follows the "
+                        "branch through its folds, which holds the states of both sweep directions)")
+    p.add_argument("--model", default="iwan", help=model_help("iwan"))
+    add_law_arguments(p)
     p.add_argument("--zeta", type=float, default=0.0, help="viscous damping ratio (default 0)")
     p.add_argument("--m", type=float, default=PAPER["m"], help=f"mass, kg (default {PAPER['m']:g})")
     p.add_argument("--k", type=float, default=PAPER["k"], help=f"stiffness, N/m (default {PAPER['k']:g})")
@@ -48,12 +58,16 @@ def add_arguments(p) -> None:
                         "normal load is prescribed, N = N0 + N1 sin(w t + delta)")
     p.add_argument("--mu", type=float, default=PAPER["mu"], help=f"friction coefficient (default {PAPER['mu']:g})")
     p.add_argument("--n0", type=float, default=PAPER["n0"], help=f"static normal load N0, N (default {PAPER['n0']:g})")
-    p.add_argument("--steps-per-period", type=int, default=None, help="time steps per forcing period (solver default)")
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="run the sweep lines on this Dask scheduler")
-    p.add_argument("--workers", type=int, default=None, help="local parallel workers (default: all cores)")
-    p.add_argument("--harmonics", type=int, default=config.HB_HARMONICS,
+    p.add_argument("--steps-per-period", type=int, default=None,
+                   help="time: time steps per forcing period (solver default)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="time: run the sweep lines on the Dask scheduler at ADDRESS (e.g. tcp://host:8786; "
+                        f"connection timeout {config.SWEEP_SCHEDULER_TIMEOUT_S:g} s)")
+    p.add_argument("--workers", type=int, default=None,
+                   help="time: local parallel workers (default: all cores; not with --scheduler)")
+    p.add_argument("--harmonics", type=int, default=None,
                    help=f"hb: number of harmonics (default {config.HB_HARMONICS})")
-    p.add_argument("--samples", type=int, default=config.HB_SAMPLES,
+    p.add_argument("--samples", type=int, default=None,
                    help=f"hb: time samples per period (default {config.HB_SAMPLES})")
     p.add_argument("--out", default=None, metavar="DIR", help="write frc.nc, frc.csv, frc.png here")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
@@ -73,9 +87,10 @@ def parse_gamma(text: str) -> np.ndarray:
     V.finite("--gamma STOP", stop)
     if not stop >= start:
         raise ValueError(f"--gamma STOP must be >= START ({start:g}), got {stop:g}")
+    # a float until bounded: (STOP - START) / STEP may be huge or inf
+    V.count_at_most("--gamma START:STOP:STEP", (stop - start) / step + 1.0,
+                    config.SWEEP_MAX_GAMMA_POINTS, "points")
     count = int(math.floor((stop - start) / step + 1e-9)) + 1
-    if count > 100000:
-        raise ValueError(f"--gamma must have at most 100000 points, got {count}")
     return np.round(start + step * np.arange(count), 12)
 
 
@@ -89,11 +104,61 @@ def _jsonable(values):
     return out
 
 
+#: options of one method only, with the reason they do not apply to the other
+_TIME_ONLY = {
+    "sweep": "the continuation follows the branch through its folds, which holds the states of both "
+             "sweep directions",
+    "steps_per_period": "harmonic balance has no time steps (see --samples)",
+    "scheduler": "the continuation is one sequential path",
+    "workers": "the continuation is one sequential path",
+}
+_HB_ONLY = ("harmonics", "samples")
+
+
+def _option(dest: str) -> str:
+    return "--" + dest.replace("_", "-")
+
+
+def _check_method_options(args) -> None:
+    """Refuse the options that the chosen method would ignore; fill the
+    defaults of the others."""
+    if args.method == "hb":
+        for dest, why in _TIME_ONLY.items():
+            if getattr(args, dest) is not None:
+                raise ValueError(f"{_option(dest)} applies to --method time only: {why}")
+        args.harmonics = config.HB_HARMONICS if args.harmonics is None else args.harmonics
+        args.samples = config.HB_SAMPLES if args.samples is None else args.samples
+        return
+    for dest in _HB_ONLY:
+        if getattr(args, dest) is not None:
+            raise ValueError(f"{_option(dest)} applies to --method hb only")
+    if args.scheduler is not None and args.workers is not None:
+        raise ValueError("--workers cannot be combined with --scheduler: the cluster's workers run the lines")
+    args.sweep = "both" if args.sweep is None else args.sweep
+
+
+def _check_derived(args, gammas) -> None:
+    """Quantities computed from several options stay finite and positive."""
+    fy = V.derived("fy = --mu x --n0", args.mu * args.n0, positive=True)
+    if args.f1 is not None:
+        V.derived("beta = --mu x --n0 / --f1", fy / args.f1, positive=True)
+    else:
+        V.derived("F1 = --mu x --n0 / --beta", fy / args.beta, positive=True)
+    V.derived("--eta x --n0 (normal-load amplitude, N)", args.eta * args.n0)
+    w0 = V.derived("w0 = sqrt(--k / --m)", math.sqrt(args.k / args.m), positive=True)
+    V.derived("--gamma STOP x w0 (highest forcing frequency, rad/s)", float(gammas[-1]) * w0)
+    V.derived("2 pi / (--gamma START x w0) (longest forcing period, s)", 2.0 * math.pi / (float(gammas[0]) * w0))
+    V.derived("--zeta x 2 sqrt(--k x --m) (viscous coefficient)", 2.0 * args.zeta * math.sqrt(args.k) * math.sqrt(args.m))
+    V.derived("--kt / fy (normalised contact stiffness)", args.kt / fy)
+
+
 def _validate(args):
     from ..laws import law_names
 
     V.choice("--method", args.method, ("time", "hb"))
-    V.choice("--sweep", args.sweep, ("up", "down", "both"))
+    _check_method_options(args)
+    if args.method == "time":
+        V.choice("--sweep", args.sweep, ("up", "down", "both"))
     V.choice("--model", args.model, law_names())
     gammas = parse_gamma(args.gamma)
     V.nonnegative("--eta", args.eta)
@@ -102,7 +167,7 @@ def _validate(args):
     else:
         args.beta = V.positive("--beta", 1.0 if args.beta is None else args.beta)
     V.finite("--delta", args.delta)
-    V.positive_int("--n", args.n)
+    args.law_params = law_params(args)
     V.nonnegative("--zeta", args.zeta)
     for key in ("m", "k", "kt", "kn", "mu", "n0"):
         V.positive(f"--{key}", getattr(args, key))
@@ -110,11 +175,39 @@ def _validate(args):
         V.positive_int("--steps-per-period", args.steps_per_period, 8)
     if args.workers is not None:
         V.positive_int("--workers", args.workers)
-    V.positive_int("--harmonics", args.harmonics)
-    V.positive_int("--samples", args.samples, 4)
-    if args.out is not None and Path(args.out).exists() and not Path(args.out).is_dir():
-        raise ValueError(f"--out must be a directory, got existing file {args.out!r}")
+    if args.method == "hb":
+        V.positive_int("--harmonics", args.harmonics)
+        V.positive_int("--samples", args.samples, 4)
+    _check_derived(args, gammas)
+    if args.out is not None:
+        subdirs = ("lines",) if args.method == "time" else ()
+        V.output_dir("--out", args.out, files=("frc.nc", "frc.csv", "frc.png"), subdirs=subdirs)
     return gammas
+
+
+def _connect(address):
+    """A Dask client of the scheduler at ``address``, or a ValueError naming
+    --scheduler (quickly: a short connection timeout)."""
+    from distributed import Client
+    from distributed.comm import parse_address
+    from distributed.comm.addressing import parse_host_port
+    from distributed.comm.registry import get_backend
+
+    try:  # the address itself, without starting a client
+        scheme, location = parse_address(address)
+        get_backend(scheme)
+        if scheme in ("tcp", "tls", "ws", "wss"):
+            parse_host_port(location)
+    except ValueError as exc:
+        raise ValueError(f"--scheduler must be a Dask scheduler address such as tcp://host:8786, got "
+                         f"{address!r}: {exc}") from None
+    timeout = config.SWEEP_SCHEDULER_TIMEOUT_S
+    try:
+        return Client(address, timeout=timeout)
+    except (OSError, TimeoutError, ValueError, TypeError) as exc:
+        raise ValueError(
+            f"--scheduler cannot reach a Dask scheduler at {address!r} within {timeout:g} s: {exc}"
+        ) from None
 
 
 def _header(args) -> dict:
@@ -125,7 +218,7 @@ def _header(args) -> dict:
     else:
         head["beta"] = args.beta
         head["f1"] = args.mu * args.n0 / args.beta
-    head.update(delta_deg=args.delta, model=args.model, n=args.n, zeta=args.zeta,
+    head.update(delta_deg=args.delta, model=args.model, law_params=args.law_params, zeta=args.zeta,
                 m=args.m, k=args.k, kt=args.kt, kn=args.kn, mu=args.mu, n0=args.n0)
     return head
 
@@ -134,11 +227,7 @@ def _run_time(args, gammas):
     from ..sweeps import frc_sweep, status_name
 
     directions = ("up", "down") if args.sweep == "both" else (args.sweep,)
-    client = None
-    if args.scheduler:
-        from distributed import Client
-
-        client = Client(args.scheduler)
+    client = None if args.scheduler is None else _connect(args.scheduler)
     try:
         ds = frc_sweep(
             gammas,
@@ -148,7 +237,7 @@ def _run_time(args, gammas):
             deltas=[args.delta],
             directions=directions,
             model=args.model,
-            n=args.n,
+            law_params=args.law_params,
             zeta=args.zeta,
             m=args.m, k=args.k, kt=args.kt, mu=args.mu, n0=args.n0,
             steps_per_period=args.steps_per_period,
@@ -210,7 +299,7 @@ def _run_hb(args, gammas):
         delta=math.radians(args.delta),
         model=args.model,
         zeta=args.zeta,
-        n=args.n,
+        law_params=args.law_params,
         m=args.m, k=args.k, kt=args.kt, mu=args.mu, n0=args.n0,
     )
     if gammas.size < 2:
@@ -295,11 +384,23 @@ def run(args) -> int:
     return 0
 
 
+def _digits(values, least: int = 4) -> int:
+    """Fewest significant digits (>= ``least``) that print distinct values
+    distinctly (at most 17, which round-trips any float)."""
+    vals = sorted({float(v) for v in values if v is not None})
+    for p in range(least, 17):
+        if len({f"{v:.{p}g}" for v in vals}) == len(vals):
+            return p
+    return 17
+
+
 def _print_table(result) -> None:
     if result["method"] == "time":
         dirs = list(result["directions"])
-        print("gamma    " + "  ".join(f"{'q_' + d:>12s} {'status':>11s}" for d in dirs))
         g = result["directions"][dirs[0]]["gamma"]
+        p = _digits(g)
+        w = max(8, p + 6)
+        print(f"{'gamma':<{w}s} " + "  ".join(f"{'q_' + d:>12s} {'status':>11s}" for d in dirs))
         for i, gi in enumerate(g):
             cells = []
             for d in dirs:
@@ -307,10 +408,12 @@ def _print_table(result) -> None:
                 a = r["amplitude_q"][i]
                 cells.append(f"{'-' if a is None or r['status'][i] != 'periodic' else f'{a:.5g}':>12s} "
                              f"{r['status'][i]:>11s}")
-            print(f"{gi:<8.4g} " + "  ".join(cells))
+            print(f"{gi:<{w}.{p}g} " + "  ".join(cells))
     else:
         print(f"status: {result['status']} {result['message']}")
+        p = _digits([g for br in result["branches"] for g in br["gamma"]])
+        w = max(8, p + 6)
         for b, br in enumerate(result["branches"]):
             print(f"branch {b}: {len(br['gamma'])} points, folds at {br['folds']}")
             for g, a, s in zip(br["gamma"], br["amplitude_q"], br["stable"]):
-                print(f"  {g:<8.4g} {a if a is not None else float('nan'):>12.5g} {'stable' if s else 'unstable'}")
+                print(f"  {g:<{w}.{p}g} {a if a is not None else float('nan'):>12.5g} {'stable' if s else 'unstable'}")

@@ -12,10 +12,20 @@ v = (eta N_ref / kn) sin(2 pi f t + delta): identical to the prescribed
 load in contact, 0 instead of negative while separated, so the tangential
 loop does not depend on kn.
 
-Everything is computed first; ``--out DIR`` then receives ``loop.csv``
-(columns t, x, N, T, state) and ``loop.png`` (T against x, separated samples
-marked), each written atomically. Bad input is a ValueError: one line on
-stderr, exit status 2, no file written.
+With ``--input``, the instants where N changes sign between two samples
+are inserted into the history (N = 0 there, x linear), so ``loop.csv`` has
+more rows than the input: its boolean column ``inserted`` marks them, and
+the console and ``--json`` (``n_inserted``) say how many. A ``--period``
+that does not divide the history leaves a remainder that is not analysed
+(``remainder_s``); a reported cycle in which the contact never closes gets
+a warning on stderr and in ``warnings``.
+
+Everything is validated, computed and serialised first; ``--out DIR`` then
+receives ``loop.csv`` (columns t, x, N, T, state, inserted) and ``loop.png``
+(T against x, separated samples marked), each written atomically. Bad input
+(options, the CSV file, an unwritable ``--out``, sizes beyond the limits,
+derived quantities that overflow) is a ValueError: one line on stderr, exit
+status 2, no file written.
 """
 
 from __future__ import annotations
@@ -23,27 +33,33 @@ from __future__ import annotations
 import io
 import json
 import math
+import sys
 from pathlib import Path
 
+import numpy as np
+
 from .. import config
+from ._law_args import add_law_arguments, law_params, model_help
 
 NAME = "loop"
 HELP = "quasi-static hysteresis loop of a contact law under prescribed tangential motion and normal load"
 
-
-def _law_choices():
-    from ..laws import law_names
-
-    return law_names()
+#: defaults of the harmonic shorthand (refused with --input)
+_HARMONIC = {
+    "amplitude": 0.5e-3,
+    "frequency": 1.0,
+    "eta": 0.0,
+    "delta": 0.0,
+    "cycles": config.QS_CYCLES,
+    "steps_per_cycle": config.QS_STEPS_PER_CYCLE,
+}
 
 
 def add_arguments(p) -> None:
-    p.add_argument("--model", default="iwan", choices=_law_choices(),
-                   help="contact law: iwan (closed form, full Masing memory), iwan-paper (the paper's "
-                        "last-reversal rule), discrete (n Jenkins elements, ground truth), jenkins "
-                        "(default: iwan)")
-    p.add_argument("--n", type=int, default=config.LAW_DISCRETE_N,
-                   help=f"number of Jenkins elements of --model discrete (default {config.LAW_DISCRETE_N})")
+    from ..laws import law_names
+
+    p.add_argument("--model", default="iwan", choices=law_names(), help=model_help("iwan"))
+    add_law_arguments(p)
     p.add_argument("--kt", type=float, default=1e5, help="total tangential stiffness kt, N/m (default 1e5)")
     p.add_argument("--mu", type=float, default=0.1, help="friction coefficient mu (default 0.1)")
     p.add_argument("--n-ref", type=float, default=100.0, dest="n_ref",
@@ -51,48 +67,98 @@ def add_arguments(p) -> None:
     p.add_argument("--kn", type=float, default=None,
                    help="normal stiffness, N/m: N = max(0, N_ref + kn v) with prescribed normal motion "
                         "v = (eta N_ref / kn) sin(2 pi f t + delta) (default: N prescribed directly)")
-    p.add_argument("--amplitude", type=float, default=0.5e-3, help="tangential amplitude A, m (default 0.5e-3)")
-    p.add_argument("--frequency", type=float, default=1.0, help="frequency f, Hz (default 1)")
-    p.add_argument("--eta", type=float, default=0.0, help="normal-load ratio N1 / N0 (default 0; > 1 separates)")
-    p.add_argument("--delta", type=float, default=0.0, help="phase of the normal load, degrees (default 0)")
-    p.add_argument("--cycles", type=int, default=config.QS_CYCLES,
-                   help=f"number of cycles (default {config.QS_CYCLES}); metrics of the last one")
-    p.add_argument("--steps-per-cycle", type=int, default=config.QS_STEPS_PER_CYCLE, dest="steps_per_cycle",
-                   help=f"time steps per cycle (default {config.QS_STEPS_PER_CYCLE})")
+    p.add_argument("--amplitude", type=float, default=None,
+                   help=f"tangential amplitude A, m (default {_HARMONIC['amplitude']:g})")
+    p.add_argument("--frequency", type=float, default=None,
+                   help=f"frequency f, Hz (default {_HARMONIC['frequency']:g})")
+    p.add_argument("--eta", type=float, default=None,
+                   help=f"normal-load ratio N1 / N0 (default {_HARMONIC['eta']:g}; > 1 separates)")
+    p.add_argument("--delta", type=float, default=None,
+                   help=f"phase of the normal load, degrees (default {_HARMONIC['delta']:g})")
+    p.add_argument("--cycles", type=int, default=None,
+                   help=f"number of cycles (default {_HARMONIC['cycles']}); metrics of the last one")
+    p.add_argument("--steps-per-cycle", type=int, default=None, dest="steps_per_cycle",
+                   help=f"time steps per cycle (default {_HARMONIC['steps_per_cycle']}; "
+                        f"--cycles x --steps-per-cycle <= {config.QS_MAX_SAMPLES})")
     p.add_argument("--input", default=None, metavar="FILE.csv",
-                   help="history from CSV with columns t, x, N (s, m, N), replacing the harmonic shorthand; "
-                        "the whole history is then one cycle unless --period is given")
+                   help="history from CSV with columns t, x, N (s, m, N; headers such as 't [s]' or 'time' "
+                        "and ',', ';', tab or space separators are accepted), replacing the harmonic shorthand "
+                        "(--amplitude, --frequency, --eta, --delta, --cycles, --steps-per-cycle, --kn are then "
+                        "refused); the whole history is one cycle unless --period is given. The instants where N "
+                        "changes sign between two samples are inserted as rows of loop.csv, marked in its "
+                        "column 'inserted' (n_inserted in --json)")
     p.add_argument("--period", type=float, default=None,
-                   help="with --input: cycle length, s (default: whole history)")
-    p.add_argument("--out", default=None, metavar="DIR", help="write DIR/loop.csv and DIR/loop.png")
+                   help="with --input: cycle length, s (default: whole history); a remainder shorter than "
+                        "--period at the end is not analysed (reported)")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="write DIR/loop.csv (columns t, x, N, T, state, inserted) and DIR/loop.png")
     p.add_argument("--json", action="store_true", help="print the last full cycle's metrics as one JSON object")
+
+
+def _option(dest: str) -> str:
+    return "--" + dest.replace("_", "-")
+
+
+def _check_sources(args) -> None:
+    """The harmonic shorthand and --input exclude each other; fill the
+    shorthand's defaults."""
+    if args.input is not None:
+        given = [_option(d) for d in (*_HARMONIC, "kn") if getattr(args, d) is not None]
+        if given:
+            raise ValueError(
+                f"{', '.join(given)} cannot be combined with --input: the CSV gives the whole history "
+                "(t, x, N); drop them or drop --input"
+            )
+        return
+    if args.period is not None:
+        raise ValueError("--period applies to --input only (the harmonic period is 1 / --frequency)")
+    for dest, value in _HARMONIC.items():
+        if getattr(args, dest) is None:
+            setattr(args, dest, value)
+
+
+def _check_derived(args) -> None:
+    """Quantities computed from several options: no overflow, no size
+    beyond the limits (checked before anything is allocated)."""
+    from .. import _validate as V
+
+    fy = V.derived("fy = --mu x --n-ref", args.mu * args.n_ref, positive=args.mu > 0.0)
+    if args.input is not None:
+        return
+    V.count_at_most("--cycles x --steps-per-cycle", float(args.cycles) * args.steps_per_cycle,
+                    config.QS_MAX_SAMPLES, "samples")
+    V.derived("--cycles / --frequency (duration, s)", args.cycles / args.frequency)
+    V.derived("--eta x --n-ref (normal-load amplitude, N)", args.eta * args.n_ref)
+    V.derived("--kt x --amplitude (elastic force, N)", args.kt * args.amplitude)
+    if fy > 0.0:
+        V.derived("--kt x --amplitude / fy (normalised displacement)", args.kt * args.amplitude / fy)
+    if args.kn is not None:
+        V.derived("--eta x --n-ref / --kn (normal motion, m)", args.eta * args.n_ref / args.kn)
 
 
 def _validate_args(args):
     from .. import _validate as V
 
-    V.positive_int("--n", args.n, 1)
+    _check_sources(args)
     V.positive("--kt", args.kt)
     V.nonnegative("--mu", args.mu)
     V.positive("--n-ref", args.n_ref)
     if args.kn is not None:
         V.positive("--kn", args.kn)
-    V.positive("--amplitude", args.amplitude)
-    V.positive("--frequency", args.frequency)
-    V.nonnegative("--eta", args.eta)
-    V.finite("--delta", args.delta)
-    V.positive_int("--cycles", args.cycles, 1)
-    V.positive_int("--steps-per-cycle", args.steps_per_cycle, 4)
+    if args.input is None:
+        V.positive("--amplitude", args.amplitude)
+        V.positive("--frequency", args.frequency)
+        V.nonnegative("--eta", args.eta)
+        V.finite("--delta", args.delta)
+        V.positive_int("--cycles", args.cycles, 1)
+        V.positive_int("--steps-per-cycle", args.steps_per_cycle, 4)
+    else:
+        V.input_file("--input", args.input)
     if args.period is not None:
         V.positive("--period", args.period)
-        if args.input is None:
-            raise ValueError("--period applies to --input only (the harmonic period is 1 / --frequency)")
-    if args.input is not None and args.kn is not None:
-        raise ValueError("--kn cannot be combined with --input: the CSV gives the normal load N directly")
+    _check_derived(args)
     if args.out is not None:
-        out = Path(args.out)
-        if out.exists() and not out.is_dir():
-            raise ValueError(f"--out must be a directory, got existing file {str(out)!r}")
+        V.output_dir("--out", args.out, files=("loop.csv", "loop.png"))
 
 
 def _plot_png(res, title) -> bytes:
@@ -128,30 +194,48 @@ def _jsonable(v):
     return v
 
 
-def run(args) -> int:
-    import pandas as pd
+def _history(args, law):
+    """The prescribed history and the cycle length (None: one window),
+    validated before the march."""
+    from .. import _validate as V
+    from ..drivers import cycle_count, harmonic_history, read_history_csv
 
-    from .._io import atomic_path
-    from ..drivers import harmonic_history, quasistatic, read_history_csv
-    from ..laws import make_law
-
-    _validate_args(args)
-    law = make_law(args.model, kt=args.kt, mu=args.mu, n_ref=args.n_ref, n=args.n)
-    if args.input is not None:
-        t, x, N = read_history_csv(args.input)
-        period = args.period
-    else:
+    if args.input is None:
         t, x, N = harmonic_history(
             args.amplitude, args.frequency, args.n_ref, eta=args.eta, delta=math.radians(args.delta),
             cycles=args.cycles, steps_per_cycle=args.steps_per_cycle, kn=args.kn,
         )
-        period = 1.0 / args.frequency
-    res = quasistatic(law, t, x, N, period=period)
-    last = res.last_cycle()
+        return t, x, N, 1.0 / args.frequency
+    t, x, N = read_history_csv(args.input, name="--input")
+    if args.period is not None:
+        cycle_count(t, args.period, name="--period")
+    if law.fy > 0.0:
+        xmax = float(np.max(np.abs(x)))
+        V.derived("--kt x max|x| / fy (normalised displacement of --input)", args.kt * xmax / law.fy)
+    return t, x, N, args.period
 
+
+def _notes(args, res, period) -> dict:
+    """What the user must know about the history actually analysed: rows
+    inserted, an unanalysed remainder, a contact that never closes."""
+    last = res.last_cycle()
+    duration = float(res.t[-1] - res.t[0])
+    remainder = float(res.t[-1]) - last["t_end_s"]
+    if remainder <= config.QS_SNAP_RTOL * duration:
+        remainder = 0.0
+    warnings = []
+    sl = res.cycle_slice(-1)
+    if np.all(res.N[sl] <= 0.0):
+        what = "reported cycle" if period is not None else "history"
+        warnings.append(f"the contact never closes (N <= 0 throughout the {what}): energy, forces and "
+                        "stiffness are 0")
+    return {"n_inserted": int(res.n_inserted), "remainder_s": remainder, "warnings": warnings}
+
+
+def _report(args, law, res, period, lp) -> dict:
+    last = res.last_cycle()
     params = {"kt_N_per_m": args.kt, "mu": args.mu, "n_ref_N": args.n_ref, "fy_N": law.fy}
-    if args.model == "discrete":
-        params["n"] = args.n
+    params.update(lp)
     if args.input is not None:
         params.update(input=str(args.input), period_s=period)
     else:
@@ -161,34 +245,73 @@ def run(args) -> int:
         )
     report = {"model": args.model, "parameters": params, "n_cycles": res.n_cycles, **last}
     report["cycle_is_period"] = period is not None
-    report = {k: _jsonable(v) for k, v in report.items()}
+    report.update(_notes(args, res, period))
+    return {k: _jsonable(v) for k, v in report.items()}
 
-    # everything computed: now the files, each atomically
+
+def _write_files(args, res) -> None:
+    """loop.png and loop.csv, each atomically (everything is computed)."""
+    import pandas as pd
+
+    from .._io import atomic_path
+
+    title = f"{args.model}: kt={args.kt:g} N/m, mu={args.mu:g}, N_ref={args.n_ref:g} N"
+    if args.input is None:
+        title += f", eta={args.eta:g}, delta={args.delta:g} deg"
+    png = _plot_png(res, title)
+    table = pd.DataFrame({"t": res.t, "x": res.x, "N": res.N, "T": res.T, "state": res.state,
+                          "inserted": res.inserted})
+    csv_text = table.to_csv(index=False, float_format="%.17g")
+    out = Path(args.out)
+    with atomic_path(out / "loop.csv") as tmp:
+        Path(tmp).write_text(csv_text)
+    with atomic_path(out / "loop.png") as tmp:
+        Path(tmp).write_bytes(png)
+
+
+def _print_console(args, law, res, report, period) -> None:
+    what = "last cycle" if period is not None else "whole history (work done)"
+    print(f"jointdyn loop: {args.model}, fy = {law.fy:g} N, {res.n_cycles} cycle(s), {what} "
+          f"[{report['t_start_s']:g}, {report['t_end_s']:g}] s")
+    print(f"  energy per cycle   {report['energy_per_cycle_J']:.6g} J")
+    print(f"  force min / max    {report['force_min_N']:.6g} / {report['force_max_N']:.6g} N")
+    ksec, loss = report["secant_stiffness_N_per_m"], report["loss_factor"]
+    print(f"  secant stiffness   {float('nan') if ksec is None else ksec:.6g} N/m")
+    print(f"  loss factor        {float('nan') if loss is None else loss:.6g}")
+    print(f"  time fractions     stick-slip {report['stick_slip_fraction']:.4f}, "
+          f"macroslip {report['macroslip_fraction']:.4f}, separation {report['separation_fraction']:.4f}")
+    if args.input is not None:
+        n_in = res.t.size - res.n_inserted
+        where = "; column 'inserted' of loop.csv" if args.out is not None else ""
+        print(f"  rows               {n_in} from --input + {res.n_inserted} inserted (N = 0 crossings{where})")
+    if report["remainder_s"] > 0.0:
+        print(f"  not analysed       the last {report['remainder_s']:g} s (after t = {report['t_end_s']:g} s): "
+              "shorter than --period")
     if args.out is not None:
-        title = f"{args.model}: kt={args.kt:g} N/m, mu={args.mu:g}, N_ref={args.n_ref:g} N"
-        if args.input is None:
-            title += f", eta={args.eta:g}, delta={args.delta:g} deg"
-        png = _plot_png(res, title)
-        table = pd.DataFrame({"t": res.t, "x": res.x, "N": res.N, "T": res.T, "state": res.state})
-        csv_text = table.to_csv(index=False, float_format="%.17g")
-        out = Path(args.out)
-        with atomic_path(out / "loop.csv") as tmp:
-            Path(tmp).write_text(csv_text)
-        with atomic_path(out / "loop.png") as tmp:
-            Path(tmp).write_bytes(png)
+        print(f"  wrote {Path(args.out) / 'loop.csv'}, {Path(args.out) / 'loop.png'}")
 
+
+def run(args) -> int:
+    from ..drivers import quasistatic
+    from ..laws import make_law
+
+    _validate_args(args)
+    lp = law_params(args)
+    law = make_law(args.model, kt=args.kt, mu=args.mu, n_ref=args.n_ref, **lp)
+    t, x, N, period = _history(args, law)
+    res = quasistatic(law, t, x, N, period=period)
+    if not np.all(np.isfinite(res.T)):
+        raise ValueError("the parameters overflow double precision (the force T is not finite): "
+                         "reduce --kt or --amplitude, or raise --mu x --n-ref")
+    report = _report(args, law, res, period, lp)
+    text = json.dumps(report, allow_nan=False) if args.json else None
+    # everything computed and serialised: now the files, each atomically
+    if args.out is not None:
+        _write_files(args, res)
+    for w in report["warnings"]:
+        print(f"jointdyn loop: warning: {w}", file=sys.stderr)
     if args.json:
-        print(json.dumps(report, allow_nan=False))
+        print(text)
     else:
-        what = "last cycle" if period is not None else "whole history (work done)"
-        print(f"jointdyn loop: {args.model}, fy = {law.fy:g} N, {res.n_cycles} cycle(s), {what} "
-              f"[{last['t_start_s']:g}, {last['t_end_s']:g}] s")
-        print(f"  energy per cycle   {last['energy_per_cycle_J']:.6g} J")
-        print(f"  force min / max    {last['force_min_N']:.6g} / {last['force_max_N']:.6g} N")
-        print(f"  secant stiffness   {last['secant_stiffness_N_per_m']:.6g} N/m")
-        print(f"  loss factor        {last['loss_factor']:.6g}")
-        print(f"  time fractions     stick-slip {last['stick_slip_fraction']:.4f}, "
-              f"macroslip {last['macroslip_fraction']:.4f}, separation {last['separation_fraction']:.4f}")
-        if args.out is not None:
-            print(f"  wrote {Path(args.out) / 'loop.csv'}, {Path(args.out) / 'loop.png'}")
+        _print_console(args, law, res, report, period)
     return 0

@@ -6,6 +6,7 @@ import numpy as np
 
 from .. import _validate as V
 from .._jit import specialize
+from ..laws import ContactLaw
 
 __all__ = ["march"]
 
@@ -29,37 +30,40 @@ def march(law, x, N, state=None):
     Parameters
     ----------
     law : ContactLaw
-        Any registered contact law.
+        Any registered contact law (:func:`jointdyn.make_law`).
     x : ndarray
         Tangential displacement samples, m.
     N : ndarray
         Normal-load samples, N (same length).
     state : ndarray, optional
-        Committed state to start from; default the law's virgin state at
-        ``x[0], N[0]``.
+        Committed state to start from (validated by ``law.check_state``);
+        default the law's virgin state at ``x[0], N[0]``.
 
     Raises
     ------
     ValueError
-        If ``x`` or ``N`` is empty, not 1-D or not finite, if their lengths
-        differ, or if ``state`` is not a vector of ``law.state_size``.
+        If ``law`` is not a contact law, if ``x`` or ``N`` is empty, not 1-D
+        or not finite, if their lengths differ, or if ``state`` is not an
+        admissible state of ``law`` (shape ``(law.state_size,)``, finite
+        live part, law-specific fields valid).
 
     Returns
     -------
     T, kT, code, state : ndarray, ndarray, ndarray(int8), ndarray
         Force (N), tangent (N/m), motion state per sample, final state.
     """
+    if not isinstance(law, ContactLaw):
+        raise ValueError(
+            f"law must be a ContactLaw (e.g. jointdyn.Iwan or jointdyn.make_law(name, ...)), "
+            f"got {law!r} ({type(law).__name__})"
+        )
     x = V.finite_array("x", x)
     N = V.finite_array("N", N)
     V.same_length(x=x, N=N)
     if state is None:
         s0 = law.initial_state(float(x[0]), float(N[0]))
     else:
-        # not checked for finiteness: rows beyond a state's live part (e.g. the
-        # unused reversal-point stack of Iwan) may hold anything
-        s0 = np.array(state, dtype=np.float64)
-        if s0.ndim != 1 or s0.shape[0] != law.state_size:
-            raise ValueError(f"state must have shape ({law.state_size},) (law.state_size), got {s0.shape}")
+        s0 = law.check_state(state)
     return _march_unchecked(law, x, N, s0)
 
 

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -26,9 +25,18 @@ import pandas as pd
 from .. import _validate as V
 from .. import config
 from ..laws import MACROSLIP, SEPARATION, STATE_NAMES, STICK_SLIP, ContactLaw, HarmonicLoad, UnilateralSpring
+from ._csv import read_history_csv
 from ._march import march
 
-__all__ = ["LoopResult", "harmonic_history", "read_history_csv", "quasistatic", "harmonic_loop", "CYCLE_COLUMNS"]
+__all__ = [
+    "LoopResult",
+    "harmonic_history",
+    "read_history_csv",
+    "quasistatic",
+    "harmonic_loop",
+    "cycle_count",
+    "CYCLE_COLUMNS",
+]
 
 #: columns of :attr:`LoopResult.cycles`, in order
 CYCLE_COLUMNS = (
@@ -87,7 +95,8 @@ def harmonic_history(
     cycles : int
         Number of periods (>= 1).
     steps_per_cycle : int
-        Uniform steps per period (>= 4).
+        Uniform steps per period (>= 4); ``cycles x steps_per_cycle`` is at
+        most :data:`config.QS_MAX_SAMPLES`.
     x_offset : float
         Constant added to x, m (finite).
     kn : float, optional
@@ -118,6 +127,10 @@ def harmonic_history(
     x_offset = V.finite("x_offset", x_offset)
     if kn is not None:
         kn = V.positive("kn", kn)
+    V.count_at_most("cycles x steps_per_cycle", float(cycles) * steps, config.QS_MAX_SAMPLES, "samples")
+    V.derived("cycles / frequency (duration, s)", cycles / f)
+    V.derived("eta x n0 (normal-load amplitude, N)", eta * n0)
+    V.derived("|x_offset| + amplitude (largest displacement, m)", abs(x_offset) + A)
     w = 2.0 * math.pi * f
     # t_i = (i / steps) / f: the period boundaries k / f are exact samples
     t = (np.arange(cycles * steps + 1) / steps) / f
@@ -153,70 +166,6 @@ def harmonic_history(
     return t, x, N
 
 
-def read_history_csv(path):
-    """Read a history ``t, x, N`` (SI units: s, m, N) from a CSV file.
-
-    The file has a header row naming at least the columns ``t``, ``x`` and
-    ``N`` (other columns are ignored), one sample per row.
-
-    Parameters
-    ----------
-    path : str or Path
-        CSV file.
-
-    Returns
-    -------
-    t, x, N : ndarray
-        Float64 arrays of equal length (>= 2), finite, t strictly increasing.
-
-    Raises
-    ------
-    ValueError
-        Missing file or column, columns of different lengths (empty trailing
-        cells), a non-numeric, NaN or infinite entry, fewer than 2 samples,
-        or t not strictly increasing.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"input must be an existing CSV file, got {str(path)!r}")
-    try:
-        df = pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True)
-    except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError) as exc:
-        raise ValueError(f"input {str(path)!r} is not a readable CSV file: {exc}") from None
-    df.columns = [str(c).strip() for c in df.columns]
-    missing = [c for c in ("t", "x", "N") if c not in df.columns]
-    if missing:
-        raise ValueError(
-            f"input CSV must have columns t, x, N (SI units); missing {', '.join(missing)} "
-            f"(found {', '.join(df.columns) or 'none'})"
-        )
-    cols = {}
-    lengths = {}
-    for name in ("t", "x", "N"):
-        raw = [s.strip() for s in df[name].tolist()]
-        filled = [i for i, s in enumerate(raw) if s != ""]
-        n = filled[-1] + 1 if filled else 0
-        if len(filled) != n:
-            row = next(i for i in range(n) if raw[i] == "")
-            raise ValueError(f"column {name} has an empty cell at data row {row + 1}")
-        vals = np.empty(n)
-        for i in range(n):
-            try:
-                vals[i] = float(raw[i])
-            except ValueError:
-                raise ValueError(f"column {name} must be numeric, got {raw[i]!r} at data row {i + 1}") from None
-        cols[name] = vals
-        lengths[name] = n
-    V.same_length(**cols)
-    n = lengths["t"]
-    if n < 2:
-        raise ValueError(f"input CSV must have at least 2 samples, got {n}")
-    t = V.increasing("t", V.finite_array("t", cols["t"]))
-    x = V.finite_array("x", cols["x"])
-    N = V.finite_array("N", cols["N"])
-    return t, x, N
-
-
 # --------------------------------------------------------------------------
 # result
 # --------------------------------------------------------------------------
@@ -248,6 +197,9 @@ class LoopResult:
         itself cannot fail).
     n_inserted : int
         Number of zero-crossing instants of N inserted into the input history.
+    inserted : ndarray of bool
+        True for the samples that are not samples of the input history (the
+        inserted zero-crossing instants); ``n_inserted`` of them.
     """
 
     t: np.ndarray
@@ -261,6 +213,7 @@ class LoopResult:
     law_name: str
     status: str = "ok"
     n_inserted: int = 0
+    inserted: np.ndarray | None = None
 
     @property
     def n_cycles(self) -> int:
@@ -306,24 +259,28 @@ def _insert_crossings(t, x, N):
     """Insert the instants where N changes sign strictly between samples.
 
     x and N are taken linear between samples; N is exactly 0 at the new
-    samples.
+    samples. A crossing instant that rounds onto a neighbouring sample time
+    is not inserted, so every input sample stays.
+
+    Returns
+    -------
+    t, x, N : ndarray
+        The history with the crossing instants.
+    inserted : ndarray of bool
+        True at the inserted samples.
     """
     pos = N > 0.0
     neg = N < 0.0
     i = np.flatnonzero((pos[:-1] & neg[1:]) | (neg[:-1] & pos[1:]))
     if i.size == 0:
-        return t, x, N, 0
+        return t, x, N, np.zeros(t.size, dtype=bool)
     r = N[i] / (N[i] - N[i + 1])  # in (0, 1)
     tc = t[i] + r * (t[i + 1] - t[i])
     xc = x[i] + r * (x[i + 1] - x[i])
-    t2 = np.insert(t, i + 1, tc)
-    x2 = np.insert(x, i + 1, xc)
-    N2 = np.insert(N, i + 1, 0.0)
-    # guard against rounding producing a non-increasing time
-    if not np.all(np.diff(t2) > 0.0):
-        keep = np.concatenate(([True], np.diff(t2) > 0.0))
-        t2, x2, N2 = t2[keep], x2[keep], N2[keep]
-    return t2, x2, N2, int(i.size)
+    inside = (tc > t[i]) & (tc < t[i + 1])
+    i, tc, xc = i[inside], tc[inside], xc[inside]
+    inserted = np.insert(np.zeros(t.size, dtype=bool), i + 1, True)
+    return np.insert(t, i + 1, tc), np.insert(x, i + 1, xc), np.insert(N, i + 1, 0.0), inserted
 
 
 def _interval_states(N, code):
@@ -417,6 +374,48 @@ def _window_metrics(t, x, T, sep, contact, i0, i1):
     }
 
 
+def cycle_count(t, period, name: str = "period") -> int:
+    """Number of full cycles of length ``period`` in the history sampled at ``t``.
+
+    Bounded before anything is computed: at least one cycle, and at most one
+    per :data:`config.QS_MIN_INTERVALS_PER_CYCLE` sample intervals (a cycle
+    has to be sampled to be a loop; this also bounds the work by the size of
+    the history, whatever ``period``).
+
+    Parameters
+    ----------
+    t : ndarray
+        Sample times, s (finite, strictly increasing, >= 2 samples).
+    period : float
+        Cycle length, s (> 0).
+    name : str
+        How error messages name ``period`` (the CLI passes ``--period``).
+
+    Returns
+    -------
+    int
+        The number of full cycles, >= 1.
+
+    Raises
+    ------
+    ValueError
+        ``period`` out of range; the message gives the allowed range.
+    """
+    period = V.positive(name, period)
+    duration = float(t[-1] - t[0])
+    most = max(1, (len(t) - 1) // config.QS_MIN_INTERVALS_PER_CYCLE)
+    ratio = duration / period * (1.0 + config.QS_SNAP_RTOL)  # inf for a tiny period: compared as a float
+    if not ratio < most + 1:
+        raise ValueError(
+            f"{name} must be at least {duration / most!r} s (at most {most} cycle{'s' if most > 1 else ''} of "
+            f">= {config.QS_MIN_INTERVALS_PER_CYCLE} sample intervals in {len(t)} samples over {duration!r} s), "
+            f"got {period!r}"
+        )
+    if ratio < 1.0:
+        raise ValueError(f"{name} must be at most the duration of the history ({duration!r} s), got {period!r}")
+    return int(math.floor(ratio))
+
+
 def quasistatic(law, t, x, N, *, period=None, state=None) -> LoopResult:
     """March ``law`` over a prescribed history and measure its loops.
 
@@ -470,7 +469,9 @@ def quasistatic(law, t, x, N, *, period=None, state=None) -> LoopResult:
     N : array_like
         Normal load, N (finite, same length; N <= 0 is separation).
     period : float, optional
-        Cycle length, s (> 0, at most the duration of the history).
+        Cycle length, s (> 0, at most the duration of the history, and long
+        enough for :data:`config.QS_MIN_INTERVALS_PER_CYCLE` sample
+        intervals per cycle on average; see :func:`cycle_count`).
     state : ndarray, optional
         Committed law state to start from (default: virgin at x[0], N[0]).
 
@@ -494,15 +495,10 @@ def quasistatic(law, t, x, N, *, period=None, state=None) -> LoopResult:
     if t.size < 2:
         raise ValueError(f"t must have at least 2 samples, got {t.size}")
     V.increasing("t", t)
-    duration = float(t[-1] - t[0])
     if period is not None:
         period = V.positive("period", period)
-        ncyc = int(math.floor(duration / period * (1.0 + config.QS_SNAP_RTOL)))
-        if ncyc < 1:
-            raise ValueError(
-                f"period must be at most the duration of the history ({duration!r} s), got {period!r}"
-            )
-    t, x, N, n_ins = _insert_crossings(t, x, N)
+        ncyc = cycle_count(t, period)
+    t, x, N, inserted = _insert_crossings(t, x, N)
 
     # re-contact instants: N == 0 followed by N > 0
     recontact = np.zeros(N.size, dtype=bool)
@@ -542,7 +538,8 @@ def quasistatic(law, t, x, N, *, period=None, state=None) -> LoopResult:
         cycles=cycles,
         law_name=getattr(law, "name", type(law).__name__),
         status="ok",
-        n_inserted=n_ins,
+        n_inserted=int(np.count_nonzero(inserted)),
+        inserted=inserted,
     )
 
 

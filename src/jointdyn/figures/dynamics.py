@@ -3,7 +3,8 @@
 ``fig6``
     Frequency-response curves: normalised amplitude of q = kt x / fy vs
     gamma for eta = 0.01, 0.5, 1.5, 10 and beta from 0.1 to 1000, swept up
-    and down (parallel sweep); points without a steady state are marked.
+    and down (parallel sweep); points without a steady state are marked on
+    a rug axis below each panel, never on the amplitude axis.
 ``fig7``
     Steady loops T vs x under a small tangential excitation with separation
     (eta > 1): the contact opens while it carries load (the force drops to
@@ -12,7 +13,8 @@
     normal load against the motion.
 ``fig8``
     Steady loops for delta from 0 to 180 deg, in contact (eta = 0.5) and with
-    separation (eta = 1.5).
+    separation (eta = 1.5), with the exact discrete model beside the closed
+    form, and the energy per cycle of both against delta.
 ``energy_delta``
     Energy dissipated by the contact per cycle vs delta, in contact and with
     separation.
@@ -52,59 +54,111 @@ def _gamma_grid(spec):
 
 
 def fig6_data(gammas=None, etas=FIG6_ETAS, betas=FIG6_BETAS, **kw):
-    """The Fig 6 sweep as a tidy table (one row per point)."""
+    """The Fig 6 sweep as a tidy table (one row per point, with the contact model's name)."""
     from ..sweeps import frc_sweep, to_frame
 
     g = _gamma_grid(FIG6_GAMMA) if gammas is None else gammas
     ds = frc_sweep(g, etas=etas, betas=betas, directions=("up", "down"), **kw)
     df = to_frame(ds)
+    df["model"] = ds.attrs.get("model", "")
     return df[["eta", "beta", "direction", "gamma", "amplitude_q", "offset_m", "amplitude_m",
-               "energy_contact_J", "periods", "status", "status_name"]]
+               "energy_contact_J", "periods", "status", "status_name", "model"]]
 
 
-@register_figure("fig6", "Frequency response: amplitude of q vs gamma for eta in {0.01, 0.5, 1.5, 10}, beta 0.1..1000", 60)
+@register_figure("fig6", "Paper Fig 6: amplitude of q vs gamma; eta in {0.01, 0.5, 1.5, 10} by panel, beta 0.1..1000 "
+                 "by colour", 60)
 def fig6():
     return {"curves": fig6_data()}
+
+
+#: one colour per beta, dark enough on white (ColorBrewer Dark2 without its yellow)
+BETA_COLORS = ("#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#a6761d", "#666666")
+#: rug marker per non-periodic status name (marker, face colour or None for filled)
+RUG_MARKERS = {"not-settled": ("o", "none"), "unbounded": ("x", None)}
+
+
+def _status_names(codes):
+    """Sweep status names of integer codes (``config.SWEEP_STATUS``; "missing" otherwise)."""
+    from .. import config
+
+    known = config.SWEEP_STATUS
+    return np.array([known[c] if 0 <= c < len(known) else "missing" for c in np.asarray(codes, int)])
+
+
+def _linear_limits(ax):
+    """Vertical lines at the two linear limits of the damper, labelled above the axes."""
+    from ..systems import PAPER
+
+    trans = ax.get_xaxis_transform()
+    for g, text, ls in ((1.0, "gamma = 1\nall slipping", "-"),
+                        (math.sqrt(1.0 + PAPER["kt"] / PAPER["k"]), "gamma = 1.33\nall stuck", ":")):
+        ax.axvline(g, color="0.45", lw=0.8, ls=ls, zorder=0)
+        ax.text(g, 1.01, text, transform=trans, ha="center", va="bottom", fontsize=7, color="0.3")
+
+
+def _fig6_panel(ax, rug, df, betas):
+    """Curves of one eta: sweep up as a wide pale band, sweep down as a thin
+    line on top (where the two differ, the band and the line part); points
+    without a steady state as markers on the rug axes below (one row per beta)."""
+    for ib, beta in enumerate(betas):
+        color = BETA_COLORS[ib % len(BETA_COLORS)]
+        for d in ("up", "down"):
+            sub = df[(df.beta == beta) & (df.direction == d)].sort_values("gamma")
+            names = _status_names(sub.status)
+            ok = names == "periodic"
+            y = np.where(ok, sub.amplitude_q.to_numpy(), np.nan)
+            if d == "up":
+                ax.plot(sub.gamma, y, "-", color=color, lw=4.0, alpha=0.35, solid_capstyle="butt")
+            else:
+                ax.plot(sub.gamma, y, "-", color=color, lw=1.1, label=f"beta = {beta:g}")
+            for name, (marker, face) in RUG_MARKERS.items():
+                sel = names == name
+                if sel.any():
+                    rug.plot(sub.gamma[sel], np.full(sel.sum(), ib), marker, color=color, ms=5,
+                             mfc=face if face else color, ls="none")
+    ax.set_yscale("log")
+    ax.grid(alpha=0.3, which="both")
+    rug.set_ylim(-0.8, len(betas) - 0.2)
+    rug.set_yticks([])
+    rug.set_ylabel("no steady\nstate", fontsize=7, rotation=0, ha="right", va="center")
+    rug.grid(alpha=0.3, axis="x")
+    _linear_limits(ax)
+
+
+def _fig6_legend(fig, ax):
+    from matplotlib.lines import Line2D
+
+    h, lab = ax.get_legend_handles_labels()
+    h += [Line2D([], [], color="k", lw=4.0, alpha=0.35), Line2D([], [], color="k", lw=1.1),
+          Line2D([], [], color="k", marker="x", ls="none"), Line2D([], [], color="k", marker="o", mfc="none", ls="none")]
+    lab += ["sweep up (pale band)", "sweep down (thin line)", "unbounded (rug)", "not settled (rug)"]
+    fig.legend(h, lab, loc="outside lower center", ncol=6, fontsize=8, frameon=False)
 
 
 @fig6.plotter
 def _plot_fig6(tables, out_dir):
     plt = pyplot()
-
-    from ..sweeps._plot import mark_legend, plot_frc_curve
-
     df = tables["curves"]
     etas = sorted(df.eta.unique())
     betas = sorted(df.beta.unique())
-    cmap = plt.get_cmap("viridis")
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7.5), sharex=True)
-    for ax, eta in zip(axes.ravel(), etas):
-        for ib, beta in enumerate(betas):
-            color = cmap(ib / max(1, len(betas) - 1))
-            for d, style in (("up", "-"), ("down", "--")):
-                sub = df[(df.eta == eta) & (df.beta == beta) & (df.direction == d)].sort_values("gamma")
-                plot_frc_curve(ax, sub.gamma, sub.amplitude_q, sub.status, color=color, linestyle=style,
-                               label=f"beta = {beta:g}" if d == "up" else None,
-                               rug_y=0.02 + 0.025 * ib)
-        ax.set_yscale("log")
-        lo, hi = ax.get_ylim()  # free the bottom quarter for the rug markers
-        ax.set_ylim(lo / (hi / lo) ** 0.3, hi)
-        ax.set_title(f"eta = {eta:g}" + (" (separation)" if eta > 1 else ""), fontsize=10)
-        ax.axvline(1.0, color="0.7", lw=0.6)
-        ax.axvline(math.sqrt(1 + 3e5 / 3.9e5), color="0.7", lw=0.6, ls=":")
-        ax.grid(alpha=0.3, which="both")
-    for ax in axes[1]:
-        ax.set_xlabel("gamma = w / w0")
-    for ax in axes[:, 0]:
-        ax.set_ylabel("amplitude of q = kt x / fy")
-    mark_legend(axes[0, 0], fontsize=7, ncol=8)
-    leg = axes[0, 0].get_legend()
-    handles, labels = leg.legend_handles, [t.get_text() for t in leg.get_texts()]
-    leg.remove()
-    fig.legend(handles, labels, loc="lower center", ncol=8, fontsize=7, frameon=False)
-    fig.suptitle("Fig 6: steady response, sweep up (solid) and down (dashed); markers at the bottom: "
-                 "no steady state (x unbounded, o not settled)", fontsize=9)
-    fig.tight_layout(rect=(0, 0.04, 1, 1))
+    fig = plt.figure(figsize=(11, 9.5), layout="constrained")
+    gs = fig.add_gridspec(4, 2, height_ratios=[7, 1.3, 7, 1.3])
+    first = None
+    for k, eta in enumerate(etas[:4]):
+        r, c = divmod(k, 2)
+        ax = fig.add_subplot(gs[2 * r, c], sharex=first)
+        first = first or ax
+        rug = fig.add_subplot(gs[2 * r + 1, c], sharex=first)
+        _fig6_panel(ax, rug, df[df.eta == eta], betas)
+        ax.set_title(f"eta = {eta:g}" + (" (separation)" if eta > 1 else " (contact)"), fontsize=10, pad=22)
+        ax.tick_params(labelbottom=False)
+        rug.set_xlabel("gamma = w / w0")
+        ax.set_ylabel("half peak-to-peak amplitude\nof q = kt x / fy")
+        if k == 0:
+            _fig6_legend(fig, ax)
+    model = f", contact model {df['model'].iloc[0]}" if "model" in df else ""
+    fig.suptitle("Paper Fig 6: steady response vs frequency ratio gamma; eta = N1/N0 varied by panel, "
+                 f"beta = mu N0 / F1 by colour (delta = 0{model})", fontsize=10)
     return save_figure(fig, out_dir, "fig6")
 
 
@@ -133,6 +187,26 @@ def steady_loop(eta, beta, gamma, delta_deg, *, model="iwan", **kw):
     return res, df
 
 
+def _opening_run(code):
+    """Indices around the first opening of a loop: ``(i, j)`` with ``i`` the
+    last sample before separation (code 2) and ``j`` the start of the
+    macroslip run (code 1) that leads into it (``j == i`` when there is
+    none); None when the loop never opens. The loop is periodic: runs may
+    wrap around its start."""
+    code = np.asarray(code)
+    n = code.size
+    opens = np.flatnonzero((code == 2) & (np.roll(code, 1) != 2))
+    if opens.size == 0:
+        return None
+    i = (opens[0] - 1) % n
+    j = i
+    for _ in range(n):
+        if code[(j - 1) % n] != 1:
+            break
+        j = (j - 1) % n
+    return int(i), int(j)
+
+
 def _opening_drop(df):
     """How much load the contact carries when it starts to open.
 
@@ -143,27 +217,23 @@ def _opening_drop(df):
     force lost over a small travel is the jump of Fig 7a; a force near 0 is
     the continuous case of Fig 7b. NaN when the loop has no opening.
     """
-    code = df["code"].to_numpy()
+    run = _opening_run(df["code"].to_numpy())
+    if run is None:
+        return math.nan, math.nan
+    i, j = run
     x = df["x"].to_numpy()
     T = df["T"].to_numpy()
-    n = code.size
-    opens = np.flatnonzero((code == 2) & (np.roll(code, 1) != 2))
-    if opens.size == 0:
-        return math.nan, math.nan
-    i = (opens[0] - 1) % n
-    j = i
-    for _ in range(n):
-        if code[(j - 1) % n] != 1:
-            break
-        j = (j - 1) % n
     amp = 0.5 * (x.max() - x.min())
     return float(T[j]), float(abs(x[i] - x[j]) / amp) if amp > 0 else math.nan
 
 
-def _loops(cases):
+def _loops(cases, model="iwan"):
+    """Steady loops of ``cases`` ((label, eta, beta, gamma, delta_deg) each)
+    with contact model ``model``: the loops as one long table and one row of
+    results per case."""
     rows, info = [], []
     for label, eta, beta, gamma, delta in cases:
-        res, df = steady_loop(eta, beta, gamma, delta)
+        res, df = steady_loop(eta, beta, gamma, delta, model=model)
         df.insert(0, "case", label)
         df.insert(1, "eta", eta)
         df.insert(2, "beta", beta)
@@ -171,25 +241,63 @@ def _loops(cases):
         df.insert(4, "delta_deg", delta)
         rows.append(df)
         drop_T, drop_dx = _opening_drop(df)
-        info.append(dict(case=label, eta=eta, beta=beta, gamma=gamma, delta_deg=delta, status=res.status,
+        info.append(dict(case=label, model=model, eta=eta, beta=beta, gamma=gamma, delta_deg=delta, status=res.status,
                          amplitude_q=res.amplitude_q, energy_contact_J=res.energy_contact_J,
                          drop_T_N=drop_T, drop_dx_over_amp=drop_dx, periods=res.periods))
     return pd.concat(rows, ignore_index=True), pd.DataFrame(info)
 
 
-@register_figure("fig7", "Loops under a small tangential excitation with separation: force jump vs continuous", 70)
+@register_figure("fig7", "Paper Fig 7: loops under a small tangential load with separation, delta varied: force jump "
+                 "vs continuous", 70)
 def fig7():
     loops, info = _loops(FIG7_CASES)
     return {"loops": loops, "cases": info}
 
 
-def _loop_axes(ax, df, label, color):
+def _loop_axes(ax, df, label, color, ls="-", lw=1.2):
     x = df["x"].to_numpy() * 1e6
     T = df["T"].to_numpy()
     sep = df["code"].to_numpy() == 2
-    ax.plot(np.r_[x, x[:1]], np.r_[T, T[:1]], color=color, lw=1.2, label=label)
+    ax.plot(np.r_[x, x[:1]], np.r_[T, T[:1]], color=color, lw=lw, ls=ls, label=label)
     if sep.any():
         ax.plot(x[sep], T[sep], ".", color=color, ms=2.5, alpha=0.6)
+
+
+def _path_arrows(ax, x, T, color, count=8):
+    """Arrows along a loop in the direction of time, evenly spaced in time."""
+    n = x.size
+    step = max(1, n // 200)
+    for k in range(count):
+        i = (k * n) // count
+        j = (i + step) % n
+        if (x[i], T[i]) != (x[j], T[j]):
+            ax.annotate("", xy=(x[j], T[j]), xytext=(x[i], T[i]),
+                        arrowprops=dict(arrowstyle="-|>", color=color, lw=1.2, mutation_scale=14))
+
+
+def _label_opening(ax, df, color):
+    """The paper's Fig 7 labels: A where the contact starts to lose its load
+    on the way to opening, S on the separated stretch, B where contact returns."""
+    x = df["x"].to_numpy() * 1e6
+    T = df["T"].to_numpy()
+    code = df["code"].to_numpy()
+    run = _opening_run(code)
+    if run is None:
+        return
+    i, j = run
+    ax.plot([x[j]], [T[j]], "o", color="k", ms=4)
+    ax.annotate("A", (x[j], T[j]), xytext=(6, 4), textcoords="offset points", fontsize=12, fontweight="bold")
+    sep = np.flatnonzero(code == 2)
+    mid = sep[sep.size // 2]
+    ax.annotate("S", (x[mid], 0.0), xytext=(0, 8), textcoords="offset points", fontsize=12, fontweight="bold",
+                ha="center")
+    n = code.size
+    back = [(k + 1) % n for k in sep if code[(k + 1) % n] != 2]
+    if back:
+        b = back[0]
+        ax.plot([x[b]], [T[b]], "o", color="k", ms=4)
+        ax.annotate("B", (x[b], T[b]), xytext=(-6, -14), textcoords="offset points", fontsize=12,
+                    fontweight="bold", ha="right")
 
 
 @fig7.plotter
@@ -197,28 +305,66 @@ def _plot_fig7(tables, out_dir):
     plt = pyplot()
 
     loops, info = tables["loops"], tables["cases"]
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
-    for ax, (_, row) in zip(axes, info.iterrows()):
+    fig, axes = plt.subplots(1, 2, figsize=(11, 5.0), layout="constrained")
+    for ax, (_, row), tag in zip(axes, info.iterrows(), "ab"):
         df = loops[loops.case == row.case]
-        _loop_axes(ax, df, "loop (dots: separated, T = 0)", "C0")
-        ax.set_title(f"{row.case}\neta = {row.eta:g}, beta = {row.beta:g}, gamma = {row.gamma:g}, "
-                     f"delta = {row.delta_deg:g} deg\nload when opening starts = {row.drop_T_N:.3g} N, lost over "
-                     f"{row.drop_dx_over_amp:.2g} of the amplitude", fontsize=8)
-        ax.set_xlabel("x (um)")
-        ax.set_ylabel("T (N)")
+        _loop_axes(ax, df, None, "C0")
+        _path_arrows(ax, df["x"].to_numpy() * 1e6, df["T"].to_numpy(), "C0")
+        _label_opening(ax, df, "C0")
+        ax.set_title(f"({tag}) delta = {row.delta_deg:g} deg: {row.case.split(': ', 1)[-1]}\n"
+                     f"load when opening starts (A) = {row.drop_T_N:.3g} N, lost over "
+                     f"{row.drop_dx_over_amp:.2g} of the amplitude", fontsize=9)
+        ax.set_xlabel("tangential displacement x (um)")
+        ax.set_ylabel("tangential force T (N)")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
-    fig.suptitle("Fig 7: separation under a small tangential load. (a) the contact opens while it carries "
-                 "tangential load, so T falls to 0 at almost fixed x; (b) it opens near T = 0", fontsize=9)
-    fig.tight_layout()
+    row = info.iloc[0]
+    fig.suptitle(f"Paper Fig 7: steady loops under a small tangential load with separation, phase delta varied "
+                 f"(eta = {row.eta:g}, beta = {row.beta:g}, gamma = {row.gamma:g}, closed-form Iwan)\n"
+                 "arrows: direction of time; A: the contact starts to lose its load; S: separated (T = 0, dots); "
+                 "B: contact returns", fontsize=9)
     return save_figure(fig, out_dir, "fig7")
 
 
-@register_figure("fig8", "Steady loops for delta = 0..180 deg, in contact (eta 0.5) and with separation (eta 1.5)", 80)
+#: Fig 8: the paper's closed form beside the exact model
+FIG8_MODELS = (("discrete", "exact discrete Iwan (n = 1000)", "exact"), ("iwan", "closed-form Iwan", "closed form"))
+#: phases of the energy-per-cycle panel (the loop panels show FIG8_DELTAS)
+FIG8_ENERGY_DELTAS = tuple(float(d) for d in range(0, 181, 15))
+
+
+@register_figure("fig8", "Paper Fig 8: steady loops for delta = 0..180 deg, in contact (eta 0.5) and with separation "
+                 "(eta 1.5); exact model beside the closed form, energy per cycle vs delta", 80)
 def fig8():
-    cases = [(f"eta {eta:g} delta {d:g}", eta, FIG8_BETA, FIG8_GAMMA, d) for eta in FIG8_ETAS for d in FIG8_DELTAS]
-    loops, info = _loops(cases)
-    return {"loops": loops, "cases": info}
+    deltas = sorted(set(FIG8_DELTAS) | set(FIG8_ENERGY_DELTAS))
+    loops, info = [], []
+    for model, _, _ in FIG8_MODELS:
+        cases = [(f"{model} eta {eta:g} delta {d:g}", eta, FIG8_BETA, FIG8_GAMMA, d) for eta in FIG8_ETAS
+                 for d in deltas]
+        lp, inf = _loops(cases, model=model)
+        lp.insert(1, "model", model)
+        keep = lp.delta_deg.isin(FIG8_DELTAS)  # loops drawn; every phase enters the energy panel
+        loops.append(lp[keep])
+        info.append(inf)
+    return {"loops": pd.concat(loops, ignore_index=True), "cases": pd.concat(info, ignore_index=True)}
+
+
+def _fig8_energy(ax, info, eta):
+    """Energy dissipated by the contact per cycle vs delta, one curve per
+    model, the largest loop of each starred and named in the title."""
+    largest = []
+    for k, (model, label, short) in enumerate(FIG8_MODELS):
+        rows = info[(info.eta == eta) & (info.model == model)].sort_values("delta_deg")
+        ok = rows.status == "periodic"
+        ax.plot(rows.delta_deg, np.where(ok, rows.energy_contact_J * 1e3, np.nan), "-o" if k == 0 else "--s",
+                color="k" if k == 0 else "C3", ms=3.5, mfc="none" if k else None, label=label)
+        best = rows[ok].loc[rows[ok].energy_contact_J.idxmax()]
+        ax.plot([best.delta_deg], [best.energy_contact_J * 1e3], "*", color="k" if k == 0 else "C3", ms=11)
+        largest.append(f"{short} {best.delta_deg:g} deg")
+    ax.set_xticks(range(0, 181, 45))
+    ax.set_xlabel("delta (deg)")
+    ax.set_ylabel("energy dissipated per cycle (mJ)")
+    ax.set_title(f"loop area vs delta, eta = {eta:g}\nlargest (star): " + ", ".join(largest), fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
 
 
 @fig8.plotter
@@ -226,26 +372,33 @@ def _plot_fig8(tables, out_dir):
     plt = pyplot()
 
     loops, info = tables["loops"], tables["cases"]
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    etas = sorted(info.eta.unique())
+    fig, axes = plt.subplots(len(etas), 3, figsize=(15, 4.6 * len(etas)), squeeze=False, layout="constrained",
+                             gridspec_kw={"width_ratios": [1, 1, 0.8]})
     cmap = plt.get_cmap("plasma")
-    for ax, eta in zip(axes, sorted(info.eta.unique())):
-        rows = info[info.eta == eta].sort_values("delta_deg")
-        for i, (_, row) in enumerate(rows.iterrows()):
-            df = loops[loops.case == row.case]
-            _loop_axes(ax, df, f"delta = {row.delta_deg:g} deg, E = {row.energy_contact_J:.3g} J",
-                       cmap(i / max(1, len(rows) - 1) * 0.9))
-        ax.set_title(f"eta = {eta:g} ({'separation' if eta > 1 else 'contact'}), beta = {FIG8_BETA:g}, "
-                     f"gamma = {FIG8_GAMMA:g}", fontsize=9)
-        ax.set_xlabel("x (um)")
-        ax.set_ylabel("T (N)")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
-    fig.suptitle("Fig 8: steady hysteresis loops vs phase delta of the normal load (dots: separated)", fontsize=9)
-    fig.tight_layout()
+    for r, eta in enumerate(etas):
+        for c, (model, label, _) in enumerate(FIG8_MODELS):
+            ax = axes[r, c]
+            rows = info[(info.eta == eta) & (info.model == model) & info.delta_deg.isin(FIG8_DELTAS)]
+            for i, (_, row) in enumerate(rows.sort_values("delta_deg").iterrows()):
+                _loop_axes(ax, loops[loops.case == row.case], f"delta = {row.delta_deg:g} deg",
+                           cmap(i / max(1, len(rows) - 1) * 0.85))
+            ax.set_title(f"{label}: eta = {eta:g} ({'separation' if eta > 1 else 'contact'})", fontsize=9)
+            ax.set_xlabel("x (um)")
+            ax.set_ylabel("T (N)")
+            ax.grid(alpha=0.3)
+        _fig8_energy(axes[r, 2], info, eta)
+    h, lab = axes[0, 0].get_legend_handles_labels()
+    fig.legend(h, lab, loc="outside lower center", ncol=len(h), fontsize=8, frameon=False)
+    fig.suptitle(f"Paper Fig 8: steady loops, phase delta of the normal load varied (beta = {FIG8_BETA:g}, "
+                 f"gamma = {FIG8_GAMMA:g}; dots: separated)\nThe paper finds the largest loop near delta = 90 deg "
+                 "and the smallest at 0 and 180 deg: compare the largest loop (star) of the exact model and of the "
+                 "closed form, right", fontsize=10)
     return save_figure(fig, out_dir, "fig8")
 
 
-@register_figure("energy_delta", "Energy dissipated per cycle vs delta, in contact and with separation", 85)
+@register_figure("energy_delta", "Beyond paper Fig 8: energy dissipated per cycle vs delta, in contact and with "
+                 "separation", 85)
 def energy_delta():
     from ..sweeps import frc_sweep, to_frame
 
@@ -258,11 +411,13 @@ def energy_delta():
 
 @energy_delta.plotter
 def _plot_energy(tables, out_dir):
+    from matplotlib.lines import Line2D
+
     plt = pyplot()
 
     df = tables["energy"]
     etas = sorted(df.eta.unique())
-    fig, axes = plt.subplots(1, len(etas), figsize=(5.2 * len(etas), 4.2), squeeze=False)
+    fig, axes = plt.subplots(1, len(etas), figsize=(5.6 * len(etas), 5.0), squeeze=False, layout="constrained")
     styles = ["-", "--", ":", "-."]
     for ax, eta in zip(axes[0], etas):
         sub_eta = df[df.eta == eta]
@@ -271,21 +426,24 @@ def _plot_energy(tables, out_dir):
         for ib, beta in enumerate(betas):
             for ig, gamma in enumerate(gammas):
                 sub = sub_eta[(sub_eta.beta == beta) & (sub_eta.gamma == gamma)].sort_values("delta")
-                ok = sub.status == 0
+                ok = (sub.status == 0).to_numpy()
                 color = f"C{ig}"
-                ax.plot(sub.delta, np.where(ok, sub.energy_contact_J, np.nan), marker="o", ms=3, ls=styles[ib % 4],
-                        color=color,
-                        label=f"beta = {beta:g}, gamma = {gamma:g}")
-                if (~ok).any():
-                    ax.plot(sub.delta[~ok], np.full((~ok).sum(), 0.03), "x", color=color,
-                            transform=ax.get_xaxis_transform())
+                ax.plot(sub.delta, np.where(ok, sub.energy_contact_J, np.nan), marker="o", ms=3,
+                        ls=styles[ib % 4], color=color, label=f"beta = {beta:g}, gamma = {gamma:g}")
+                if (~ok).any():  # no steady state: an "x" on the bottom edge, never a number
+                    ax.plot(sub.delta.to_numpy()[~ok], np.full((~ok).sum(), 0.0), "x", color=color, ms=8, mew=1.6,
+                            transform=ax.get_xaxis_transform(), clip_on=False)
         ax.set_yscale("log")
         ax.set_xlabel("delta (deg)")
         ax.set_ylabel("energy dissipated by the contact per cycle (J)")
-        ax.set_title(f"eta = {eta:g} ({'separation' if eta > 1 else 'contact'}); x: no steady state", fontsize=9)
+        ax.set_title(f"eta = {eta:g} ({'separation' if eta > 1 else 'contact'})", fontsize=10)
         ax.set_xticks(range(0, 181, 30))
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=7)
-    fig.suptitle("Contact dissipation per cycle vs the phase delta of the normal load (forced damper)", fontsize=9)
-    fig.tight_layout()
+    h, lab = axes[0, 0].get_legend_handles_labels()
+    h.append(Line2D([], [], color="k", marker="x", ls="none", ms=8, mew=1.6))
+    lab.append("no steady state (on the bottom edge)")
+    fig.legend(h, lab, loc="outside lower center", ncol=4, fontsize=8, frameon=False)
+    fig.suptitle("Beyond paper Fig 8: energy dissipated by the contact per cycle, phase delta of the normal load "
+                 "varied,\nfor several forcing levels beta (line style) and frequencies gamma (colour) of the forced "
+                 "damper", fontsize=10)
     return save_figure(fig, out_dir, "energy_delta")

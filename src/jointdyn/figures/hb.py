@@ -45,6 +45,7 @@ def fig6_hb_data(etas=HB_ETAS, betas=HB_BETAS, gamma=HB_GAMMA, time_step=HB_TIME
             df.insert(0, "beta", beta)
             df.insert(0, "eta", eta)
             df["status"] = ds.attrs["status"]
+            df["model"] = model
             rows.append(df)
     tables = {"hb": pd.concat(rows, ignore_index=True)}
     if time_domain:
@@ -56,7 +57,8 @@ def fig6_hb_data(etas=HB_ETAS, betas=HB_BETAS, gamma=HB_GAMMA, time_step=HB_TIME
     return tables
 
 
-@register_figure("fig6_hb", "Fig 6 by harmonic balance (stable solid, unstable dashed, folds) over time-domain sweeps", 65)
+@register_figure("fig6_hb", "Paper Fig 6 cases by harmonic balance (stable solid, unstable dashed, folds) over "
+                 "time-domain sweeps; eta by panel, beta by colour", 65)
 def fig6_hb():
     return fig6_hb_data()
 
@@ -70,60 +72,76 @@ def _runs(mask):
     return np.split(idx, cuts)
 
 
+def _hb_curve(ax, sub, color):
+    """One HB branch: stable pieces solid, unstable dashed, folds as squares;
+    a new piece starts at a change of branch or a gap."""
+    g = sub.gamma.to_numpy()
+    a = sub.amplitude_q.to_numpy()
+    st = sub.stable.to_numpy().astype(bool)
+    brk = np.r_[False, (np.diff(sub.branch.to_numpy()) != 0) | sub.gap.to_numpy().astype(bool)[1:]]
+    piece = np.cumsum(brk)
+    for pc in np.unique(piece):
+        idx = np.flatnonzero(piece == pc)
+        for run in _runs(st[idx]):
+            j = idx[run[0]: run[-1] + 2] if run[-1] + 1 < idx.size else idx[run]
+            ax.plot(g[j], a[j], "-", color=color, lw=1.4)
+        for run in _runs(~st[idx]):
+            j = idx[max(run[0] - 1, 0): run[-1] + 2]
+            ax.plot(g[j], a[j], "--", color=color, lw=1.4)
+    f = sub.fold.to_numpy().astype(bool)
+    ax.plot(g[f], a[f], "ks", ms=5, mfc="none")
+
+
+def _hb_legend(fig, betas, statuses):
+    from matplotlib.lines import Line2D
+
+    from .dynamics import BETA_COLORS
+
+    h, lab = [], []
+    for ib, beta in enumerate(betas):
+        h.append(Line2D([], [], color=BETA_COLORS[ib % len(BETA_COLORS)], lw=1.4))
+        lab.append(f"beta = {beta:g}" + (" (HB stopped: unbounded)" if statuses.get(beta) == "unbounded" else ""))
+    h += [Line2D([], [], color="k", ls="--"), Line2D([], [], color="k", marker="s", mfc="none", ls="none"),
+          Line2D([], [], color="k", marker="^", mfc="none", ls="none"),
+          Line2D([], [], color="k", marker="v", mfc="none", ls="none")]
+    lab += ["HB unstable (Hill)", "HB fold", "time domain, sweep up (periodic points)",
+            "time domain, sweep down (periodic points)"]
+    fig.legend(h, lab, loc="outside lower center", ncol=4, fontsize=8, frameon=False)
+
+
 @fig6_hb.plotter
 def _plot_fig6_hb(tables, out_dir):
-    plt = pyplot()
+    from .dynamics import BETA_COLORS, _linear_limits
 
+    plt = pyplot()
     hb = tables["hb"]
     td = tables.get("time")
     etas = sorted(hb.eta.unique())
     betas = sorted(hb.beta.unique())
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7.5), sharex=True)
+    fig, axes = plt.subplots(2, 2, figsize=(11, 9), sharex=True, layout="constrained")
+    statuses = {}
     for ax, eta in zip(axes.ravel(), etas):
         for ib, beta in enumerate(betas):
-            color = f"C{ib}"
+            color = BETA_COLORS[ib % len(BETA_COLORS)]
             sub = hb[(hb.eta == eta) & (hb.beta == beta)].reset_index(drop=True)
-            g = sub.gamma.to_numpy()
-            a = sub.amplitude_q.to_numpy()
-            st = sub.stable.to_numpy().astype(bool)
-            # pieces: same branch, no gap between consecutive points
-            brk = np.r_[False, (np.diff(sub.branch.to_numpy()) != 0) | sub.gap.to_numpy().astype(bool)[1:]]
-            piece = np.cumsum(brk)
-            for pc in np.unique(piece):
-                idx = np.flatnonzero(piece == pc)
-                for run in _runs(st[idx]):
-                    j = idx[run[0]: run[-1] + 2] if run[-1] + 1 < idx.size else idx[run]
-                    ax.plot(g[j], a[j], "-", color=color, lw=1.3)
-                for run in _runs(~st[idx]):
-                    j = idx[max(run[0] - 1, 0): run[-1] + 2]
-                    ax.plot(g[j], a[j], "--", color=color, lw=1.3)
-            f = sub.fold.to_numpy().astype(bool)
-            ax.plot(g[f], a[f], "ks", ms=4, mfc="none")
-            label = f"beta = {beta:g}"
+            _hb_curve(ax, sub, color)
             if sub.status.iloc[0] == "unbounded":
-                label += " (unbounded)"
-                ax.plot([], [], color=color, label=None)
-            ax.plot([], [], "-", color=color, label=label)
+                statuses[beta] = "unbounded"
             if td is not None:
                 for d, mk in (("up", "^"), ("down", "v")):
                     t = td[(td.eta == eta) & (td.beta == beta) & (td.direction == d) & (td.status_name == "periodic")]
-                    ax.plot(t.gamma, t.amplitude_q, mk, color=color, ms=3.5, alpha=0.6, mfc="none")
+                    ax.plot(t.gamma, t.amplitude_q, mk, color=color, ms=4, alpha=0.7, mfc="none")
         ax.set_yscale("log")
-        ax.set_title(f"eta = {eta:g}" + (" (separation)" if eta > 1 else ""), fontsize=10)
+        ax.set_title(f"eta = {eta:g}" + (" (separation)" if eta > 1 else " (contact)"), fontsize=10, pad=22)
         ax.grid(alpha=0.3, which="both")
+        _linear_limits(ax)
     for ax in axes[1]:
         ax.set_xlabel("gamma = w / w0")
     for ax in axes[:, 0]:
-        ax.set_ylabel("amplitude of q = kt x / fy")
-    h = axes[0, 0]
-    h.plot([], [], "k--", label="HB unstable")
-    h.plot([], [], "ks", mfc="none", label="fold")
-    h.plot([], [], "k^", mfc="none", label="time, sweep up")
-    h.plot([], [], "kv", mfc="none", label="time, sweep down")
-    h.plot([], [], " ", label="(time points: periodic only)")
-    h.legend(fontsize=7, ncol=2, loc="upper right")
-    fig.suptitle("Fig 6 by harmonic balance (H = 7, 128 samples; 512 for eta > 1; Hill stability) "
-                 "over time-domain steady states",
-                 fontsize=9)
-    fig.tight_layout()
+        ax.set_ylabel("half peak-to-peak amplitude\nof q = kt x / fy")
+    _hb_legend(fig, betas, statuses)
+    model = f", contact model {hb['model'].iloc[0]}" if "model" in hb else ""
+    fig.suptitle("Paper Fig 6 cases by harmonic balance over time-domain steady states; eta varied by panel, "
+                 f"beta by colour\n(H = 7, 128 samples per period, 512 for eta > 1; stability by Hill's method{model})",
+                 fontsize=10)
     return save_figure(fig, out_dir, "fig6_hb")

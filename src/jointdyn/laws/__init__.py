@@ -1,8 +1,13 @@
 """Contact laws: compiled trial-step kernels and thin parameter classes.
 
-Importing this package registers every built-in law (``iwan``, ``iwan-paper``,
-``discrete``, ``jenkins``) for :func:`make_law`.
+Importing this package imports every module of it whose name does not start
+with ``_``; each law module registers its law(s) (built in: ``iwan``,
+``iwan-paper``, ``discrete``, ``jenkins``), so a new law is one module
+dropped here (see :mod:`jointdyn.laws._base` for the contract).
 """
+
+import importlib as _importlib
+import pkgutil as _pkgutil
 
 from ._base import (
     MACROSLIP,
@@ -10,14 +15,24 @@ from ._base import (
     STATE_NAMES,
     STICK_SLIP,
     ContactLaw,
+    LawParameter,
+    canonical_law_params,
     law_names,
+    law_param,
+    law_parameters,
+    law_summary,
     make_law,
     register,
 )
-from .discrete import DiscreteIwan, Jenkins
-from .exact import ExactIwan  # noqa: F401 - registers "iwan-exact"
-from .iwan import Iwan, backbone
-from .normal import HarmonicLoad, NormalLoad, SampledLoad, UnilateralSpring
+
+for _module in _pkgutil.iter_modules(__path__):
+    if not _module.name.startswith("_"):
+        _importlib.import_module(f"{__name__}.{_module.name}")
+
+from .discrete import DiscreteIwan, Jenkins  # noqa: E402
+from .exact import ExactIwan  # noqa: E402
+from .iwan import Iwan, backbone  # noqa: E402
+from .normal import HarmonicLoad, NormalLoad, SampledLoad, UnilateralSpring  # noqa: E402
 
 __all__ = [
     "STICK_SLIP",
@@ -25,13 +40,19 @@ __all__ = [
     "SEPARATION",
     "STATE_NAMES",
     "ContactLaw",
+    "LawParameter",
     "Iwan",
     "DiscreteIwan",
+    "ExactIwan",
     "Jenkins",
     "backbone",
     "register",
     "make_law",
     "law_names",
+    "law_param",
+    "law_parameters",
+    "law_summary",
+    "canonical_law_params",
     "NormalLoad",
     "HarmonicLoad",
     "SampledLoad",

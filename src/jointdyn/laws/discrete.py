@@ -12,10 +12,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from .. import _validate as V
 from .. import config
 from .._jit import jit
-from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, register
+from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, law_param, register
 
 __all__ = ["DiscreteIwan", "Jenkins", "discrete_step", "discrete_step_jvp", "discrete_init", "discrete_init_jvp"]
 
@@ -192,12 +191,8 @@ class DiscreteIwan(ContactLaw):
         with slip force mu N(t) (use :class:`Jenkins`).
     """
 
-    n: int = config.LAW_DISCRETE_N
+    n: int = law_param(config.LAW_DISCRETE_N, low=1, help="number of Jenkins elements")
     name: ClassVar[str] = "discrete"
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        object.__setattr__(self, "n", V.positive_int("n", self.n))
 
     @property
     def step(self):
@@ -225,6 +220,12 @@ class DiscreteIwan(ContactLaw):
     def init_jvp(self):
         return discrete_init_jvp
 
+    @property
+    def x_slip(self) -> float:
+        """Slip displacement of the strongest element, 2 fy (n - 1/2) / (n kt) (m):
+        the whole virgin curve is in macroslip beyond it."""
+        return 2.0 * self.fy * (self.n - 0.5) / (self.n * self.kt)
+
 
 @dataclass(frozen=True)
 class Jenkins(DiscreteIwan):
@@ -238,18 +239,11 @@ class Jenkins(DiscreteIwan):
     name: ClassVar[str] = "jenkins"
 
     def __post_init__(self) -> None:
+        if isinstance(self.n, bool) or self.n != 1:
+            raise ValueError(f"n must be 1 for a Jenkins element (allowed range [1, 1]), got {self.n!r}")
+        object.__setattr__(self, "n", 1)
         super().__post_init__()
-        if self.n != 1:
-            raise ValueError(f"n must be 1 for a Jenkins element (allowed range [1, 1]), got {self.n}")
 
 
-def _make_discrete(*, kt, mu, n_ref, n=config.LAW_DISCRETE_N, **_):
-    return DiscreteIwan(kt=kt, mu=mu, n_ref=n_ref, n=n)
-
-
-def _make_jenkins(*, kt, mu, n_ref, **_):
-    return Jenkins(kt=kt, mu=mu, n_ref=n_ref)
-
-
-register("discrete", _make_discrete)
-register("jenkins", _make_jenkins)
+register("discrete", DiscreteIwan, summary="n Jenkins elements in parallel, the exact discrete Iwan model and ground truth")
+register("jenkins", Jenkins, summary="one Jenkins element: spring kt in series with a slider mu N")

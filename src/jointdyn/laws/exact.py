@@ -65,10 +65,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from .. import _validate as V
 from .. import config
 from .._jit import jit
-from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, register
+from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, law_param, register
 
 __all__ = [
     "ExactIwan",
@@ -532,12 +531,11 @@ class ExactIwan(ContactLaw):
         see the module docstring and docs/exact-iwan.md for its error).
     """
 
-    capacity: int = config.IWAN_EXACT_CAPACITY
+    capacity: int = law_param(
+        config.IWAN_EXACT_CAPACITY, low=MIN_CAPACITY,
+        help="linear pieces kept after a step (above it, three adjacent pieces are merged into two)",
+    )
     name: ClassVar[str] = "iwan-exact"
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        object.__setattr__(self, "capacity", V.positive_int("capacity", self.capacity, MIN_CAPACITY))
 
     @property
     def step(self):
@@ -563,6 +561,12 @@ class ExactIwan(ContactLaw):
         return _HEAD + 3 * self.room
 
     @property
+    def x_slip(self) -> float:
+        """2 fy / kt (m): the virgin curve reaches macroslip when the
+        strongest element (u = 2) slips."""
+        return 2.0 * self.fy / self.kt
+
+    @property
     def init(self):
         return exact_init
 
@@ -576,8 +580,4 @@ def piece_count(state) -> int:
     return int(state[_M])
 
 
-def _make_exact(*, kt, mu, n_ref, capacity=config.IWAN_EXACT_CAPACITY, **_):
-    return ExactIwan(kt=kt, mu=mu, n_ref=n_ref, capacity=capacity)
-
-
-register("iwan-exact", _make_exact)
+register("iwan-exact", ExactIwan)

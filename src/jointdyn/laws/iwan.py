@@ -41,10 +41,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from .. import _validate as V
 from .. import config
 from .._jit import jit
-from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, register
+from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, law_param, register
 
 __all__ = ["Iwan", "iwan_step", "iwan_step_jvp", "iwan_init", "iwan_init_jvp", "backbone"]
 
@@ -140,69 +139,71 @@ def _branch(s, m, base, d, q, alpha):
     return g0 + d * S, 0.0, d, 0.0, 1.0, d, ref, ref + 1, ref + 2
 
 
-# inline="always": inlined (Numba IR) into the two public kernels, so that
-# they are small enough for LLVM to inline into the caller's time loop; a
-# call with three arrays passed field by field cost half of the step time.
-@jit(inline="always")
-def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
-    # The derivative arguments are either all arrays or all None; Numba
-    # prunes the ``is not None`` branches at compile time, so the plain step
-    # carries no derivative code at all.
-    kt = params[0]
-    fy = params[1]
-    n_ref = params[2]
-    last_only = params[3] != 0.0
-    max_depth = int(params[4])
-    alpha = N / n_ref
-    nd = 0
-    if dx is not None:
-        nd = dx.shape[0]
+# The trial step is split into the helpers below, each doing one job. Those
+# on the path of every step (copy of the live state, rejoin test, branch
+# force, saturation, derivatives) are inline="always" (inlined at the Numba
+# IR level), so that each public kernel is one function small enough for LLVM
+# to inline into the caller's time loop (a call passing three arrays field by
+# field cost half of the step time). Those on rare paths (separation,
+# re-contact, a reversal, a rejoin) are compiled apart and called: that keeps
+# the inlined step small, and quick to compile into every loop that binds
+# it. The derivative arguments (ds_old, ds_new, dx, dN, dT) are either all
+# arrays or all None; Numba prunes the ``is not None`` branches at compile
+# time, so the plain step carries no derivative code at all.
 
-    # --- separation (or no friction) ---------------------------------------
-    if alpha <= 0.0 or fy <= 0.0:
-        qs0 = kt / fy if fy > 0.0 else 0.0
-        for r in range(_HEAD):
-            s_new[r] = 0.0
-        s_new[_Q] = qs0 * x
-        s_new[_A] = alpha
-        if ds_new is not None:
-            for j in range(nd):
-                for r in range(_HEAD):
-                    ds_new[r, j] = 0.0
-                ds_new[_Q, j] = qs0 * dx[j]
-                ds_new[_A, j] = dN[j] / n_ref
-                dT[j] = 0.0
-        if alpha > 0.0:
-            s_new[_BASE] = _VIRGIN
-            return 0.0, 0.0, MACROSLIP
-        s_new[_BASE] = _SEP
-        return 0.0, 0.0, SEPARATION
 
-    qs = kt / fy  # dq = qs * dx
-    ia = 1.0 / n_ref  # dalpha = ia * dN
-    q = qs * x
+@jit
+def _separate(s_new, x, alpha, kt, fy, n_ref, ds_new, dx, dN, dT, nd):
+    """Open contact (alpha <= 0) or no friction (fy = 0): T = 0, memory lost.
 
-    # --- (re)contact: virgin curve from here --------------------------------
-    if s_old[_BASE] == _SEP:
-        for r in range(_HEAD):
-            s_new[r] = 0.0
-        s_new[_Q] = q
-        s_new[_A] = alpha
+    The state keeps q and alpha (so that the next step can detect motion);
+    with alpha > 0 (no friction) the base curve is virgin and the code
+    MACROSLIP, otherwise the base is separated and the code SEPARATION.
+    """
+    qs0 = kt / fy if fy > 0.0 else 0.0
+    for r in range(_HEAD):
+        s_new[r] = 0.0
+    s_new[_Q] = qs0 * x
+    s_new[_A] = alpha
+    if ds_new is not None:
+        for j in range(nd):
+            for r in range(_HEAD):
+                ds_new[r, j] = 0.0
+            ds_new[_Q, j] = qs0 * dx[j]
+            ds_new[_A, j] = dN[j] / n_ref
+            dT[j] = 0.0
+    if alpha > 0.0:
         s_new[_BASE] = _VIRGIN
-        s_new[_BQ] = q
-        if ds_new is not None:
-            for j in range(nd):
-                for r in range(_HEAD):
-                    ds_new[r, j] = 0.0
-                ds_new[_Q, j] = qs * dx[j]
-                ds_new[_A, j] = ia * dN[j]
-                ds_new[_BQ, j] = qs * dx[j]
-                dT[j] = 0.0
-        return 0.0, kt, STICK_SLIP
+        return 0.0, 0.0, MACROSLIP
+    s_new[_BASE] = _SEP
+    return 0.0, 0.0, SEPARATION
 
-    # --- copy the live part of the committed state --------------------------
-    # (rows _Q, _G, _A, _DIR, _BASE, _M are written at the end of the step)
-    m = int(s_old[_M])
+
+@jit
+def _contact_start(s_new, q, alpha, kt, qs, ia, ds_new, dx, dN, dT, nd):
+    """(Re)contact after separation: a virgin curve starts at q (T = 0, kT = kt)."""
+    for r in range(_HEAD):
+        s_new[r] = 0.0
+    s_new[_Q] = q
+    s_new[_A] = alpha
+    s_new[_BASE] = _VIRGIN
+    s_new[_BQ] = q
+    if ds_new is not None:
+        for j in range(nd):
+            for r in range(_HEAD):
+                ds_new[r, j] = 0.0
+            ds_new[_Q, j] = qs * dx[j]
+            ds_new[_A, j] = ia * dN[j]
+            ds_new[_BQ, j] = qs * dx[j]
+            dT[j] = 0.0
+    return 0.0, kt, STICK_SLIP
+
+
+@jit(inline="always")
+def _copy_live(s_old, s_new, m, ds_old, ds_new, nd):
+    """Copy the live part of the committed state: base point, its force offset
+    and the m reversal points (rows _Q, _G, _A, _DIR, _BASE, _M are written at
+    the end of the step); the derivative rows up to the stack top likewise."""
     s_new[_BQ] = s_old[_BQ]
     s_new[_BA] = s_old[_BA]
     s_new[_BG] = s_old[_BG]
@@ -212,76 +213,157 @@ def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
         for r in range(_HEAD + 3 * m):
             for j in range(nd):
                 ds_new[r, j] = ds_old[r, j]
-    q_prev = s_old[_Q]
-    d = s_old[_DIR]
-    base = s_old[_BASE]
 
-    # --- reversal detection: the previous point becomes a reversal point ---
+
+@jit
+def _push_reversal(s_old, s_new, m, last_only, max_depth, ds_old, ds_new, nd):
+    """Push the previous point (q, G, alpha of the committed state) onto the
+    reversal stack: it becomes the only point under the last-reversal rule,
+    and the innermost pair is forgotten when the stack is full. Returns the
+    new depth."""
+    if last_only:
+        m = 0
+    elif m >= max_depth:
+        m -= 2  # forget the innermost pair (documented limitation)
+    r = _HEAD + 3 * m
+    s_new[r] = s_old[_Q]
+    s_new[r + 1] = s_old[_G]
+    s_new[r + 2] = s_old[_A]
+    if ds_new is not None:
+        for j in range(nd):
+            ds_new[r, j] = ds_old[_Q, j]
+            ds_new[r + 1, j] = ds_old[_G, j]
+            ds_new[r + 2, j] = ds_old[_A, j]
+    return m + 1
+
+
+@jit(inline="always")
+def _rejoin_point(s_new, m):
+    """Where a branch of depth m >= 1 rejoins an earlier one: the reversal
+    point below its own start (m >= 2), or the mirror point 2 q_c - q_0 of
+    the virgin curve (m = 1)."""
+    if m >= 2:
+        return s_new[_HEAD + 3 * (m - 2)]
+    return 2.0 * s_new[_BQ] - s_new[_HEAD]
+
+
+@jit(inline="always")
+def _reaches_rejoin(s_new, m, base, d, q):
+    """Whether the current branch (depth m, direction d) has reached its
+    rejoin point at q; a first branch rejoins the virgin curve only, never a
+    saturated base."""
+    if m >= 2 or (m == 1 and base == _VIRGIN):
+        return d * (q - _rejoin_point(s_new, m)) >= -_WIPE_TOL
+    return False
+
+
+@jit
+def _rejoin(s_new, m, base, d, q, alpha, ia, ds_new, dN, nd):
+    """Masing's extended rules with the force-offset rule, once the current
+    branch has reached its rejoin point; returns the stack depth left.
+
+    The branch rejoins the one the point belonged to and both points are
+    forgotten, as long as rejoin points are reached. The mismatch of the two
+    branches at the rejoin point qt is added to the rejoined branch's
+    reference force (its G0, or the base offset), so that T stays
+    continuous; it is zero at constant alpha. Compiled apart (rare path):
+    the step stays small for LLVM and quick to compile.
+    """
+    while True:
+        qt = _rejoin_point(s_new, m)
+        m_after = m - 2 if m >= 2 else 0
+        gb, cqb, cab, c0qb, c0gb, c0ab, rqb, rgb, rab = _branch(s_new, m, base, d, qt, alpha)
+        ga, cqa, caa, c0qa, c0ga, c0aa, rqa, rga, raa = _branch(s_new, m_after, base, d, qt, alpha)
+        rg = _BG if m_after == 0 else _HEAD + 3 * (m_after - 1) + 1
+        if ds_new is not None:
+            for j in range(nd):
+                if m >= 2:
+                    dqj = ds_new[_HEAD + 3 * (m - 2), j]
+                else:
+                    dqj = 2.0 * ds_new[_BQ, j] - ds_new[_HEAD, j]
+                daj = ia * dN[j]
+                dgb = cqb * dqj + cab * daj + c0qb * ds_new[rqb, j] + c0gb * ds_new[rgb, j] + c0ab * ds_new[rab, j]
+                dga = cqa * dqj + caa * daj + c0qa * ds_new[rqa, j] + c0ga * ds_new[rga, j] + c0aa * ds_new[raa, j]
+                ds_new[rg, j] += dgb - dga
+        s_new[rg] += gb - ga
+        m = m_after
+        if not _reaches_rejoin(s_new, m, base, d, q):
+            return m
+
+
+@jit(inline="always")
+def _wipe_to_saturation(s_new, q, alpha, qs, ia, ds_new, dx, dN, nd):
+    """Macroslip under full memory: every slider slips, so the reversal memory
+    is wiped and the saturation point (q_s, alpha_s) = (q, alpha) becomes the
+    base curve's reference, without force offset."""
+    s_new[_BQ] = q
+    s_new[_BA] = alpha
+    s_new[_BG] = 0.0
+    if ds_new is not None:
+        for j in range(nd):
+            ds_new[_BQ, j] = qs * dx[j]
+            ds_new[_BA, j] = ia * dN[j]
+            ds_new[_BG, j] = 0.0
+
+
+@jit(inline="always")
+def _propagate(ds_new, dT, fy, qs, ia, dx, dN, cq, ca, c0q, c0g, c0a, rq, rg, ra, nd):
+    """Derivative of the step: dG = cq dq + ca dalpha + c0q dq_ref + c0g dG_ref
+    + c0a dalpha_ref (reference rows rq, rg, ra), dT = fy dG, and the
+    derivative of the committed point (q, G, alpha)."""
+    for j in range(nd):
+        dgj = (
+            cq * qs * dx[j]
+            + ca * ia * dN[j]
+            + c0q * ds_new[rq, j]
+            + c0g * ds_new[rg, j]
+            + c0a * ds_new[ra, j]
+        )
+        dT[j] = fy * dgj
+        ds_new[_Q, j] = qs * dx[j]
+        ds_new[_G, j] = dgj
+        ds_new[_A, j] = ia * dN[j]
+
+
+@jit(inline="always")
+def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
+    """Trial step with optional forward-mode derivatives (see the helpers)."""
+    kt = params[0]
+    fy = params[1]
+    n_ref = params[2]
+    last_only = params[3] != 0.0
+    max_depth = int(params[4])
+    alpha = N / n_ref
+    nd = 0
+    if dx is not None:
+        nd = dx.shape[0]
+    if alpha <= 0.0 or fy <= 0.0:
+        return _separate(s_new, x, alpha, kt, fy, n_ref, ds_new, dx, dN, dT, nd)
+    qs = kt / fy  # dq = qs * dx
+    ia = 1.0 / n_ref  # dalpha = ia * dN
+    q = qs * x
+    if s_old[_BASE] == _SEP:
+        return _contact_start(s_new, q, alpha, kt, qs, ia, ds_new, dx, dN, dT, nd)
+
+    m = int(s_old[_M])
+    _copy_live(s_old, s_new, m, ds_old, ds_new, nd)
+    base = s_old[_BASE]
+    d = s_old[_DIR]
+    # reversal detection: moving against d makes the previous point a reversal point
+    q_prev = s_old[_Q]
     if q != q_prev:
         dnew = 1.0 if q > q_prev else -1.0
-        if d == 0.0:
-            d = dnew
-        elif dnew != d:
-            if last_only:
-                m = 0
-            elif m >= max_depth:
-                m -= 2  # forget the innermost pair (documented limitation)
-            r = _HEAD + 3 * m
-            s_new[r] = q_prev
-            s_new[r + 1] = s_old[_G]
-            s_new[r + 2] = s_old[_A]
-            if ds_new is not None:
-                for j in range(nd):
-                    ds_new[r, j] = ds_old[_Q, j]
-                    ds_new[r + 1, j] = ds_old[_G, j]
-                    ds_new[r + 2, j] = ds_old[_A, j]
-            m += 1
-            d = dnew
+        if d != 0.0 and dnew != d:
+            m = _push_reversal(s_old, s_new, m, last_only, max_depth, ds_old, ds_new, nd)
+        d = dnew
+    # Masing's extended rules: rejoin earlier branches while they are reached
+    if not last_only and _reaches_rejoin(s_new, m, base, d, q):
+        m = _rejoin(s_new, m, base, d, q, alpha, ia, ds_new, dN, nd)
 
-    # --- Masing's extended rules: rejoin earlier branches ------------------
-    # At constant alpha the rejoined branch passes through the current point
-    # (exact Masing memory). When alpha has changed since its reversal point
-    # it does not, and a plain rejoin would make T jump; the mismatch of the
-    # two branches at the rejoin point qt is kept as a constant force offset
-    # on the rejoined branch (its G0, or the base offset): zero at constant
-    # alpha, and T continuous as the step shrinks.
-    if not last_only:
-        while True:
-            m_after = -1
-            qt = 0.0
-            if m >= 2:
-                qt = s_new[_HEAD + 3 * (m - 2)]
-                if d * (q - qt) >= -_WIPE_TOL:
-                    m_after = m - 2
-            elif m == 1 and base == _VIRGIN:
-                qt = 2.0 * s_new[_BQ] - s_new[_HEAD]
-                if d * (q - qt) >= -_WIPE_TOL:
-                    m_after = 0
-            if m_after < 0:
-                break
-            # mismatch of the two branches at the rejoin point qt
-            gb, cqb, cab, c0qb, c0gb, c0ab, rqb, rgb, rab = _branch(s_new, m, base, d, qt, alpha)
-            ga, cqa, caa, c0qa, c0ga, c0aa, rqa, rga, raa = _branch(s_new, m_after, base, d, qt, alpha)
-            rg = _BG if m_after == 0 else _HEAD + 3 * (m_after - 1) + 1
-            if ds_new is not None:
-                for j in range(nd):
-                    if m >= 2:
-                        dqj = ds_new[_HEAD + 3 * (m - 2), j]
-                    else:
-                        dqj = 2.0 * ds_new[_BQ, j] - ds_new[_HEAD, j]
-                    daj = ia * dN[j]
-                    dgb = cqb * dqj + cab * daj + c0qb * ds_new[rqb, j] + c0gb * ds_new[rgb, j] + c0ab * ds_new[rab, j]
-                    dga = cqa * dqj + caa * daj + c0qa * ds_new[rqa, j] + c0ga * ds_new[rga, j] + c0aa * ds_new[raa, j]
-                    ds_new[rg, j] += dgb - dga
-            s_new[rg] += gb - ga
-            m = m_after
-
-    # --- force from the current branch -------------------------------------
-    # dG = cq*dq + ca*dalpha + c0q*dq_ref + c0g*dG_ref + c0a*dalpha_ref,
-    # the reference point (q_ref, G_ref, alpha_ref) being state rows rq, rg, ra
+    # force on the current branch: G and the coefficients of its derivative
     G, cq, ca, c0q, c0g, c0a, rq, rg, ra = _branch(s_new, m, base, d, q, alpha)
 
-    # --- clip (macroslip) ---------------------------------------------------
+    # clip (macroslip): |G| = alpha, no stiffness left
     code = STICK_SLIP
     if G >= alpha * (1.0 - _SAT_RTOL) or G <= -alpha * (1.0 - _SAT_RTOL):
         sg = 1.0 if G > 0.0 else -1.0
@@ -293,34 +375,13 @@ def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
         c0a = 0.0
         ca = sg
         if not last_only:
-            # every slider slips: wipe the memory, remember the saturation
             m = 0
             base = _SAT
             d = sg
-            s_new[_BQ] = q
-            s_new[_BA] = alpha
-            s_new[_BG] = 0.0
-            if ds_new is not None:
-                for j in range(nd):
-                    ds_new[_BQ, j] = qs * dx[j]
-                    ds_new[_BA, j] = ia * dN[j]
-                    ds_new[_BG, j] = 0.0
+            _wipe_to_saturation(s_new, q, alpha, qs, ia, ds_new, dx, dN, nd)
 
-    # --- derivatives ------------------------------------------------------
     if ds_new is not None:
-        for j in range(nd):
-            dgj = (
-                cq * qs * dx[j]
-                + ca * ia * dN[j]
-                + c0q * ds_new[rq, j]
-                + c0g * ds_new[rg, j]
-                + c0a * ds_new[ra, j]
-            )
-            dT[j] = fy * dgj
-            ds_new[_Q, j] = qs * dx[j]
-            ds_new[_G, j] = dgj
-            ds_new[_A, j] = ia * dN[j]
-
+        _propagate(ds_new, dT, fy, qs, ia, dx, dN, cq, ca, c0q, c0g, c0a, rq, rg, ra, nd)
     s_new[_Q] = q
     s_new[_G] = G
     s_new[_A] = alpha
@@ -426,14 +487,15 @@ class Iwan(ContactLaw):
         innermost pair of reversal points is forgotten.
     """
 
-    memory: str = "full"
-    max_depth: int = config.IWAN_MAX_DEPTH
+    memory: str = law_param(
+        "full", choices=("full", "last"),
+        help="reversal memory: full (Masing's extended rules) or last (the paper's last-reversal rule)",
+    )
+    max_depth: int = law_param(
+        config.IWAN_MAX_DEPTH, low=2,
+        help="capacity of the reversal-point stack (the innermost pair is forgotten when full)",
+    )
     name: ClassVar[str] = "iwan"
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        V.choice("memory", self.memory, ("full", "last"))
-        object.__setattr__(self, "max_depth", V.positive_int("max_depth", self.max_depth, 2))
 
     @property
     def step(self):
@@ -461,14 +523,42 @@ class Iwan(ContactLaw):
     def init_jvp(self):
         return iwan_init_jvp
 
+    @property
+    def passive(self) -> bool:
+        """Full memory only: the last-reversal rule can create energy after
+        nested reversals (it forgets the outer loops)."""
+        return self.memory == "full"
 
-def _make_iwan(*, kt, mu, n_ref, **_):
-    return Iwan(kt=kt, mu=mu, n_ref=n_ref, memory="full")
+    @property
+    def x_slip(self) -> float:
+        """2 fy / kt (m): the virgin curve G_oa reaches macroslip at q = 2."""
+        return 2.0 * self.fy / self.kt
+
+    def _state_error(self, s):
+        """The head and the live reversal points finite, the depth an integer
+        in [0, max_depth], the base code and the direction valid (the stack
+        rows beyond the depth are never read and may hold anything)."""
+        head = s[:_HEAD]
+        if not np.all(np.isfinite(head)):
+            return f"entries 0..{_HEAD - 1} must be finite, got {head.tolist()}"
+        m = s[_M]
+        if not (m == int(m) and 0 <= m <= self.max_depth):
+            return f"entry {_M} (reversal-stack depth) must be an integer in [0, {self.max_depth}], got {float(m)!r}"
+        if s[_BASE] not in (_SEP, _VIRGIN, _SAT):
+            return f"entry {_BASE} (base curve) must be 0, 1 or 2, got {float(s[_BASE])!r}"
+        if s[_DIR] not in (-1.0, 0.0, 1.0):
+            return f"entry {_DIR} (direction) must be -1, 0 or 1, got {float(s[_DIR])!r}"
+        live = s[_HEAD : _HEAD + 3 * int(m)]
+        if not np.all(np.isfinite(live)):
+            return f"the {int(m)} live reversal points (entries {_HEAD}..{_HEAD + 3 * int(m) - 1}) must be finite"
+        return None
 
 
-def _make_iwan_paper(*, kt, mu, n_ref, **_):
-    return Iwan(kt=kt, mu=mu, n_ref=n_ref, memory="last")
-
-
-register("iwan", _make_iwan)
-register("iwan-paper", _make_iwan_paper)
+register(
+    "iwan", Iwan, fixed={"memory": "full"},
+    summary="closed-form Iwan with full Masing memory, exact at constant N for any history",
+)
+register(
+    "iwan-paper", Iwan, fixed={"memory": "last"},
+    summary="closed-form Iwan with the paper's last-reversal rule",
+)

@@ -113,10 +113,12 @@ class LineSpec:
         ``up`` (gamma increasing) or ``down``.
     gammas : tuple of float
         Grid, increasing (the line visits it in its direction).
-    model, n, zeta, overrides, steps_per_period
-        Contact law name, discrete elements, viscous damping ratio, paper
-        parameter overrides as ``((name, value), ...)``, integration steps per
-        forcing period (None: solver default).
+    model, law_params, zeta, overrides, steps_per_period
+        Contact law name, its law-specific parameters as the canonical
+        ``((name, value), ...)`` of :func:`jointdyn.laws.canonical_law_params`,
+        viscous damping ratio, paper parameter overrides as
+        ``((name, value), ...)``, integration steps per forcing period (None:
+        solver default).
     """
 
     eta: float
@@ -126,7 +128,7 @@ class LineSpec:
     direction: str
     gammas: tuple
     model: str = "iwan"
-    n: int = config.LAW_DISCRETE_N
+    law_params: tuple = ()
     zeta: float = 0.0
     overrides: tuple = ()
     steps_per_period: int | None = None
@@ -136,6 +138,7 @@ class LineSpec:
         d = asdict(self)
         d["gammas"] = [repr(float(g)) for g in self.gammas]
         d["overrides"] = [[k, repr(float(v))] for k, v in self.overrides]
+        d["law_params"] = [[k, repr(v) if isinstance(v, float) else v] for k, v in self.law_params]
         for key in ("eta", "beta", "f1", "delta_deg", "zeta"):
             if d[key] is not None:
                 d[key] = repr(float(d[key]))
@@ -159,7 +162,7 @@ class LineSpec:
             delta=math.radians(self.delta_deg),
             model=self.model,
             zeta=self.zeta,
-            n=self.n,
+            law_params=dict(self.law_params),
             **dict(self.overrides),
         )
 
@@ -291,8 +294,9 @@ def _floats(name, values, check):
     return out
 
 
-def _check_inputs(gammas, etas, betas, f1s, deltas, directions, model, n, zeta, overrides, steps_per_period):
-    from ..laws import law_names
+def _check_inputs(gammas, etas, betas, f1s, deltas, directions, model, law_params, zeta, overrides,
+                  steps_per_period):
+    from ..laws import canonical_law_params, law_names
 
     g = _floats("gamma", gammas, V.positive)
     g = tuple(sorted(g))
@@ -315,7 +319,7 @@ def _check_inputs(gammas, etas, betas, f1s, deltas, directions, model, n, zeta, 
     if len(set(directions)) != len(directions):
         raise ValueError(f"direction must not contain duplicates, got {directions}")
     V.choice("model", model, law_names())
-    n = V.positive_int("n", n)
+    law_params = canonical_law_params(model, law_params)
     zeta = V.nonnegative("zeta", zeta)
     ov = []
     for key in _OVERRIDES:
@@ -326,7 +330,22 @@ def _check_inputs(gammas, etas, betas, f1s, deltas, directions, model, n, zeta, 
         ov.append((key, val))
     if steps_per_period is not None:
         steps_per_period = V.positive_int("steps_per_period", steps_per_period, 8)
-    return g, etas, betas, f1s, deltas, directions, model, n, zeta, tuple(ov), steps_per_period
+    return g, etas, betas, f1s, deltas, directions, model, law_params, zeta, tuple(ov), steps_per_period
+
+
+def _check_client(client) -> None:
+    """``client`` is None or a connected ``distributed.Client``."""
+    if client is None:
+        return
+    try:
+        from distributed import Client
+    except ImportError:  # pragma: no cover - dask[distributed] is a dependency
+        Client = None
+    if Client is None or not isinstance(client, Client):
+        raise ValueError(
+            "client must be a distributed.Client (connect first: distributed.Client('tcp://host:8786')) "
+            f"or None for local workers, got {type(client).__name__} {client!r:.80}"
+        )
 
 
 def frc_sweep(
@@ -338,7 +357,8 @@ def frc_sweep(
     deltas=(0.0,),
     directions=("up", "down"),
     model: str = "iwan",
-    n: int = config.LAW_DISCRETE_N,
+    law_params: dict | None = None,
+    n: int | None = None,
     zeta: float = 0.0,
     m: float | None = None,
     k: float | None = None,
@@ -374,9 +394,13 @@ def frc_sweep(
     directions : sequence of {"up", "down"}
         Sweep directions.
     model : str
-        Contact law (``iwan``, ``iwan-paper``, ``discrete``, ``jenkins``).
-    n : int
-        Elements of the discrete law.
+        Contact law, one of :func:`jointdyn.laws.law_names`.
+    law_params : dict, optional
+        Law-specific parameters of ``model``
+        (:func:`jointdyn.laws.law_parameters`), e.g. ``{"n": 200}``.
+    n : int, optional
+        Shorthand for ``law_params={"n": n}`` (elements of ``discrete``);
+        a model without that parameter refuses it.
     zeta : float
         Viscous damping ratio (paper: 0).
     m, k, kt, mu, n0 : float, optional
@@ -384,13 +408,15 @@ def frc_sweep(
     steps_per_period : int, optional
         Integration steps per forcing period (solver default if None).
     client : distributed.Client, optional
-        Run the lines on this Dask cluster.
+        Run the lines on this Dask cluster (a connected client, not an
+        address).
     n_workers : int, optional
         Local parallel workers (default: all usable cores; 1 runs serially
         in this process).
     out : path, optional
         Directory for resumable per-line files and the final ``frc.nc`` and
-        ``frc.csv`` (all written atomically).
+        ``frc.csv`` (all written atomically); checked for writability before
+        anything is computed.
     progress : bool
         Show a tqdm bar over points (hidden when not a terminal).
     on_line : callable, optional
@@ -413,12 +439,20 @@ def frc_sweep(
     """
     from tqdm import tqdm
 
-    g, etas, betas, f1s, deltas, directions, model, n, zeta, ov, spp = _check_inputs(
-        gammas, etas, betas, f1s, deltas, directions, model, n, zeta,
+    law_params = dict(law_params or {})
+    if n is not None:
+        if "n" in law_params:
+            raise ValueError("n is given twice: as n and in law_params; give it once")
+        law_params["n"] = n
+    g, etas, betas, f1s, deltas, directions, model, law_params, zeta, ov, spp = _check_inputs(
+        gammas, etas, betas, f1s, deltas, directions, model, law_params, zeta,
         dict(m=m, k=k, kt=kt, mu=mu, n0=n0), steps_per_period,
     )
     if n_workers is not None:
         n_workers = V.positive_int("n_workers", n_workers)
+    _check_client(client)
+    if out is not None:  # before computing: no finished line is lost to an unwritable out
+        V.output_dir("out", out, files=("frc.nc", "frc.csv"), subdirs=("lines",))
     load_name, loads = ("beta", betas) if f1s is None else ("f1", f1s)
     if load_name == "beta" and dict(ov).get("mu", 0.5) <= 0:
         raise ValueError("mu must be > 0 when sweeping beta = mu N0 / F1")
@@ -436,7 +470,7 @@ def frc_sweep(
                         direction=direction,
                         gammas=g,
                         model=model,
-                        n=n,
+                        law_params=law_params,
                         zeta=zeta,
                         overrides=ov,
                         steps_per_period=spp,
@@ -476,13 +510,13 @@ def frc_sweep(
     finally:
         bar.close()
 
-    ds = _assemble(arrays, etas, load_name, loads, deltas, directions, g, model, n, zeta, ov, spp)
+    ds = _assemble(arrays, etas, load_name, loads, deltas, directions, g, model, law_params, zeta, ov, spp)
     if out is not None:
         write_outputs(ds, out)
     return ds
 
 
-def _assemble(arrays, etas, load_name, loads, deltas, directions, g, model, n, zeta, ov, spp):
+def _assemble(arrays, etas, load_name, loads, deltas, directions, g, model, law_params, zeta, ov, spp):
     import xarray as xr
 
     from ..systems import PAPER
@@ -522,7 +556,7 @@ def _assemble(arrays, etas, load_name, loads, deltas, directions, g, model, n, z
     attrs = {
         "title": "steady-state frequency response of the friction damper (MODEL.md section 6)",
         "model": model,
-        "n_elements": int(n),
+        **{f"law_param_{key}": val for key, val in law_params},
         "zeta": float(zeta),
         "steps_per_period": int(spp) if spp is not None else "solver default",
         "fy_N": float(fy),

@@ -1,0 +1,128 @@
+"""The documentation: the site builds with warnings as errors and runs every
+gallery example; the code of the getting-started and guide pages runs; no
+file refers to a path outside the repository; relative links resolve.
+
+The two slow tests carry the ``docs`` marker (``pytest -m "not docs"``
+leaves them out locally); they run by default.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+#: copied beside docs/ for a build in a scratch folder (the pages include or link these)
+BUILD_INPUTS = ("docs", "examples", "CHANGELOG.md", "README.md")
+#: build outputs inside docs/ that a copy must not carry along
+_OUTPUTS = shutil.ignore_patterns("_build", "auto_examples", "generated", "sg_execution_times.rst", "__pycache__")
+
+
+def _env():
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    env["MPLBACKEND"] = "Agg"
+    return env
+
+
+@pytest.mark.docs
+def test_site_builds_strict_and_runs_the_gallery(tmp_path):
+    src = tmp_path / "src"
+    for name in BUILD_INPUTS:
+        path = ROOT / name
+        if path.is_dir():
+            shutil.copytree(path, src / name, ignore=_OUTPUTS)
+        else:
+            shutil.copy2(path, src / name)
+    out = tmp_path / "html"
+    cmd = [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html", str(src / "docs"), str(out)]
+    proc = subprocess.run(cmd, cwd=tmp_path, env=_env(), capture_output=True, text=True)
+    warnings = [line for line in proc.stderr.splitlines() if "WARNING" in line or "ERROR" in line]
+    assert proc.returncode == 0, "\n".join(warnings) or proc.stderr[-5000:]
+    # every example ran and has its page
+    for script in (ROOT / "examples").glob("plot_*.py"):
+        page = out / "auto_examples" / f"{script.stem}.html"
+        assert page.is_file(), f"gallery page missing for {script.name}"
+    # every public name of the package has its anchor in the API reference
+    import jointdyn
+
+    api = "".join(p.read_text() for p in (out / "api" / "generated").glob("*.html"))
+    missing = [n for n in jointdyn.__all__ if f'id="jointdyn.{n}"' not in api
+               and not re.search(rf'id="jointdyn\.[a-z_]+\.{re.escape(n)}"', api)]
+    assert not missing, f"public names without an API entry: {missing}"
+
+
+def _python_blocks(page: Path) -> str:
+    return "\n".join(re.findall(r"```python\n(.*?)```", page.read_text(), re.S))
+
+
+GUIDE_PAGES = [DOCS / "getting-started.md", *sorted((DOCS / "guide").glob("*.md"))]
+
+
+@pytest.mark.docs
+@pytest.mark.parametrize("page", [p for p in GUIDE_PAGES if "```python" in p.read_text()], ids=lambda p: p.name)
+def test_guide_code_runs(page, tmp_path, monkeypatch, capsys):
+    """The Python blocks of one page, in order, in one namespace (files land in a scratch folder)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    monkeypatch.chdir(tmp_path)
+    code = _python_blocks(page)
+    exec(compile(code, str(page), "exec"), {"__name__": f"docs_{page.stem}"})
+    assert capsys.readouterr().out.strip(), f"{page.name} printed nothing"
+
+
+def _repository_files():
+    """Tracked files (a git checkout) or every file (an unpacked source distribution)."""
+    git = shutil.which("git")
+    if git and (ROOT / ".git").exists():
+        names = subprocess.run([git, "ls-files", "-z"], cwd=ROOT, capture_output=True, check=True).stdout
+        return [ROOT / n for n in names.decode().split("\0") if n]
+    skip = {".git", "__pycache__", "_build", "auto_examples", "generated", ".hypothesis", ".pytest_cache"}
+    return [p for p in ROOT.rglob("*") if p.is_file() and not skip & set(p.relative_to(ROOT).parts)]
+
+
+#: references to the private notes beside the repository, or to absolute paths of a machine
+_OUTSIDE = re.compile(r"\.\./shared\b|/work/|(?<![\w.])shared/(MODEL|paper)")
+
+
+def test_no_file_refers_outside_the_repository():
+    offenders = []
+    for path in _repository_files():
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (UnicodeDecodeError, FileNotFoundError):
+            continue  # binary (images) or deleted in the work tree
+        for no, line in enumerate(text.splitlines(), 1):
+            if _OUTSIDE.search(line) and path.name != Path(__file__).name:
+                offenders.append(f"{path.relative_to(ROOT)}:{no}: {line.strip()[:100]}")
+    assert not offenders, "\n".join(offenders)
+
+
+_LINK = re.compile(r"\]\(([^)\s]+)\)")
+
+
+@pytest.mark.parametrize("page", ["README.md", "CHANGELOG.md", *[str(p.relative_to(ROOT)) for p in DOCS.glob("**/*.md")
+                                  if "_build" not in p.parts and "generated" not in p.parts]])
+def test_relative_links_resolve(page):
+    path = ROOT / page
+    broken = []
+    for target in _LINK.findall(path.read_text()):
+        if re.match(r"^[a-z][a-z0-9+.-]*:", target) or target.startswith("#"):
+            continue
+        file = target.split("#", 1)[0]
+        if "auto_examples/" in file:  # written by the gallery at build time
+            file = "../examples/" + Path(file).stem + ".py" if Path(file).stem != "index" else "../examples/README.txt"
+            base = DOCS
+        else:
+            base = path.parent
+        if not (base / file).exists():
+            broken.append(target)
+    assert not broken, f"{page}: links to missing files: {broken}"
