@@ -16,6 +16,8 @@ comparable with ``jointdyn.march(law, x, N)``.
 
 from __future__ import annotations
 
+from reference_exact import ExactIwanRef
+
 STICK_SLIP, MACROSLIP, SEPARATION = 0, 1, 2
 
 #: a branch value with |G| >= alpha (1 - SAT_RTOL) counts as macroslip (the
@@ -272,6 +274,7 @@ class IwanPaperRef:
 #: every law in ``jointdyn.laws.law_names()`` needs an entry (the reference
 #: comparison fails for a law without one)
 REFERENCES = {
+    "iwan-exact": lambda law, x0, n0: ExactIwanRef(law.kt, law.mu, law.n_ref, law.capacity, x0, n0),
     "iwan": lambda law, x0, n0: IwanRef(law.kt, law.mu, law.n_ref, x0, n0, max_depth=law.max_depth),
     "iwan-paper": lambda law, x0, n0: IwanPaperRef(law.kt, law.mu, law.n_ref, x0, n0),
     "discrete": lambda law, x0, n0: DiscreteIwanRef(law.kt, law.mu, law.n_ref, law.n, x0, n0),

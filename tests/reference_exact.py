@@ -16,9 +16,11 @@ each step is done the straightforward way:
 5. while there are more than ``capacity`` pieces, three adjacent pieces
    j-1, j, j+1 (vertices (u0, p0) .. (u3, p3)) are replaced by two through
    a new vertex at uw = (u1 + u2) / 2 whose value keeps the integral of P
-   over [u0, u3]; the j chosen is the first with the least
-   (|change of P at u1| + |change of P at u2|) (u3 - u0); a new piece
-   within SNAP * alpha of a clip line over [0, its upper end] is put on it;
+   over [u0, u3]; only merges whose new vertex lies within the limits
+   (|pw| <= alpha uw) are candidates, and the j chosen is the first with the
+   least (|change of P at u1| + |change of P at u2|) (u3 - u0) (if there is
+   no candidate: j = 1, with pw clamped to the limits); a new piece within
+   SNAP * alpha of a clip line over [0, its upper end] is put on it;
 6. T = fy / 2 * integral of P over [0, 2], kT = kt / 2 * (measure of the
    pieces that are not on a clip line).
 
@@ -137,10 +139,19 @@ class ExactIwanRef:
             pwd = area2 - wl * p0 - wr * p3  # pw * d
             e1 = (p0 - p1) * wl * d + (pwd - p0 * d) * (u1 - u0)  # (change at u1) wl d
             e2 = (pwd - p2 * d) * wr + (p3 * d - pwd) * (u2 - uw)  # (change at u2) wr d
+            if abs(pwd) > alpha * uw * d:
+                continue  # the vertex would leave the limits: not a candidate
             num, den = abs(e1) * wr + abs(e2) * wl, wl * wr
             if best is None or num * best[1] < best[0] * den:
-                best = (num, den, j, u0, uw, u3, p0, pwd / d, p3)
-        _, _, j, u0, uw, u3, p0, pw, p3 = best
+                best = (num, den, j)
+        j = 1 if best is None else best[2]  # no admissible merge: the first, clamped
+        left, mid, right = pieces[j - 1], pieces[j], pieces[j + 1]
+        u0, u1, u2, u3 = left[0], left[1], mid[1], right[1]
+        p0, p3 = value(left, u0), value(right, u3)
+        area2 = 2.0 * (integral(left) + integral(mid) + integral(right))
+        uw = 0.5 * (u1 + u2)
+        pw = (area2 - (uw - u0) * p0 - (u3 - uw) * p3) / (u3 - u0)
+        pw = min(max(pw, -alpha * uw), alpha * uw)
         pieces[j - 1 : j + 2] = [_line(u0, p0, uw, pw, alpha), _line(uw, pw, u3, p3, alpha)]
 
     def _outputs(self, alpha):

@@ -256,7 +256,7 @@ def test_energy_per_cycle(alpha, qa):
 
 # --- construction ---------------------------------------------------------------------------
 def test_registered_and_validated():
-    law = make_law("iwan-exact", kt=KT, mu=MU, n_ref=NREF, capacity=12, n=1000)
+    law = make_law("iwan-exact", kt=KT, mu=MU, n_ref=NREF, capacity="12")
     assert isinstance(law, ExactIwan) and law.capacity == 12
     assert law.state_size == 2 + 3 * 3 * 12
     for bad in (2, 0, -1, 3.5, "x", float("nan")):
@@ -264,6 +264,52 @@ def test_registered_and_validated():
             ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=bad)
     with pytest.raises(ValueError, match="kt"):
         make_law("iwan-exact", kt=0.0, mu=MU, n_ref=NREF)
+
+
+@pytest.mark.parametrize(
+    "row,value,what",
+    [
+        (1, 0.0, "piece count"), (1, 33.0, "piece count"), (1, 1.5, "piece count"), (1, np.nan, "entries 0..1"),
+        (0, np.inf, "entries 0..1"), (2, 1.5, "breakpoints"), (2, 0.0, "breakpoints"), (3, np.nan, "live pieces"),
+    ],
+)
+def test_check_state(row, value, what):
+    """A user-supplied state: x_prev and the piece count finite, the count an
+    integer in [1, capacity], the live pieces finite, breakpoints strictly
+    increasing from above 0 to u = 2; rows beyond the live pieces are free."""
+    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF)
+    s = law.initial_state()
+    s[row] = value
+    with pytest.raises(ValueError, match=what):
+        law.check_state(s)
+    with pytest.raises(ValueError, match="state"):
+        march(law, [0.0, 1e-4], [NREF, NREF], state=s)
+    x = XS * np.sin(np.linspace(0.0, 7.0, 300))
+    N = NREF * (1 + 0.8 * np.cos(np.linspace(0.0, 9.0, 300)))
+    s = march(law, x, N)[3]
+    m = piece_count(s)
+    assert m > 2
+    dirty = s.copy()
+    dirty[2 + 3 * m :] = np.nan
+    np.testing.assert_array_equal(law.check_state(dirty)[: 2 + 3 * m], s[: 2 + 3 * m])
+    s[2 + 3 * (m - 1)] = 1.999  # the last live breakpoint is not u = 2
+    with pytest.raises(ValueError, match="breakpoints"):
+        law.check_state(s)
+    s[2 + 3 * (m - 1)] = 2.0
+    s[2 + 3] = s[2]  # two equal breakpoints
+    with pytest.raises(ValueError, match="breakpoints"):
+        law.check_state(s)
+
+
+def test_scales_and_bounds():
+    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF)
+    assert law.x_slip == 2.0 * FY / KT and law.passive
+    assert law.max_force(2.0 * NREF) == pytest.approx(2.0 * FY) and law.max_force(-1.0) == 0.0
+    # the virgin curve reaches macroslip at x_slip and not before
+    x = np.linspace(0.0, 1.2 * law.x_slip, 1201)
+    T, kT, code, _ = march(law, x, np.full(x.size, NREF))
+    assert np.all(code[x < law.x_slip * (1 - 1e-9)] == 0) and np.all(code[x > law.x_slip * (1 + 1e-9)] == 1)
+    assert T[-1] == pytest.approx(FY, rel=1e-12)
 
 
 # --- hypothesis properties ---------------------------------------------------------------
@@ -308,6 +354,51 @@ def test_force_bound_codes_tangent_capacity(data):
     inside = N > 0.0
     assert np.array_equal((code == 1)[inside], (kT == 0.0)[inside])  # macroslip <=> nothing stuck
     assert _pieces(law, x, N).max() <= law.capacity
+
+
+def _outside_limits(law, x, N):
+    """Largest excess of |P(u)| over alpha u at the breakpoints of the
+    committed states of a march (units of fy; 0 when every element is
+    within its slip force)."""
+    p = law.params
+    s = law.initial_state(x[0], N[0])
+    s_new = np.empty_like(s)
+    worst = 0.0
+    for xi, ni in zip(x, N):
+        law.step(p, s, s_new, xi, ni)
+        s, s_new = s_new, s
+        alpha = ni / law.n_ref
+        m = piece_count(s)
+        hi = s[2 : 2 + 3 * m : 3]
+        lo = np.concatenate(([0.0], hi[:-1]))
+        a, b = s[3 : 3 + 3 * m : 3], s[4 : 4 + 3 * m : 3]
+        for u in (lo, hi):
+            worst = max(worst, float(np.max(np.abs(a + b * u) - max(alpha, 0.0) * u)))
+    return worst
+
+
+@SETTINGS
+@given(data=st.data())
+def test_merged_states_stay_within_the_limits(data):
+    """Merges keep every element within its slip force (|P(u)| <= alpha u up
+    to rounding), also at small capacities where most steps merge."""
+    law = data.draw(laws(capacities=(3, 4, 8)))
+    x, N = data.draw(histories(law))
+    assert _outside_limits(law, x, N) <= 1e-12 * max(1.0, float(np.max(np.abs(N))) / law.n_ref)
+
+
+def test_merges_within_the_limits_out_of_phase():
+    """The out-of-phase loops of Fig 4 need several times the capacity: the
+    merged states hold no element beyond its slip force (a merge that keeps
+    the integral through a corner on a clip line would put one there)."""
+    t = np.linspace(0.0, 4.0, 4 * 2000 + 1)
+    x = 2.5 * XS * np.sin(2 * np.pi * t) * (1 + 0.3 * np.sin(0.7 * t))
+    for eta in (0.3, 0.9, 1.2):
+        N = NREF * (1 + eta * np.sin(2 * np.pi * t + np.pi / 2))
+        for cap in (8, 32):
+            law = ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=cap)
+            assert _pieces(law, x, N).max() == cap  # merges happen
+            assert _outside_limits(law, x, N) <= 1e-12
 
 
 def _cycle_work(x, T):

@@ -32,8 +32,11 @@ capacity K, three adjacent pieces are merged into two: their two inner
 breakpoints u1, u2 are replaced by one vertex at (u1 + u2) / 2 whose value
 keeps the integral of P over the three pieces, so a merge leaves T
 unchanged; the merge chosen is the one that moves P least at u1 and u2
-(sum of the two changes times the width of the three pieces). This is the
-only approximation. Clipping and shifting never enlarge a difference
+(sum of the two changes times the width of the three pieces) among those
+whose vertex lies within the limits, |P| <= alpha u (so that every element
+of the merged state is admissible: an element beyond its slip force would
+give energy back when it unloads). If none does, the first is taken with
+its vertex clamped to the limits. This is the only approximation. Clipping and shifting never enlarge a difference
 between two states (both are non-expansive, element by element), so the
 force error at any later time is at most fy / 2 times the sum of the
 integrals of |change of P| of the merges before it; in practice it is far
@@ -197,7 +200,7 @@ def _write_jvp(ds, ds_old, dx, dN, k, r_old, kind, qs, ia):
 
 
 @jit(inline="always")
-def _removal_cost(u0, u1, u2, u3, p0, p1, p2, p3, area2):
+def _removal_cost(u0, u1, u2, u3, p0, p1, p2, p3, area2, alpha):
     """Cost of replacing the breakpoints u1, u2 of three adjacent pieces by
     one vertex, as a fraction ``num / den`` (no division).
 
@@ -205,22 +208,30 @@ def _removal_cost(u0, u1, u2, u3, p0, p1, p2, p3, area2):
     fy), ``area2`` is twice their integral. The new vertex is at
     uw = (u1 + u2) / 2 with the value pw that keeps the integral over
     [u0, u3]; the cost is (|change of P at u1| + |change at u2|)(u3 - u0).
+    A vertex outside the limits (|pw| > alpha uw: the merged state would
+    hold elements beyond their slip force) costs ``inf``.
     """
     uw = 0.5 * (u1 + u2)
     d = u3 - u0
     left = uw - u0
     right = u3 - uw
     pwd = area2 - left * p0 - right * p3  # pw (u3 - u0)
+    if abs(pwd) > alpha * uw * d:
+        return np.inf, 1.0
     e1 = (p0 - p1) * left * d + (pwd - p0 * d) * (u1 - u0)  # (change at u1) (uw - u0) d
     e2 = (pwd - p2 * d) * right + (p3 * d - pwd) * (u2 - uw)  # (change at u2) (u3 - uw) d
     return abs(e1) * right + abs(e2) * left, left * right
 
 
 @jit(inline="always")
-def _vertex(u0, u1, u2, u3, p0, p3, area2):
-    """The vertex (uw, pw) of :func:`_removal_cost`."""
+def _vertex(u0, u1, u2, u3, p0, p3, area2, alpha):
+    """The vertex (uw, pw) of :func:`_removal_cost`, pw clamped to the
+    limits [-alpha uw, alpha uw] (only when no merge keeps the integral
+    within them: then this merge changes T)."""
     uw = 0.5 * (u1 + u2)
-    return uw, (area2 - (uw - u0) * p0 - (u3 - uw) * p3) / (u3 - u0)
+    pw = (area2 - (uw - u0) * p0 - (u3 - uw) * p3) / (u3 - u0)
+    lim = alpha * uw
+    return uw, min(max(pw, -lim), lim)
 
 
 @jit(inline="always")
@@ -237,10 +248,11 @@ def _triple(s, j):
 
 
 @jit(inline="always")
-def _least_triple(s, m):
+def _least_triple(s, m, alpha):
     """j of the three adjacent pieces j-1, j, j+1 whose merge into two
-    (:func:`_removal_cost`) costs least (first on ties); the window of
-    three pieces slides along, each integral computed once."""
+    (:func:`_removal_cost`) costs least (first on ties; j = 1 when every
+    merge would leave the limits); the window of three pieces slides along,
+    each integral computed once."""
     best = 1
     b_num = np.inf
     b_den = 1.0
@@ -257,7 +269,7 @@ def _least_triple(s, m):
         b2 = s[r + 2]
         i2 = _integral(u2, u3, a2, b2)
         num, den = _removal_cost(u0, u1, u2, u3, a0 + b0 * u0, a0 + b0 * u1, a1 + b1 * u2, a2 + b2 * u3,
-                                 2.0 * (i0 + i1 + i2))
+                                 2.0 * (i0 + i1 + i2), alpha)
         if num * b_den < b_num * den:
             best = j
             b_num = num
@@ -429,9 +441,9 @@ def _enforce_capacity(s, ds, m, cap, alpha, total, stuck):
     rounding) and the stuck measure, updated for the merges.
     """
     while m > cap:
-        j = _least_triple(s, m)
+        j = _least_triple(s, m, alpha)
         u0, u1, u2, u3, p0, p1, p2, p3, area2 = _triple(s, j)
-        uw, pw = _vertex(u0, u1, u2, u3, p0, p3, area2)
+        uw, pw = _vertex(u0, u1, u2, u3, p0, p3, area2, alpha)
         r = _HEAD + 3 * (j - 1)
         for q in range(3):
             a, b = s[r + 3 * q + 1], s[r + 3 * q + 2]
@@ -567,6 +579,42 @@ class ExactIwan(ContactLaw):
         return 2.0 * self.fy / self.kt
 
     @property
+    def passive(self) -> bool:
+        """True: every element is an elastic-perfectly-plastic Jenkins
+        element, which creates no energy over a closed cycle at constant N
+        from any state; a merge keeps the integral of P and never leaves the
+        limits (the merged pieces lie between their neighbours' values)."""
+        return True
+
+    def max_force(self, N):
+        """Bound on |T| at normal load ``N`` (N): ``max(N, 0) / n_ref * fy``,
+        since |P(u)| <= alpha u and fy / 2 times the integral of alpha u over
+        [0, 2] is alpha fy (macroslip reaches it)."""
+        return super().max_force(N)
+
+    def _state_error(self, s):
+        """x_prev finite, the piece count an integer in [1, capacity], the
+        live pieces finite with breakpoints strictly increasing from above 0
+        and ending at u = 2 (the rows beyond the live pieces are never read
+        and may hold anything)."""
+        if not np.all(np.isfinite(s[:_HEAD])):
+            return f"entries 0..{_HEAD - 1} (x_prev, piece count) must be finite, got {s[:_HEAD].tolist()}"
+        m = s[_M]
+        if not (m == int(m) and 1 <= m <= self.capacity):
+            return f"entry {_M} (piece count) must be an integer in [1, {self.capacity}], got {float(m)!r}"
+        m = int(m)
+        live = s[_HEAD : _HEAD + 3 * m]
+        if not np.all(np.isfinite(live)):
+            return f"the {m} live pieces (entries {_HEAD}..{_HEAD + 3 * m - 1}) must be finite"
+        hi = live[0::3]
+        if not (hi[0] > 0.0 and np.all(np.diff(hi) > 0.0) and hi[-1] == U_MAX):
+            return (
+                f"the breakpoints (entries {_HEAD}, {_HEAD + 3}, ...) must increase strictly from above 0 "
+                f"and the last live one must be {U_MAX:g}, got {hi.tolist()}"
+            )
+        return None
+
+    @property
     def init(self):
         return exact_init
 
@@ -580,4 +628,7 @@ def piece_count(state) -> int:
     return int(state[_M])
 
 
-register("iwan-exact", ExactIwan)
+register(
+    "iwan-exact", ExactIwan,
+    summary="exact Iwan model with varying normal load (n -> infinity, piecewise-linear state, capacity pieces)",
+)
