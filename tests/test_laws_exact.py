@@ -7,7 +7,8 @@
   nested, growing, decaying and random histories, several load ratios;
 * the discrete model under varying load with separation: its error against
   the exact law shrinks like 1/n^2 (n = 500 ... 4000);
-* ``step_jvp`` against central finite differences of ``step`` marches;
+* ``step_jvp`` against central finite differences of ``step`` marches,
+  with and without merges (the derivative of a merge is exact too);
 * the describing-function energy per cycle (MODEL.md section 2) at
   constant load, below and beyond macroslip;
 * hypothesis properties: |T| <= alpha fy, T = 0 and SEPARATION where
@@ -201,36 +202,42 @@ def test_jvp_equals_finite_differences(seed, eta):
     for j in range(dx.shape[1]):
         xp, xm = x + h * dx[:, j], x - h * dx[:, j]
         Np, Nm = N + h * dN[:, j], N - h * dN[:, j]
-        Tp, _, cp, _ = march(law, xp, Np)
-        Tm, _, cm, _ = march(law, xm, Nm)
-        np.testing.assert_array_equal(cp, code0)  # no state transition crossed
-        np.testing.assert_array_equal(cm, code0)
-        fd = (Tp - Tm) / (2 * h)
+        np.testing.assert_array_equal(march(law, xp, Np)[2], code0)  # no state transition crossed
+        np.testing.assert_array_equal(march(law, xm, Nm)[2], code0)
+        fd = _richardson(law, x, N, dx[:, j], dN[:, j])
         scale = np.max(np.abs(fd))
         assert scale > 0.0
         np.testing.assert_allclose(dT[:, j], fd, rtol=0, atol=C.TEST_JVP_RTOL * scale)
 
 
-def test_jvp_with_merges_is_close():
-    """Where merges happen the derivative is merged at fixed breakpoints: not
-    exact (the merged vertex moves with the breakpoints), but close: within
-    1 % of the largest derivative at the default capacity on a history that
-    needs about twice as many pieces (measured 0.03 % and 0.05 %)."""
-    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF)
+def _richardson(law, x, N, dxj, dNj):
+    """Central differences of marches at h and h / 2, Richardson-extrapolated
+    (error O(h^4): the merged states are curved within h)."""
+    d = []
+    for h in (C.TEST_JVP_FD_STEP, 0.5 * C.TEST_JVP_FD_STEP):
+        d.append((march(law, x + h * dxj, N + h * dNj)[0] - march(law, x - h * dxj, N - h * dNj)[0]) / (2 * h))
+    return (4.0 * d[1] - d[0]) / 3.0
+
+
+@pytest.mark.parametrize("capacity", [3, 8, 32])
+def test_jvp_with_merges_is_exact(capacity):
+    """Merges are differentiated exactly (breakpoints carry their
+    derivatives): equal to finite differences on a history that needs
+    several times the capacity, merging at most steps."""
+    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=capacity)
     t = np.linspace(0.0, 2.0, 2 * 1000 + 1)
     x = 2.5 * XS * np.sin(2 * np.pi * t)
     N = NREF * (1 + 0.9 * np.cos(2 * np.pi * t))
-    assert _pieces(ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=1000), x, N).max() > 1.5 * law.capacity
+    assert _pieces(ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=1000), x, N).max() > 1.5 * 32
     dx = np.zeros((x.size, 2))
     dN = np.zeros_like(dx)
     dx[1:, 0] = XS * np.cos(2 * np.pi * t[1:])
     dN[1:, 1] = NREF * np.sin(4 * np.pi * t[1:])
     s0, ds0 = law.initial_state(x[0], N[0]), np.zeros((law.state_size, 2))
     dT = _march_jvp(law, x, dx, N, dN, s0, ds0)[3]
-    h = C.TEST_JVP_FD_STEP
     for j in range(2):
-        fd = (march(law, x + h * dx[:, j], N + h * dN[:, j])[0] - march(law, x - h * dx[:, j], N - h * dN[:, j])[0]) / (2 * h)
-        assert np.max(np.abs(dT[:, j] - fd)) <= 0.01 * np.max(np.abs(fd))
+        fd = _richardson(law, x, N, dx[:, j], dN[:, j])
+        np.testing.assert_allclose(dT[:, j], fd, rtol=0, atol=C.TEST_JVP_RTOL * np.max(np.abs(fd)))
 
 
 # --- describing-function energy ----------------------------------------------------------

@@ -52,13 +52,16 @@ hi_(m-1) = 2) with P(u) = a_k + b_k u (units of fy). Rows beyond the live
 pieces are not written by ``step``. A step writes at most three pieces per
 committed piece before it merges down to K, hence room for 3 K.
 
-Derivatives (``step_jvp``): rows a_k, b_k carry da_k, db_k; the breakpoint
-rows carry zero. Breakpoints need none: P is continuous in u, so moving a
-breakpoint does not change the integral, and the element-wise derivative
-dP(u) (stuck: dP + dq; clipped: +-dalpha u) is linear on each piece. At
-a merge the derivative is merged the same way at fixed breakpoints (through
-the derivatives at the outer ends, keeping the integral of the derivative,
-so dT is unchanged by it); it is exact except at the steps with merges.
+Derivatives (``step_jvp``): rows a_k, b_k carry da_k, db_k, the derivative
+of P at a fixed u (stuck: dP + dq; clipped: +-dalpha u; linear on each
+piece), and the breakpoint rows carry the breakpoints' derivatives (a cut
+by a clip line moves with the line and the piece; an old breakpoint keeps
+its derivative; u = 2 is fixed). The force needs only the first (P is
+continuous in u, so moving a breakpoint does not change the integral); the
+merges need both: the merged vertex depends on the positions of the
+breakpoints it replaces, and its derivative is taken through them, so the
+derivative is exact at every step, merges included (away from the
+measure-zero instants where a cut appears or a merge choice changes).
 """
 
 from __future__ import annotations
@@ -99,17 +102,32 @@ MIN_CAPACITY = 3
 _ABOVE, _STUCK, _BELOW = 1, 0, -1
 # kind of a piece whose derivative rows are zero (separation)
 _ZERO = 2
+# where the right end of a written piece comes from (its derivative follows):
+# the old piece's lower or upper breakpoint, or a cut by the upper or lower
+# clip line
+_END_LO, _END_HI, _END_CUT_ABOVE, _END_CUT_BELOW = 0, 1, 2, 3
 
 
 @jit(inline="always")
-def _snap(c, lo, hi):
-    """Cut position ``c`` clamped to [lo, hi]; within :data:`SNAP` of an
-    end it moves onto that end (the cut is dropped)."""
+def _cut(a, b, alpha, kind, lo, hi):
+    """Where the piece a + b u on [lo, hi] crosses the clip line of ``kind``
+    (:data:`_ABOVE`: alpha u, :data:`_BELOW`: -alpha u), and the end code
+    of that position (a cut, or :data:`_END_LO` / :data:`_END_HI`).
+
+    A cut within :data:`SNAP` of an end of the piece moves onto that end
+    (the cut is dropped); the position is clamped to [lo, hi].
+    """
+    if kind == _ABOVE:
+        c = -a / (b - alpha)
+        end = _END_CUT_ABOVE
+    else:
+        c = -a / (b + alpha)
+        end = _END_CUT_BELOW
     if c - lo <= SNAP:
-        return lo
+        return lo, _END_LO
     if hi - c <= SNAP:
-        return hi
-    return c
+        return hi, _END_HI
+    return c, end
 
 
 @jit(inline="always")
@@ -120,20 +138,17 @@ def _split(lo, hi, a, b, alpha, k_lo, k_hi):
     at each end. Returns ``c1 <= c2``: the segments [lo, c1] (kind k_lo),
     [c1, c2] (stuck) and [c2, hi] (kind k_hi) partition the piece (empty
     ones are skipped); an end whose kind is stuck has no cut of its own.
+    Also returns the end code (:func:`_cut`) of each.
     """
-    c1 = lo
-    c2 = hi
-    if k_lo == _ABOVE:
-        c1 = _snap(-a / (b - alpha), lo, hi)
-    elif k_lo == _BELOW:
-        c1 = _snap(-a / (b + alpha), lo, hi)
-    if k_hi == _ABOVE:
-        c2 = _snap(-a / (b - alpha), lo, hi)
-    elif k_hi == _BELOW:
-        c2 = _snap(-a / (b + alpha), lo, hi)
+    c1, e1 = lo, _END_LO
+    c2, e2 = hi, _END_HI
+    if k_lo != _STUCK:
+        c1, e1 = _cut(a, b, alpha, k_lo, lo, hi)
+    if k_hi != _STUCK:
+        c2, e2 = _cut(a, b, alpha, k_hi, lo, hi)
     if c2 < c1:
-        c2 = c1
-    return c1, c2
+        c2, e2 = c1, e1
+    return c1, c2, e1, e2
 
 
 @jit(inline="always")
@@ -186,16 +201,35 @@ def _write(s, k, hi, a, b):
 
 
 @jit(inline="always")
-def _write_jvp(ds, ds_old, dx, dN, k, r_old, kind, qs, ia):
+def _end_jvp(ds_old, r_old, end, c, b, alpha, da, dal, j):
+    """Derivative along direction j of the right end of a written piece (end
+    code ``end``, :func:`_cut`): an old breakpoint keeps its derivative (the
+    lower one of the old piece at row ``r_old`` is 0 for the first piece);
+    a cut c of the shifted piece (derivatives ``da`` of a, ``ds_old`` row
+    of b) by the line +-alpha u moves by -(da + (db -+ dalpha) c) / (b -+ alpha)."""
+    if end == _END_HI:
+        return ds_old[r_old, j]
+    if end == _END_LO:
+        return ds_old[r_old - 3, j] if r_old > _HEAD else 0.0
+    if end == _END_CUT_ABOVE:
+        return -(da + (ds_old[r_old + 2, j] - dal) * c) / (b - alpha)
+    return -(da + (ds_old[r_old + 2, j] + dal) * c) / (b + alpha)
+
+
+@jit(inline="always")
+def _write_jvp(ds, ds_old, dx, dN, k, r_old, kind, qs, ia, end, c, b, alpha):
     """Derivative rows of piece k: stuck, those of the old piece (row
     ``r_old``) plus dq = (kt/fy)(dx - dx_prev) on a; clipped (kind +-1),
-    (0, +-dalpha); :data:`_ZERO`, zero. The breakpoint row gets zero."""
+    (0, +-dalpha); :data:`_ZERO`, zero. The breakpoint row gets the
+    derivative of the piece's right end c (:func:`_end_jvp`; zero for
+    :data:`_ZERO`, whose end is u = 2)."""
     r = _HEAD + 3 * k
     w = 1.0 if kind == _STUCK else 0.0
     sg = float(kind) * ia if kind != _ZERO else 0.0
     for j in range(ds.shape[1]):
-        ds[r, j] = 0.0
-        ds[r + 1, j] = w * (ds_old[r_old + 1, j] + qs * (dx[j] - ds_old[_X, j]))
+        da = ds_old[r_old + 1, j] + qs * (dx[j] - ds_old[_X, j])
+        ds[r, j] = _end_jvp(ds_old, r_old, end, c, b, alpha, da, ia * dN[j], j) if kind != _ZERO else 0.0
+        ds[r + 1, j] = w * da
         ds[r + 2, j] = w * ds_old[r_old + 2, j] + sg * dN[j]
 
 
@@ -227,11 +261,16 @@ def _removal_cost(u0, u1, u2, u3, p0, p1, p2, p3, area2, alpha):
 def _vertex(u0, u1, u2, u3, p0, p3, area2, alpha):
     """The vertex (uw, pw) of :func:`_removal_cost`, pw clamped to the
     limits [-alpha uw, alpha uw] (only when no merge keeps the integral
-    within them: then this merge changes T)."""
+    within them: then this merge changes T), and the clamp: 0, or +-1 when
+    pw was put on the upper / lower limit."""
     uw = 0.5 * (u1 + u2)
     pw = (area2 - (uw - u0) * p0 - (u3 - uw) * p3) / (u3 - u0)
     lim = alpha * uw
-    return uw, min(max(pw, -lim), lim)
+    if pw > lim:
+        return uw, lim, 1.0
+    if pw < -lim:
+        return uw, -lim, -1.0
+    return uw, pw, 0.0
 
 
 @jit(inline="always")
@@ -301,26 +340,56 @@ def _stuck_part(lo, hi, a, b, alpha):
 
 
 @jit(inline="always")
-def _merge_jvp(ds, j, u0, u1, u2, u3, uw):
-    """Derivative rows of the two pieces replacing j-1, j, j+1: through the
-    derivatives at u0 and u3 and the vertex derivative that keeps the
-    integral of the derivative (fixed breakpoints)."""
+def _line_jvp(u0, dp0, du0, u1, dp1, du1, a, b, alpha, dal):
+    """Derivative (da, db) of the line a + b u through its points at u0 and
+    u1 when they move: values by dp0, dp1 and positions by du0, du1 (the
+    derivative of the line's value at a fixed u); a line put on a clip line
+    (:func:`_line`) moves with it, (0, +-dalpha)."""
+    if _stuck_part(0.0, 1.0, a, b, alpha) == 0.0:
+        return 0.0, (dal if b > 0.0 else -dal)
+    db = ((dp1 - dp0) - b * (du1 - du0)) / (u1 - u0)
+    return dp0 - b * du0 - db * u0, db
+
+
+@jit(inline="always")
+def _merge_jvp(s, ds, j, uw, pw, clamp, lines, alpha, ia, dN):
+    """Derivative rows of the two pieces replacing j-1, j, j+1 (``s`` still
+    holds the three): the exact derivative of the merge, breakpoints
+    included. The vertex value pw keeps the integral over [u0, u3], so its
+    derivative follows from those of the end values p0, p3, of the
+    integral (the pieces' derivatives plus the motion of u0 and u3; P is
+    continuous at u1, u2) and of the positions; a clamped vertex moves with
+    the limit. ``lines``: the new pieces' coefficients (a1, b1, a2, b2)."""
+    a1, b1, a2, b2 = lines
     r = _HEAD + 3 * (j - 1)
-    d = u3 - u0
-    left = uw - u0
-    right = u3 - uw
+    u0 = 0.0 if j == 1 else s[r - 3]
+    u1, u2, u3 = s[r], s[r + 3], s[r + 6]
+    bl, br = s[r + 2], s[r + 8]
+    p0 = s[r + 1] + bl * u0
+    p3 = s[r + 7] + br * u3
     for k in range(ds.shape[1]):
+        du0 = ds[r - 3, k] if j > 1 else 0.0
+        du1, du2, du3 = ds[r, k], ds[r + 3, k], ds[r + 6, k]
         da0, db0, da1, db1, da2, db2 = ds[r + 1, k], ds[r + 2, k], ds[r + 4, k], ds[r + 5, k], ds[r + 7, k], ds[r + 8, k]
-        area2 = 2.0 * (_integral(u0, u1, da0, db0) + _integral(u1, u2, da1, db1) + _integral(u2, u3, da2, db2))
-        dp0 = da0 + db0 * u0
-        dp3 = da2 + db2 * u3
-        dpw = (area2 - left * dp0 - right * dp3) / d
-        ds[r, k] = 0.0
-        ds[r + 2, k] = (dpw - dp0) / left
-        ds[r + 1, k] = dp0 - ds[r + 2, k] * u0
-        ds[r + 3, k] = 0.0
-        ds[r + 5, k] = (dp3 - dpw) / right
-        ds[r + 4, k] = dpw - ds[r + 5, k] * uw
+        dal = ia * dN[k]
+        dp0 = da0 + db0 * u0 + bl * du0
+        dp3 = da2 + db2 * u3 + br * du3
+        duw = 0.5 * (du1 + du2)
+        if clamp != 0.0:
+            dpw = clamp * (dal * uw + alpha * duw)
+        else:
+            darea2 = 2.0 * (_integral(u0, u1, da0, db0) + _integral(u1, u2, da1, db1) + _integral(u2, u3, da2, db2)
+                            + p3 * du3 - p0 * du0)
+            dpw = (darea2 - (duw - du0) * p0 - (uw - u0) * dp0 - (du3 - duw) * p3 - (u3 - uw) * dp3
+                   - pw * (du3 - du0)) / (u3 - u0)
+        dal1, dbl1 = _line_jvp(u0, dp0, du0, uw, dpw, duw, a1, b1, alpha, dal)
+        dal2, dbl2 = _line_jvp(uw, dpw, duw, u3, dp3, du3, a2, b2, alpha, dal)
+        ds[r, k] = duw
+        ds[r + 1, k] = dal1
+        ds[r + 2, k] = dbl1
+        ds[r + 3, k] = du3
+        ds[r + 4, k] = dal2
+        ds[r + 5, k] = dbl2
 
 
 @jit(inline="always")
@@ -380,12 +449,13 @@ def _exact_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
         b = s_old[r + 2]
         k_hi = _end_kind(a + b * hi, alpha * hi)
         c1 = c2 = hi  # one kind over the whole piece (a + b u is straight)
+        e1 = e2 = _END_HI
         if k_lo != k_hi:
-            c1, c2 = _split(lo, hi, a, b, alpha, k_lo, k_hi)
+            c1, c2, e1, e2 = _split(lo, hi, a, b, alpha, k_lo, k_hi)
         # segments [lo, c1] (kind k_lo), [c1, c2] (stuck), [c2, hi] (kind k_hi)
         left = lo
         for seg in range(1 if k_lo == k_hi else 3):
-            right, kind = _segment(seg, c1, c2, hi, k_lo, k_hi)
+            right, kind, end = _segment(seg, c1, c2, hi, k_lo, k_hi, e1, e2)
             if right > left:
                 a2, b2, kind = _coeffs(kind, a, b, alpha)
                 # a clipped segment on the line of the last piece extends it
@@ -393,7 +463,8 @@ def _exact_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
                     m += 1
                 _write(s_new, m - 1, right, a2, b2)
                 if ds_new is not None:
-                    _write_jvp(ds_new, ds_old, dx, dN, m - 1, r, kind, params[_P_QS], params[_P_INV_NREF])
+                    _write_jvp(ds_new, ds_old, dx, dN, m - 1, r, kind, params[_P_QS], params[_P_INV_NREF], end, right,
+                               b, alpha)
                 total += _integral(left, right, a2, b2)
                 if kind == _STUCK:
                     stuck += right - left
@@ -403,7 +474,8 @@ def _exact_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
         lo = hi
         k_lo = k_hi
     if m > int(params[_P_CAP]):
-        m, total, stuck = _enforce_capacity(s_new, ds_new, m, int(params[_P_CAP]), alpha, total, stuck)
+        m, total, stuck = _enforce_capacity(s_new, ds_new, m, int(params[_P_CAP]), alpha, total, stuck,
+                                            params[_P_INV_NREF], dN)
     if not contact:  # separation (or no friction): P = 0
         _write(s_new, 0, U_MAX, 0.0, 0.0)
         m = 1
@@ -411,7 +483,7 @@ def _exact_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
     s_new[_M] = m
     if ds_new is not None:
         if not contact:
-            _write_jvp(ds_new, ds_old, dx, dN, 0, _HEAD, _ZERO, 0.0, 0.0)
+            _write_jvp(ds_new, ds_old, dx, dN, 0, _HEAD, _ZERO, 0.0, 0.0, _END_HI, U_MAX, 0.0, 0.0)
         _jvp_force(s_new, ds_new, m, fy, dT)
         for j in range(dx.shape[0]):
             ds_new[_X, j] = dx[j]
@@ -423,17 +495,17 @@ def _exact_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
 
 
 @jit(inline="always")
-def _segment(seg, c1, c2, hi, k_lo, k_hi):
-    """Right end and kind of segment ``seg`` (0, 1, 2) of a split piece."""
+def _segment(seg, c1, c2, hi, k_lo, k_hi, e1, e2):
+    """Right end, kind and end code of segment ``seg`` (0, 1, 2) of a split piece."""
     if seg == 0:
-        return c1, k_lo
+        return c1, k_lo, e1
     if seg == 1:
-        return c2, _STUCK
-    return hi, k_hi
+        return c2, _STUCK, e2
+    return hi, k_hi, _END_HI
 
 
 @jit(inline="always")
-def _enforce_capacity(s, ds, m, cap, alpha, total, stuck):
+def _enforce_capacity(s, ds, m, cap, alpha, total, stuck, ia, dN):
     """Merge three adjacent pieces into two (:func:`_removal_cost`, least
     cost first) until at most ``cap`` pieces remain.
 
@@ -443,7 +515,7 @@ def _enforce_capacity(s, ds, m, cap, alpha, total, stuck):
     while m > cap:
         j = _least_triple(s, m, alpha)
         u0, u1, u2, u3, p0, p1, p2, p3, area2 = _triple(s, j)
-        uw, pw = _vertex(u0, u1, u2, u3, p0, p3, area2, alpha)
+        uw, pw, clamp = _vertex(u0, u1, u2, u3, p0, p3, area2, alpha)
         r = _HEAD + 3 * (j - 1)
         for q in range(3):
             a, b = s[r + 3 * q + 1], s[r + 3 * q + 2]
@@ -455,7 +527,7 @@ def _enforce_capacity(s, ds, m, cap, alpha, total, stuck):
         total += _integral(u0, uw, a1, b1) + _integral(uw, u3, a2, b2)
         stuck += _stuck_part(u0, uw, a1, b1, alpha) + _stuck_part(uw, u3, a2, b2, alpha)
         if ds is not None:
-            _merge_jvp(ds, j, u0, u1, u2, u3, uw)
+            _merge_jvp(s, ds, j, uw, pw, clamp, (a1, b1, a2, b2), alpha, ia, dN)
         _write(s, j - 1, uw, a1, b1)
         _write(s, j, u3, a2, b2)
         _shift_down(s, ds, j, m)
