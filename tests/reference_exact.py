@@ -1,4 +1,4 @@
-"""Plain-Python reference of the exact Iwan law (``iwan-exact``).
+"""Plain-Python reference of the exact Iwan law (``iwan``, the default).
 
 Written from the algorithm of ``jointdyn.laws.exact`` (module docstring) and
 MODEL.md sections 2, 3 and 5, without its state vector, its kernels or

@@ -1,4 +1,4 @@
-"""The exact Iwan law (``iwan-exact``, ``jointdyn.laws.exact``) against its oracles.
+"""The exact Iwan law (``iwan``, ``jointdyn.laws.exact``) against its oracles.
 
 * the plain-Python reference ``tests/reference_exact.py`` (same algorithm,
   lists of pieces): same force, tangent and motion state to rounding, with
@@ -27,9 +27,9 @@ import tolerances as C
 from reference import march_ref
 from reference_exact import ExactIwanRef
 
-from jointdyn import DiscreteIwan, Iwan, make_law, march
+from jointdyn import DiscreteIwan, Iwan, IwanClosedForm, make_law, march
 from jointdyn._jit import specialize
-from jointdyn.laws.exact import ExactIwan, piece_count
+from jointdyn.laws.exact import piece_count
 
 KT, MU, NREF = 1e5, 0.1, 100.0
 FY = MU * NREF
@@ -70,7 +70,7 @@ def _reference_cases():
 @pytest.mark.parametrize("capacity", [3, 5, 16, 200])
 @pytest.mark.parametrize("x,N", _reference_cases())
 def test_kernel_matches_reference(capacity, x, N):
-    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=capacity)
+    law = Iwan(kt=KT, mu=MU, n_ref=NREF, capacity=capacity)
     T, kT, code, _ = march(law, x, N)
     Tr, kTr, cr = march_ref(ExactIwanRef(KT, MU, NREF, capacity, x[0], N[0]), x, N)
     np.testing.assert_allclose(T, Tr, rtol=0, atol=C.TEST_EXACT_REFERENCE_ATOL_FY * FY)
@@ -85,10 +85,10 @@ def test_reference_cases_merge_and_separate():
     seen = set()
     for p in _reference_cases():
         x, N = p.values
-        seen.update(np.unique(march(ExactIwan(kt=KT, mu=MU, n_ref=NREF), x, N)[2]).tolist())
+        seen.update(np.unique(march(Iwan(kt=KT, mu=MU, n_ref=NREF), x, N)[2]).tolist())
     assert seen == {0, 1, 2}
     x, N = _reference_cases()[-1].values
-    assert _pieces(ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=200), x, N).max() > 16
+    assert _pieces(Iwan(kt=KT, mu=MU, n_ref=NREF, capacity=200), x, N).max() > 16
 
 
 def test_zero_friction():
@@ -96,7 +96,7 @@ def test_zero_friction():
     rng = np.random.default_rng(7)
     x = H.random_walk(rng, 200, 1e-5)
     N = H.normal_history(rng, 200, NREF, 1.5)
-    T, kT, code, _ = march(ExactIwan(kt=KT, mu=0.0, n_ref=NREF), x, N)
+    T, kT, code, _ = march(Iwan(kt=KT, mu=0.0, n_ref=NREF), x, N)
     assert np.all(T == 0.0) and np.all(kT == 0.0)
     np.testing.assert_array_equal(code, np.where(N <= 0.0, 2, 1))
 
@@ -118,12 +118,12 @@ def _constant_load_histories():
 @pytest.mark.parametrize("alpha", [1.0, 0.4, 1.7])
 @pytest.mark.parametrize("x", _constant_load_histories())
 def test_equals_full_memory_closed_form_at_constant_load(alpha, x):
-    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF)
+    law = Iwan(kt=KT, mu=MU, n_ref=NREF)
     N = np.full(x.size, alpha * NREF)
     # no merge: the exact law is exact here
     assert _pieces(law, x, N).max() < law.capacity
     T, kT, code, _ = march(law, x, N)
-    Tc, kTc, cc, _ = march(Iwan(kt=KT, mu=MU, n_ref=NREF, memory="full"), x, N)
+    Tc, kTc, cc, _ = march(IwanClosedForm(kt=KT, mu=MU, n_ref=NREF, memory="full"), x, N)
     np.testing.assert_allclose(T, Tc, rtol=0, atol=C.TEST_EXACT_CLOSED_FORM_ATOL_FY * FY)
     np.testing.assert_allclose(kT, kTc, rtol=0, atol=C.TEST_EXACT_CLOSED_FORM_ATOL_FY * KT)
 
@@ -134,7 +134,7 @@ def test_discrete_converges_like_one_over_n_squared(eta, delta):
     t = np.linspace(0.0, 3.0, 3001)
     x = XS * (0.8 * np.sin(2 * np.pi * t) + 0.5 * np.sin(7.3 * t) * np.exp(-0.3 * t) + 0.2 * np.sin(23 * t))
     N = NREF * (1.0 + eta * np.sin(2 * np.pi * 1.3 * t + delta))
-    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=4000)
+    law = Iwan(kt=KT, mu=MU, n_ref=NREF, capacity=4000)
     assert _pieces(law, x, N).max() < law.capacity
     T = march(law, x, N)[0]
     err = [np.max(np.abs(march(DiscreteIwan(kt=KT, mu=MU, n_ref=NREF, n=n), x, N)[0] - T)) for n in (500, 1000, 2000, 4000)]
@@ -186,7 +186,7 @@ def _jvp_case(seed, eta):
 
 @pytest.mark.parametrize("seed,eta", [(1, 0.0), (2, 0.5), (3, 0.8), (4, 1.3), (5, 1.6)])
 def test_jvp_equals_finite_differences(seed, eta):
-    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=500)
+    law = Iwan(kt=KT, mu=MU, n_ref=NREF, capacity=500)
     x, N, dx, dN = _jvp_case(seed, eta)
     assert _pieces(law, x, N).max() < law.capacity  # no merge: exact derivatives
     s0 = np.empty(law.state_size)
@@ -224,11 +224,11 @@ def test_jvp_with_merges_is_exact(capacity):
     """Merges are differentiated exactly (breakpoints carry their
     derivatives): equal to finite differences on a history that needs
     several times the capacity, merging at most steps."""
-    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=capacity)
+    law = Iwan(kt=KT, mu=MU, n_ref=NREF, capacity=capacity)
     t = np.linspace(0.0, 2.0, 2 * 1000 + 1)
     x = 2.5 * XS * np.sin(2 * np.pi * t)
     N = NREF * (1 + 0.9 * np.cos(2 * np.pi * t))
-    assert _pieces(ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=1000), x, N).max() > 1.5 * 32
+    assert _pieces(Iwan(kt=KT, mu=MU, n_ref=NREF, capacity=1000), x, N).max() > 1.5 * 32
     dx = np.zeros((x.size, 2))
     dN = np.zeros_like(dx)
     dx[1:, 0] = XS * np.cos(2 * np.pi * t[1:])
@@ -256,21 +256,21 @@ def test_energy_per_cycle(alpha, qa):
     spc = 4000
     t = np.arange(2 * spc + 1) / spc
     x = A * np.sin(2 * np.pi * t)
-    T = march(ExactIwan(kt=KT, mu=MU, n_ref=NREF), x, np.full(x.size, alpha * NREF))[0]
+    T = march(Iwan(kt=KT, mu=MU, n_ref=NREF), x, np.full(x.size, alpha * NREF))[0]
     E = float(np.sum(0.5 * (T[spc + 1 :] + T[spc:-1]) * np.diff(x[spc:])))
     assert E == pytest.approx(_energy_formula(A, alpha), rel=C.TEST_EXACT_ENERGY_RTOL)
 
 
 # --- construction ---------------------------------------------------------------------------
 def test_registered_and_validated():
-    law = make_law("iwan-exact", kt=KT, mu=MU, n_ref=NREF, capacity="12")
-    assert isinstance(law, ExactIwan) and law.capacity == 12
+    law = make_law("iwan", kt=KT, mu=MU, n_ref=NREF, capacity="12")
+    assert isinstance(law, Iwan) and law.capacity == 12
     assert law.state_size == 2 + 3 * 3 * 12
     for bad in (2, 0, -1, 3.5, "x", float("nan")):
         with pytest.raises(ValueError, match="capacity"):
-            ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=bad)
+            Iwan(kt=KT, mu=MU, n_ref=NREF, capacity=bad)
     with pytest.raises(ValueError, match="kt"):
-        make_law("iwan-exact", kt=0.0, mu=MU, n_ref=NREF)
+        make_law("iwan", kt=0.0, mu=MU, n_ref=NREF)
 
 
 @pytest.mark.parametrize(
@@ -284,7 +284,7 @@ def test_check_state(row, value, what):
     """A user-supplied state: x_prev and the piece count finite, the count an
     integer in [1, capacity], the live pieces finite, breakpoints strictly
     increasing from above 0 to u = 2; rows beyond the live pieces are free."""
-    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF)
+    law = Iwan(kt=KT, mu=MU, n_ref=NREF)
     s = law.initial_state()
     s[row] = value
     with pytest.raises(ValueError, match=what):
@@ -309,7 +309,7 @@ def test_check_state(row, value, what):
 
 
 def test_scales_and_bounds():
-    law = ExactIwan(kt=KT, mu=MU, n_ref=NREF)
+    law = Iwan(kt=KT, mu=MU, n_ref=NREF)
     assert law.x_slip == 2.0 * FY / KT and law.passive
     assert law.max_force(2.0 * NREF) == pytest.approx(2.0 * FY) and law.max_force(-1.0) == 0.0
     # the virgin curve reaches macroslip at x_slip and not before
@@ -331,7 +331,7 @@ def laws(draw, capacities=(3, 4, 8, 32)):
     kt = 10.0 ** draw(st.floats(3.0, 8.0))
     mu = draw(st.floats(0.01, 1.0))
     n_ref = 10.0 ** draw(st.floats(0.0, 4.0))
-    return ExactIwan(kt=kt, mu=mu, n_ref=n_ref, capacity=draw(st.sampled_from(capacities)))
+    return Iwan(kt=kt, mu=mu, n_ref=n_ref, capacity=draw(st.sampled_from(capacities)))
 
 
 @st.composite
@@ -403,7 +403,7 @@ def test_merges_within_the_limits_out_of_phase():
     for eta in (0.3, 0.9, 1.2):
         N = NREF * (1 + eta * np.sin(2 * np.pi * t + np.pi / 2))
         for cap in (8, 32):
-            law = ExactIwan(kt=KT, mu=MU, n_ref=NREF, capacity=cap)
+            law = Iwan(kt=KT, mu=MU, n_ref=NREF, capacity=cap)
             assert _pieces(law, x, N).max() == cap  # merges happen
             assert _outside_limits(law, x, N) <= 1e-12
 

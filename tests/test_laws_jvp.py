@@ -21,7 +21,7 @@ import law_histories as H
 
 from law_cases import registry_laws
 
-from jointdyn import Iwan, march
+from jointdyn import Iwan, IwanClosedForm, march
 from jointdyn.laws import law_names, make_law
 import tolerances as C
 from jointdyn._jit import specialize
@@ -56,7 +56,7 @@ def march_jvp(law, x, dx, N, dN, state):
 
 #: every registered law with every parameter set of law_cases.variants (few elements)
 LAWS = {case: law for case, _, law in registry_laws(KT, MU, NREF, small=True)}
-FULL = Iwan(kt=KT, mu=MU, n_ref=NREF)
+FULL = IwanClosedForm(kt=KT, mu=MU, n_ref=NREF)
 
 
 def _case(seed, eta):
@@ -124,10 +124,11 @@ def test_jvp_cases_cover_every_state():
     assert seen == {0, 1, 2}
 
 
-def test_jvp_of_constant_load_branch_closed_form():
+@pytest.mark.parametrize("law", [FULL, Iwan(kt=KT, mu=MU, n_ref=NREF)], ids=["iwan-closed", "iwan"])
+def test_jvp_of_constant_load_branch_closed_form(law):
     """d T / d x along a Masing branch: kT of the branch, by hand: after a
-    reversal at q0 the slope is kt (1 - (q0 - q)/(4 alpha)) (c = 2)."""
-    law = FULL
+    reversal at q0 the slope is kt (1 - (q0 - q)/(4 alpha)) (c = 2); the
+    closed form and the exact law (equal at constant load)."""
     x = np.concatenate([np.linspace(0, 0.8 * XS, 20), np.linspace(0.8 * XS, 0.0, 21)[1:]])
     N = np.full(x.size, NREF)
     dx = np.zeros((x.size, 1))

@@ -6,7 +6,7 @@ Each constant says what it bounds and in which units.
 # --- contact laws ----------------------------------------------------------
 #: closed-form energy per cycle vs the formula (relative)
 TEST_ENERGY_RTOL = 5e-3
-#: closed-form Iwan vs discrete (n = 4000), as a fraction of fy
+#: closed-form Iwan (iwan-closed) vs discrete (n = 4000) at constant load, as a fraction of fy
 TEST_IWAN_VS_DISCRETE_FY = 5e-3
 #: compiled kernels vs plain-Python references (absolute, in units of fy)
 TEST_REFERENCE_ATOL_FY = 1e-9
@@ -46,7 +46,7 @@ TEST_HB_DF_RTOL = 1e-4
 #: harmonic balance vs time-domain steady state (relative)
 TEST_HB_VS_TIME_RTOL = 1e-2
 
-# --- exact Iwan law (iwan-exact) ---------------------------------------------
+# --- exact Iwan law (iwan) ---------------------------------------------------
 #: compiled kernel vs the plain-Python reference (absolute, units of fy / kt)
 TEST_EXACT_REFERENCE_ATOL_FY = 1e-12
 TEST_EXACT_REFERENCE_ATOL_KT = 1e-12

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _validate as V
+from . import config
 from .laws import ContactLaw, make_law
 
 __all__ = ["Contact", "System", "PAPER"]
@@ -195,7 +196,7 @@ class System:
         eta: float = 0.5,
         beta: float = 1.0,
         delta: float = 0.0,
-        model: str = "iwan",
+        model: str = config.MODEL,
         zeta: float = 0.0,
         f1: float | None = None,
         law_params: dict | None = None,
@@ -213,7 +214,9 @@ class System:
         delta : float
             Normal-load phase, rad.
         model : str
-            Contact-law name (``iwan``, ``iwan-paper``, ``discrete``, ``jenkins``).
+            Contact-law name (:func:`jointdyn.laws.law_names`; default
+            ``iwan``, the exact Iwan model; ``iwan-closed``, ``iwan-paper``,
+            ``discrete``, ``jenkins``).
         zeta : float
             Viscous damping ratio (paper: 0).
         f1 : float, optional

@@ -1,5 +1,7 @@
 """Exact Iwan model with varying normal load: the discrete model at n -> infinity.
 
+The default contact law of jointdyn (:class:`Iwan`, registered as ``iwan``).
+
 The uniform Iwan model (MODEL.md sections 2, 3, 5) is a continuum of Jenkins
 elements with slip strengths spread uniformly over [0, 2 fy] at the
 reference load, each limit scaled by alpha = N / N_ref. Its state is the
@@ -20,7 +22,7 @@ a list of linear pieces, and the model is the discrete model's limit with
 no discretisation at all: Masing's memory (nested loops, rejoins) is
 automatic, no reversal is ever detected, and slip caused by a falling normal
 load within a branch is included. At constant load it equals the full-memory
-closed form (:class:`~jointdyn.Iwan`) for any history.
+closed form (:class:`~jointdyn.IwanClosedForm`) for any history.
 
 Adjacent pieces with identical coefficients are joined (exact). A cut
 closer than :data:`SNAP` (units of u) to the end of its piece is dropped
@@ -76,7 +78,7 @@ from .._jit import jit
 from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, law_param, register
 
 __all__ = [
-    "ExactIwan",
+    "Iwan",
     "exact_step",
     "exact_step_jvp",
     "exact_init",
@@ -593,13 +595,15 @@ def exact_init_jvp(params, x0, dx0, n0, dn0, s, ds):
 
 
 @dataclass(frozen=True)
-class ExactIwan(ContactLaw):
-    """Exact Iwan law with slip forces scaled by N(t)/N_ref.
+class Iwan(ContactLaw):
+    """Exact Iwan law with slip forces scaled by N(t)/N_ref (the default contact law).
 
     The limit n -> infinity of :class:`~jointdyn.DiscreteIwan`, computed
     exactly with a piecewise-linear state (module docstring): any history,
     any normal load, separation included. Equal to the full-memory closed
-    form :class:`~jointdyn.Iwan` at constant normal load.
+    form :class:`~jointdyn.IwanClosedForm` at constant normal load; unlike
+    the closed forms, it includes the slip caused by a falling normal load
+    within a branch. Registered as ``iwan``.
 
     Parameters
     ----------
@@ -616,10 +620,10 @@ class ExactIwan(ContactLaw):
     """
 
     capacity: int = law_param(
-        config.IWAN_EXACT_CAPACITY, low=MIN_CAPACITY,
+        config.IWAN_CAPACITY, low=MIN_CAPACITY,
         help="linear pieces kept after a step (above it, three adjacent pieces are merged into two)",
     )
-    name: ClassVar[str] = "iwan-exact"
+    name: ClassVar[str] = "iwan"
 
     @property
     def step(self):
@@ -696,11 +700,11 @@ class ExactIwan(ContactLaw):
 
 
 def piece_count(state) -> int:
-    """Number of linear pieces of an :class:`ExactIwan` state vector."""
+    """Number of linear pieces of an :class:`Iwan` state vector."""
     return int(state[_M])
 
 
 register(
-    "iwan-exact", ExactIwan,
-    summary="exact Iwan model with varying normal load (n -> infinity, piecewise-linear state, capacity pieces)",
+    "iwan", Iwan,
+    summary="exact Iwan model with varying normal load (the discrete model at n -> infinity; default)",
 )
