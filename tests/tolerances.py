@@ -65,3 +65,8 @@ TEST_EXACT_MERGE_FY = 1e-5
 #: loop area vs the describing-function energy (relative; trapezoid rule at
 #: 4000 samples per cycle)
 TEST_EXACT_ENERGY_RTOL = 1e-5
+
+# --- energy balance of steady states ------------------------------------------
+#: rounding floor of a period's contact dissipation (units of fy x_slip, the
+#: contact's energy scale): added to the point's energy-balance residual
+TEST_DISSIPATION_FLOOR = 1e-12
