@@ -209,7 +209,7 @@ def _plot_fig2(tables, out_dir):
     ax.set_ylabel("tangential force T (N)")
     ax.set_title("Paper Fig 2: Iwan hysteresis loops at constant normal load, amplitude A varied\n"
                  f"kt = {p['kt'] / 1e3:g} kN/m, fy = {fy:g} N, x = A sin(2 pi t); steady cycle "
-                 f"(last of {_CYCLES}); {model_label(loops['model'].iloc[0])}", fontsize=10)
+                 f"(last of {_CYCLES})\n{model_label(loops['model'].iloc[0])}", fontsize=10)
     ax.grid(True, alpha=0.3)
     _legend_below(fig, ax, loops, colors, ncol=2)
     return save_figure(fig, out_dir, "fig2", dpi=150)
@@ -235,9 +235,9 @@ def _plot_eta_family(tables, out_dir, name, delta_deg, paper_fig):
     ax.set_ylabel("tangential force T (N)")
     phase = _PHASE_WORDS.get(float(delta_deg), f"delta = {delta_deg:g} deg")
     ax.set_title(
-        f"Paper Fig {paper_fig}: normal load {phase} with the motion (delta = {delta_deg:g} deg), "
-        f"eta = N1/N0 varied\nx = {p['amplitude'] * 1e3:g} mm sin(2 pi t), N = N0 (1 + eta sin(2 pi t + delta)), "
-        f"N0 = {p['n0']:g} N; {model_label(loops['model'].iloc[0])}", fontsize=9,
+        f"Paper Fig {paper_fig}: normal load {phase} with the motion, eta = N1/N0 varied\n"
+        f"x = {p['amplitude'] * 1e3:g} mm sin(2 pi t), N = N0 (1 + eta sin(2 pi t + delta)), "
+        f"delta = {delta_deg:g} deg, N0 = {p['n0']:g} N\n{model_label(loops['model'].iloc[0])}", fontsize=9,
     )
     ax.grid(True, alpha=0.3)
     _legend_below(fig, ax, loops, colors, ncol=4)
