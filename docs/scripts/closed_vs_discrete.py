@@ -42,7 +42,7 @@ MARKERS = {A_PAPER: "table", A_SMALL: "table-small"}
 
 
 def last_cycle(model, A, eta, delta_deg, n=1000):
-    law = make_law(model, kt=KT, mu=MU, n_ref=N0, n=n)
+    law = make_law(model, kt=KT, mu=MU, n_ref=N0, **({"n": n} if model == "discrete" else {}))
     r = harmonic_loop(law, A, 1.0, N0, eta=eta, delta=math.radians(delta_deg), cycles=CYCLES,
                       steps_per_cycle=STEPS)
     sl = r.cycle_slice(-1)
@@ -53,7 +53,7 @@ def rows(A):
     out = []
     cases = [(d, e) for d in DELTAS for e in ETAS]
     for delta, eta in tqdm(cases, desc=f"A = {A * 1e3:g} mm", disable=None):
-        full, t1, T1 = last_cycle("iwan", A, eta, delta)
+        full, t1, T1 = last_cycle("iwan-closed", A, eta, delta)
         paper, t2, T2 = last_cycle("iwan-paper", A, eta, delta)
         disc, t3, T3 = last_cycle("discrete", A, eta, delta)
         fine, _, _ = last_cycle("discrete", A, eta, delta, n=4000)

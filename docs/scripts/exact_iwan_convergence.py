@@ -1,4 +1,4 @@
-"""Convergence study of the exact Iwan law (``iwan-exact``): docs/exact-iwan.md.
+"""Convergence study of the exact Iwan law (``iwan``, the default contact law): docs/exact-iwan.md.
 
 Usage::
 
@@ -33,17 +33,17 @@ from pathlib import Path
 
 import numpy as np
 
-from jointdyn import DiscreteIwan, Iwan, config, harmonic_loop
+from jointdyn import DiscreteIwan, Iwan, IwanClosedForm, config, harmonic_loop
 from jointdyn._io import atomic_write_text
 from jointdyn.dynamics import steady_state
-from jointdyn.laws.exact import ExactIwan, piece_count
+from jointdyn.laws.exact import piece_count
 from jointdyn.systems import PAPER, System
 
 PAGE = Path(__file__).resolve().parents[1] / "exact-iwan.md"
 START, END = "<!-- tables:start -->", "<!-- tables:end -->"
 #: capacity treated as "no merge" (checked: the piece counts stay below it)
 K_REF = 2048
-K_DEFAULT = config.IWAN_EXACT_CAPACITY
+K_DEFAULT = config.IWAN_CAPACITY
 CAPACITIES = (8, 12, 16, 24, 32, 48, 64)
 DISCRETE_N = (50, 200, 1000, 4000)
 
@@ -81,10 +81,10 @@ def _pieces(law, x, N, state=None):
 
 
 def _qs_models():
-    models = {"exact K=%d" % K: ExactIwan(**QS, capacity=K) for K in (K_REF,) + CAPACITIES}
+    models = {"exact K=%d" % K: Iwan(**QS, capacity=K) for K in (K_REF,) + CAPACITIES}
     models.update({"discrete n=%d" % n: DiscreteIwan(**QS, n=n) for n in DISCRETE_N})
-    models["closed form (full memory)"] = Iwan(**QS, memory="full")
-    models["paper rule (last reversal)"] = Iwan(**QS, memory="last")
+    models["closed form (full memory)"] = IwanClosedForm(**QS, memory="full")
+    models["paper rule (last reversal)"] = IwanClosedForm(**QS, memory="last")
     return models
 
 
@@ -114,12 +114,12 @@ def quasi_static():
 
 
 def _frc_models():
-    models = {"exact K=%d" % K: (lambda K=K: ExactIwan(kt=PAPER["kt"], mu=PAPER["mu"], n_ref=PAPER["n0"], capacity=K))
+    models = {"exact K=%d" % K: (lambda K=K: Iwan(kt=PAPER["kt"], mu=PAPER["mu"], n_ref=PAPER["n0"], capacity=K))
               for K in (K_REF,) + CAPACITIES}
     for n in DISCRETE_N:
         models["discrete n=%d" % n] = lambda n=n: DiscreteIwan(kt=PAPER["kt"], mu=PAPER["mu"], n_ref=PAPER["n0"], n=n)
-    models["closed form (full memory)"] = lambda: Iwan(kt=PAPER["kt"], mu=PAPER["mu"], n_ref=PAPER["n0"])
-    models["paper rule (last reversal)"] = lambda: Iwan(kt=PAPER["kt"], mu=PAPER["mu"], n_ref=PAPER["n0"],
+    models["closed form (full memory)"] = lambda: IwanClosedForm(kt=PAPER["kt"], mu=PAPER["mu"], n_ref=PAPER["n0"])
+    models["paper rule (last reversal)"] = lambda: IwanClosedForm(kt=PAPER["kt"], mu=PAPER["mu"], n_ref=PAPER["n0"],
                                                         memory="last")
     return models
 
@@ -180,12 +180,12 @@ def fig6_grid(gammas=GRID_GAMMAS):
         for beta in GRID_BETAS:
             for d in ("up", "down"):
                 t0 = time.process_time()
-                q_ref, pmax = _sweep(lambda: ExactIwan(kt=kt, mu=mu, n_ref=n0, capacity=K_REF), eta, beta, gammas, d,
+                q_ref, pmax = _sweep(lambda: Iwan(kt=kt, mu=mu, n_ref=n0, capacity=K_REF), eta, beta, gammas, d,
                                      count_pieces=True)
                 t1 = time.process_time()
-                q_def, _ = _sweep(lambda: ExactIwan(kt=kt, mu=mu, n_ref=n0, capacity=K_DEFAULT), eta, beta, gammas, d)
+                q_def, _ = _sweep(lambda: Iwan(kt=kt, mu=mu, n_ref=n0, capacity=K_DEFAULT), eta, beta, gammas, d)
                 t2 = time.process_time()
-                q_cf, _ = _sweep(lambda: Iwan(kt=kt, mu=mu, n_ref=n0), eta, beta, gammas, d)
+                q_cf, _ = _sweep(lambda: IwanClosedForm(kt=kt, mu=mu, n_ref=n0), eta, beta, gammas, d)
                 t3 = time.process_time()
                 out.append(dict(eta=eta, beta=beta, direction=d, q_ref=q_ref, q_def=q_def, pieces=pmax,
                                 seconds=(t1 - t0, t2 - t1, t3 - t2)))
