@@ -264,7 +264,7 @@ def _vertex(u0, u1, u2, u3, p0, p3, area2, alpha):
     """The vertex (uw, pw) of :func:`_removal_cost`, pw clamped to the
     limits [-alpha uw, alpha uw] (only when no merge keeps the integral
     within them: then this merge changes T), and the clamp: 0, or +-1 when
-    pw was put on the upper / lower limit."""
+    pw is put on the upper / lower limit."""
     uw = 0.5 * (u1 + u2)
     pw = (area2 - (uw - u0) * p0 - (u3 - uw) * p3) / (u3 - u0)
     lim = alpha * uw
