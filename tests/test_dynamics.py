@@ -14,12 +14,16 @@ from jointdyn.laws import SEPARATION, HarmonicLoad, make_law
 from jointdyn.systems import PAPER, Contact, System
 from jointdyn.dynamics import (
     Restart,
+    RunStatus,
     SteadyState,
+    SteadyStatus,
     Trajectory,
     integrate,
     integrate_sampled,
     steady_state,
 )
+from jointdyn.dynamics._core import LOADS_HARMONIC, RUN_BLOWUP, RUN_OK, RUN_OVERFLOW
+from jointdyn.dynamics._model import make_model, run
 
 M, K, KT = PAPER["m"], PAPER["k"], PAPER["kt"]
 
@@ -327,6 +331,48 @@ def test_unsettled_response_is_not_reported_as_a_number():
     assert math.isnan(r.amplitude_q) and math.isnan(r.amplitude_m)
     assert r.periods < config.SS_MAX_PERIODS
     assert steady_state(System.paper_damper(eta=0.5, beta=2.0), 1.15).status == "periodic"
+
+
+# --- statuses and the runner's buffers ------------------------------------------
+
+
+def test_status_enumerations():
+    assert [m.code for m in (RunStatus.OK, RunStatus.BLOW_UP, RunStatus.OVERFLOW)] == [RUN_OK, RUN_BLOWUP, RUN_OVERFLOW]
+    # files and tables carry the values
+    assert [m.value for m in SteadyStatus] == ["periodic", "not-settled", "unbounded"]
+    assert SteadyStatus.PERIODIC.ok and not SteadyStatus.NOT_SETTLED.ok and not SteadyStatus.UNBOUNDED.ok
+    assert RunStatus.OK.ok and not RunStatus.BLOW_UP.ok
+    assert all(m.message for m in (*RunStatus, *SteadyStatus))
+    r = steady_state(System.paper_damper(eta=0.5, beta=2.0), 1.2, keep_loop=False)
+    assert r.status is SteadyStatus.PERIODIC and r.status == "periodic" and r.ok
+
+
+def test_blow_up_is_reported():
+    # negative damping: the response grows like exp(25 t) until the guard stops it
+    s = System(M=[[1.0]], C=[[-50.0]], K=[[100.0]], force=[1.0])
+    tr = integrate(s, 1.0, periods=200)
+    assert tr.status is RunStatus.BLOW_UP and not tr.status.ok
+    assert tr.t[-1] < 200 * 2 * math.pi / 10.0
+    r = steady_state(s, 1.0)
+    assert r.status is SteadyStatus.UNBOUNDED and r.detail == "blow-up"
+
+
+def test_full_sample_buffer_is_enlarged_and_the_run_repeated():
+    s = System.paper_damper(eta=1.5, beta=2.0)
+    model = make_model(s, 1.1 * s.w0, 64)
+    x0, v0 = np.array([1e-4]), np.zeros(1)
+    S0 = model.initial_states(x0)
+    runs = []
+    for capacity in (1, 100000):
+        x, v, S = x0.copy(), v0.copy(), S0.copy()
+        res = run(model, model.grid, LOADS_HARMONIC, x, v, S, 2, record=True, capacity=capacity)
+        assert res.status is RunStatus.OK and res.done == 2
+        runs.append((res, x, S))
+    (a, xa, Sa), (b, xb, Sb) = runs
+    for p, q in zip(a.samples, b.samples):
+        np.testing.assert_array_equal(p, q)
+    np.testing.assert_array_equal(xa, xb)
+    np.testing.assert_array_equal(Sa, Sb)
 
 
 # --- bad input ---------------------------------------------------------------

@@ -9,7 +9,7 @@ import numpy as np
 
 from jointdyn import config
 from jointdyn.dynamics._core import N_SUMMARY, S_EC, S_EV, S_W, S_XMAX, S_XMIN
-from jointdyn.dynamics.integrate import _Model
+from jointdyn.dynamics._model import make_model
 from jointdyn.dynamics.steady import _History, _check_periodic
 from jointdyn.systems import System
 
@@ -43,7 +43,7 @@ def _reference(summ, Z, p, K, n, w, K_stuck, M, floor, amp_rtol, energy_rtol, ba
 
 def test_compiled_periodicity_check_equals_reference():
     system = System.paper_damper(eta=0.5, beta=2.0)
-    model = _Model(system, 1.1 * system.w0, 64)
+    model = make_model(system, 1.1 * system.w0, 64)
     rng = np.random.default_rng(7)
     amp_rtol, energy_rtol = config.SS_AMP_RTOL, config.SS_ENERGY_RTOL
     outcomes = set()
@@ -72,7 +72,7 @@ def test_compiled_periodicity_check_equals_reference():
         h.add(summ, Z[1:])
         got = _check_periodic(h, p, K, model, amp_rtol, energy_rtol)
         floor = 1e-14 + 1e-9 * sum(c.law.fy / c.law.kt for c in system.contacts)
-        want = _reference(h.summ, h.Z, p, K, model.n, model.w, model.K_stuck, system.M, floor,
+        want = _reference(h.summ, h.Z, p, K, model.n, model.w, model.pack.K_stuck, system.M, floor,
                           amp_rtol, energy_rtol, config.SS_BALANCE_RTOL)  # fmt: skip
         assert got == want, f"case {case}"
         outcomes.add(got)

@@ -144,17 +144,14 @@ def test_changed_spec_is_recomputed(fake, tmp_path):
     assert len(fake.calls) == len(GAMMAS)
 
 
-def test_threads_and_dask_equal_serial(fake):
+def test_threads_and_dask_equal_serial(fake, monkeypatch):
     from distributed import Client, LocalCluster
 
     kw = dict(etas=[0.5, 1.5], betas=[1.0, 2.0, 5.0], progress=False)
     serial = frc_sweep(GAMMAS, **kw, n_workers=1)
-    pool = _frc.config.SWEEP_POOL
-    try:
-        _frc.config.SWEEP_POOL = "thread"
+    with monkeypatch.context() as mp:  # the local pool kind for this call only
+        mp.setattr(_frc.config, "SWEEP_POOL", "thread")
         threads = frc_sweep(GAMMAS, **kw, n_workers=2)
-    finally:
-        _frc.config.SWEEP_POOL = pool
     xr.testing.assert_identical(serial, threads)
     with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
         with Client(lc) as client:
@@ -204,15 +201,10 @@ def test_status_codes_match_config():
 
 
 # --- with the real time-domain solver -------------------------------------
-def _dyn():
-    return pytest.importorskip("jointdyn.dynamics")
-
-
 def test_linear_stuck_limit_real_solver():
     """eta = 0, beta = 1000 (F1 = 0.05 N): the joint hardly slips, so the
     response is the linear one with stiffness k + kt:
     q = kt / fy * F1 / (k + kt - m w^2), w = gamma sqrt(k/m)."""
-    _dyn()
     g = [0.8, 1.6]
     ds = frc_sweep(g, etas=[0.0], betas=[1000.0], directions=("up",), n_workers=1, progress=False)
     q = ds.amplitude_q.sel(eta=0.0, beta=1000.0, delta=0.0, direction="up").values
@@ -226,7 +218,6 @@ def test_linear_stuck_limit_real_solver():
 def test_real_solver_serial_equals_dask_and_resume(tmp_path):
     """Deterministic: serial == Dask LocalCluster; an interrupted sweep
     resumes to the identical result without recomputing finished lines."""
-    _dyn()
     from distributed import Client, LocalCluster
 
     g = [0.9, 1.0, 1.1]
@@ -261,7 +252,6 @@ def test_energy_balance_real_solver():
     """Undamped (zeta = 0) steady state: the work of the force per period
     equals the energy the contact dissipates (delta sweep, contact and
     separation)."""
-    _dyn()
     ds = frc_sweep([0.8], etas=[0.5, 1.5], betas=[1.0], deltas=[0.0, 90.0], directions=("up",),
                    n_workers=1, progress=False)
     assert (ds.status.values == 0).all()

@@ -37,6 +37,15 @@ TEST_TI_ENERGY_RTOL = 0.01
 TEST_TI_STEP_HALVING_RTOL = 0.005
 #: compiled law inside the integrator vs drivers.march, in units of fy
 TEST_TI_MARCH_ATOL_FY = 1e-9
+#: error ratio when the RK4 step is halved on a smooth problem (fourth
+#: order: 16; the range allows for the higher-order terms at the coarsest step)
+TEST_TI_ORDER_RATIO = (13.0, 19.0)
+#: smooth 2-DOF problem at 512 steps per period vs the DOP853 reference,
+#: relative to the largest displacement (measured 4e-9)
+TEST_TI_REFERENCE_RTOL = 1e-8
+#: monodromy matrix of a linear system (RK4 period map, central differences)
+#: vs the exact matrix exponential, relative to its largest entry
+TEST_MONODROMY_LINEAR_RTOL = 1e-6
 
 # --- harmonic balance ----------------------------------------------------------
 #: exact Jacobian vs central finite differences (relative to max |J|)

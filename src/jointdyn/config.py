@@ -118,6 +118,15 @@ SS_SHOOT_FD = 1e-6
 #: a Floquet multiplier above 1 + this marks an unstable orbit
 SS_FLOQUET_TOL = 1e-3
 
+# --- monodromy (finite-difference Floquet multipliers of the period map) --------------
+#: relative central-difference step of the monodromy check of harmonic-balance
+#: solutions (of the amplitude for displacements, of w times it for velocities)
+MONODROMY_FD_STEP = 1e-6
+#: periods, and samples per period, of the harmonic-balance displacement over
+#: which each contact law is marched to obtain its state at the section
+MONODROMY_WARM_PERIODS = 3
+MONODROMY_WARM_SAMPLES = 4096
+
 # --- steady state: unbounded response ----------------------------------------------
 #: amplitude increasing over this many consecutive periods ...
 SS_GROWTH_PERIODS = 40

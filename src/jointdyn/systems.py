@@ -7,7 +7,9 @@ MODEL.md section 6::
     N_c(t) = n0 + n1 sin(w t + delta).
 
 The excitation frequency w is not part of the system: solvers take it (or
-gamma = w / w0) as an argument, so one System serves a whole sweep.
+gamma = w / w0) as an argument, so one System serves a whole sweep. The
+contact selection and the normal loads are packed for the solvers by
+:func:`jointdyn.kinematics.contact_kinematics`, their one home.
 All contacts of one system use the same contact-law class (one compiled
 kernel); their parameters may differ.
 """
@@ -22,6 +24,7 @@ import numpy as np
 
 from . import _validate as V
 from . import config
+from .kinematics import harmonic_load_samples
 from .laws import ContactLaw, make_law
 
 __all__ = ["Contact", "System", "PAPER"]
@@ -73,8 +76,8 @@ class Contact:
         return self.n1 / self.n0
 
     def normal_load(self, w: float, t):
-        """N(t) = n0 + n1 sin(w t + delta), N."""
-        return self.n0 + self.n1 * np.sin(w * np.asarray(t, dtype=float) + self.delta)
+        """N(t) = n0 + n1 sin(w t + delta), N (:func:`jointdyn.kinematics.harmonic_load`)."""
+        return harmonic_load_samples(self.n0, self.n1, self.delta, w * np.asarray(t, dtype=float))
 
 
 @dataclass(frozen=True)

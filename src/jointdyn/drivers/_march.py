@@ -78,3 +78,18 @@ def _march_unchecked(law, x, N, s0, params=None):
     p = law.params if params is None else params
     specialize(_march_template, STEP=law.step)(p, s0, x, N, T, kT, code, s_final)
     return T, kT, code, s_final
+
+
+def law_marcher(step):
+    """The compiled march of a law kernel over a history, for compiled loops.
+
+    Returns ``marcher(params, s0, x, N, T, kT, code, s_final)``: steps the
+    kernel ``step`` over the samples ``x[i]`` (m), ``N[i]`` (N) from the
+    committed state ``s0`` (not written), committing after each, into the
+    force ``T`` (N), tangent ``kT`` (N/m) and motion state ``code`` (int8)
+    per sample and the final state ``s_final`` (no validation; the same
+    compiled loop as :func:`march`). Templates that march a law over a
+    history bind it as a placeholder (e.g. ``MARCH``) with
+    :func:`jointdyn._jit.specialize`.
+    """
+    return specialize(_march_template, STEP=step)

@@ -2,11 +2,15 @@
 
 Public API: :func:`integrate` (harmonic loads), :func:`integrate_sampled`
 (sampled loads), :class:`Trajectory`, :class:`Restart`,
-:func:`steady_state` and :class:`SteadyState`.
+:func:`steady_state` and :class:`SteadyState`, the statuses
+:class:`RunStatus` and :class:`SteadyStatus`, and the monodromy matrix of
+the period map (:func:`monodromy_matrix`, :func:`fd_monodromy`).
 """
 
 from .integrate import Restart, Trajectory, integrate, integrate_sampled
-from .steady import STATUSES, SteadyState, steady_state
+from .monodromy import fd_monodromy, monodromy_matrix
+from .status import RunStatus, SteadyStatus
+from .steady import SteadyState, steady_state
 
 __all__ = [
     "integrate",
@@ -15,5 +19,8 @@ __all__ = [
     "Restart",
     "steady_state",
     "SteadyState",
-    "STATUSES",
+    "RunStatus",
+    "SteadyStatus",
+    "monodromy_matrix",
+    "fd_monodromy",
 ]

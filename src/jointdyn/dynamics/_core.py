@@ -16,10 +16,50 @@ Events are never smeared over a step:
 * when the relative velocity of any contact changes sign inside a step, the
   instant of the extremum of u is located on the cubic Hermite interpolant
   of (u, du) over the step, the step is redone up to that instant and
-  committed there, so that the law's reversal point is the true extremum.
+  committed there, so that the law's reversal point is the true extremum;
+* when the motion state of a contact changes inside a step (onset or end of
+  macroslip), the instant is located by bisection on the law's state code
+  and the step is redone up to there.
 
-The templates call the global placeholder ``STEP`` (the law kernel) and are
-compiled per law with :func:`jointdyn._jit.specialize`.
+The runner is one loop around a single evaluation of the right-hand side
+(law trial steps included), so that the law kernel is compiled inline once;
+an *evaluation kind* (``EVAL_*``) says what the evaluation is for (the
+start, RK stages 2..4, the end of the step, a bisection probe), and small
+helpers inlined by Numba do one job each: the stage time and the probe
+state, the RK combination, the reversal split, the loads of sampled grids,
+the linear forces and the stage derivatives, the state-change test and the
+bisection, commit and record, the period summary. Two rules keep the loop
+as fast as a hand-written one (both measured):
+
+* the law kernel is called in the template's body, not inside a helper
+  (inlined, the call measured 3.5x slower);
+* a helper called at every evaluation takes arrays (not tuples), has no
+  branch on which array it touches and creates no array view: otherwise
+  the reference counts of its arguments, which Numba updates at every
+  inlined call, are not optimised away (1.3 to 2x slower).
+
+The runner takes five grouped arguments (tuples of arrays):
+
+``system``  ``(Minv, K, C, f, kin, P)``: inverse mass matrix, stiffness and
+            damping matrices, forcing amplitudes (mode LOADS_HARMONIC), the
+            contact kinematics tuple (:mod:`jointdyn.kinematics`) and the law
+            parameter rows
+``grid``    ``(t, N, F, sin_mid, sin_end, N_mid)``: step grid (s), normal
+            loads (N) at its points, sampled forcing F (N; mode
+            LOADS_SAMPLED), forcing sines at the midpoint and end of every
+            step and normal loads at the midpoints (mode LOADS_HARMONIC)
+``control`` ``(mode, repetitions, phase0, w, rdof, max_split, record)``
+``io``      ``(x, v, S, cap)``: state in and out (S: committed law states,
+            one row per contact) and the blow-up caps of (x, v)
+``out``     ``(t, x, v, T, N, code, summary, z_end)``: recorded samples and
+            the per-repetition summary (columns ``S_*``) and end states
+
+It returns ``(samples recorded, run status RUN_*, repetitions done)``
+(samples: ``capacity + 1`` with RUN_OVERFLOW when the buffers were full).
+The template calls the global placeholders ``STEP`` (the law kernel) and
+``NORMAL_LOAD`` (:func:`jointdyn.kinematics.normal_load`, bound so that the
+compiled copy's cache name follows the kinematics source, whose helpers are
+compiled into it) and is compiled per law with :func:`jointdyn._jit.specialize`.
 """
 
 from __future__ import annotations
@@ -29,25 +69,39 @@ import math
 import numpy as np
 
 from .._jit import jit
+from ..kinematics import apply_tangential_force, normal_load, tangential
+from ..laws._base import SEPARATION
 
 # columns of the per-period summary
 S_XMAX, S_XMIN, S_EC, S_EV, S_W, S_XMEAN, S_STEPS = range(7)
 N_SUMMARY = 7
 
-# run status
+#: run status (compiled codes; :class:`~jointdyn.dynamics.RunStatus` names them)
 RUN_OK, RUN_BLOWUP, RUN_OVERFLOW = 0, 1, 2
+
+#: load modes: harmonic forcing and normal loads, or sampled (piecewise linear)
+LOADS_HARMONIC, LOADS_SAMPLED = 0, 1
+
+#: evaluation kinds: the initial evaluation, RK stages 2..4 of the current
+#: attempt, the end of the step (commit), a bisection probe
+EVAL_START, EVAL_STAGE2, EVAL_STAGE3, EVAL_STAGE4, EVAL_END, EVAL_PROBE = -1, 0, 1, 2, 3, 4
+
+#: rows of the stage table: RK stages 1..4, end of step (= stage 1 of the
+#: next step), bisection probe
+ROW_END, ROW_PROBE, N_ROWS = 4, 5, 6
 
 # a change of motion state inside a step is located by this many probes (the
 # first at _SPLIT_GUARD, then bisection: 2^-38 of a step) and the step is
-# split there unless it lies within _SPLIT_GUARD of either end; compile-time
-# constants of the templates (a change here recompiles via the source hash).
-# Fewer probes (24: 1e-7 of a step) changed the outcome of a nearly
-# unstable orbit (eta 1.5, beta 2, gamma 1.18: periodic -> not settled)
+# split there unless it lies within _SPLIT_GUARD of either end (the same
+# guard applies to reversal splits); compile-time constants of the templates
+# (a change here recompiles via the source hash). Fewer probes (24: 1e-7 of
+# a step) changed the outcome of a nearly unstable orbit (eta 1.5, beta 2,
+# gamma 1.18: periodic -> not settled)
 _BISECT_PROBES = 40
 _SPLIT_GUARD = 1e-6
 
 
-@jit
+@jit(inline="always")
 def _hermite_root(u0, u1, du0, du1, h):
     """Root s in (0, 1) of the derivative of the cubic Hermite interpolant.
 
@@ -69,7 +123,7 @@ def _hermite_root(u0, u1, du0, du1, h):
     return 0.5 * (lo + hi)
 
 
-@jit
+@jit(inline="always")
 def _hermite_value(u0, u1, du0, du1, h, s):
     """Cubic Hermite interpolant of u at fraction s of a step of length h."""
     s2 = s * s
@@ -82,383 +136,394 @@ def _hermite_value(u0, u1, du0, du1, h, s):
     )
 
 
-def _run_template(
-    mode, tgrid, Ngrid, Fgrid, nper, phase0, w, fvec, n0, n1, dlt,
-    Minv, K, C, cdof, cdof2, P, S_io, x_io, v_io, rdof, xcap, max_split,
-    rec, out_t, out_x, out_v, out_T, out_N, out_code, summ, zend,
-    sin_mid, sin_end, N_mid,
-):  # pragma: no cover - compiled
-    """March ``nper`` repetitions of the step grid ``tgrid`` (see module docstring).
+# --- where to evaluate -----------------------------------------------------------
 
-    Returns (samples recorded, status, periods completed). ``x_io``, ``v_io``
-    and ``S_io`` (committed law states, one row per contact) are updated in
-    place. ``summ[k]`` holds the per-period summary (max/min/mean of
-    x[rdof], contact and viscous dissipation, work of the forcing, steps)
-    and ``zend[k]`` the state (x, v) at the end of repetition k.
 
-    The right-hand side (law trial steps included) is evaluated at one
-    single place in the loop body, so that it is compiled inline (a call
-    per evaluation with a dozen array arguments costs more than the law).
-    """
-    n = x_io.shape[0]
-    nc = cdof.shape[0]
-    J = tgrid.shape[0] - 1
-    ny = 2 * n + 4
-    period = tgrid[J] - tgrid[0]
-    Sa = S_io.copy()
-    Sb = S_io.copy()
-    y0 = np.zeros(ny)
-    y1 = np.zeros(ny)
-    ys = np.zeros(ny)
-    kk = np.zeros((6, ny))  # rows 1..3: stages 2..4; row 4: end of step (= next row 0); row 5: probes
-    work = np.zeros(n)
-    Fv = np.zeros(n)
-    Nv = np.zeros(nc)
-    Tc = np.zeros(nc)
-    codes = np.zeros(nc, dtype=np.int64)
-    code_c = np.zeros(nc, dtype=np.int64)  # motion state of the committed laws
-    # bisection for a change of motion state inside a step (e == 4 probes)
-    blo = 0.0
-    bhi = 1.0
-    bit = 0
-    sm = 0.0
-    located = False
+@jit(inline="always")
+def _probe_state(sm, h, y0, y1, ys, n):  # pragma: no cover - compiled
+    """(x, v) at fraction ``sm`` of the step on the cubic Hermite interpolant
+    (x) and the linear one (v)."""
     for i in range(n):
-        y0[i] = x_io[i]
-        y0[n + i] = v_io[i]
-    # mode 0: sin_mid, sin_end, N_mid (see grid_sines) are the harmonic loads
-    # at the midpoint and the end of every grid step, computed once per grid
+        ys[i] = _hermite_value(y0[i], y1[i], y0[n + i], y1[n + i], h, sm)
+        ys[n + i] = y0[n + i] + sm * (y1[n + i] - y0[n + i])
+
+
+@jit(inline="always")
+def _stage_time(e, t0, h, tc, end_idx):  # pragma: no cover - compiled
+    """(time s, grid index or -1, stage offset a s) of evaluation ``e`` (not a probe)."""
+    if e == EVAL_START:
+        return t0, 0, 0.0
+    if e == EVAL_END:
+        return tc + h, end_idx, h
+    a_ = 0.5 * h if e < EVAL_STAGE4 else h
+    return tc + a_, end_idx if e == EVAL_STAGE4 else -1, a_
+
+
+@jit(inline="always")
+def _rk4_combine(y0, kk, h, y1, ys):  # pragma: no cover - compiled
+    """End of the RK4 step: y1 = y0 + h/6 (k1 + 2 k2 + 2 k3 + k4), also into
+    ys (the state of the end-of-step evaluation)."""
+    for r in range(y1.shape[0]):
+        y1[r] = y0[r] + h / 6.0 * (kk[0, r] + 2.0 * kk[1, r] + 2.0 * kk[2, r] + kk[3, r])
+        ys[r] = y1[r]
+
+
+@jit(inline="always")
+def _reversal_fraction(tan_idx, tan_w, y0, y1, h, n):  # pragma: no cover - compiled
+    """Earliest velocity reversal of any contact inside the step, as a fraction
+    of the step (Hermite root); 2.0 when there is none away from the ends."""
+    sbest = 2.0
+    for c in range(tan_idx.shape[0]):
+        du0 = tangential(tan_idx, tan_w, c, y0, n)
+        du1 = tangential(tan_idx, tan_w, c, y1, n)
+        if du0 * du1 < 0.0:
+            u0 = tangential(tan_idx, tan_w, c, y0, 0)
+            u1 = tangential(tan_idx, tan_w, c, y1, 0)
+            sr = _hermite_root(u0, u1, du0, du1, h)
+            if sr > _SPLIT_GUARD and sr < 1.0 - _SPLIT_GUARD and sr < sbest:
+                sbest = sr
+    return sbest
+
+
+# --- loads at a time ---------------------------------------------------------------
+
+
+@jit(inline="always")
+def _sampled_row(tgrid, table, tau, gidx, j, out):  # pragma: no cover - compiled
+    """Sampled loads at tau: the table row at a grid point, else linear between
+    the grid points j and j + 1 (sampled grids only: it branches on the table
+    row, which costs reference counting at every call)."""
+    if gidx >= 0:
+        for c in range(out.shape[0]):
+            out[c] = table[gidx, c]
+    else:
+        al = (tau - tgrid[j]) / (tgrid[j + 1] - tgrid[j])
+        for c in range(out.shape[0]):
+            out[c] = table[j, c] + al * (table[j + 1, c] - table[j, c])
+
+
+# --- right-hand side: M x'' = F - C v - K x - sum_c B_c T_c -----------------------------
+
+
+@jit(inline="always")
+def _linear_forces(K, C, ys, Fv, n, work):  # pragma: no cover - compiled
+    """work = F - C v - K x, N."""
+    for i in range(n):
+        acc = Fv[i]
+        for m in range(n):
+            acc -= C[i, m] * ys[n + m] + K[i, m] * ys[m]
+        work[i] = acc
+
+
+@jit(inline="always")
+def _derivatives(Minv, C, ys, Fv, n, rdof, work, pc, kk, row):  # pragma: no cover - compiled
+    """Row ``row`` of the stage table: (v, M^-1 work, contact, viscous and forcing
+    power, x[rdof]); ``pc`` is the power of the contact forces, W."""
+    pv = 0.0
+    pw = 0.0
+    for i in range(n):
+        vi = ys[n + i]
+        acc = 0.0
+        for m in range(n):
+            acc += Minv[i, m] * work[m]
+            pv += vi * C[i, m] * ys[n + m]
+        kk[row, i] = vi
+        kk[row, n + i] = acc
+        pw += Fv[i] * vi
+    kk[row, 2 * n] = pc
+    kk[row, 2 * n + 1] = pv
+    kk[row, 2 * n + 2] = pw
+    kk[row, 2 * n + 3] = ys[rdof]
+
+
+# --- after an evaluation -----------------------------------------------------------
+
+
+@jit(inline="always")
+def _state_changed(codes, code_c, ignore_separation):  # pragma: no cover - compiled
+    """True when a contact's motion state differs from the committed one
+    (optionally not counting separation, whose instants are grid points)."""
+    changed = False
+    for c in range(codes.shape[0]):
+        if codes[c] != code_c[c]:
+            if not ignore_separation or (codes[c] != SEPARATION and code_c[c] != SEPARATION):
+                changed = True
+    return changed
+
+
+@jit(inline="always")
+def _probe_done(changed, sm, blo, bhi, bit):  # pragma: no cover - compiled
+    """One bisection step on the motion state; returns (blo, bhi, probes done,
+    next evaluation): EVAL_PROBE to go on, EVAL_STAGE2 to redo the step up to
+    the change (fraction bhi), EVAL_END when no split is needed (the probes
+    overwrote the trial buffers: the end is evaluated again)."""
+    if changed:
+        bhi = sm
+    else:
+        blo = sm
+    bit += 1
+    # a change already at the first probe (just after the start: the first
+    # step after a reversal out of macroslip) needs no split
+    nxt = EVAL_END
+    if bit < _BISECT_PROBES and not (changed and bit == 1):
+        nxt = EVAL_PROBE
+    elif bhi > _SPLIT_GUARD and bhi < 1.0 - _SPLIT_GUARD:
+        nxt = EVAL_STAGE2
+    return blo, bhi, bit, nxt
+
+
+@jit(inline="always")
+def _bisection(e, codes, code_c, sm, blo, bhi, bit, h, end_idx, attempt):  # pragma: no cover - compiled
+    """Start the bisection for a change of motion state (after the end-of-step
+    evaluation ``e = EVAL_END``) or take its next step (after a probe).
+
+    Returns (blo, bhi, probes done, next evaluation, h, end index, attempt,
+    located): the step is redone up to the change (h = bhi h, attempt 1) or,
+    when no split is needed, its end is evaluated again and committed
+    (located True).
+    """
+    if e == EVAL_END:
+        return 0.0, 1.0, 0, EVAL_PROBE, h, end_idx, attempt, False
+    blo, bhi, bit, nxt = _probe_done(_state_changed(codes, code_c, False), sm, blo, bhi, bit)
+    if nxt == EVAL_STAGE2:
+        h, end_idx, attempt = bhi * h, -1, 1
+    return blo, bhi, bit, nxt, h, end_idx, attempt, nxt == EVAL_END
+
+
+@jit(inline="always")
+def _record(out_t, out_x, out_v, out_T, out_N, out_code, i, t, y, n, Tc, Nv, codes):  # pragma: no cover
+    """Write sample ``i`` (time t, state y, contact forces, loads, codes)."""
+    out_t[i] = t
+    for k in range(n):
+        out_x[i, k] = y[k]
+        out_v[i, k] = y[n + k]
+    for c in range(Tc.shape[0]):
+        out_T[i, c] = Tc[c]
+        out_N[i, c] = Nv[c]
+        out_code[i, c] = codes[c]
+
+
+@jit(inline="always")
+def _extremum(y0, y1, h, rdof, n, xmax, xmin):  # pragma: no cover - compiled
+    """(max, min) of x[rdof] so far, with the extremum inside the step (Hermite)."""
+    xr0 = y0[rdof]
+    xr1 = y1[rdof]
+    vr0 = y0[n + rdof]
+    vr1 = y1[n + rdof]
+    if vr0 * vr1 < 0.0:
+        sr = _hermite_root(xr0, xr1, vr0, vr1, h)
+        xe = _hermite_value(xr0, xr1, vr0, vr1, h, sr)
+        if xe > xmax:
+            xmax = xe
+        if xe < xmin:
+            xmin = xe
+    if xr1 > xmax:
+        xmax = xr1
+    if xr1 < xmin:
+        xmin = xr1
+    return xmax, xmin
+
+
+@jit(inline="always")
+def _commit(y0, y1, kk, code_c, codes, xcap, n):  # pragma: no cover - compiled
+    """Accept the step: y0 = y1, stage 1 of the next step, committed codes;
+    returns RUN_BLOWUP if the new state is non-finite or beyond the caps, else RUN_OK."""
+    status = RUN_OK
+    for c in range(codes.shape[0]):
+        code_c[c] = codes[c]
+    for r in range(y0.shape[0]):
+        y0[r] = y1[r]
+        kk[0, r] = kk[ROW_END, r]
+    for i in range(2 * n):
+        if not (abs(y0[i]) <= xcap[i]):
+            status = RUN_BLOWUP
+    return status
+
+
+@jit(inline="always")
+def _period_summary(summ, zend, k, y0, n, xmax, xmin, nsteps, period):  # pragma: no cover - compiled
+    """Summary row and end state of repetition k; resets the energy integrals."""
+    summ[k, S_XMAX] = xmax
+    summ[k, S_XMIN] = xmin
+    summ[k, S_EC] = y0[2 * n]
+    summ[k, S_EV] = y0[2 * n + 1]
+    summ[k, S_W] = y0[2 * n + 2]
+    summ[k, S_XMEAN] = y0[2 * n + 3] / period
+    summ[k, S_STEPS] = nsteps
+    for i in range(n):
+        zend[k, i] = y0[i]
+        zend[k, n + i] = y0[n + i]
+    for r in range(2 * n, y0.shape[0]):
+        y0[r] = 0.0
+
+
+@jit(inline="always")
+def _workspace(x, v, nc):  # pragma: no cover - compiled
+    """Buffers of a run: y0 (start of the step, = (x, v, 0...)), y1, ys (stage
+    state), the stage table, forces and loads, trial and committed codes."""
+    n = x.shape[0]
+    y0 = np.zeros(2 * n + 4)
+    ys = np.zeros(2 * n + 4)  # = y0: the state of the initial evaluation
+    for i in range(n):
+        y0[i] = ys[i] = x[i]
+        y0[n + i] = ys[n + i] = v[i]
+    return (y0, np.zeros(2 * n + 4), ys, np.zeros((N_ROWS, 2 * n + 4)), np.zeros(n),
+            np.zeros(n), np.zeros(nc), np.zeros(nc), np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64))
+
+
+@jit(inline="always")
+def _after_start(y0, kk, code_c, codes, n, record, out, t0, Tc, Nv):  # pragma: no cover - compiled
+    """After the initial evaluation (once per run): committed codes, stage 1,
+    sample 0 (when recording), energy integrals zeroed; returns the samples recorded."""
+    for c in range(codes.shape[0]):
+        code_c[c] = codes[c]
+    for r in range(y0.shape[0]):
+        kk[0, r] = kk[ROW_END, r]
     nrec = 0
-    cap = out_t.shape[0]
-    status = 0
-    done = 0
-    # evaluation state machine: e = 0, 1, 2 are the RK stages 2..4 of the
-    # current attempt, e = 3 the end of the step (commit), e = 4 a probe of
-    # the bisection for a change of motion state inside the step; e = -1
-    # the initial evaluation at the start.
-    k = 0
-    j = 0
-    tc = tgrid[0]
-    t_end = tgrid[1]
-    h = t_end - tc
-    end_idx = 1
-    attempt = 0
-    nsplit = 0
-    nsteps = 0
-    xmax = y0[rdof]
-    xmin = y0[rdof]
-    e = -1
-    while True:
-        # ---- where to evaluate ------------------------------------------
-        if e == -1:
-            tau = tgrid[0]
-            gidx = 0
-            for r in range(ny):
-                ys[r] = y0[r]
-        elif e < 3:
-            a_ = 0.5 * h if e < 2 else h
-            for r in range(ny):
-                ys[r] = y0[r] + a_ * kk[e, r]
-            tau = tc + a_
-            gidx = end_idx if e == 2 else -1
-        elif e == 4:
-            # probe at fraction sm of the step on the cubic Hermite
-            # interpolant of the step (only the contact states are used)
-            # first probe just after the start: a change right there (the
-            # first step after a reversal out of macroslip) needs no split
-            sm = _SPLIT_GUARD if bit == 0 else 0.5 * (blo + bhi)
-            for i in range(n):
-                ys[i] = _hermite_value(y0[i], y1[i], y0[n + i], y1[n + i], h, sm)
-                ys[n + i] = y0[n + i] + sm * (y1[n + i] - y0[n + i])
-            tau = tc + sm * h
-            gidx = -1
-        else:
-            for r in range(ny):
-                y1[r] = y0[r] + h / 6.0 * (kk[0, r] + 2.0 * kk[1, r] + 2.0 * kk[2, r] + kk[3, r])
-            if attempt == 0 and nsplit < max_split:
-                # velocity reversal of any contact inside the step?
-                sbest = 2.0
-                for c in range(nc):
-                    d1 = cdof[c]
-                    d2 = cdof2[c]
-                    du0 = y0[n + d1]
-                    du1 = y1[n + d1]
-                    u0 = y0[d1]
-                    u1 = y1[d1]
-                    if d2 >= 0:
-                        du0 -= y0[n + d2]
-                        du1 -= y1[n + d2]
-                        u0 -= y0[d2]
-                        u1 -= y1[d2]
-                    if du0 * du1 < 0.0:
-                        sr = _hermite_root(u0, u1, du0, du1, h)
-                        if sr > 1e-6 and sr < 1.0 - 1e-6 and sr < sbest:
-                            sbest = sr
-                if sbest < 1.0:
-                    h = sbest * h
-                    end_idx = -1
-                    attempt = 1
-                    e = 0
-                    continue
-            for r in range(ny):
-                ys[r] = y1[r]
-            tau = tc + h
-            gidx = end_idx
-        # ---- loads at tau (grid value at a grid point) --------------------
-        if mode == 0:
-            # an unsplit grid step (attempt 0, no split yet) evaluates at its
-            # midpoint (stages 2, 3) and its end (stage 4, commit)
-            fresh = e >= 0 and e <= 3 and attempt == 0 and nsplit == 0
-            if fresh:
-                sp = sin_mid[j] if e < 2 else sin_end[j]
-            else:
-                ph = phase0 + w * tau
-                sp = math.sin(ph)
-            for i in range(n):
-                Fv[i] = fvec[i] * sp
-            if gidx >= 0:
-                for c in range(nc):
-                    Nv[c] = Ngrid[gidx, c]
-            elif fresh:
-                for c in range(nc):
-                    Nv[c] = N_mid[j, c]
-            else:
-                for c in range(nc):
-                    Nv[c] = n0[c] + n1[c] * math.sin(phase0 + w * tau + dlt[c])
-        else:
-            if gidx >= 0:
-                for i in range(n):
-                    Fv[i] = Fgrid[gidx, i]
-                for c in range(nc):
-                    Nv[c] = Ngrid[gidx, c]
-            else:
-                al = (tau - tgrid[j]) / (tgrid[j + 1] - tgrid[j])
-                for i in range(n):
-                    Fv[i] = Fgrid[j, i] + al * (Fgrid[j + 1, i] - Fgrid[j, i])
-                for c in range(nc):
-                    Nv[c] = Ngrid[j, c] + al * (Ngrid[j + 1, c] - Ngrid[j, c])
-        # ---- right-hand side: M x'' = F - C v - K x - sum_c B_c T_c ---------
-        row = e + 1 if (e >= 0 and e < 3) else (5 if e == 4 else 4)
-        for i in range(n):
-            acc = Fv[i]
-            for m in range(n):
-                acc -= C[i, m] * ys[n + m] + K[i, m] * ys[m]
-            work[i] = acc
-        pc = 0.0
-        for c in range(nc):
-            d1 = cdof[c]
-            d2 = cdof2[c]
-            u = ys[d1]
-            du = ys[n + d1]
-            if d2 >= 0:
-                u -= ys[d2]
-                du -= ys[n + d2]
-            t_, k_, c_ = STEP(P[c], Sa[c], Sb[c], u, Nv[c])  # noqa: F821 - bound by specialize
-            Tc[c] = t_
-            codes[c] = c_
-            work[d1] -= t_
-            if d2 >= 0:
-                work[d2] += t_
-            pc += t_ * du
-        pv = 0.0
-        pw = 0.0
-        for i in range(n):
-            vi = ys[n + i]
-            acc = 0.0
-            for m in range(n):
-                acc += Minv[i, m] * work[m]
-                pv += vi * C[i, m] * ys[n + m]
-            kk[row, i] = vi
-            kk[row, n + i] = acc
-            pw += Fv[i] * vi
-        kk[row, 2 * n] = pc
-        kk[row, 2 * n + 1] = pv
-        kk[row, 2 * n + 2] = pw
-        kk[row, 2 * n + 3] = ys[rdof]
-        # ---- after the evaluation -----------------------------------------
-        if e == -1:
-            for c in range(nc):
-                code_c[c] = codes[c]
-            for r in range(ny):
-                kk[0, r] = kk[4, r]
-            if rec:
-                out_t[0] = tgrid[0]
-                for i in range(n):
-                    out_x[0, i] = y0[i]
-                    out_v[0, i] = y0[n + i]
-                for c in range(nc):
-                    out_T[0, c] = Tc[c]
-                    out_N[0, c] = Nv[c]
-                    out_code[0, c] = codes[c]
-                nrec = 1
-            for r in range(2 * n, ny):
-                y0[r] = 0.0
-            e = 0
-            continue
-        if e < 3:
-            e += 1
-            continue
-        if e == 4:
-            changed = False
-            for c in range(nc):
-                if codes[c] != code_c[c]:
-                    changed = True
-            if changed:
-                bhi = sm
-            else:
-                blo = sm
-            bit += 1
-            if bit < _BISECT_PROBES and not (changed and bit == 1):
-                continue
-            if bhi > _SPLIT_GUARD and bhi < 1.0 - _SPLIT_GUARD:
-                # redo the step up to the change of state
-                h = bhi * h
-                end_idx = -1
-                attempt = 1
-                e = 0
-                continue
-            # no split after all: the probes overwrote the trial buffers,
-            # evaluate the end of the step again and commit it
-            located = True
-            e = 3
-            continue
-        # change of motion state (e.g. onset or end of macroslip) inside the
-        # step: locate it by bisection on the law's state code (trial steps
-        # from the committed state) and redo the step up to there, so that
-        # kinks of the force are not smeared over a step (separation and
-        # re-contact are already grid points)
-        if attempt == 0 and nsplit < max_split and not located:
-            changed = False
-            for c in range(nc):
-                if codes[c] != code_c[c] and codes[c] != 2 and code_c[c] != 2:
-                    changed = True
-            if changed:
-                blo = 0.0
-                bhi = 1.0
-                bit = 0
-                e = 4
-                continue
-        located = False
-        # commit the step: swap the law-state buffers
-        Sa, Sb = Sb, Sa
-        for c in range(nc):
-            code_c[c] = codes[c]
-        t_new = t_end if end_idx >= 0 else tc + h
-        # extremum of the response DOF inside the step (Hermite)
-        xr0 = y0[rdof]
-        xr1 = y1[rdof]
-        vr0 = y0[n + rdof]
-        vr1 = y1[n + rdof]
-        if vr0 * vr1 < 0.0:
-            sr = _hermite_root(xr0, xr1, vr0, vr1, h)
-            xe = _hermite_value(xr0, xr1, vr0, vr1, h, sr)
-            if xe > xmax:
-                xmax = xe
-            if xe < xmin:
-                xmin = xe
-        if xr1 > xmax:
-            xmax = xr1
-        if xr1 < xmin:
-            xmin = xr1
-        for r in range(ny):
-            y0[r] = y1[r]
-            kk[0, r] = kk[4, r]
-        nsteps += 1
-        if rec:
-            if nrec >= cap:
-                status = 2
-            else:
-                out_t[nrec] = k * period + t_new
-                for i in range(n):
-                    out_x[nrec, i] = y0[i]
-                    out_v[nrec, i] = y0[n + i]
-                for c in range(nc):
-                    out_T[nrec, c] = Tc[c]
-                    out_N[nrec, c] = Nv[c]
-                    out_code[nrec, c] = codes[c]
-                nrec += 1
-        for i in range(2 * n):
-            if not (abs(y0[i]) <= xcap[i]):
-                status = 1
-        if status != 0:
-            break
-        # next attempt: rest of the grid step, or the next grid step
-        e = 0
-        attempt = 0
-        if end_idx < 0:
-            nsplit += 1
-            tc = t_new
-            h = t_end - tc
-            end_idx = j + 1
-            continue
-        j += 1
-        if j == J:
-            summ[k, 0] = xmax
-            summ[k, 1] = xmin
-            summ[k, 2] = y0[2 * n]
-            summ[k, 3] = y0[2 * n + 1]
-            summ[k, 4] = y0[2 * n + 2]
-            summ[k, 5] = y0[2 * n + 3] / period
-            summ[k, 6] = nsteps
-            for i in range(n):
-                zend[k, i] = y0[i]
-                zend[k, n + i] = y0[n + i]
-            done += 1
-            k += 1
-            if k == nper:
-                break
-            j = 0
-            xmax = y0[rdof]
-            xmin = y0[rdof]
-            nsteps = 0
-            for r in range(2 * n, ny):
-                y0[r] = 0.0
-        nsplit = 0
-        tc = tgrid[j]
-        t_end = tgrid[j + 1]
-        h = t_end - tc
-        end_idx = j + 1
+    if record:
+        _record(out[0], out[1], out[2], out[3], out[4], out[5], 0, t0, y0, n, Tc, Nv, codes)
+        nrec = 1
+    for r in range(2 * n, y0.shape[0]):
+        y0[r] = 0.0
+    return nrec
+
+
+@jit(inline="always")
+def _write_back(x_io, v_io, S_io, y0, Sa):  # pragma: no cover - compiled
+    """Final state into the caller's x, v and law states."""
+    n = x_io.shape[0]
     for i in range(n):
         x_io[i] = y0[i]
         v_io[i] = y0[n + i]
-    for c in range(nc):
+    for c in range(S_io.shape[0]):
         for r in range(S_io.shape[1]):
             S_io[c, r] = Sa[c, r]
+
+
+def _run_template(system, grid, control, io, out):  # pragma: no cover - compiled
+    """March ``control[1]`` repetitions of the step grid (see module docstring)."""
+    Minv, K, C, fvec, (tan_idx, tan_w, n_kind, n_par), P = system
+    tgrid, Ngrid, Fgrid, sin_mid, sin_end, N_mid = grid
+    mode, nper, phase0, w, rdof, max_split, record = control
+    x_io, v_io, S_io, xcap = io
+    out_t, out_x, out_v, out_T, out_N, out_code, summ, zend = out
+    n, nc, J = x_io.shape[0], S_io.shape[0], tgrid.shape[0] - 1
+    Sa, Sb = S_io.copy(), S_io.copy()
+    y0, y1, ys, kk, work, Fv, Nv, Tc, codes, code_c = _workspace(x_io, v_io, nc)
+    blo, bhi, bit, sm, located, e = 0.0, 1.0, 0, 0.0, False, EVAL_START
+    nrec, status, done, k, j, attempt, nsplit, nsteps = 0, RUN_OK, 0, 0, 0, 0, 0, 0
+    tc, t_end, end_idx, h, period = tgrid[0], tgrid[1], 1, tgrid[1] - tgrid[0], tgrid[J] - tgrid[0]
+    xmax = xmin = y0[rdof]
+    while True:
+        if e == EVAL_END:
+            _rk4_combine(y0, kk, h, y1, ys)
+            if attempt == 0 and nsplit < max_split:
+                sbest = _reversal_fraction(tan_idx, tan_w, y0, y1, h, n)
+                if sbest < 1.0:  # redo the step up to the velocity reversal
+                    h, end_idx, attempt, e = sbest * h, -1, 1, EVAL_STAGE2
+                    continue
+        if e == EVAL_PROBE:
+            sm = _SPLIT_GUARD if bit == 0 else 0.5 * (blo + bhi)
+            tau, gidx = tc + sm * h, -1
+            _probe_state(sm, h, y0, y1, ys, n)
+        else:
+            tau, gidx, a_ = _stage_time(e, tgrid[0], h, tc, end_idx)
+            if e >= EVAL_STAGE2 and e < EVAL_END:  # RK stages (ys holds the start and the end already)
+                for r in range(ys.shape[0]):
+                    ys[r] = y0[r] + a_ * kk[e, r]
+        # ---- loads at tau (tables: grid points, midpoints of unsplit harmonic steps)
+        fresh = mode == LOADS_HARMONIC and e >= EVAL_STAGE2 and e <= EVAL_END and attempt == 0 and nsplit == 0
+        if mode == LOADS_HARMONIC:
+            sp = (sin_mid[j] if e < EVAL_STAGE4 else sin_end[j]) if fresh else math.sin(phase0 + w * tau)
+            for i in range(n):
+                Fv[i] = fvec[i] * sp
+        else:
+            _sampled_row(tgrid, Fgrid, tau, gidx, j, Fv)
+        if gidx >= 0 or fresh:
+            for c in range(nc):
+                Nv[c] = Ngrid[gidx, c] if gidx >= 0 else N_mid[j, c]
+        elif mode == LOADS_SAMPLED:
+            _sampled_row(tgrid, Ngrid, tau, gidx, j, Nv)
+        else:
+            for c in range(nc):
+                Nv[c] = NORMAL_LOAD(n_kind[c], n_par, c, phase0 + w * tau, ys)  # noqa: F821 - bound by specialize
+        # ---- right-hand side (the law kernel here: inside an inlined helper 3.5x slower)
+        _linear_forces(K, C, ys, Fv, n, work)
+        pc = 0.0
+        for c in range(nc):
+            u, du = tangential(tan_idx, tan_w, c, ys, 0), tangential(tan_idx, tan_w, c, ys, n)
+            t_, k_, c_ = STEP(P[c], Sa[c], Sb[c], u, Nv[c])  # noqa: F821 - bound by specialize
+            Tc[c], codes[c] = t_, c_
+            apply_tangential_force(tan_idx, tan_w, c, t_, work)
+            pc += t_ * du
+        row = e + 1 if (e >= EVAL_STAGE2 and e < EVAL_END) else (ROW_PROBE if e == EVAL_PROBE else ROW_END)
+        _derivatives(Minv, C, ys, Fv, n, rdof, work, pc, kk, row)
+        # ---- after the evaluation -----------------------------------------
+        if e < EVAL_END:  # the start, or RK stages 2, 3: on to the next stage (EVAL_START + 1 = EVAL_STAGE2)
+            if e == EVAL_START:
+                nrec = _after_start(y0, kk, code_c, codes, n, record, out, tgrid[0], Tc, Nv)
+            e += 1
+            continue
+        # change of motion state inside an unsplit step (separation and
+        # re-contact are grid points): located by bisection
+        if e == EVAL_PROBE or (attempt == 0 and nsplit < max_split and not located
+                               and _state_changed(codes, code_c, True)):  # fmt: skip
+            blo, bhi, bit, e, h, end_idx, attempt, located = _bisection(e, codes, code_c, sm, blo, bhi, bit, h, end_idx,
+                                                                        attempt)  # fmt: skip
+            continue
+        located = False
+        Sa, Sb = Sb, Sa
+        t_new = t_end if end_idx >= 0 else tc + h
+        xmax, xmin = _extremum(y0, y1, h, rdof, n, xmax, xmin)
+        status = _commit(y0, y1, kk, code_c, codes, xcap, n)
+        nsteps += 1
+        if record:  # a full buffer is overwritten in its last row and the run repeated by the caller
+            _record(out_t, out_x, out_v, out_T, out_N, out_code, min(nrec, out_t.shape[0] - 1), k * period + t_new,
+                    y0, n, Tc, Nv, codes)  # fmt: skip
+            nrec += 1
+            status = RUN_OVERFLOW if nrec > out_t.shape[0] and status == RUN_OK else status
+        if status != RUN_OK:
+            break
+        # next attempt: rest of the grid step, or the next grid step
+        e, attempt = EVAL_STAGE2, 0
+        if end_idx < 0:
+            nsplit, tc, h, end_idx = nsplit + 1, t_new, t_end - t_new, j + 1
+            continue
+        j += 1
+        if j == J:
+            _period_summary(summ, zend, k, y0, n, xmax, xmin, nsteps, period)
+            done, k = done + 1, k + 1
+            if k == nper:
+                break
+            j, nsteps = 0, 0
+            xmax = xmin = y0[rdof]
+        nsplit, tc, t_end, end_idx, h = 0, tgrid[j], tgrid[j + 1], j + 1, tgrid[j + 1] - tgrid[j]
+    _write_back(x_io, v_io, S_io, y0, Sa)
     return nrec, status, done
 
 
 @jit
-def grid_sines(tgrid, w, phase0, n0, n1, dlt):
+def grid_sines(tgrid, w, phase0):  # pragma: no cover - compiled
     """Forcing sines at the midpoint and end of every step of a harmonic grid
-    and the normal loads at the midpoints (the grid repeats each period, so an
-    unsplit step reuses them; arguments ``sin_mid, sin_end, N_mid`` of the
-    runner in mode 0)."""
+    (the grid repeats each period, so an unsplit step reuses them)."""
     J = tgrid.shape[0] - 1
-    nc = n0.shape[0]
     sin_mid = np.empty(J)
     sin_end = np.empty(J)
-    N_mid = np.empty((J, nc))
     for j in range(J):
-        pm = phase0 + w * (tgrid[j] + 0.5 * (tgrid[j + 1] - tgrid[j]))
-        sin_mid[j] = math.sin(pm)
+        sin_mid[j] = math.sin(phase0 + w * (tgrid[j] + 0.5 * (tgrid[j + 1] - tgrid[j])))
         sin_end[j] = math.sin(phase0 + w * tgrid[j + 1])
-        for c in range(nc):
-            N_mid[j, c] = n0[c] + n1[c] * math.sin(pm + dlt[c])
-    return sin_mid, sin_end, N_mid
-
-
-@jit
-def grid_loads(tgrid, w, n0, n1, dlt):
-    """Normal loads N_c(t) = n0_c + n1_c sin(w t + delta_c) at the grid points, N."""
-    N = np.empty((tgrid.shape[0], n0.shape[0]))
-    for j in range(tgrid.shape[0]):
-        for c in range(n0.shape[0]):
-            N[j, c] = n0[c] + n1[c] * math.sin(w * tgrid[j] + dlt[c])
-    return N
+    return sin_mid, sin_end
 
 
 def compiled_runner(step):
     """The RK4 runner with ``step`` (a law kernel) bound, compiled and cached."""
     from .._jit import specialize
 
-    return specialize(_run_template, STEP=step)
+    return specialize(_run_template, STEP=step, NORMAL_LOAD=normal_load)
+
+
+__all__ = [
+    "S_XMAX", "S_XMIN", "S_EC", "S_EV", "S_W", "S_XMEAN", "S_STEPS", "N_SUMMARY",
+    "RUN_OK", "RUN_BLOWUP", "RUN_OVERFLOW", "LOADS_HARMONIC", "LOADS_SAMPLED",
+    "compiled_runner", "grid_sines",
+]  # fmt: skip

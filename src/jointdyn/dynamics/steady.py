@@ -22,17 +22,16 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from .._jit import jit, specialize
-from ..drivers import march
+from .._jit import jit
 from ..systems import System
-from ._core import grid_loads
 from ._core import N_SUMMARY, S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
-from .integrate import Restart, Trajectory, _Model, _omega
+from ._model import Model, make_model
+from ._start import clean_states, linear_start
+from .integrate import Restart, Trajectory, _omega, _trajectory
+from .monodromy import fd_monodromy
+from .status import SteadyStatus
 
-__all__ = ["SteadyState", "steady_state", "STATUSES"]
-
-#: possible values of :attr:`SteadyState.status`
-STATUSES = ("periodic", "not-settled", "unbounded")
+__all__ = ["SteadyState", "steady_state"]
 
 
 @dataclass(frozen=True)
@@ -45,8 +44,9 @@ class SteadyState:
 
     Attributes
     ----------
-    status : str
-        ``"periodic"``, ``"not-settled"`` or ``"unbounded"``.
+    status : SteadyStatus
+        ``"periodic"``, ``"not-settled"`` or ``"unbounded"`` (its ``message``
+        says what it means).
     detail : str
         More on the status: ``"integration"`` or ``"shooting"`` (how a
         periodic state was reached); ``"growing"``, ``"blow-up"``
@@ -86,7 +86,7 @@ class SteadyState:
         The final p periods, sampled at every step (if ``keep_loop``).
     """
 
-    status: str
+    status: SteadyStatus
     detail: str
     period_multiple: int
     gamma: float
@@ -109,7 +109,7 @@ class SteadyState:
     @property
     def ok(self) -> bool:
         """True when a periodic steady state was found."""
-        return self.status == "periodic"
+        return SteadyStatus(self.status).ok
 
     def to_record(self) -> dict:
         """The scalar fields as a flat dict (one row of a sweep table)."""
@@ -144,7 +144,7 @@ class _History:
 
 
 def _amplitude_scale(model, A):
-    floor = 1e-14 + 1e-9 * sum(c.law.fy / c.law.kt for c in model.system.contacts)
+    floor = 1e-14 + 1e-9 * model.pack.xlin
     return max(A, floor)
 
 
@@ -237,7 +237,7 @@ def _check_periodic(h: _History, p: int, K: int, model, amp_rtol, energy_rtol):
     """
     if h.size < K * p:
         return False
-    return bool(_periodic_arrays(h.summ, h.Z, p, K, model.n, model.w, model.K_stuck, model.M,
+    return bool(_periodic_arrays(h.summ, h.Z, p, K, model.n, model.w, model.pack.K_stuck, model.pack.M,
                                  _amplitude_scale(model, 0.0), amp_rtol, energy_rtol, config.SS_BALANCE_RTOL))  # fmt: skip
 
 
@@ -265,8 +265,8 @@ def _growing(h: _History, model, amp_rtol) -> bool:
         return False
     # a contact in microslip dissipates ~A^3 (faster than the work ~A of the
     # forcing): growth can only be unbounded once the friction saturates
-    cs = model.system.contacts
-    if cs and not A[-1] > config.SS_UNBOUNDED_Q * cs[0].law.fy / cs[0].law.kt:
+    laws = model.pack.laws
+    if laws and not A[-1] > config.SS_UNBOUNDED_Q * laws[0].fy / laws[0].kt:
         return False
     return True
 
@@ -331,208 +331,74 @@ def _contraction(h: _History, model):
     return (d[-1] / d[0]) ** (1.0 / (d.size - 1)), d[-1]
 
 
-def _df_template(Z0, f, B, kt, P, sin_th, cos_th, loads, ns, iters, rtol, xmax, S_out, X_out):  # pragma: no cover - compiled
-    """Describing-function iteration of :func:`_linear_start`, compiled (``STEP``, ``INIT`` bound).
+def _booker(counters):
+    """``count(result, fraction=1)``: books the periods and steps of a run into ``counters``."""
 
-    Returns False if the iteration diverges (non-finite or absurdly large X);
-    else writes X (complex amplitudes, m) and the law states after the
-    two-cycle march of the final estimate. ``np.linalg.solve`` raises
-    ``LinAlgError`` for a singular dynamic stiffness.
+    def count(res, frac=1.0):
+        counters["periods"] += res.done * frac
+        counters["steps"] += int(res.summary[:, S_STEPS].sum()) if res.done else 0
+
+    return count
+
+
+def _section(model: Model, x, v, S, rdof, count):
+    """Move to the Poincare section of shooting; returns (x, v, S, grid of one
+    period from there, section time s), or None on a blow-up.
+
+    The section is at phase 0, or in the middle of a separation when every
+    contact separates (law states reset there, so (x, v) is the whole state
+    and the map is exact); at phase 0 the law states are first rebuilt from
+    the last period alone (``config.SS_SHOOT_CLEAN_STATE``).
     """
-    n = f.shape[0]
-    nc = B.shape[0]
-    L = sin_th.shape[0]
-    slen = S_out.shape[1]
-    kc = np.zeros(nc, dtype=np.complex128)
-    for i in range(nc):
-        kc[i] = kt[i]
-    X = np.zeros(n, dtype=np.complex128)
-    U = np.zeros(nc, dtype=np.complex128)
-    Z = np.zeros((n, n), dtype=np.complex128)
-    sa = np.zeros(slen)
-    sb = np.zeros(slen)
-    have = False
-    final = False
-    it = 0
-    while True:
-        if not final:
-            for a in range(n):
-                for b in range(n):
-                    Z[a, b] = Z0[a, b]
-            for i in range(nc):
-                for a in range(n):
-                    for b in range(n):
-                        Z[a, b] += B[i, a] * kc[i] * B[i, b]
-            Xn = np.linalg.solve(Z, f)
-            big = 0.0
-            diff = 0.0
-            for a in range(n):
-                if not (np.isfinite(Xn[a].real) and np.isfinite(Xn[a].imag)):
-                    return False
-                big = max(big, abs(Xn[a]))
-                diff = max(diff, abs(Xn[a] - X[a]))
-            if big > xmax:
-                return False
-            conv = have and diff <= rtol * big
-            for a in range(n):
-                X[a] = Xn[a]
-            have = True
-            it += 1
-            final = conv or it >= iters
-        for i in range(nc):
-            acc = 0.0 + 0.0j
-            for a in range(n):
-                acc += B[i, a] * X[a]
-            U[i] = acc
-        for i in range(nc):
-            if U[i] == 0 and not final:
-                continue
-            ur = U[i].real
-            ui = U[i].imag
-            INIT(P[i], ur * sin_th[0] + ui * cos_th[0], loads[i, 0], sa)  # noqa: F821 - bound by specialize
-            ca = 0.0
-            cb = 0.0
-            for j in range(L):
-                T, _, _ = STEP(P[i], sa, sb, ur * sin_th[j] + ui * cos_th[j], loads[i, j])  # noqa: F821
-                sa, sb = sb, sa
-                if ns <= j < 2 * ns:
-                    ca += T * sin_th[j]
-                    cb += T * cos_th[j]
-            if final:
-                for r in range(slen):
-                    S_out[i, r] = sa[r]
-            else:
-                kc[i] = 0.5 * kc[i] + 0.5 * (2.0 / ns) * (ca + 1j * cb) / U[i]
-        if final:
-            break
-    for a in range(n):
-        X_out[a] = X[a]
-    return True
-
-
-# the describing-function march: two cycles of 64 samples ending before t = 0
-# (theta = w t), and t = 0 itself; the first harmonic is taken over the second
-_DF_NS = 64
-_DF_TH = np.append(2 * math.pi * np.arange(2 * _DF_NS) / _DF_NS - 4 * math.pi, 0.0)
-_DF_GRID = (_DF_NS, _DF_TH, np.sin(_DF_TH), np.cos(_DF_TH))
-
-
-def _linear_start(model: _Model):
-    """Equivalent-linearisation estimate of the periodic state at phase 0.
-
-    Solves (K - w^2 M + i w C + sum_c k_c B_c B_c^T) X = f with k_c the
-    describing function (first harmonic of T over one cycle of
-    u = Im(U e^{i w t}) with the actual N_c(t), marched with the real law),
-    started from the stuck stiffness kt and iterated with relaxation 1/2
-    until X changes by less than ``config.SS_LINEAR_RTOL`` (at most
-    ``config.SS_LINEAR_ITERS`` solves). The iteration is one compiled call
-    (``_df_template``). Returns x, v (m, m/s) and law states at t = 0 (law
-    marched over the last two cycles of the estimate), or None if the
-    iteration diverges.
-    """
-    sysm = model.system
-    n, w = model.n, model.w
-    Z0 = model.K - w * w * model.M + 1j * w * model.C
-    f = model.fvec.astype(np.complex128)
-    ns, th, sin_th, cos_th = _DF_GRID
-    loads = grid_loads(th, 1.0, model.n0, model.n1, model.dlt).T.copy()
-    S = np.zeros((model.nc, model.slen))
-    X = np.zeros(n, dtype=np.complex128)
-    run = specialize(_df_template, STEP=model.step, INIT=model.init)
-    xscale = model.fmax / model.kmin + model.xlin
-    try:
-        ok = run(Z0, f, model.B, model.kt, model.P, sin_th, cos_th, loads, ns,
-                 config.SS_LINEAR_ITERS if model.nc else 1, config.SS_LINEAR_RTOL, 1e3 * xscale, S, X)  # fmt: skip
-    except np.linalg.LinAlgError:
-        return None
-    if not ok:
-        return None
-    return np.imag(X).copy(), w * np.real(X).copy(), S
-
-
-def _clean_states(model: _Model, x, v, S, rdof, count):
-    """One recorded period, then law states rebuilt from that period alone.
-
-    A slowly decaying transient leaves a long nested sequence of reversal
-    points in a Masing law's memory, which makes the state at a period
-    boundary differ from period to period even once (x, v) repeat. The law
-    is re-marched (drivers.march) from its virgin state over two repetitions
-    of the last period's contact displacement and normal load, which keeps
-    the current loop and forgets the transient. Returns (x, v, S) at the
-    end of the period, or None on a blow-up.
-    """
-    x = x.copy()
-    v = v.copy()
-    S = S.copy()
-    summ, _, st_, done, smp = model.run_periods(x, v, S, 1, rec=True, rdof=rdof)
-    count(summ, done)
-    if st_ != 0 or done < 1:
-        return None
-    _, X, _, _, N, _ = smp
-    Snew = np.zeros_like(S)
-    for i, c in enumerate(model.system.contacts):
-        u = X[:, c.dof] - (X[:, c.dof2] if c.dof2 >= 0 else 0.0)
-        uu = np.concatenate([u, u[1:]])
-        NN = np.concatenate([N[:, i], N[1:, i]])
-        s0 = c.law.initial_state(float(uu[0]), float(NN[0]))
-        sf = march(c.law, uu, NN, state=s0)[3]
-        Snew[i, : sf.size] = sf
-    return x, v, np.ascontiguousarray(Snew)
-
-
-def _shoot(model: _Model, x, v, S, rdof, tol, counters):
-    """Newton on the period map (x, v) -> (x, v)(t + T) with the law state carried.
-
-    The Poincare section is at phase 0, or in the middle of a separation
-    when every contact separates (law states reset there, so (x, v) is the
-    whole state and the map is exact). The finite-difference monodromy
-    perturbs (x, v) with the law state kept (a displacement perturbation
-    acts as a motion of the contact). Returns (x, v, S, converged,
-    floquet_max) at a phase-0 boundary. ``counters`` (dict) gets the
-    periods, steps and iterations spent.
-    """
-    n = model.n
-    w = model.w
-    Tp = model.period
-    floq = math.nan
     ts = model.section_time()
-    x0, v0, S0 = x.copy(), v.copy(), S.copy()
-
-    def count(summ, done, frac=1.0):
-        counters["periods"] += done * frac
-        counters["steps"] += int(summ[:, S_STEPS].sum()) if done else 0
-
     if ts > 0.0:
-        tg, Ng = model.segment_grid(0.0, ts)
-        summ, _, st_, done = model.run_grid(x, v, S, tg, Ng, 1, rdof)
-        count(summ, done, ts / Tp)
-        if st_ != 0:
-            return x0, v0, S0, False, floq
-        tgp, Ngp = model.segment_grid(ts, ts + Tp)
-    else:
-        tgp, Ngp = model.tgrid, model.Ngrid
-        if config.SS_SHOOT_CLEAN_STATE and model.nc:
-            cl = _clean_states(model, x, v, S, rdof, count)
-            if cl is None:
-                return x0, v0, S0, False, floq
-            x, v, S = cl
-    z = np.concatenate([x, v])
-    sines = model.sines_of(tgp)
+        res = model.run_grid(x, v, S, model.segment_grid(0.0, ts), 1, rdof)
+        count(res, ts / model.period)
+        if not res.status.ok:
+            return None
+        return x, v, S, model.segment_grid(ts, ts + model.period), ts
+    if config.SS_SHOOT_CLEAN_STATE and model.nc:
+        cl = clean_states(model, x, v, S, rdof, count)
+        if cl is None:
+            return None
+        x, v, S = cl
+    return x, v, S, model.grid, ts
 
-    def phi(zz, SS):
-        xx = zz[:n].copy()
-        vv = zz[n:].copy()
-        S2 = SS.copy()
-        summ, zend, status, done = model.run_grid(xx, vv, S2, tgp, Ngp, 1, rdof, sines)
-        count(summ, done)
-        if status != 0 or done < 1:
-            return None, None, None
-        return np.concatenate([xx, vv]), S2, summ[0]
 
+def _line_search(phi, z, dz, D, S1, rn):
+    """Damped Newton step: the first of z + lam dz D (lam = 1, 1/2, ...; |lam dz|
+    <= SS_SHOOT_MAXSTEP) whose residual is below ``rn``; None if none is."""
+    lam = 1.0
+    big = float(np.max(np.abs(dz)))
+    if big > config.SS_SHOOT_MAXSTEP:
+        lam = config.SS_SHOOT_MAXSTEP / big
+    for _ls in range(config.SS_SHOOT_HALVINGS):
+        zn = z + lam * dz * D
+        zn1, Sn1, sn1 = phi(zn, S1)
+        if zn1 is not None:
+            rnew = np.max(np.abs((zn1 - zn) / D))
+            if rnew < rn:
+                return zn, zn1, Sn1, sn1
+        lam *= 0.5
+    return None
+
+
+def _newton(model: Model, phi, z, S, tol, counters):
+    """Newton on the period map from (z, S); returns (z, S, converged, floquet_max)
+    (converged False also when the period map blows up).
+
+    Residuals are compared in the scale of the first iterate, so that a step
+    that merely inflates the amplitude (a relative residual shrinking because
+    the scale grows: an undamped resonance) is never taken for progress. A
+    stalled Newton (noise of the non-smooth law) may still have removed most
+    of the transient: its best iterate is kept if it gained a factor of 100
+    (the integration that follows decides).
+    """
+    n, w = model.n, model.w
+    floq = math.nan
     z1, S1, s1 = phi(z, S)
     if z1 is None:
-        return x0, v0, S0, False, floq
-    converged = False
+        return z, S, False, floq
     best = None  # (residual, z, S, first residual) in the fixed scale D0
     D0 = None
     for _ in range(config.SS_SHOOT_MAXIT):
@@ -540,63 +406,65 @@ def _shoot(model: _Model, x, v, S, rdof, tol, counters):
         xs = _amplitude_scale(model, max(A, np.max(np.abs(z[:n]))))
         D = np.concatenate([np.full(n, xs), np.full(n, xs * w)])
         if D0 is None:
-            # residuals are compared in the scale of the first iterate, so
-            # that a step that merely inflates the amplitude (a relative
-            # residual shrinking because the scale grows: an undamped
-            # resonance) is never taken for progress
             D0 = D
         r = (z1 - z) / D0
         rn = float(np.max(np.abs(r)))
         if best is None or rn < best[0]:
             best = (rn, z.copy(), S.copy(), rn if best is None else best[3])
         if float(np.max(np.abs((z1 - z) / D))) <= tol:
-            converged = True
-            break
+            return z, S, True, floq
         D = D0
         counters["shoot"] += 1
-        Jm = np.empty((2 * n, 2 * n))
-        for j in range(2 * n):
-            e = config.SS_SHOOT_FD * D[j]
-            zp = z.copy()
-            zp[j] += e
-            zj, _, _ = phi(zp, S)
-            if zj is None:
-                return x0, v0, S0, False, floq
-            Jm[:, j] = (zj - z1) / D / config.SS_SHOOT_FD
+        Jm = fd_monodromy(lambda zz: phi(zz, S)[0], z, D, config.SS_SHOOT_FD, z1)
+        if Jm is None:
+            return z, S, False, floq
         floq = float(np.max(np.abs(np.linalg.eigvals(Jm))))
         dz = np.linalg.lstsq(Jm - np.eye(2 * n), -r, rcond=1e-8)[0]
-        # damped step: accept the first that reduces the residual
-        lam = 1.0
-        accepted = False
-        big = float(np.max(np.abs(dz)))
-        if big > config.SS_SHOOT_MAXSTEP:
-            lam = config.SS_SHOOT_MAXSTEP / big
-        for _ls in range(config.SS_SHOOT_HALVINGS):
-            zn = z + lam * dz * D
-            zn1, Sn1, sn1 = phi(zn, S1)
-            if zn1 is not None:
-                rnew = np.max(np.abs((zn1 - zn) / D))
-                if rnew < rn:
-                    accepted = True
-                    break
-            lam *= 0.5
-        if not accepted:
+        step = _line_search(phi, z, dz, D, S1, rn)
+        if step is None:
             break
-        z, S, z1, S1, s1 = zn, S1, zn1, Sn1, sn1
-    if not converged:
-        # a stalled Newton (noise of the non-smooth law) may still have
-        # removed most of the transient: keep its best iterate if it gained
-        # a factor of 100; the integration that follows decides
-        if best is None or not best[0] <= 1e-2 * best[3]:
-            return x0, v0, S0, False, floq
-        z, S = best[1], best[2]
+        z, S, z1, S1, s1 = step[0], S1, step[1], step[2], step[3]
+    if best is None or not best[0] <= 1e-2 * best[3]:
+        return z, S, False, floq
+    return best[1], best[2], True, floq
+
+
+def _shoot(model: Model, x, v, S, rdof, tol, counters):
+    """Newton on the period map (x, v) -> (x, v)(t + T) with the law state carried.
+
+    The finite-difference monodromy (:func:`~jointdyn.dynamics.monodromy.fd_monodromy`,
+    forward differences) perturbs (x, v) with the law state kept (a
+    displacement perturbation acts as a motion of the contact); the steps
+    are minimum-norm (least squares), because the offset of a partly stuck
+    contact is neutral. Returns (x, v, S, converged, floquet_max) at a
+    phase-0 boundary. ``counters`` (dict) gets the periods, steps and
+    iterations spent.
+    """
+    n = model.n
+    x0, v0, S0 = x.copy(), v.copy(), S.copy()
+    count = _booker(counters)
+    sec = _section(model, x, v, S, rdof, count)
+    if sec is None:
+        return x0, v0, S0, False, math.nan
+    x, v, S, grid, ts = sec
+
+    def phi(zz, SS):
+        xx, vv, S2 = zz[:n].copy(), zz[n:].copy(), SS.copy()
+        res = model.run_grid(xx, vv, S2, grid, 1, rdof)
+        count(res)
+        if not res.status.ok or res.done < 1:
+            return None, None, None
+        return np.concatenate([xx, vv]), S2, res.summary[0]
+
+    z, S, ok, floq = _newton(model, phi, np.concatenate([x, v]), S, tol, counters)
+    if not ok:
+        return x0, v0, S0, False, floq
     x = z[:n].copy()
     v = z[n:].copy()
     if ts > 0.0:
-        tg, Ng = model.segment_grid(ts, Tp)
-        summ, _, st_, done = model.run_grid(x, v, S, tg, Ng, 1, rdof)
-        count(summ, done, (Tp - ts) / Tp)
-        if st_ != 0:
+        res = model.run_grid(x, v, S, model.segment_grid(ts, model.period), 1, rdof)
+        count(res, (model.period - ts) / model.period)
+        if not res.status.ok:
             return x0, v0, S0, False, floq
     return x, v, S, True, floq
 
@@ -609,11 +477,126 @@ def _unpack_start(start, model):
     x = np.array(start.x, dtype=float)
     v = np.array(start.v, dtype=float)
     S = np.array(start.states, dtype=float, ndmin=2)
-    if x.shape != (model.n,) or v.shape != (model.n,) or S.shape != (model.nc, model.slen):
+    if x.shape != (model.n,) or v.shape != (model.n,) or S.shape != (model.nc, model.pack.slen):
         raise ValueError("start does not belong to this system (shapes of x, v or law states differ)")
     if not (np.all(np.isfinite(x)) and np.all(np.isfinite(v))):
         raise ValueError("start must be finite (NaN/inf in its x or v)")
     return x, v, np.ascontiguousarray(S)
+
+
+@dataclass
+class _March:
+    """The working state of :func:`steady_state` (mutable; never returned)."""
+
+    x: np.ndarray
+    v: np.ndarray
+    S: np.ndarray
+    hist: _History
+    counters: dict
+    shots: int = 0
+    floq: float = math.nan
+
+    def shoot(self, model, rdof, amp_rtol) -> bool:
+        """One shooting attempt; the state and a fresh history are kept if it
+        converged to a stable orbit (the largest multiplier is always kept)."""
+        self.shots += 1
+        xs_, vs_, Ss_, ok, self.floq = _shoot(model, self.x.copy(), self.v.copy(), self.S.copy(), rdof,
+                                              0.1 * amp_rtol, self.counters)  # fmt: skip
+        if ok and not (self.floq > 1.0 + config.SS_FLOQUET_TOL):
+            self.x, self.v, self.S = xs_, vs_, np.ascontiguousarray(Ss_)
+            self.hist = _History(np.concatenate([self.x, self.v]))
+            return True
+        return False
+
+
+def _period_multiple(hist, model, K, amp_rtol, energy_rtol) -> int:
+    """Smallest p <= SS_MAX_MULTIPLE with which the history repeats (0 if none);
+    a multiple p > 1 must not be a slowly alternating approach to period 1."""
+    for p in range(1, config.SS_MAX_MULTIPLE + 1):
+        if _check_periodic(hist, p, K, model, amp_rtol, energy_rtol):
+            if p > 1 and _one_period_decaying(hist, K * p, model):
+                continue
+            return p
+    return 0
+
+
+def _need_shoot(hist, model, growing, amp_rtol, chunk) -> bool:
+    """Shoot when the estimated number of periods to converge exceeds
+    SS_SHOOT_AFTER, when the distance does not contract, or when growing."""
+    est = _contraction(hist, model)
+    if est is None:
+        return False
+    rho, dlast = est
+    A = 0.5 * (hist.summ[-1][S_XMAX] - hist.summ[-1][S_XMIN])
+    target = amp_rtol * _amplitude_scale(model, A)
+    if growing:
+        return True
+    if rho >= 1.0:
+        return hist.size >= 2 * chunk
+    if dlast > target:
+        return math.log(target / dlast) / math.log(rho) > config.SS_SHOOT_AFTER
+    return False
+
+
+def _settle(model, st: _March, K, maxp, amp_rtol, energy_rtol, rdof, shooting):
+    """Integrate chunks of periods (shooting over slow transients) until classified.
+
+    Returns (status or None when max_periods ran out, detail, p).
+    """
+    chunk = max(config.SS_CHUNK, K)
+    while True:
+        nrun = int(min(chunk, maxp - st.counters["periods"]))
+        if nrun <= 0:
+            return None, "", 0
+        res = model.run_periods(st.x, st.v, st.S, nrun, rdof=rdof)
+        _booker(st.counters)(res)
+        st.hist.add(res.summary, res.z_end)
+        if not res.status.ok:
+            return SteadyStatus.UNBOUNDED, "blow-up", 0
+        p_found = _period_multiple(st.hist, model, K, amp_rtol, energy_rtol)
+        long_p = 0 if p_found else _long_period(st.hist, K, model, amp_rtol, energy_rtol)
+        growing = False if (p_found or long_p) else _growing(st.hist, model, amp_rtol)
+        can_shoot = shooting and st.shots < config.SS_MAX_SHOTS
+        # a multiple p > 1 may be a lightly damped transient whose free
+        # frequency is commensurate with the forcing: first look for a
+        # stable period-1 orbit by shooting (once per history)
+        if (p_found > 1 or long_p) and can_shoot and not st.hist.shot_checked:
+            st.hist.shot_checked = True
+            if st.shoot(model, rdof, amp_rtol):
+                continue
+        if p_found:
+            return SteadyStatus.PERIODIC, "shooting" if st.counters["shoot"] else "integration", p_found
+        if long_p:
+            return SteadyStatus.NOT_SETTLED, f"period-{long_p}", 0
+        if growing and not can_shoot:
+            return SteadyStatus.UNBOUNDED, "growing", 0
+        if st.counters["periods"] >= maxp or (not can_shoot and _stalled(st.hist, model)):
+            return None, "", 0
+        if can_shoot and _need_shoot(st.hist, model, growing, amp_rtol, chunk):
+            st.shoot(model, rdof, amp_rtol)
+
+
+def _periodic_values(model, st: _March, p, rdof, keep_loop):
+    """Amplitude, offset, energies of the final p periods (and the recorded loop)."""
+    if keep_loop:
+        res = model.run_periods(st.x, st.v, st.S, p, rec=True, rdof=rdof)
+        _booker(st.counters)(res)
+        loop = _trajectory(res, st.x, st.v, st.S)
+        summ = res.summary
+    else:
+        loop = None
+        summ = np.asarray(st.hist.summ[-p:])
+    A = 0.5 * (summ[:, S_XMAX].max() - summ[:, S_XMIN].min())
+    vals = {"amplitude_m": float(A), "amplitude_q": math.nan}
+    if model.pack.laws:
+        law = model.pack.laws[0]
+        vals["amplitude_q"] = float(law.kt * A / law.fy) if law.fy > 0 else math.inf
+    vals["offset_m"] = float(summ[:, S_XMEAN].mean())
+    vals["max_abs_m"] = float(max(abs(summ[:, S_XMAX].max()), abs(summ[:, S_XMIN].min())))
+    vals["energy_contact_J"] = float(summ[:, S_EC].mean())
+    vals["energy_viscous_J"] = float(summ[:, S_EV].mean())
+    vals["work_force_J"] = float(summ[:, S_W].mean())
+    return vals, loop
 
 
 def steady_state(
@@ -670,8 +653,8 @@ def steady_state(
     Returns
     -------
     SteadyState
-        With ``status`` "periodic", "not-settled" or "unbounded"; amplitudes
-        are NaN unless periodic.
+        With ``status`` (:class:`SteadyStatus`) "periodic", "not-settled" or
+        "unbounded"; amplitudes are NaN unless periodic.
     """
     if not isinstance(system, System):
         raise ValueError(f"system must be a System, got {type(system).__name__}")
@@ -686,131 +669,40 @@ def steady_state(
     if rdof >= system.ndof:
         raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {rdof}")
     w = _omega(system, gamma)
-    gamma = float(gamma)
-    model = _Model(system, w, spp, events=_events)
-
-    if start is not None:
-        x, v, S = _unpack_start(start, model)
-    else:
-        est = _linear_start(model)
-        if est is None:
-            x = np.zeros(model.n)
-            v = np.zeros(model.n)
-            S = model.initial_states(x)
-        else:
-            x, v, S = est
-            S = np.ascontiguousarray(S)
-
-    counters = {"periods": 0, "steps": 0, "shoot": 0}
-    hist = _History(np.concatenate([x, v]))
-    status, detail, p_found = None, "", 0
-    shots = 0
-    floq = math.nan
-    pmax = config.SS_MAX_MULTIPLE
-    chunk = max(config.SS_CHUNK, K)
-    while True:
-        nrun = int(min(chunk, maxp - counters["periods"]))
-        if nrun <= 0:
-            break
-        summ, zend, st, done, _ = model.run_periods(x, v, S, nrun, rdof=rdof)
-        counters["periods"] += done
-        counters["steps"] += int(summ[:, S_STEPS].sum()) if done else 0
-        hist.add(summ, zend)
-        if st != 0:
-            status, detail = "unbounded", "blow-up"
-            break
-        for p in range(1, pmax + 1):
-            if _check_periodic(hist, p, K, model, amp_rtol, energy_rtol):
-                if p > 1 and _one_period_decaying(hist, K * p, model):
-                    continue  # a slowly alternating approach to a period-1 state
-                p_found = p
-                break
-        long_p = 0 if p_found else _long_period(hist, K, model, amp_rtol, energy_rtol)
-        growing = False if (p_found or long_p) else _growing(hist, model, amp_rtol)
-        can_shoot = shooting and shots < config.SS_MAX_SHOTS
-        # a multiple p > 1 may be a lightly damped transient whose free
-        # frequency is commensurate with the forcing: first look for a
-        # stable period-1 orbit by shooting (once per history)
-        if (p_found > 1 or long_p) and can_shoot and not hist.shot_checked:
-            hist.shot_checked = True
-            shots += 1
-            xs_, vs_, Ss_, ok, floq = _shoot(model, x.copy(), v.copy(), S.copy(), rdof, 0.1 * amp_rtol, counters)
-            if ok and not (floq > 1.0 + config.SS_FLOQUET_TOL):
-                x, v, S = xs_, vs_, np.ascontiguousarray(Ss_)
-                hist = _History(np.concatenate([x, v]))
-                p_found = 0
-                continue
-        if p_found:
-            status = "periodic"
-            detail = "shooting" if counters["shoot"] else "integration"
-            break
-        if long_p:
-            status, detail = "not-settled", f"period-{long_p}"
-            break
-        if growing and not can_shoot:
-            status, detail = "unbounded", "growing"
-            break
-        if counters["periods"] >= maxp:
-            break
-        if not can_shoot and _stalled(hist, model):
-            break
-        if can_shoot:
-            est = _contraction(hist, model)
-            need_shoot = False
-            if est is not None:
-                rho, dlast = est
-                A = 0.5 * (hist.summ[-1][S_XMAX] - hist.summ[-1][S_XMIN])
-                target = amp_rtol * _amplitude_scale(model, A)
-                if growing:
-                    need_shoot = True
-                elif rho >= 1.0:
-                    need_shoot = hist.size >= 2 * chunk
-                elif dlast > target:
-                    need_shoot = math.log(target / dlast) / math.log(rho) > config.SS_SHOOT_AFTER
-            if need_shoot:
-                shots += 1
-                xs_, vs_, Ss_, ok, floq = _shoot(model, x.copy(), v.copy(), S.copy(), rdof, 0.1 * amp_rtol, counters)
-                if ok and not (floq > 1.0 + config.SS_FLOQUET_TOL):
-                    x, v, S = xs_, vs_, np.ascontiguousarray(Ss_)
-                    hist = _History(np.concatenate([x, v]))
-
+    model = make_model(system, w, spp, events=_events)
+    x, v, S = _first_state(model, start)
+    st = _March(x, v, S, _History(np.concatenate([x, v])), {"periods": 0, "steps": 0, "shoot": 0})
+    status, detail, p_found = _settle(model, st, K, maxp, amp_rtol, energy_rtol, rdof, shooting)
     if status is None:
         # did not settle within max_periods: say why if we can
-        status = "not-settled"
-        if hist.size >= config.SS_STALL_PERIODS and _stalled(hist, model):
-            detail = "quasi-periodic-or-chaotic"
-        else:
-            detail = "slowly-converging"
-    last = hist.summ[-1] if hist.size else None
+        status = SteadyStatus.NOT_SETTLED
+        stalled = st.hist.size >= config.SS_STALL_PERIODS and _stalled(st.hist, model)
+        detail = "quasi-periodic-or-chaotic" if stalled else "slowly-converging"
+    last = st.hist.summ[-1] if st.hist.size else None
     last_amp = 0.5 * (last[S_XMAX] - last[S_XMIN]) if last is not None else math.nan
-
     nan = math.nan
     vals = dict(amplitude_q=nan, amplitude_m=nan, offset_m=nan, max_abs_m=nan,
                 energy_contact_J=nan, energy_viscous_J=nan, work_force_J=nan)  # fmt: skip
     loop = None
-    if status == "periodic":
-        p = p_found
-        if keep_loop:
-            summ, zend, st, done, smp = model.run_periods(x, v, S, p, rec=True, rdof=rdof)
-            counters["periods"] += done
-            counters["steps"] += int(summ[:, S_STEPS].sum())
-            t, X, Vv, T, N, code = smp
-            loop = Trajectory(t=t, x=X, v=Vv, T=T, N=N, code=code, final=Restart(x.copy(), v.copy(), S.copy()))
-        else:
-            summ = np.asarray(hist.summ[-p:])
-        A = 0.5 * (summ[:, S_XMAX].max() - summ[:, S_XMIN].min())
-        vals["amplitude_m"] = float(A)
-        if system.contacts:
-            law = system.contacts[0].law
-            vals["amplitude_q"] = float(law.kt * A / law.fy) if law.fy > 0 else math.inf
-        vals["offset_m"] = float(summ[:, S_XMEAN].mean())
-        vals["max_abs_m"] = float(max(abs(summ[:, S_XMAX].max()), abs(summ[:, S_XMIN].min())))
-        vals["energy_contact_J"] = float(summ[:, S_EC].mean())
-        vals["energy_viscous_J"] = float(summ[:, S_EV].mean())
-        vals["work_force_J"] = float(summ[:, S_W].mean())
+    if status.ok:
+        vals, loop = _periodic_values(model, st, p_found, rdof, keep_loop)
     return SteadyState(
-        status=status, detail=detail, period_multiple=int(p_found), gamma=gamma, omega=w,
-        periods=int(math.ceil(counters["periods"])), steps=int(counters["steps"]),
-        shooting_iterations=int(counters["shoot"]), floquet_max=float(floq),
-        last_amplitude_m=float(last_amp), restart=Restart(x.copy(), v.copy(), S.copy()), loop=loop, **vals,
+        status=status, detail=detail, period_multiple=int(p_found), gamma=float(gamma), omega=w,
+        periods=int(math.ceil(st.counters["periods"])), steps=int(st.counters["steps"]),
+        shooting_iterations=int(st.counters["shoot"]), floquet_max=float(st.floq),
+        last_amplitude_m=float(last_amp), restart=Restart(st.x.copy(), st.v.copy(), st.S.copy()), loop=loop,
+        **vals,
     )  # fmt: skip
+
+
+def _first_state(model, start):
+    """(x, v, S) to start from: the warm start, else the equivalent-linearisation
+    estimate, else rest with virgin law states."""
+    if start is not None:
+        return _unpack_start(start, model)
+    est = linear_start(model)
+    if est is None:
+        x = np.zeros(model.n)
+        return x, np.zeros(model.n), model.initial_states(x)
+    x, v, S = est
+    return x, v, np.ascontiguousarray(S)

@@ -5,7 +5,8 @@ detection (see docs/harmonic-balance.md)."""
 from .continuation import ContinuationResult, continuation, newton, turning_points
 from .frc import HBBranch, HBSolution, branch_dataset, continue_hb, frc_hb, harmonic_balance
 from .problem import PARAMETERS, HBProblem
-from .stability import hill_exponents, hill_growth, hill_stability, monodromy_multipliers
+from .monodromy import monodromy_multipliers
+from .stability import hill_exponents, hill_growth, hill_stability
 
 __all__ = [
     "frc_hb",

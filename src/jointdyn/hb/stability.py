@@ -1,4 +1,4 @@
-"""Stability of harmonic-balance solutions: Hill's method and a monodromy check.
+"""Stability of harmonic-balance solutions: Hill's method.
 
 Hill's method
 -------------
@@ -31,13 +31,7 @@ range, which may have spurious positive real parts. The solution is
 unstable when a selected exponent has ``Re(s) > HB_STABILITY_RTOL * w``.
 Floquet multipliers are ``exp(2 pi s / w)``.
 
-Monodromy check
----------------
-:func:`monodromy_multipliers` integrates the equations of motion over one
-period (compiled velocity-Verlet march of the same contact kernels, the
-contact state taken from the periodic HB orbit) and differentiates the
-period map by central finite differences in the 2n positions and
-velocities.
+The independent monodromy check lives in :mod:`jointdyn.hb.monodromy`.
 """
 
 from __future__ import annotations
@@ -45,12 +39,10 @@ from __future__ import annotations
 import numpy as np
 
 from .. import config
-from .._jit import jit, specialize
-from ..drivers import march
-from ..laws import MACROSLIP, SEPARATION
+from .._jit import jit
 from ._eig import eigvals_inplace
 
-__all__ = ["hill_exponents", "hill_stability", "hill_growth", "monodromy_multipliers", "derivative_matrix"]
+__all__ = ["hill_exponents", "hill_stability", "hill_growth", "derivative_matrix"]
 
 
 def derivative_matrix(H: int) -> np.ndarray:
@@ -312,147 +304,3 @@ def hill_stability(JX, M, C, w, H, rtol: float = config.HB_STABILITY_RTOL):
     growth = float(sel[0].real) / w  # sel is sorted by decreasing real part
     mult = np.exp(sel * 2.0 * np.pi / w)
     return growth <= rtol, growth, mult
-
-
-def _verlet_template(Minv, C, K, f, Bm, params, states, n0, n1, dl, w, t0, x0, v0, h, nsteps, xo, vo):  # pragma: no cover - compiled
-    """Velocity-Verlet march of M x'' + C x' + K x + sum B_c T_c = f sin(w t)."""
-    n = x0.shape[0]
-    nc = Bm.shape[0]
-    x = x0.copy()
-    v = v0.copy()
-    sa = states.copy()
-    sb = states.copy()
-    Tc = np.zeros(nc)
-    a = np.zeros(n)
-    rhs = np.zeros(n)
-    # step -1 evaluates (and commits) the force at t0, x0: the perturbation
-    # of x0 loads the contact; then velocity-Verlet steps
-    for step in range(-1, nsteps):
-        t1 = t0 + (step + 1) * h
-        if step < 0:
-            xn = x.copy()
-            vp = v.copy()
-        else:
-            xn = x + h * v + 0.5 * h * h * a
-            vp = v + h * a
-        for c in range(nc):
-            u = 0.0
-            for i in range(n):
-                u += Bm[c, i] * xn[i]
-            N = n0[c] + n1[c] * np.sin(w * t1 + dl[c])
-            t_, k_, c_ = STEP(params[c], sa[c], sb[c], u, N)  # noqa: F821
-            Tc[c] = t_
-        sa, sb = sb, sa
-        for i in range(n):
-            r = f[i] * np.sin(w * t1) - K[i, :] @ xn - C[i, :] @ vp
-            for c in range(nc):
-                r -= Bm[c, i] * Tc[c]
-            rhs[i] = r
-        an = Minv @ rhs
-        if step >= 0:
-            v = v + 0.5 * h * (a + an)
-            x = xn
-        a = an
-    xo[:] = x
-    vo[:] = v
-    states[:, :] = sa
-
-
-def _pad_stack(rows):
-    m = max(len(r) for r in rows)
-    out = np.zeros((len(rows), m))
-    for i, r in enumerate(rows):
-        out[i, : len(r)] = r
-    return out
-
-
-def monodromy_multipliers(problem, X, p, *, steps: int = 4096, eps: float = 1e-6, warm_periods: int = 3):
-    """Floquet multipliers from finite differences of the period map.
-
-    Parameters
-    ----------
-    problem : HBProblem
-        The harmonic-balance problem (system, parameter).
-    X : ndarray
-        HB coefficients of the periodic solution.
-    p : float
-        Parameter value.
-    steps : int
-        Velocity-Verlet steps per period.
-    eps : float
-        Relative perturbation of positions (scaled by the amplitude) and
-        velocities (scaled by w times the amplitude).
-    warm_periods : int
-        Periods of the HB displacement marched through each contact law to
-        obtain the contact state at t = 0.
-
-    Returns
-    -------
-    ndarray complex (2n,)
-        Eigenvalues of the finite-difference monodromy matrix.
-    """
-    sysm = problem.system
-    n = problem.n
-    w = problem.omega(p)
-    Tper = 2.0 * np.pi / w
-    h = Tper / steps
-    w_, f, loads = problem._split(p)
-    Xm = X.reshape(problem.nh, n)
-    # Poincare section where the contacts hold the least memory (all open,
-    # else all in macroslip): there the contact state is a function of the
-    # positions, velocities and load, so the 2n-dimensional period map is exact
-    ev = problem.evaluate(X, p)
-    codes = np.array(ev.code).reshape(len(ev.code), -1)
-    j0 = 0
-    for target in (SEPARATION, MACROSLIP):
-        hit = np.flatnonzero(np.all(codes == target, axis=0))
-        if hit.size:
-            j0 = int(hit[hit.size // 2])
-            break
-    tau0 = 2.0 * np.pi * j0 / problem.Ns
-    D = derivative_matrix(problem.H)
-
-    def basis(tau):
-        E = np.ones((tau.size, problem.nh))
-        for k in range(1, problem.H + 1):
-            E[:, 2 * k - 1] = np.cos(k * tau)
-            E[:, 2 * k] = np.sin(k * tau)
-        return E
-
-    e0 = basis(np.array([tau0]))[0]
-    x0 = e0 @ Xm
-    v0 = w * (e0 @ (D @ Xm))
-    tt = tau0 + np.arange(warm_periods * steps + 1) * (2.0 * np.pi / steps)
-    xs = basis(tt) @ Xm
-    states, params = [], []
-    for c, b, (n0, n1, dl, _) in zip(problem.contacts, problem.B, loads):
-        N = n0 + n1 * np.sin(tt + dl)
-        s = march(c.law, xs @ b, N)[3]
-        states.append(s)
-        params.append(c.law.params)
-    S = _pad_stack(states)
-    Pm = _pad_stack(params)
-    Bm = np.array(problem.B) if problem.B else np.zeros((0, n))
-    n0a = np.array([l[0] for l in loads])
-    n1a = np.array([l[1] for l in loads])
-    dla = np.array([l[2] for l in loads])
-    law = problem.contacts[0].law
-    fn = specialize(_verlet_template, STEP=law.step)
-    Minv = np.linalg.inv(sysm.M)
-    amp = max(float(np.max(np.abs(xs))), 1e-12)
-
-    def pmap(z):
-        xo = np.empty(n)
-        vo = np.empty(n)
-        st = S.copy()
-        fn(Minv, sysm.C, sysm.K, f, Bm, Pm, st, n0a, n1a, dla, w, tau0 / w, z[:n].copy(), z[n:].copy(), h, steps, xo, vo)
-        return np.concatenate((xo, vo))
-
-    z0 = np.concatenate((x0, v0))
-    scale = np.concatenate((np.full(n, amp), np.full(n, amp * w)))
-    Phi = np.empty((2 * n, 2 * n))
-    for j in range(2 * n):
-        dz = np.zeros(2 * n)
-        dz[j] = eps * scale[j]
-        Phi[:, j] = (pmap(z0 + dz) - pmap(z0 - dz)) / (2 * dz[j])
-    return np.linalg.eigvals(Phi)

@@ -1,0 +1,353 @@
+"""A System packed for the compiled RK4 runner, its step grids, and the one call of the runner.
+
+:func:`pack_system` holds the frequency-independent arrays (one per System
+object, cached); :func:`make_model` adds a forcing frequency and the step
+grid of one period with the separation and re-contact instants; :func:`run`
+is the only place that calls the compiled runner (``_core.py``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import config
+from .._cache import by_identity
+from ..kinematics import (
+    NORMAL_HARMONIC,
+    ContactKinematics,
+    contact_kinematics,
+    load_events,
+    load_table,
+    midpoint_loads,
+    no_contact_init,
+    no_contact_step,
+    normal_load_at,
+    selection_matrix,
+    tangential_history,
+)
+from ._core import LOADS_HARMONIC, N_SUMMARY, RUN_OVERFLOW, compiled_runner, grid_sines
+from .status import RunStatus, run_status
+
+__all__ = ["PackedSystem", "pack_system", "Model", "make_model", "Grid", "RunResult", "run"]
+
+
+@dataclass(frozen=True)
+class PackedSystem:
+    """The frequency-independent arrays of a System for the compiled runner.
+
+    Shared by every model of the same System object and never written.
+    ``arrays`` is the runner's ``system`` argument ``(Minv, K, C, f, kin, P)``.
+    """
+
+    ndof: int
+    ncontacts: int
+    M: np.ndarray
+    Minv: np.ndarray
+    K: np.ndarray
+    C: np.ndarray
+    fvec: np.ndarray
+    kin: ContactKinematics
+    #: dense selection rows (nc, ndof) and stuck stiffnesses kt (N/m)
+    B: np.ndarray
+    kt: np.ndarray
+    #: law parameter rows (nc, longest), state length, the laws, their kernels
+    P: np.ndarray
+    slen: int
+    laws: tuple
+    step: object
+    init: object
+    runner: object
+    #: stiffness with every contact stuck, its highest and lowest natural frequencies (rad/s)
+    K_stuck: np.ndarray
+    w_max: float
+    w_min_stuck: float
+    #: sum of fy / kt (m), largest forcing amplitude (N), smallest modal stiffness (N/m)
+    xlin: float
+    fmax: float
+    kmin: float
+    arrays: tuple
+    #: output buffers of a run that records nothing, and the sampled-forcing
+    #: table of a harmonic grid (unused there)
+    nobufs: tuple
+    no_forcing_table: np.ndarray
+
+
+@by_identity
+def pack_system(system) -> PackedSystem:
+    """The :class:`PackedSystem` of ``system`` (cached per System object)."""
+    n = system.ndof
+    cs = system.contacts
+    kin = contact_kinematics(system)
+    M = np.ascontiguousarray(system.M, dtype=np.float64)
+    Minv = np.ascontiguousarray(np.linalg.inv(system.M))
+    K = np.ascontiguousarray(system.K, dtype=np.float64)
+    C = np.ascontiguousarray(system.C, dtype=np.float64)
+    fvec = np.ascontiguousarray(system.force, dtype=np.float64)
+    if cs:
+        P = np.zeros((len(cs), max(c.law.params.size for c in cs)))
+        for i, c in enumerate(cs):
+            P[i, : c.law.params.size] = c.law.params
+        slen = max(c.law.state_size for c in cs)
+        step, init = cs[0].law.step, cs[0].law.init
+    else:
+        P, slen, step, init = np.zeros((0, 5)), 1, no_contact_step, no_contact_init
+    B = selection_matrix(kin, n)
+    kt = np.array([c.law.kt for c in cs], dtype=np.float64)
+    # stiffest linear mode with every contact stuck: keeps RK4 accurate/stable
+    Kst = K.copy()
+    for i in range(len(cs)):
+        Kst += kt[i] * np.outer(B[i], B[i])
+    from scipy.linalg import eigh
+
+    lam = eigh(0.5 * (Kst + Kst.T), system.M, eigvals_only=True)
+    w_max = math.sqrt(max(lam[-1], 0.0))
+    w_min = math.sqrt(max(lam[0], 0.0))
+    fmax = float(np.max(np.abs(fvec)))
+    return PackedSystem(
+        ndof=n, ncontacts=len(cs), M=M, Minv=Minv, K=K, C=C, fvec=fvec, kin=kin, B=B, kt=kt, P=P,
+        slen=slen, laws=tuple(c.law for c in cs), step=step, init=init, runner=compiled_runner(step),
+        K_stuck=np.ascontiguousarray(Kst), w_max=w_max, w_min_stuck=w_min,
+        xlin=sum(c.law.fy / c.law.kt for c in cs), fmax=fmax,
+        kmin=max(w_min**2 * float(np.min(np.diag(system.M))), 1e-300),
+        arrays=(Minv, K, C, fvec, kin.arrays, P), nobufs=_buffers(1, n, len(cs)), no_forcing_table=np.zeros((1, n)),
+    )  # fmt: skip
+
+
+def _buffers(cap, n, nc):
+    """Sample buffers (t, x, v, T, N, code) for ``cap`` samples."""
+    return (
+        np.zeros(cap),
+        np.zeros((cap, n)),
+        np.zeros((cap, n)),
+        np.zeros((cap, nc)),
+        np.zeros((cap, nc)),
+        np.zeros((cap, nc), dtype=np.int8),
+    )
+
+
+#: a step grid with its load tables: the runner's ``grid`` argument
+#: ``(t, N, F, sin_mid, sin_end, N_mid)`` (see ``_core.py``)
+Grid = tuple
+
+
+def _harmonic_tables(pack: PackedSystem, tg, Ng, w) -> Grid:
+    """The runner's grid tuple of a harmonic step grid tg (s) with normal loads Ng (N)."""
+    sin_mid, sin_end = grid_sines(tg, w, 0.0)
+    N_mid = midpoint_loads(pack.kin.arrays, tg, w, 0.0)
+    return (tg, Ng, pack.no_forcing_table, sin_mid, sin_end, N_mid)
+
+
+def _period_grid(pack: PackedSystem, w: float, J: int, events: bool):
+    """Step grid of one forcing period with the separation/re-contact instants, and its normal loads.
+
+    J uniform steps; an instant within ``TI_EVENT_MERGE`` of a step of a
+    grid point moves that point, else it is inserted. The load is snapped
+    to exactly 0 at a separation and to ``TI_RECONTACT_ALPHA n0`` at a
+    re-contact.
+    """
+    Tp = 2 * math.pi / w
+    t = np.arange(J + 1) * (Tp / J)  # np.linspace(0, Tp, J + 1), bit for bit, cheaper
+    t[J] = Tp
+    tol = config.TI_EVENT_MERGE * Tp / J
+    tg = t
+    ev_at = {}
+    for te, ci, rising in load_events(pack.kin, w, Tp) if events else ():
+        k = int(np.argmin(np.abs(tg - te)))
+        if abs(tg[k] - te) <= tol:
+            if k == 0 or k == tg.size - 1:
+                # an event at the period boundary: keep the boundary exact
+                te = tg[k]
+            else:
+                tg[k] = te
+            ev_at.setdefault(k, []).append((ci, rising))
+        else:
+            k = int(np.searchsorted(tg, te))
+            tg = np.insert(tg, k, te)
+            # re-key events recorded at later indices
+            ev_at = {(kk + 1 if kk >= k else kk): v for kk, v in ev_at.items()}
+            ev_at.setdefault(k, []).append((ci, rising))
+    N = load_table(pack.kin.arrays, tg, w)
+    for k, lst in ev_at.items():
+        for ci, rising in lst:
+            N[k, ci] = config.TI_RECONTACT_ALPHA * pack.kin.normal_par[ci, 0] if rising else 0.0
+            if k == 0:
+                N[tg.size - 1, ci] = N[0, ci]
+            if k == tg.size - 1:
+                N[0, ci] = N[k, ci]
+    return tg, np.ascontiguousarray(N)
+
+
+@dataclass(frozen=True)
+class Model:
+    """A packed System at one forcing frequency, with its period grid.
+
+    Built by :func:`make_model`. ``grid`` is the period grid (None when
+    ``w == 0``: sampled loads); ``xcap0`` and ``xcap`` are the blow-up caps
+    of the displacements (m) and of (x, v).
+    """
+
+    pack: PackedSystem
+    system: object
+    w: float
+    events: bool
+    max_split: int
+    J: int
+    xcap0: float
+    xcap: np.ndarray
+    grid: Grid | None
+    period: float
+
+    @property
+    def n(self) -> int:
+        return self.pack.ndof
+
+    @property
+    def nc(self) -> int:
+        return self.pack.ncontacts
+
+    def cap(self, x, v) -> np.ndarray:
+        """Blow-up caps, never below TI_BLOWUP_FACTOR times the starting state."""
+        wv = max(self.pack.w_max, self.w, 1.0)
+        xs = float(np.max(np.abs(x))) + float(np.max(np.abs(v))) / wv
+        if config.TI_BLOWUP_FACTOR * xs <= self.xcap0:
+            return self.xcap  # the usual case: the start is far below the caps
+        n = self.n
+        return np.maximum(self.xcap, config.TI_BLOWUP_FACTOR * np.concatenate([np.full(n, xs), np.full(n, xs * wv)]))
+
+    def segment_grid(self, ta: float, tb: float) -> Grid:
+        """Grid for ta < t <= tb (0 <= ta < tb <= ta + period), from the period grid."""
+        Tp = self.period
+        base, Nbase = self.grid[0], self.grid[1]
+        tt = np.concatenate([base[:-1], base + Tp])
+        NN = np.concatenate([Nbase[:-1], Nbase], axis=0)
+        eps = 1e-12 * Tp
+        inside = (tt > ta + eps) & (tt < tb - eps)
+        tg = np.concatenate([[ta], tt[inside], [tb]])
+        Ng = np.empty((tg.size, self.nc))
+        Ng[1:-1] = NN[inside]
+        for ci in range(self.nc):
+            Ng[0, ci] = normal_load_at(self.pack.kin, ci, self.w, ta)
+            Ng[-1, ci] = normal_load_at(self.pack.kin, ci, self.w, tb)
+        # an end point that is a grid point keeps its (event-snapped) value
+        for idx, te in ((0, ta), (-1, tb)):
+            k = np.flatnonzero(np.abs(tt - te) <= eps)
+            if k.size:
+                Ng[idx] = NN[k[0]]
+        return _harmonic_tables(self.pack, np.ascontiguousarray(tg), np.ascontiguousarray(Ng), self.w)
+
+    def section_time(self) -> float:
+        """Poincare-section time in [0, period) where every contact is open, else 0.
+
+        Mid-separation of the first separating contact; there the law states
+        are reset, so (x, v) is the whole state of the period map.
+        """
+        kin = self.pack.kin
+        for c in range(self.nc):
+            n0, n1, delta = kin.normal_par[c]
+            if kin.normal_kind[c] == NORMAL_HARMONIC and n1 > n0:
+                ts = ((1.5 * math.pi - float(delta)) / self.w) % self.period
+                if all(normal_load_at(kin, cc, self.w, ts) < 0.0 for cc in range(self.nc)):
+                    return ts
+                return 0.0
+        return 0.0
+
+    def initial_states(self, x: np.ndarray, loads=None) -> np.ndarray:
+        """Virgin law states at displacements x (m) and normal loads ``loads`` (N;
+        default the loads at t = 0, event-snapped: a re-contact at t = 0 starts
+        the virgin curve there)."""
+        S = np.zeros((self.nc, self.pack.slen))
+        u = tangential_history(self.pack.kin.arrays, np.ascontiguousarray(x, dtype=np.float64)[None, :])[0]
+        for i, law in enumerate(self.pack.laws):
+            if loads is not None:
+                n_at0 = loads[i]
+            elif self.grid is not None:
+                n_at0 = self.grid[1][0, i]
+            else:
+                n_at0 = normal_load_at(self.pack.kin, i, self.w, 0.0)
+            s = law.initial_state(float(u[i]), float(n_at0))
+            S[i, : s.size] = s
+        return S
+
+    def run_grid(self, x, v, S, grid: Grid, nper: int, rdof: int = 0):
+        """Run ``nper`` repetitions of ``grid`` in place, recording nothing."""
+        return run(self, grid, LOADS_HARMONIC, x, v, S, nper, rdof=rdof)
+
+    def run_periods(self, x, v, S, nper: int, *, rec: bool = False, rdof: int = 0):
+        """Run ``nper`` forcing periods in place (optionally recording every step)."""
+        cap = nper * (self.J + 4 * self.nc + 8) + 1
+        return run(self, self.grid, LOADS_HARMONIC, x, v, S, nper, rdof=rdof, record=rec, capacity=cap)
+
+
+def make_model(system, w: float, steps_per_period: int, *, events: bool = True,
+               force_scale: float | None = None) -> Model:  # fmt: skip
+    """A :class:`Model` of ``system`` at forcing frequency ``w`` (rad/s; 0: sampled loads).
+
+    ``steps_per_period`` is raised so that w_max h <= ``TI_MAX_OMEGA_H``.
+    ``events=False`` (for the convergence study only): no step boundaries
+    at separation/re-contact and no splits at velocity reversals.
+    ``force_scale`` (N, default the largest forcing amplitude) sets the
+    blow-up caps.
+    """
+    pack = pack_system(system)
+    w = float(w)
+    J = int(steps_per_period)
+    if w > 0:
+        J = max(J, int(math.ceil(2 * math.pi * pack.w_max / (w * config.TI_MAX_OMEGA_H))))
+    fs = pack.fmax if force_scale is None else force_scale
+    xcap0 = config.TI_BLOWUP_FACTOR * (fs / pack.kmin + pack.xlin + 1e-12)
+    xcap = np.empty(2 * pack.ndof)
+    xcap[: pack.ndof] = xcap0
+    xcap[pack.ndof :] = xcap0 * max(pack.w_max, w, 1.0)
+    grid, period = None, math.nan
+    if w > 0:
+        tg, Ng = _period_grid(pack, w, J, events)
+        grid, period = _harmonic_tables(pack, tg, Ng, w), 2 * math.pi / w
+    return Model(pack=pack, system=system, w=w, events=bool(events),
+                 max_split=config.TI_MAX_SPLITS if events else 0, J=J, xcap0=xcap0, xcap=xcap,
+                 grid=grid, period=period)  # fmt: skip
+
+
+@dataclass(frozen=True, slots=True)
+class RunResult:
+    """What one :func:`run` returns.
+
+    ``summary`` (done, N_SUMMARY) and ``z_end`` (done, 2 n) hold the
+    per-repetition summary (columns ``S_*`` of ``_core.py``) and the state
+    at the end of each repetition; ``samples`` is ``(t, x, v, T, N, code)``
+    when recording, else None.
+    """
+
+    summary: np.ndarray
+    z_end: np.ndarray
+    status: RunStatus
+    done: int
+    samples: tuple | None
+
+
+def run(model: Model, grid: Grid, mode: int, x, v, S, nper: int, *, rdof: int = 0, record: bool = False,
+        capacity: int = 1) -> RunResult:  # fmt: skip
+    """March ``nper`` repetitions of ``grid`` from (x, v, S), which are updated in place.
+
+    The only call of the compiled runner. When recording, ``capacity``
+    samples are allocated and doubled (the run repeated from the same
+    start) until they suffice.
+    """
+    pack = model.pack
+    summ = np.zeros((nper, N_SUMMARY))
+    zend = np.zeros((nper, 2 * pack.ndof))
+    control = (mode, nper, 0.0, model.w, rdof, model.max_split, record)
+    io = (x, v, S, model.cap(x, v))
+    if record:
+        x0, v0, S0 = x.copy(), v.copy(), S.copy()
+    while True:
+        bufs = _buffers(capacity, pack.ndof, pack.ncontacts) if record else pack.nobufs
+        nrec, status, done = pack.runner(pack.arrays, grid, control, io, (*bufs, summ, zend))
+        if status != RUN_OVERFLOW:
+            break
+        capacity *= 2
+        x[:], v[:], S[:] = x0, v0, S0
+    samples = tuple(b[:nrec] for b in bufs) if record else None
+    return RunResult(summ[:done], zend[:done], run_status(status), done, samples)
