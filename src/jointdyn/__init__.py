@@ -2,8 +2,10 @@
 
 Public API (everything else is private):
 
-- contact laws: :class:`Iwan`, :class:`DiscreteIwan`, :class:`Jenkins`,
-  :func:`make_law` (:func:`law_names`, :func:`law_parameters`), normal loads;
+- contact laws: :class:`Iwan` (the exact Iwan model, the default),
+  :class:`IwanClosedForm` (the paper's closed forms), :class:`DiscreteIwan`,
+  :class:`Jenkins`, :func:`make_law` (:func:`law_names`,
+  :func:`law_parameters`), normal loads;
 - drivers: :func:`march`, :func:`quasistatic`, :func:`harmonic_loop`;
 - systems: :class:`System`, :class:`Contact`;
 - time integration: :func:`integrate`, :func:`steady_state`;
@@ -22,6 +24,7 @@ from .laws import (
     ContactLaw,
     DiscreteIwan,
     Iwan,
+    IwanClosedForm,
     Jenkins,
     backbone,
     law_names,
@@ -71,6 +74,7 @@ __all__ = [
     "STATE_NAMES",
     "ContactLaw",
     "Iwan",
+    "IwanClosedForm",
     "DiscreteIwan",
     "Jenkins",
     "backbone",

@@ -47,7 +47,7 @@ def add_arguments(p) -> None:
     p.add_argument("--sweep", default=None,
                    help="time: up, down or both (default both); hb: refused (the continuation follows the "
                         "branch through its folds, which holds the states of both sweep directions)")
-    p.add_argument("--model", default="iwan", help=model_help("iwan"))
+    p.add_argument("--model", default=config.MODEL, help=model_help(config.MODEL))
     add_law_arguments(p)
     p.add_argument("--zeta", type=float, default=0.0, help="viscous damping ratio (default 0)")
     p.add_argument("--m", type=float, default=PAPER["m"], help=f"mass, kg (default {PAPER['m']:g})")
