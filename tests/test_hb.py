@@ -10,9 +10,9 @@ from scipy.optimize import brentq
 
 import tolerances
 from jointdyn import System, config
+from jointdyn.continuation import continuation, turning_points
 from jointdyn.hb import (
     HBProblem,
-    continuation,
     continue_hb,
     frc_hb,
     harmonic_balance,
@@ -229,8 +229,6 @@ def _damper(eta=0.1, delta=0.0, n0=100.0, f1=25.0):
 
 
 def test_turning_points_ignore_jitter_within_the_band():
-    from jointdyn.hb import turning_points
-
     lam = np.array([0.0, 1.0, 2.0, 2.0001, 1.99995, 2.5, 3.0, 2.0, 1.0, 1.5, 4.0])
     assert list(turning_points(lam, band=0.01)) == [6, 8]
     assert list(turning_points(lam, band=0.0)) == [3, 4, 6, 8]

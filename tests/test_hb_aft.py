@@ -1,6 +1,7 @@
 """The compiled HB evaluation (jointdyn.hb._aft._eval_template) against a
 plain-Python reference of the same AFT march: every pass marched in full,
-the law's kernels called one sample at a time from Python. Covers the
+the law's kernels (restart by ``init_jvp``, march by ``step_jvp``) called
+one sample at a time from Python. Covers the
 shortcut of the compiled march (a pass stops once the state and its
 derivatives repeat, to HB_PERIODIC_RTOL, those of the first pass at the
 same sample; the rest of the pass is then copied) on stuck, slipping and
@@ -16,8 +17,8 @@ from jointdyn.hb import HBProblem
 
 def _reference(p, X, lam):
     """R, JX, Jp, T, code, info of HBProblem.evaluate, marched in Python."""
-    w, dwdp, Fe, Fp, Nsamp, dN, SX, SN = p._eval_inputs(lam)
-    AK, AC, AM = p._linear_parts()
+    w, dwdp, Fe, Fp, Nsamp, dN = p._inputs(lam)
+    AK, AC, AM = p._lin
     A = AK + w * AC + w * w * AM
     R = A @ X - Fe
     JX = A.copy()
@@ -33,11 +34,14 @@ def _reference(p, X, lam):
         b = p._Bm[c]
         U = X.reshape(nh, n) @ b
         u = p.E @ U
-        a = law.initial_state(float(U[0]), float(Nsamp[c, 0]))
-        da = np.zeros((a.size, nd))
-        da[:, 0] = SX[c, : a.size]
+        # virgin state at the mean displacement: direction 0 moves the mean, the parameter the load
+        dx0, dn0 = np.zeros(nd), np.zeros(nd)
+        dx0[0] = 1.0
         if has_p:
-            da[:, nh] = SN[c, : a.size] * dN[c, 0]
+            dn0[nh] = dN[c, 0]
+        a, da = np.empty(law.state_size), np.empty((law.state_size, nd))
+        law.init_jvp(law.params, float(U[0]), dx0, float(Nsamp[c, 0]), dn0, a, da)
+        assert np.array_equal(a, law.initial_state(float(U[0]), float(Nsamp[c, 0])))
         T1, T2, dT1 = np.zeros(ns), np.zeros(ns), np.zeros((ns, nd))
         s_end = np.empty_like(a)
         passes, period = 0, 0.0

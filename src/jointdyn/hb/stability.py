@@ -45,21 +45,14 @@ from __future__ import annotations
 import numpy as np
 
 from .. import config
+from .._cache import by_value
 from .._jit import jit, specialize
 from ..drivers import march
+from ..fourier import derivative_matrix
 from ..laws import MACROSLIP, SEPARATION
 from ._eig import eigvals_inplace
 
-__all__ = ["hill_exponents", "hill_stability", "hill_growth", "monodromy_multipliers", "derivative_matrix"]
-
-
-def derivative_matrix(H: int) -> np.ndarray:
-    """d/dtau on the real coefficients (1, cos tau, sin tau, ..., sin H tau)."""
-    D = np.zeros((2 * H + 1, 2 * H + 1))
-    for k in range(1, H + 1):
-        D[2 * k - 1, 2 * k] = k
-        D[2 * k, 2 * k - 1] = -k
-    return D
+__all__ = ["hill_exponents", "hill_stability", "hill_growth", "monodromy_multipliers"]
 
 
 def _centroids(V, n, H):
@@ -78,25 +71,24 @@ def _centroids(V, n, H):
     return num / np.where(den > 0, den, 1.0)
 
 
-_PARTS: dict = {}
-
-
 def _hill_parts(M, C, H):
-    """(I (x) M^-1, [I (x) M^-1 (I (x) C), I (x) M^-1 (2 nabla (x) M)], companion template, harmonic parity of each unknown), cached."""
-    key = (M.tobytes(), C.tobytes(), M.shape[0], H)
-    hit = _PARTS.get(key)
-    if hit is None:
-        nh = 2 * H + 1
-        D2i = np.kron(np.eye(nh), np.linalg.inv(M))
-        B1 = (np.ascontiguousarray(D2i @ np.kron(np.eye(nh), C)),
-              np.ascontiguousarray(D2i @ (2.0 * np.kron(derivative_matrix(H), M))))
-        N = M.shape[0] * nh
-        A0 = np.zeros((2 * N, 2 * N))
-        A0[:N, N:] = np.eye(N)
-        if len(_PARTS) > 64:
-            _PARTS.clear()
-        hit = _PARTS[key] = (D2i, B1, A0, _parity(M.shape[0], H))
-    return hit
+    """(I (x) M^-1, [I (x) M^-1 (I (x) C), I (x) M^-1 (2 nabla (x) M)], companion template,
+    harmonic parity of each unknown), built once per (M, C, H) and shared."""
+    return _hill_parts_of(M.tobytes(), C.tobytes(), M.shape[0], int(H))
+
+
+@by_value()
+def _hill_parts_of(Mb: bytes, Cb: bytes, n: int, H: int):
+    M = np.frombuffer(Mb).reshape(n, n)
+    C = np.frombuffer(Cb).reshape(n, n)
+    nh = 2 * H + 1
+    D2i = np.kron(np.eye(nh), np.linalg.inv(M))
+    B1 = (np.ascontiguousarray(D2i @ np.kron(np.eye(nh), C)),
+          np.ascontiguousarray(D2i @ (2.0 * np.kron(derivative_matrix(H), M))))
+    N = n * nh
+    A0 = np.zeros((2 * N, 2 * N))
+    A0[:N, N:] = np.eye(N)
+    return D2i, B1, A0, _parity(n, H)
 
 
 #: machine epsilon of float64
