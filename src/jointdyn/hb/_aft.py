@@ -71,25 +71,82 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
 
     Per contact c: ``U = Xm Bm[c]``, restart of the law at the mean
     displacement ``U[0]`` and the first load sample (``INIT_JVP``), AFT
-    march of ``STEP_JVP`` until the force repeats (:func:`_march`),
+    passes of ``STEP_JVP`` (:func:`_pass`) until the force repeats,
     projection, and scatter ``R += b F``, ``JX += b b^T dF/dU``,
     ``Jp += b dF/dp``. AFT directions: the 2H+1 coefficients of u
     (du_i = E[i, d]) and, when ``has_p``, the parameter entering the
     normal load (dN_i = dN[c, i]).
+
+    The march stops when two consecutive passes agree to ``rtol * max|T|``,
+    or when the committed state at the end of a pass equals (to ``rtol``,
+    entry by entry) the one at the end of the previous pass, so that the
+    next pass would repeat this one (period 1; saves a pass). If instead
+    passes p and p-2 agree (the law's state alternates between two cycles:
+    a period-2 force under a period-1 displacement), the force and its
+    derivatives are the mean of the last two passes, which is the exact
+    projection of the 2T-periodic force on the T-periodic harmonics
+    (:func:`_period_test`).
+
+    Structure, and what it costs to compile: the loops over contacts and
+    passes are written here and the helpers are inlined by Numba. Deeper
+    chains of inlined functions (a march function inlining the pass,
+    inlined into a per-contact function) measured about 50 % more cold
+    compile than the single function this replaces, because Numba's
+    inliner re-runs its front end on each level; with one level it is
+    about 15 %. Variants that compiled the march as a function of its own,
+    or wrote the pass out here around more inlined helpers, were
+    miscompiled by Numba 0.68 (out-of-bounds writes, wrong forces); this
+    structure agrees with the plain-Python reference of
+    ``tests/test_hb_aft.py`` for every law, also with bounds checking.
     """
     R, JX, Jp, T, code, info = out
     _linear_part(lin, R, JX, Jp)
     info[INFO_PASSES] = 0.0
     info[INFO_ERROR] = 0.0
     info[INFO_PERIOD] = PERIOD_ONE
-    nc = con[0].shape[0]
-    if nc > 0:
-        wk = _workspace(con, four, load[2], code)
-        for c in range(nc):
-            passes, err, period = _contact_force(STEP_JVP, INIT_JVP, c, lin[5], con, load, four, ctl,  # noqa: F821
-                                                 wk, T, code)
-            _scatter(c, con[0], wk[5], load[2], R, JX, Jp)
-            _update_info(info, passes, err, period)
+    Bm, Pm, _ = con
+    nc = Bm.shape[0]
+    if nc == 0:
+        _scale_outputs(R, JX, Jp, scaled)
+        return
+    Nsamp, dN, has_p = load
+    E, P = four
+    max_passes, rtol = ctl
+    sig, dirs, st, pw, hist, proj = _workspace(con, four, has_p, code)
+    U, u = sig
+    a, bb, da, dbb, s_end = st
+    for c in range(nc):
+        # the law restarted at the mean displacement, marched until its force repeats
+        _contact_samples(lin[5], Bm, c, E, U, u)
+        prm = Pm[c]
+        _restart(INIT_JVP, prm, U[0], Nsamp[c, 0], dN[c, 0] if has_p else 0.0, has_p, E.shape[1], dirs,  # noqa: F821
+                 (a, bb, da, dbb))
+        Tc, dT, T1, T2, dT1, cprev = pw
+        for i in range(u.shape[0]):
+            T1[i] = 0.0
+            T2[i] = 0.0
+        passes = 0
+        err = np.inf
+        period = PERIOD_NONE
+        while passes < max_passes:
+            err, err2, tmax, cur = _pass(STEP_JVP, prm, u, Nsamp[c], dN, c, has_p, E, dirs,  # noqa: F821
+                                         (a, bb, da, dbb), (Tc, dT, T1, T2, dT1, cprev), hist, code, passes, rtol)
+            if cur == 1:  # committed state back in (a, da), once per pass
+                a, bb = bb, a
+                da, dbb = dbb, da
+            passes += 1
+            done, period, err = _period_test(passes, err, err2, tmax, rtol, a, s_end, Tc, dT, T1, dT1)
+            if done:
+                break
+            # history of the last two passes (buffers swapped, not copied)
+            T1, T2 = T2, T1
+            for i in range(u.shape[0]):
+                T1[i] = Tc[i]
+                cprev[i] = code[c, i]
+            dT, dT1 = dT1, dT
+        _project(c, P, Tc, dT, T, proj)
+        _scatter(c, Bm, proj, has_p, R, JX, Jp)
+        _update_info(info, passes, err, period)
     _scale_outputs(R, JX, Jp, scaled)
 
 
@@ -131,7 +188,9 @@ def _workspace(con, four, has_p, code):  # pragma: no cover - compiled
     sig = (np.empty(nh), np.empty(ns))
     # directions of a sample: dx = E[i] (0 on the parameter), dN = dN[c, i] on the parameter
     dirs = (np.zeros(nd), np.zeros(nd), np.empty(nd), np.zeros(nd), np.zeros(nd))
-    st = (np.empty(ssz), np.empty(ssz), np.empty((ssz, nd)), np.empty((ssz, nd)), np.empty(ssz))
+    # zeros, not garbage: entries of a state that a law leaves unwritten in a step
+    # keep a defined value, so the end-of-pass comparison of states is deterministic
+    st = (np.zeros(ssz), np.zeros(ssz), np.zeros((ssz, nd)), np.zeros((ssz, nd)), np.zeros(ssz))
     pw = (np.empty(ns), np.empty((ns, nd)), np.empty(ns), np.empty(ns), np.empty((ns, nd)),
           np.empty(ns, dtype=code.dtype))
     nhist = ns if ssz <= _HIST_MAX_STATE else 0
@@ -174,72 +233,13 @@ def _restart(init_jvp, prm, U0, N0, dN0, has_p, nh, dirs, st):  # pragma: no cov
 
 
 @jit(inline="always")
-def _contact_force(step_jvp, init_jvp, c, X, con, load, four, ctl, wk, T, code):  # pragma: no cover - compiled
-    """AFT of contact c: samples, restart, march, projection into ``wk[5] = (F, G)``.
-
-    Returns ``(passes, err, period)`` of the march (see :func:`_march`).
-    """
-    Bm, Pm, _ = con
-    Nsamp, dN, has_p = load
-    E, P = four
-    sig, dirs, st, pw, hist, proj = wk
-    U, u = sig
-    nh = E.shape[1]
-    _contact_samples(X, Bm, c, E, U, u)
-    prm = Pm[c]
-    _restart(init_jvp, prm, U[0], Nsamp[c, 0], dN[c, 0] if has_p else 0.0, has_p, nh, dirs, st)
-    passes, err, period, Tc, dT = _march(step_jvp, prm, u, Nsamp[c], dN, c, has_p, E, dirs, st, pw, hist, code,
-                                         ctl[0], ctl[1])
+def _project(c, P, Tc, dT, T, proj):  # pragma: no cover - compiled
+    """T[c] = Tc; F = P Tc, G = P dT (force coefficients and their derivatives) into ``proj``."""
     for i in range(Tc.shape[0]):
         T[c, i] = Tc[i]
     F, G = proj
     F[:] = np.dot(P, Tc)
     G[:, :] = np.dot(P, dT)
-    return passes, err, period
-
-
-@jit(inline="always")
-def _march(step_jvp, prm, u, Nc, dN, c, has_p, E, dirs, st, pw, hist, code, max_passes, rtol):  # pragma: no cover
-    """March the law over whole periods of the samples until its force repeats.
-
-    The march stops when two consecutive passes agree to ``rtol * max|T|``,
-    or when the committed state at the end of a pass equals (to ``rtol``,
-    entry by entry) the one at the end of the previous pass, so that the
-    next pass would repeat this one (period 1; saves a pass). If instead
-    passes p and p-2 agree (the law's state alternates between two cycles:
-    a period-2 force under a period-1 displacement), the force and its
-    derivatives are the mean of the last two passes, which is the exact
-    projection of the 2T-periodic force on the T-periodic harmonics
-    (:func:`_period_test`). Returns ``(passes, err, period, Tc, dT)``:
-    ``err`` the last change between passes (0 when the end states
-    repeated), ``period`` one of ``PERIOD_*``, ``Tc`` and ``dT`` the force
-    samples and derivatives of the result.
-    """
-    a, bb, da, dbb, s_end = st
-    Tc, dT, T1, T2, dT1, cprev = pw
-    for i in range(u.shape[0]):
-        T1[i] = 0.0
-        T2[i] = 0.0
-    passes = 0
-    err = np.inf
-    period = PERIOD_NONE
-    while passes < max_passes:
-        err, err2, tmax, cur = _pass(step_jvp, prm, u, Nc, dN, c, has_p, E, dirs, (a, bb, da, dbb),
-                                     (Tc, dT, T1, T2, dT1, cprev), hist, code, passes, rtol)
-        if cur == 1:  # committed state back in (a, da), once per pass
-            a, bb = bb, a
-            da, dbb = dbb, da
-        passes += 1
-        done, period, err = _period_test(passes, err, err2, tmax, rtol, a, s_end, Tc, dT, T1, dT1)
-        if done:
-            break
-        # history of the last two passes (buffers swapped, not copied)
-        T1, T2 = T2, T1
-        for i in range(u.shape[0]):
-            T1[i] = Tc[i]
-            cprev[i] = code[c, i]
-        dT, dT1 = dT1, dT
-    return passes, err, period, Tc, dT
 
 
 @jit(inline="always")
@@ -317,7 +317,7 @@ def _copy_rest(i, Tc, dT, T1, T2, dT1, cprev, code, c, err2, tmax):  # pragma: n
 
 @jit(inline="always")
 def _period_test(passes, err, err2, tmax, rtol, a, s_end, Tc, dT, T1, dT1):  # pragma: no cover - compiled
-    """Periodicity tests after a pass: ``(done, period, err)`` (see :func:`_march`).
+    """Periodicity tests after a pass: ``(done, period, err)`` (see :func:`_eval_template`).
 
     Updates the end-of-pass state ``s_end``; for a period-2 force, ``Tc``
     and ``dT`` become the mean of the last two passes.
