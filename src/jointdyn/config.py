@@ -190,8 +190,10 @@ CONT_MAX_JUMPS = 5
 CONT_JUMP_TANGENT_MIN = 1e-3
 #: bordered linear systems (Newton corrections, tangents) of at most this
 #: many unknowns are solved by the compiled elimination of
-#: jointdyn.continuation, larger ones by LAPACK (benchmarks/bench_linalg.py)
-CONT_SMALL_SOLVE = 64
+#: jointdyn.continuation, larger ones by LAPACK (benchmarks/bench_linalg.py:
+#: the compiled elimination is 1.2-3.5x faster at 16 to 751 unknowns with
+#: single-threaded BLAS; beyond the sizes measured, LAPACK)
+CONT_SMALL_SOLVE = 800
 
 # --- harmonic balance: starts and single solutions -------------------------------------
 #: Newton iterations of the start of a branch (from the stuck linear solution)
@@ -218,5 +220,10 @@ HB_SATURATION_Q = 30.0
 HB_SATURATION_SLIP_FRACTION = 0.9
 #: a Floquet exponent with Re(s) > HB_STABILITY_RTOL * w marks instability
 HB_STABILITY_RTOL = 1e-6
+#: Hill companion matrices (2 n (2H+1) rows), or their parity blocks, of at
+#: most this many rows go through the compiled EISPACK eigenvalue solver,
+#: larger ones through LAPACK (benchmarks/bench_linalg.py: the compiled
+#: solver is 1.3-3.7x faster up to 150 rows, LAPACK 1.1-1.3x faster from 300)
+HB_SMALL_EIG = 200
 #: turning points of a branch (secant): dead band as a fraction of the range
 HB_TURNING_BAND = 5e-4
