@@ -50,7 +50,7 @@ from ._jit import jit
 from .status import Status
 
 __all__ = ["ContinuationOptions", "ContinuationStatus", "ContinuationResult", "continuation", "newton",
-           "turning_points"]
+           "turning_points", "make_options"]
 
 
 class ContinuationStatus(Status):
@@ -457,13 +457,14 @@ def newton(residual, y, lam, options: ContinuationOptions | None = None, *, coun
     ``options.max_iter`` iterations (keyword arguments override fields of
     ``options``, e.g. ``tol=1e-10``). Returns ``(y, ok, iterations)``.
     """
-    opt = _options(options, overrides)
+    opt = make_options(options, overrides)
     cnt = counter if counter is not None else {"residual_evaluations": 0}
     y, ok, it, _ = _solve_damped(residual, np.asarray(y, dtype=float), lam, None, None, opt, cnt)
     return y, ok, it
 
 
-def _options(options, overrides) -> ContinuationOptions:
+def make_options(options: ContinuationOptions | None = None, overrides: dict | None = None) -> ContinuationOptions:
+    """``options`` (default: :class:`ContinuationOptions`) with the fields in ``overrides`` replaced."""
     opt = ContinuationOptions() if options is None else options
     if not isinstance(opt, ContinuationOptions):
         raise ValueError("options must be a ContinuationOptions")
@@ -673,7 +674,7 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
     -------
     ContinuationResult
     """
-    opt = _options(options, overrides)
+    opt = make_options(options, overrides)
     lam0 = V.finite("lam0", lam0)
     lam_stop = V.finite("lam_stop", lam_stop)
     if lam_stop == lam0:

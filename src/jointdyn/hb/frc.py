@@ -43,9 +43,15 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ..continuation import ContinuationOptions, ContinuationResult, ContinuationStatus, continuation, newton
-from ..continuation import _options as _continuation_options
-from ..continuation import turning_points
+from ..continuation import (
+    ContinuationOptions,
+    ContinuationResult,
+    ContinuationStatus,
+    continuation,
+    make_options,
+    newton,
+    turning_points,
+)
 from ..fourier import derivative_matrix
 from ..laws import MACROSLIP, SEPARATION
 from ..systems import System
@@ -320,7 +326,7 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
     if start == stop:
         raise ValueError(f"{par.name} range must not be empty (start == stop == {start!r})")
     par.check_range(start, stop)
-    opt = _continuation_options(options, overrides)
+    opt = make_options(options, overrides)
     V.positive_int("max_points", opt.max_points, 2)
     problem = HBProblem(system, harmonics=harmonics, samples=samples, parameter=par, gamma=gamma)
     tr = _Tracker(problem, _scales(problem, start))
