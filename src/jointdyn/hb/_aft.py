@@ -324,9 +324,18 @@ def _period_test(passes, err, err2, tmax, rtol, a, s_end, Tc, dT, T1, dT1):  # p
     """
     if passes >= 2 and err <= rtol * tmax:
         return True, PERIOD_ONE, err
-    if passes >= 2 and _same_end(a, s_end, rtol):
-        # the next pass would repeat this one exactly: this pass is the periodic force already
-        return True, PERIOD_ONE, 0.0
+    if passes >= 2:
+        # the committed state at the end of this pass equals the one at the end of the
+        # previous pass (entry by entry, to rtol): the next pass would repeat this one
+        # exactly, so this pass is the periodic force already
+        same = True
+        for r in range(a.shape[0]):
+            m = max(abs(a[r]), abs(s_end[r]))
+            if abs(a[r] - s_end[r]) > rtol * m:
+                same = False
+                break
+        if same:
+            return True, PERIOD_ONE, 0.0
     for r in range(a.shape[0]):
         s_end[r] = a[r]
     if passes >= 4 and err2 <= rtol * tmax:
@@ -336,16 +345,6 @@ def _period_test(passes, err, err2, tmax, rtol, a, s_end, Tc, dT, T1, dT1):  # p
                 dT[i, d] = 0.5 * (dT[i, d] + dT1[i, d])
         return True, PERIOD_TWO, err
     return False, PERIOD_NONE, err
-
-
-@jit(inline="always")
-def _same_end(a, s_end, rtol):  # pragma: no cover - compiled
-    """True unless an entry of ``a`` differs from ``s_end`` by more than ``rtol`` relative."""
-    for r in range(a.shape[0]):
-        m = max(abs(a[r]), abs(s_end[r]))
-        if abs(a[r] - s_end[r]) > rtol * m:
-            return False
-    return True
 
 
 @jit(inline="always")
