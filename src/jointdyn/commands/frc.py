@@ -265,16 +265,11 @@ def _run_time(args, gammas):
 
 
 def _hb_branches(ds) -> list:
-    """Split an hb Dataset (dim ``point``) into branches (by a ``branch``
-    variable if present, else one)."""
-    if "branch" in ds.variables:
-        ids = np.asarray(ds["branch"].values)
-        groups = [np.flatnonzero(ids == b) for b in dict.fromkeys(ids.tolist())]
-    else:
-        groups = [np.arange(ds.sizes["point"])]
+    """Split an hb Dataset (dim ``point``) into its branches (variable ``branch``: segment index)."""
+    ids = np.asarray(ds["branch"].values)
     out = []
-    for idx in groups:
-        sub = ds.isel(point=idx)
+    for b in dict.fromkeys(ids.tolist()):
+        sub = ds.isel(point=np.flatnonzero(ids == b))
         br = {v: _jsonable(sub[v].values) for v in ("gamma", "amplitude_q", "amplitude_m", "offset_m", "max_abs_m")}
         br["stable"] = [bool(s) for s in np.asarray(sub["stable"].values)]
         br["folds"] = [int(i) for i in np.flatnonzero(np.asarray(sub["fold"].values, bool))]
@@ -283,13 +278,7 @@ def _hb_branches(ds) -> list:
 
 
 def _run_hb(args, gammas):
-    try:
-        from ..hb import frc_hb
-    except ImportError as exc:
-        raise ValueError(
-            "--method hb needs the harmonic-balance module jointdyn.hb, which is not available in this "
-            f"installation ({exc}); use --method time"
-        ) from None
+    from ..hb import frc_hb
     from ..systems import System
 
     system = System.paper_damper(
