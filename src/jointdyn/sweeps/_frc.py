@@ -1,4 +1,4 @@
-"""Frequency-response sweeps of the paper's friction damper (MODEL.md section 6).
+"""Frequency-response sweeps of the paper's friction damper (docs/model.md section 6).
 
 The damper ``m x'' + c x' + k x = F1 sin(w t) - T(x, N(t))`` with
 ``N = N0 (1 + eta sin(w t + delta))`` is swept in excitation frequency
@@ -374,7 +374,7 @@ def frc_sweep(
 ):
     """Steady-state frequency response of the paper's damper on a parameter grid.
 
-    Solves MODEL.md section 6, ``m x'' + c x' + k x = F1 sin(w t) - T(x, N(t))``,
+    Solves docs/model.md section 6, ``m x'' + c x' + k x = F1 sin(w t) - T(x, N(t))``,
     ``N = N0 (1 + eta sin(w t + delta))``, for every combination of the groups
     and ``gamma = w / sqrt(k/m)``, sweeping gamma up and/or down with warm
     starts (see the module docstring).
@@ -555,7 +555,7 @@ def _assemble(arrays, etas, load_name, loads, deltas, directions, g, model, law_
     else:
         coords["beta"] = ("f1", fy / np.asarray(loads, float), {"long_name": "mu N0 / F1"})
     attrs = {
-        "title": "steady-state frequency response of the friction damper (MODEL.md section 6)",
+        "title": "steady-state frequency response of the friction damper (docs/model.md section 6)",
         "model": model,
         **{f"law_param_{key}": val for key, val in law_params},
         "zeta": float(zeta),
