@@ -143,7 +143,8 @@ def backbone_dataset(backbone: Backbone):
     ``mode_shape_m`` (point, coefficient, dof): the harmonic coefficients
     (0, cos 1, sin 1, ..., cos H, sin H); ``harmonic_amplitude_m`` (point,
     harmonic, dof). Attributes: ``method``, ``status``, ``message``,
-    ``mode``, ``output_dof``, ``harmonics``, ``samples``,
+    ``linear_mode`` (the linear stuck mode it starts from; the name
+    ``mode`` is taken by netCDF files), ``output_dof``, ``harmonics``, ``samples``,
     ``omega_linear_rad_s``, ``w0_rad_s``, ``model`` and ``law`` (class
     name and parameters of the first contact's law), ``points`` and the solver counters (``counter_*``).
     """
@@ -179,7 +180,7 @@ def backbone_dataset(backbone: Backbone):
     coords = {"point": np.arange(b.points), "contact": np.arange(len(s.contacts)),
               "coefficient": np.arange(2 * H + 1), "harmonic": np.arange(H + 1), "dof": np.arange(n)}
     ds = xr.Dataset(variables, coords=coords)
-    ds.attrs.update(method=b.method, status=b.status.value, message=b.message, mode=b.linear.index,
+    ds.attrs.update(method=b.method, status=b.status.value, message=b.message, linear_mode=b.linear.index,
                     output_dof=b.output_dof, harmonics=H, samples=b.samples,
                     omega_linear_rad_s=b.linear.omega_rad_s, w0_rad_s=s.w0, model=law.name, law=repr(law),
                     points=b.points,
