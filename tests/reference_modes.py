@@ -47,7 +47,8 @@ def first_harmonic(tb, kinks, a: float):
     """(T1c, T1s) of the steady loop of amplitude a, by quadrature with the kinks as break points."""
     # the argument (a - x)/2 = a (1 - cos theta) / 2 reaches a kink x_k at cos theta = 1 - 2 x_k / a
     pts = [math.acos(1.0 - 2.0 * xk / a) for xk in kinks if 2.0 * xk / a < 2.0]
-    opts = dict(points=pts or None, limit=200, epsabs=0.0, epsrel=1e-13)
+    # absolute floor at rounding of the force scale (a stuck Jenkins loop has T1s = 0)
+    opts = dict(points=pts or None, limit=200, epsabs=1e-13 * abs(tb(a)), epsrel=1e-13)
     c = quad(lambda t: loop_force(tb, a, t) * math.cos(t), 0.0, math.pi, **opts)[0]
     s = quad(lambda t: loop_force(tb, a, t) * math.sin(t), 0.0, math.pi, **opts)[0]
     return 2.0 * c / math.pi, 2.0 * s / math.pi

@@ -52,6 +52,7 @@ import math
 
 import numpy as np
 
+from .. import _validate as V
 from .. import config
 from ..continuation import ContinuationOptions, ContinuationStatus, continuation, make_options, newton
 from ..fourier import derivative_matrix
@@ -117,6 +118,8 @@ class EPMCProblem:
         self.system = system
         self.output_dof = output_dof_of(system, output_dof)
         n = system.ndof
+        H = V.positive_int("harmonics", harmonics, 1)
+        V.positive_int("samples", samples, 2 * H + 2)
         free = dataclasses.replace(system, force=np.zeros(n), force_phase_deg=np.zeros(n))
         try:
             self.hb = HBProblem(free, harmonics=harmonics, samples=samples, max_passes=max_passes)
