@@ -284,6 +284,11 @@ MODES_MIN_EIGENVALUE_RATIO = 1e-12
 #: starts at zero displacement)
 QSMA_STEPS_PER_DECADE = 40
 QSMA_DECADES_BELOW = 3
+#: push steps per backbone point: the work integrals use every step (their
+#: error at a kink of a law, e.g. the onset of slip of a Jenkins element,
+#: falls as the square of the step), the backbone reports every
+#: QSMA_SUBSTEPS-th
+QSMA_SUBSTEPS = 4
 #: QSMA equilibrium: Newton converged when max |residual| <= this times the
 #: largest elastic or applied force; iterations per step
 QSMA_TOL = 1e-12

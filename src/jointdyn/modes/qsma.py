@@ -228,8 +228,8 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         DOF whose displacement is prescribed and reported (default: the
         system's response DOF).
     steps_per_decade : int
-        Push steps per decade of amplitude (every one is a backbone point
-        inside the range).
+        Backbone points per decade of amplitude; the push takes
+        ``config.QSMA_SUBSTEPS`` steps per point.
 
     Returns
     -------
@@ -245,13 +245,14 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     out_dof = output_dof_of(system, output_dof)
     spd = V.positive_int("steps_per_decade", steps_per_decade, 1)
     linear = linear_stuck_mode(system, mode, out_dof)
-    grid, first = push_grid(lo, hi, spd)
+    sub = config.QSMA_SUBSTEPS
+    grid, first = push_grid(lo, hi, spd * sub)
     reached, xs, als, Ts, kTs, Bm = _push(system, grid, out_dof, linear)
     u = xs @ Bm.T
     W = _hermite_work(u[:reached + 1], Ts[:reached + 1], kTs[:reached + 1])
-    sel = slice(first + 1, reached + 1)  # rows of the requested range (row 0 is the origin)
+    sel = slice(first + 1, reached + 1, sub)  # backbone rows in the requested range (row 0 is the origin)
     x, alpha, U, T = xs[sel], als[sel], u[sel], Ts[sel]
-    E = 8.0 * W[first + 1:] - 4.0 * U * T
+    E = 8.0 * W[sel] - 4.0 * U * T
     phi = linear.mass_normalised
     M, C = system.M, system.C
     q = x @ (M @ phi)
@@ -263,7 +264,7 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     X = np.zeros((x.shape[0], 3 * system.ndof))
     X[:, system.ndof:2 * system.ndof] = x
     ok = reached == grid.size
-    status = ModeStatus.COMPLETE if ok else (ModeStatus.FAILED if reached > first + 1 else ModeStatus.NO_START)
+    status = ModeStatus.COMPLETE if ok else (ModeStatus.FAILED if x.shape[0] else ModeStatus.NO_START)
     message = ("pushed to the largest amplitude" if ok else
                f"the static equilibrium did not converge at {grid[reached]:.6g} m (Newton, "
                f"{config.QSMA_MAX_ITER} iterations)")
