@@ -107,3 +107,16 @@ def test_refuses_what_it_cannot_do():
         qsma(jd.System.paper_damper(eta=0.5))
     with pytest.raises(ValueError, match="steps_per_decade must be an integer >= 1"):
         qsma(jd.System.paper_damper(eta=0.0), steps_per_decade=0)
+
+
+@pytest.mark.parametrize("lo, hi", [(0.5, 1.0), (0.3, 1.7), (1e-2, 1e2), (0.999, 1.0)])
+def test_backbone_spans_the_requested_range_exactly(lo, hi):
+    """First point at min, last at max (any ratio, not only whole decades), geometric in between with at
+    least steps_per_decade points per decade."""
+    b = qsma(jd.System.paper_damper(eta=0.0), (lo * XS, hi * XS))
+    assert b.status.ok
+    assert b.amplitude_m[0] == pytest.approx(lo * XS, rel=1e-12)
+    assert b.amplitude_m[-1] == pytest.approx(hi * XS, rel=1e-12)
+    step = np.diff(np.log10(b.amplitude_m))
+    np.testing.assert_allclose(step, step[0], rtol=1e-6)
+    assert step[0] <= 1.0 / jd.config.QSMA_STEPS_PER_DECADE * (1 + 1e-9)

@@ -38,6 +38,7 @@ import numpy as np
 
 from .. import config
 from .._jit import jit, specialize
+from ..continuation import _lu_solve
 from ..kinematics import contact_kinematics, selection_matrix
 from ._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
 from .backbone import Backbone, ModeStatus
@@ -68,12 +69,13 @@ def _push_template(grid, lin, con, ctl, out):  # pragma: no cover - compiled
     nc = Bm.shape[0]
     s_old = np.zeros((nc, ssz))
     s_new = np.zeros((nc, ssz))
+    jvp = (np.zeros((ssz, 0)), np.zeros((ssz, 0)), np.zeros(0))  # no derivative directions
     x = np.zeros(n)
     A = np.empty((n + 1, n + 1))
     r = np.empty(n + 1)
     for c in range(nc):
         INIT(Pm[c], 0.0, Nc[c], s_old[c])  # noqa: F821
-    _contact_forces(STEP, Pm, Bm, Nc, s_old, s_new, x, Ts[0], kTs[0])  # noqa: F821
+    _contact_forces(STEP_JVP, Pm, Bm, Nc, s_old, s_new, jvp, x, Ts[0], kTs[0])  # noqa: F821
     als[0] = 0.0
     alpha = 0.0
     a_prev = 0.0
@@ -83,14 +85,15 @@ def _push_template(grid, lin, con, ctl, out):  # pragma: no cover - compiled
         alpha = alpha * (a / a_prev) if a_prev > 0.0 else 0.0
         ok = False
         for _ in range(max_iter):
-            _contact_forces(STEP, Pm, Bm, Nc, s_old, s_new, x, Ts[i + 1], kTs[i + 1])  # noqa: F821
+            _contact_forces(STEP_JVP, Pm, Bm, Nc, s_old, s_new, jvp, x, Ts[i + 1], kTs[i + 1])  # noqa: F821
             if _assemble(K, f, j, Bm, Ts[i + 1], kTs[i + 1], x, alpha, a, A, r) <= tol:
                 ok = True
                 break
-            dx = np.linalg.solve(A, r)
+            if not _lu_solve(A, r):
+                return i
             for k in range(n):
-                x[k] -= dx[k]
-            alpha -= dx[n]
+                x[k] -= r[k]
+            alpha -= r[n]
         if not ok:
             return i
         for c in range(nc):
@@ -114,13 +117,20 @@ def _predict(x, a, a_prev, j):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _contact_forces(step, Pm, Bm, Nc, s_old, s_new, x, T, kT):  # pragma: no cover - compiled
-    """Force T[c] (N) and tangent kT[c] (N/m) of every contact at displacements x, from the committed states."""
+def _contact_forces(step_jvp, Pm, Bm, Nc, s_old, s_new, jvp, x, T, kT):  # pragma: no cover - compiled
+    """Force T[c] (N) and tangent kT[c] (N/m) of every contact at displacements x, from the committed states.
+
+    The law's ``step_jvp`` with no derivative direction: its primal outputs
+    are those of ``step`` bit for bit (law contract), and it is the kernel
+    harmonic balance has compiled already (``step`` is inlined into its
+    callers, which costs a compile of the whole law per template).
+    """
+    ds, dd, d1 = jvp
     for c in range(Bm.shape[0]):
         u = 0.0
         for k in range(x.shape[0]):
             u += Bm[c, k] * x[k]
-        t_, k_, _ = step(Pm[c], s_old[c], s_new[c], u, Nc[c])
+        t_, k_, _ = step_jvp(Pm[c], s_old[c], ds, s_new[c], dd, u, d1, Nc[c], d1, d1)
         T[c] = t_
         kT[c] = k_
 
@@ -162,15 +172,17 @@ def _assemble(K, f, j, Bm, T, kT, x, alpha, a, A, r):  # pragma: no cover - comp
 
 
 def push_grid(lo: float, hi: float, steps_per_decade: int = config.QSMA_STEPS_PER_DECADE,
-              decades_below: int = config.QSMA_DECADES_BELOW):
+              decades_below: int = config.QSMA_DECADES_BELOW, substeps: int = 1):
     """(grid, first): the push's displacements (m) and the index of ``lo`` in it.
 
-    Geometric with ``steps_per_decade`` steps per decade, from ``lo``
-    ``decades_below`` decades down to ``hi``; ``lo`` and ``hi`` are grid
-    points.
+    Geometric, from ``lo`` ``decades_below`` decades down to ``hi``, with
+    ``substeps`` steps per backbone point and at least ``steps_per_decade``
+    backbone points per decade. ``lo`` and ``hi`` are grid points, and from
+    ``lo`` on every ``substeps``-th point is a backbone point, ``hi``
+    included.
     """
-    below = np.geomspace(lo * 10.0 ** (-decades_below), lo, decades_below * steps_per_decade + 1)[:-1]
-    m = max(int(math.ceil(math.log10(hi / lo) * steps_per_decade)), 1)
+    below = np.geomspace(lo * 10.0 ** (-decades_below), lo, decades_below * steps_per_decade * substeps + 1)[:-1]
+    m = substeps * max(int(math.ceil(math.log10(hi / lo) * steps_per_decade)), 1)
     return np.concatenate((below, np.geomspace(lo, hi, m + 1))), below.size
 
 
@@ -203,7 +215,7 @@ def _push(system, grid, out_dof, linear):
     kTs = np.zeros((p + 1, nc))
     K = np.ascontiguousarray(system.K_reference)
     f = np.ascontiguousarray(system.M @ linear.mass_normalised)
-    kernel = specialize(_push_template, STEP=laws[0].step, INIT=laws[0].init)
+    kernel = specialize(_push_template, STEP_JVP=laws[0].step_jvp, INIT=laws[0].init)
     reached = kernel(grid, (K, f, int(out_dof)), (Bm, Pm, Nc, int(ssz)),
                      (float(config.QSMA_TOL), int(config.QSMA_MAX_ITER)), (xs, als, Ts, kTs))
     return int(reached), xs, als, Ts, kTs, Bm
@@ -246,7 +258,7 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     spd = V.positive_int("steps_per_decade", steps_per_decade, 1)
     linear = linear_stuck_mode(system, mode, out_dof)
     sub = config.QSMA_SUBSTEPS
-    grid, first = push_grid(lo, hi, spd * sub)
+    grid, first = push_grid(lo, hi, spd, substeps=sub)
     reached, xs, als, Ts, kTs, Bm = _push(system, grid, out_dof, linear)
     u = xs @ Bm.T
     W = _hermite_work(u[:reached + 1], Ts[:reached + 1], kTs[:reached + 1])
