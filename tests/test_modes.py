@@ -261,3 +261,29 @@ def test_output_dof_that_does_not_move_is_refused():
     s = jd.System(M, None, K, contacts=(jd.Contact(law, dof=0),))
     with pytest.raises(ValueError, match="output_dof: DOF 1 does not move in linear stuck mode 1"):
         epmc(s, mode=1, output_dof=1, progress=False)
+
+
+@pytest.mark.parametrize("model", ["jenkins", "iwan"])
+def test_a_contact_split_in_two_halves_gives_the_same_mode_and_half_the_energy_each(model):
+    """Two contacts with kt/2 and N0/2 on the same DOF are one contact with kt and N0 (same slip
+    displacement, half the force each): same backbone, and each dissipates half the energy per cycle."""
+    def system(n):
+        law = jd.make_law(model, kt=KT / n, mu=0.5, n_ref=100.0 / n)
+        return jd.System(np.array([[M_]]), None, np.array([[K_]]), contacts=(jd.Contact(law),) * n)
+
+    from jointdyn.modes import qsma
+
+    one, two = (epmc(system(n), (0.1 * XS, 10 * XS), harmonics=3, progress=False) for n in (1, 2))
+    assert one.status.ok and two.status.ok and two.energy_contact_j.shape == (two.points, 2)
+    for q in (0.5, 1.5, 5.0):
+        w1, xi1, X1 = _at(one, q * XS)
+        w2, xi2, X2 = _at(two, q * XS)
+        assert w2 == pytest.approx(w1, rel=1e-10) and xi2 == pytest.approx(xi1, rel=1e-8, abs=1e-12)
+        E1 = one.problem.energies(X1, w1, one.problem.evaluate(X1, w1))[2]
+        E2 = two.problem.energies(X2, w2, two.problem.evaluate(X2, w2))[2]
+        np.testing.assert_allclose(E2, [0.5 * E1[0]] * 2, rtol=1e-8, atol=1e-14 * KT * XS * XS)
+    np.testing.assert_allclose(two.energy_contact_j[:, 0], two.energy_contact_j[:, 1], rtol=1e-12)
+    q1, q2 = qsma(system(1), (0.1 * XS, 10 * XS)), qsma(system(2), (0.1 * XS, 10 * XS))
+    np.testing.assert_allclose(q2.omega_rad_s, q1.omega_rad_s, rtol=1e-12)
+    np.testing.assert_allclose(q2.energy_contact_j, 0.5 * q1.energy_contact_j.repeat(2, axis=1), rtol=1e-9,
+                               atol=1e-15 * KT * XS * XS)
