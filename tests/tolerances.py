@@ -79,3 +79,30 @@ TEST_EXACT_ENERGY_RTOL = 1e-5
 #: rounding floor of a period's contact dissipation (units of fy x_slip, the
 #: contact's energy scale): added to the point's energy-balance residual
 TEST_DISSIPATION_FLOOR = 1e-12
+
+# --- nonlinear modes (jointdyn.modes) --------------------------------------------
+#: one-harmonic EPMC vs the describing function of the exact loop (relative;
+#: the AFT's trapezoidal projection of the kinked force converges as
+#: 1/samples^2: measured 4e-7 for Jenkins at 4096 samples, 7e-10 for Iwan)
+TEST_MODES_DF_RTOL = 1e-6
+#: damping ratio from xi vs the contact (and viscous) dissipation per cycle
+#: (relative; measured below 1e-9 with the modes' Newton tolerance)
+TEST_MODES_ENERGY_RTOL = 1e-8
+#: tiny amplitude (1e-7 fy/kt) vs the linear stuck mode, relative
+TEST_MODES_LINEAR_RTOL = 1e-6
+#: several harmonics vs one harmonic where the loop is mildly nonlinear (relative)
+TEST_MODES_ONE_HARMONIC_RTOL = 1e-2
+#: H = 7 vs H = 9 (converged in H; relative, measured in docs/modes.md)
+TEST_MODES_H_CONVERGED_RTOL = 2e-3
+#: single-mode synthesis vs full harmonic balance: peak amplitude and frequency (relative)
+TEST_MODES_SYNTHESIS_RTOL = 2e-2
+#: EPMC vs tmdsimpy's EPMC on the Jenkins damper at the default discretisation:
+#: frequency and damping ratio (relative; the issue's thresholds)
+TEST_MODES_TMDSIMPY_OMEGA_RTOL = 1e-3
+TEST_MODES_TMDSIMPY_DAMPING_RTOL = 1e-2
+#: ... and with tmdsimpy's own discretisation (H = 7, 4096 samples): the same
+#: discrete equations, equal to rounding (measured 1e-12)
+TEST_MODES_TMDSIMPY_SAME_RTOL = 1e-9
+#: QSMA of the uniform Iwan contact vs the closed-form Masing secant and loop
+#: area (the Hermite-corrected work integral is exact for the quadratic backbone)
+TEST_QSMA_MASING_RTOL = 1e-9

@@ -255,3 +255,44 @@ HB_STABILITY_RTOL = 1e-6
 HB_SMALL_EIG = 200
 #: turning points of a branch (secant): dead band as a fraction of the range
 HB_TURNING_BAND = 5e-4
+
+# --- nonlinear modes (jointdyn.modes) ------------------------------------------------
+#: default amplitude range of a backbone (first-harmonic amplitude of the
+#: output DOF), in units of fy / kt of the first contact: from deep in the
+#: stuck regime to well into macroslip (four decades)
+MODES_AMPLITUDE_Q = (1e-2, 1e2)
+#: EPMC continuation in log10 of the amplitude (unknowns scaled by the
+#: amplitude, frequency and self-excitation by the linear frequency, residual
+#: by the stiffness times the amplitude): first and largest arc-length step
+#: (the largest bounds the spacing to 1/16 decade: at least 16 points per decade)
+MODES_DS_START = 0.02
+MODES_DS_MAX = 0.0625
+#: Newton tolerance of an EPMC point on that scaled residual; tight because
+#: the energy balance of a point (self-excitation against dissipation) holds
+#: to the residual relative to the damping ratio, which is small at small
+#: amplitudes
+MODES_TOL = 1e-12
+#: Newton iterations of the first EPMC point (from the linear stuck mode)
+MODES_START_MAX_ITER = 30
+#: a DOF moves in a linear mode when |phi_dof| exceeds this fraction of max |phi|
+MODES_MIN_PARTICIPATION = 1e-8
+#: K (tangential contacts free) is positive definite for nonlinear modes when
+#: its smallest eigenvalue of (M, K) exceeds this fraction of the largest
+MODES_MIN_EIGENVALUE_RATIO = 1e-12
+#: QSMA static push: steps per decade of the output-DOF displacement, and
+#: decades pushed below the smallest requested amplitude (the work integral
+#: starts at zero displacement)
+QSMA_STEPS_PER_DECADE = 40
+QSMA_DECADES_BELOW = 3
+#: push steps per backbone point: the work integrals use every step (their
+#: error at a kink of a law, e.g. the onset of slip of a Jenkins element,
+#: falls as the square of the step), the backbone reports every
+#: QSMA_SUBSTEPS-th
+QSMA_SUBSTEPS = 4
+#: QSMA equilibrium: Newton converged when max |residual| <= this times the
+#: largest elastic or applied force; iterations per step
+QSMA_TOL = 1e-12
+QSMA_MAX_ITER = 50
+#: single-nonlinear-mode synthesis: the resonance peak is located on the
+#: backbone to this relative tolerance in amplitude
+SYNTHESIS_PEAK_RTOL = 1e-10

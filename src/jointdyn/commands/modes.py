@@ -1,0 +1,262 @@
+"""``jointdyn modes``: backbone of a nonlinear mode (frequency and damping ratio against amplitude).
+
+The system is the paper's friction damper at its constant normal load
+(``--model``, ``--law-param``) or a TOML system file (``--system``; its
+forcing is not used, its normal loads must be autonomous). ``--method
+epmc`` (default) follows the extended periodic motion concept by harmonic
+balance (:func:`jointdyn.modes.epmc`, ``--harmonics``, ``--samples``,
+``--max-points``); ``--method qsma`` is the quasi-static estimate
+(:func:`jointdyn.modes.qsma`). The amplitude is the first-harmonic
+amplitude of the output DOF in metres (``--amplitude MIN:MAX``, stepped
+logarithmically).
+
+Everything is validated before computing; ``--out`` files (``modes.nc``,
+``modes.csv``, ``modes.png``) are written atomically after computing.
+
+Exit status: 0 for a complete backbone; 2 for bad input (one line, no
+file); :data:`EXIT_PARTIAL` (3) when the backbone stops short (status
+``failed``, ``max-points`` or ``no-start``): the files are still written
+and carry the status, and ``--json`` prints it.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .. import _validate as V
+from .. import config
+from ._law_args import add_law_arguments, law_params, model_help
+
+NAME = "modes"
+HELP = "backbone of a nonlinear mode (natural frequency and damping ratio against amplitude) by EPMC or QSMA"
+#: exit status of a backbone that stops short of the amplitude range (files are still written)
+EXIT_PARTIAL = 3
+#: options of the EPMC only
+_EPMC_ONLY = ("harmonics", "samples", "max_points")
+
+
+def add_arguments(p) -> None:
+    q0, q1 = config.MODES_AMPLITUDE_Q
+    p.add_argument("--system", default=None, metavar="FILE.toml",
+                   help="system file (structure, contacts, normal loads; its forcing is not used) instead of the "
+                        "paper's damper at constant normal load")
+    p.add_argument("--method", default="epmc", help="epmc (extended periodic motion concept, default) or qsma "
+                                                    "(quasi-static modal analysis, the fast estimate)")
+    p.add_argument("--model", default=None, help=model_help(config.MODEL) + "; not with --system (its file names "
+                                                                           "its laws)")
+    add_law_arguments(p)
+    p.add_argument("--amplitude", default=None, metavar="MIN:MAX",
+                   help="range of the first-harmonic amplitude of the output DOF, m (default "
+                        f"{q0:g}:{q1:g} times fy/kt of the first contact)")
+    p.add_argument("--mode", type=int, default=1, help="linear stuck mode to start from, 1-based (default 1)")
+    p.add_argument("--output-dof", type=int, default=None,
+                   help="DOF whose amplitude is the modal amplitude (default: the system's output DOF)")
+    p.add_argument("--harmonics", type=int, default=None, help=f"epmc: harmonics (default {config.HB_HARMONICS})")
+    p.add_argument("--samples", type=int, default=None,
+                   help=f"epmc: AFT time samples per period (default {config.HB_SAMPLES})")
+    p.add_argument("--max-points", type=int, default=None,
+                   help=f"epmc: bound on the points of the backbone (default {config.CONT_MAX_POINTS})")
+    p.add_argument("--out", default=None, metavar="DIR", help="write modes.nc, modes.csv, modes.png here")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
+
+
+def parse_amplitude(text: str) -> tuple[float, float]:
+    """``MIN:MAX`` (m) -> (min, max) with 0 < min < max."""
+    parts = str(text).split(":")
+    if len(parts) != 2:
+        raise ValueError(f"--amplitude must be MIN:MAX (metres), got {text!r}")
+    try:
+        lo, hi = (float(s) for s in parts)
+    except ValueError:
+        raise ValueError(f"--amplitude must be MIN:MAX of numbers (metres), got {text!r}") from None
+    V.positive("--amplitude MIN", lo)
+    V.positive("--amplitude MAX", hi)
+    if not hi > lo:
+        raise ValueError(f"--amplitude MAX must be > MIN ({lo:g} m), got {hi:g} m")
+    return lo, hi
+
+
+def read_system_file(path):
+    """The System of a TOML system file: ``jointdyn.read_system`` where the package has it, else a
+    minimal reader of the same schema (:func:`_read_minimal`)."""
+    import jointdyn
+
+    reader = getattr(jointdyn, "read_system", None)
+    return (reader or _read_minimal)(path)
+
+
+def _read_minimal(path):
+    """Structure (``[structure]`` M, K, C), contacts (``[[contact]]``) and ``[output] dof`` of a TOML file.
+
+    The subset of the system-file schema a free vibration needs; ``[[force]]``
+    entries are read for completeness. Errors name the file and the key.
+    """
+    import tomllib
+
+    from ..kinematics import ConstantLoad, HarmonicLoad, NormalSpring
+    from ..laws import make_law
+    from ..systems import Contact, System
+
+    with open(path, "rb") as fh:
+        try:
+            doc = tomllib.load(fh)
+        except tomllib.TOMLDecodeError as exc:
+            raise ValueError(f"{path}: not valid TOML: {exc}") from None
+    try:
+        st = doc["structure"]
+        n = len(st["M"])
+        contacts = []
+        for i, c in enumerate(doc.get("contact", [])):
+            key = f"contact[{i}]"
+            extra = {k: v for k, v in c.items() if k not in ("law", "kt", "mu", "n_ref", "tangential", "normal")}
+            nrm = dict(c["normal"])
+            if "kn" in nrm:
+                load = NormalSpring(**nrm)
+            elif "n1" in nrm or "phase_deg" in nrm:
+                load = HarmonicLoad(**nrm)
+            else:
+                load = ConstantLoad(**nrm)
+            law = make_law(c["law"], kt=c["kt"], mu=c["mu"], n_ref=c.get("n_ref", load.n0), **extra)
+            contacts.append(Contact(law, normal=load, **dict(c["tangential"])))
+        force = np.zeros(n)
+        phase = np.zeros(n)
+        for f in doc.get("force", []):
+            force[int(f["dof"])] = f["amplitude"]
+            phase[int(f["dof"])] = f.get("phase_deg", 0.0)
+        return System(st["M"], st.get("C"), st["K"], contacts=tuple(contacts), force=force, force_phase_deg=phase,
+                      output_dof=doc.get("output", {}).get("dof"))
+    except KeyError as exc:
+        raise ValueError(f"{path}: key {exc.args[0]!r} is missing") from None
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{path}: {' '.join(str(exc).split())}") from None
+
+
+def _validate(args):
+    """Options checked and the System built; returns ``(system, amplitude range, label)``."""
+    from ..laws import law_names
+    from ..modes._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
+    from ..systems import System
+
+    V.choice("--method", args.method, ("epmc", "qsma"))
+    if args.method == "qsma":
+        for dest in _EPMC_ONLY:
+            if getattr(args, dest) is not None:
+                raise ValueError(f"--{dest.replace('_', '-')} applies to --method epmc only")
+    if args.system is not None:
+        if args.model is not None or args.law_param or args.n is not None:
+            raise ValueError("--model, --law-param and --n cannot be combined with --system: the system file "
+                             "names the law of each contact")
+        system = read_system_file(V.input_file("--system", args.system))
+        label = Path(args.system).name
+    else:
+        args.model = config.MODEL if args.model is None else V.choice("--model", args.model, law_names())
+        args.law_params = law_params(args)
+        system = System.paper_damper(eta=0.0, model=args.model, law_params=args.law_params)
+        label = f"paper's damper, {args.model}"
+    check_free_vibration(system, args.method.upper(), springs=args.method == "epmc")
+    amps = amplitude_range(system, None if args.amplitude is None else parse_amplitude(args.amplitude))
+    args.output_dof = output_dof_of(system, args.output_dof)
+    linear_stuck_mode(system, V.positive_int("--mode", args.mode, 1), args.output_dof)
+    if args.method == "epmc":
+        args.harmonics = V.positive_int("--harmonics", config.HB_HARMONICS if args.harmonics is None
+                                        else args.harmonics, 1)
+        args.samples = V.positive_int("--samples", config.HB_SAMPLES if args.samples is None else args.samples,
+                                      2 * args.harmonics + 2)
+        args.max_points = V.positive_int("--max-points", config.CONT_MAX_POINTS if args.max_points is None
+                                         else args.max_points, 2)
+    if args.out is not None:
+        V.output_dir("--out", args.out, files=("modes.nc", "modes.csv", "modes.png"))
+    return system, amps, label
+
+
+def _compute(args, system, amps):
+    from ..modes import backbone_dataset, epmc, qsma
+
+    if args.method == "qsma":
+        b = qsma(system, amps, mode=args.mode, output_dof=args.output_dof)
+    else:
+        b = epmc(system, amps, mode=args.mode, output_dof=args.output_dof, harmonics=args.harmonics,
+                 samples=args.samples, max_points=args.max_points, progress=None if not args.json else False)
+    return b, backbone_dataset(b)
+
+
+def _jsonable(values):
+    """Nested lists of an array, NaN and infinities as None (JSON has no NaN)."""
+    def clean(v):
+        if isinstance(v, list):
+            return [clean(x) for x in v]
+        return None if isinstance(v, float) and not math.isfinite(v) else v
+
+    return clean(np.asarray(values).tolist())
+
+
+def _result(args, ds, label) -> dict:
+    keys = ("amplitude_m", "amplitude_q", "omega_rad_s", "frequency_hz", "damping_ratio", "damping_ratio_contacts",
+            "damping_ratio_viscous", "energy_contact_j")
+    return {"method": args.method, "system": label, "mode": int(ds.attrs["linear_mode"]),
+            "output_dof": int(ds.attrs["output_dof"]), "harmonics": int(ds.attrs["harmonics"]),
+            "samples": int(ds.attrs["samples"]), "omega_linear_rad_s": float(ds.attrs["omega_linear_rad_s"]),
+            "branches": [{k: _jsonable(ds[k].values) for k in keys}],
+            "status": str(ds.attrs["status"]), "message": str(ds.attrs["message"])}
+
+
+def _plot(ds, title: str, path: Path) -> None:
+    from .._io import atomic_path
+    from ..figures import pyplot
+
+    plt = pyplot()
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(6.4, 6.0), sharex=True)
+    a = ds.amplitude_m.values
+    ax1.plot(a, ds.omega_rad_s.values, "-", color="C0")
+    ax1.axhline(ds.attrs["omega_linear_rad_s"], color="0.6", ls=":", lw=1, label="linear, contacts stuck")
+    ax1.set_ylabel("natural frequency, rad/s")
+    ax1.legend(fontsize=8)
+    ax2.plot(a, ds.damping_ratio.values, "-", color="C3")
+    ax2.set_ylabel("modal damping ratio")
+    ax2.set_xlabel("first-harmonic amplitude of DOF %d, m" % ds.attrs["output_dof"])
+    for ax in (ax1, ax2):
+        ax.set_xscale("log")
+        ax.grid(alpha=0.3, which="both")
+    ax1.set_title(f"{ds.attrs['method'].upper()} backbone of mode {ds.attrs['linear_mode']} ({title}); "
+                  f"status {ds.attrs['status']}", fontsize=9)
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=120)
+    plt.close(fig)
+
+
+def _write(ds, out: Path, title: str) -> None:
+    from .._io import atomic_path
+
+    with atomic_path(out / "modes.nc") as tmp:
+        ds.to_netcdf(tmp, engine="scipy")
+    with atomic_path(out / "modes.csv") as tmp:  # one row per point (per-DOF and per-contact data in modes.nc)
+        flat = ds.drop_dims([d for d in ds.dims if d != "point"])
+        flat.to_dataframe().reset_index().to_csv(tmp, index=False)
+    _plot(ds, title, out / "modes.png")
+
+
+def run(args) -> int:
+    system, amps, label = _validate(args)
+    backbone, ds = _compute(args, system, amps)
+    if args.out is not None:
+        _write(ds, Path(args.out), label)
+    result = _result(args, ds, label)
+    if args.json:
+        print(json.dumps(result))
+    else:
+        _print_table(result)
+    return 0 if backbone.status.ok else EXIT_PARTIAL
+
+
+def _print_table(result) -> None:
+    print(f"{result['method']} backbone of mode {result['mode']} ({result['system']}): status {result['status']}, "
+          f"{result['message']}")
+    br = result["branches"][0]
+    print(f"{'amplitude_m':>14s} {'omega_rad_s':>14s} {'frequency_hz':>14s} {'damping_ratio':>14s}")
+    for a, w, f, d in zip(br["amplitude_m"], br["omega_rad_s"], br["frequency_hz"], br["damping_ratio"]):
+        print(f"{a:14.6e} {w:14.8g} {f:14.8g} {d:14.6e}")

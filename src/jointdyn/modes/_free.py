@@ -1,0 +1,181 @@
+"""What nonlinear modes need from a System: free vibration, the linear stuck mode, scales.
+
+A nonlinear mode is a free vibration: nothing in it may be prescribed at a
+forcing frequency. Normal loads that are functions of the forcing phase (a
+:class:`~jointdyn.HarmonicLoad` with ``n1 > 0``, a
+:class:`~jointdyn.SampledLoad`) are refused, naming the contact and the
+reason; a constant load (also a harmonic load with ``n1 = 0``) and a normal
+spring (``load.autonomous``) have a place in a free vibration. Whether a
+solver evaluates a normal spring is the solver's business (EPMC: the
+harmonic-balance contact evaluation; QSMA: refused, its Masing construction
+needs constant normal loads).
+
+The linear **stuck** mode (every contact a spring kt, normal springs in
+place) starts every backbone: mode ``K`` (1-based, increasing frequency)
+of ``(M, K_reference + sum_c kt_c b_c b_c^T)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _validate as V
+from .. import config
+from ..kinematics import HarmonicLoad, NormalSpring, contact_kinematics, selection_matrix
+from ..systems import System
+
+__all__ = ["LinearMode", "check_free_vibration", "linear_stuck_mode", "output_dof_of", "amplitude_range",
+           "contact_scale"]
+
+
+@dataclass(frozen=True)
+class LinearMode:
+    """A linear mode of the structure with every contact stuck.
+
+    Attributes
+    ----------
+    index : int
+        Mode number, 1-based, in increasing frequency.
+    omega_rad_s : float
+        Natural frequency, rad/s.
+    shape : ndarray (n,)
+        Mode shape scaled to 1 at the output DOF (dimensionless).
+    mass_normalised : ndarray (n,)
+        The same shape with phi^T M phi = 1, kg^-1/2.
+    stiffness : ndarray (n, n)
+        The stuck stiffness K_reference + sum_c kt_c b_c b_c^T, N/m.
+    """
+
+    index: int
+    omega_rad_s: float
+    shape: np.ndarray
+    mass_normalised: np.ndarray
+    stiffness: np.ndarray
+
+
+def _constant(load) -> bool:
+    """True for a load that does not change in time (a harmonic load with n1 = 0 included)."""
+    return isinstance(load, HarmonicLoad) and load.n1 == 0.0
+
+
+def check_free_vibration(system, method: str, *, springs: bool = True) -> System:
+    """``system`` if it describes a free vibration with frictional contacts; ValueError otherwise.
+
+    Parameters
+    ----------
+    system : System
+    method : str
+        Name of the method, for the messages (``"EPMC"``, ``"QSMA"``).
+    springs : bool
+        Whether the method takes normal springs.
+    """
+    if not isinstance(system, System):
+        raise ValueError("system must be a jointdyn.System")
+    if not system.contacts:
+        raise ValueError(f"system must have at least one contact: {method} computes the modes of a structure "
+                         "with frictional contacts")
+    for i, c in enumerate(system.contacts):
+        load = c.normal
+        if _constant(load):
+            continue
+        if not load.autonomous:
+            what = (f"a harmonic load with n1 = {load.n1:g} N" if isinstance(load, HarmonicLoad)
+                    else f"a {type(load).__name__}")
+            raise ValueError(
+                f"contact {i}: its normal load is {what}, prescribed at a forcing frequency; a nonlinear mode is "
+                "a free vibration, which has no forcing frequency: give a constant normal load (ConstantLoad) "
+                "or a normal spring (NormalSpring)")
+        if isinstance(load, NormalSpring) and not springs:
+            raise ValueError(
+                f"contact {i}: {method} takes constant normal loads only (its Masing construction holds when "
+                "the slip limits do not change), and a normal spring makes the load follow the motion: use "
+                "EPMC for this system")
+    from scipy.linalg import eigh
+
+    lam = eigh(system.K_reference, system.M, eigvals_only=True)
+    if not lam[0] > config.MODES_MIN_EIGENVALUE_RATIO * abs(lam[-1]):
+        raise ValueError(
+            f"K must be positive definite with the tangential contacts free (smallest eigenvalue of (M, K) "
+            f"{lam[0]:.6g} (rad/s)^2): {method} needs a static equilibrium of the slipping structure (the mean "
+            "of the motion is not held by friction)")
+    return system
+
+
+def output_dof_of(system: System, output_dof) -> int:
+    """The output DOF: ``output_dof`` (validated) or the system's response DOF."""
+    if output_dof is None:
+        return system.response_dof
+    d = V.positive_int("output_dof", output_dof, 0)
+    if d >= system.ndof:
+        raise ValueError(f"output_dof must be in [0, {system.ndof - 1}], got {output_dof!r}")
+    return d
+
+
+def stuck_stiffness(system: System) -> np.ndarray:
+    """K_reference + sum_c kt_c b_c b_c^T (N/m): the structure with every contact stuck."""
+    B = selection_matrix(contact_kinematics(system), system.ndof)
+    K = system.K_reference.copy()
+    for c, b in zip(system.contacts, B):
+        K += c.law.kt * np.outer(b, b)
+    return K
+
+
+def linear_stuck_mode(system: System, mode: int, output_dof: int) -> LinearMode:
+    """Mode ``mode`` (1-based) of the stuck structure, scaled to 1 at ``output_dof``.
+
+    Raises
+    ------
+    ValueError
+        ``mode`` out of [1, n], or the output DOF does not move in that mode.
+    """
+    from scipy.linalg import eigh
+
+    n = system.ndof
+    k = V.positive_int("mode", mode, 1)
+    if k > n:
+        raise ValueError(f"mode must be in [1, {n}] (the system has {n} DOFs), got {mode!r}")
+    Ks = stuck_stiffness(system)
+    lam, phi = eigh(Ks, system.M)
+    v = phi[:, k - 1]
+    big = float(np.max(np.abs(v)))
+    if not abs(v[output_dof]) > config.MODES_MIN_PARTICIPATION * big:
+        raise ValueError(f"output_dof: DOF {output_dof} does not move in linear stuck mode {k} "
+                         f"(|phi| = {abs(v[output_dof]):.3g} of {big:.3g}); choose a DOF that moves in it")
+    if v[output_dof] < 0:
+        v = -v
+    return LinearMode(index=k, omega_rad_s=math.sqrt(max(lam[k - 1], 0.0)), shape=v / v[output_dof],
+                      mass_normalised=v, stiffness=Ks)
+
+
+def contact_scale(system: System) -> float:
+    """fy / kt of the first contact (m): the displacement scale of the default amplitudes."""
+    law = system.contacts[0].law
+    return law.fy / law.kt
+
+
+def amplitude_range(system: System, amplitude) -> tuple[float, float]:
+    """(smallest, largest) amplitude in m: ``amplitude`` validated, or the default range.
+
+    The default is ``config.MODES_AMPLITUDE_Q`` times fy / kt of the first
+    contact.
+    """
+    if amplitude is None:
+        scale = contact_scale(system)
+        if not scale > 0.0:
+            raise ValueError("amplitude must be given (min, max) in m: the first contact has no friction "
+                             "(fy = 0), so there is no default range")
+        lo, hi = (q * scale for q in config.MODES_AMPLITUDE_Q)
+        return lo, hi
+    try:
+        lo, hi = amplitude
+    except (TypeError, ValueError):
+        raise ValueError(f"amplitude must be a pair (min, max) of amplitudes in m, got {amplitude!r}") from None
+    lo = V.positive("amplitude min", lo)
+    hi = V.positive("amplitude max", hi)
+    if not hi > lo:
+        raise ValueError(f"amplitude max must be > min ({lo:g} m), got {hi:g} m")
+    V.derived("log10(amplitude max / amplitude min)", math.log10(hi / lo), positive=True)
+    return lo, hi

@@ -1,0 +1,331 @@
+"""Extended periodic motion concept (EPMC, Krack 2015): backbones of nonlinear modes.
+
+A nonlinear mode of a damped structure is sought as a periodic *free*
+motion of (docs/model.md section 9, docs/modes.md)::
+
+    M x'' + (C - xi M) x' + K x + sum_c B_c T_c(u_c, N_c) = 0,
+
+where the artificial negative mass-proportional damping xi M x' cancels
+the dissipation exactly. In normalised time tau = omega t the motion is
+expanded in harmonics 0..H (:mod:`jointdyn.fourier`) and the equations are
+those of harmonic balance (:class:`~jointdyn.hb.HBProblem`) without
+forcing, with ``C - xi M`` for C. The contact forces come from the same
+compiled AFT evaluation, with the same laws and the same exact
+forward-mode Jacobians; the linear part's derivatives along omega and xi
+are written out::
+
+    R(X, omega, xi) = R_hb(X, omega) - xi omega A_M X,
+    dR/dX = J_hb - xi omega A_M,
+    dR/domega = (A_C + 2 omega A_M) X - xi A_M X,     dR/dxi = -omega A_M X,
+
+with ``A_M`` the block ``[[0, k M], [-k M, 0]]`` of harmonic k (the
+damping block of harmonic balance with M for C).
+
+Unknowns and normalisation. The modal amplitude ``a`` is the
+first-harmonic amplitude of the output DOF; the phase is fixed by a zero
+sine coefficient of that DOF's first harmonic, so that its cosine
+coefficient is ``a``. Both coefficients are known, and their places in the
+vector of unknowns hold omega and xi instead: the system stays square
+(``n (2H + 1)`` equations and unknowns). The continuation parameter is
+``lam = log10(a)`` (logarithmic stepping over decades), the coefficients
+are scaled by ``a`` (``X = a Y``), omega and xi by the linear stuck
+frequency, and the residual by ``k_ref a`` (``k_ref`` the largest diagonal
+entry of the stuck stiffness), so every scaled quantity is of order one at
+every amplitude and the derivative along lam is exact::
+
+    R_s = R(a Y) / (k_ref a),   dR_s/dlam = ln(10) (J Y / k_ref - R_s).
+
+The branch starts at the smallest amplitude from the linear stuck mode
+(:func:`jointdyn.modes._free.linear_stuck_mode`) and is followed by the
+generic pseudo-arc-length continuation (:mod:`jointdyn.continuation`).
+
+Normal loads: every autonomous load that harmonic balance evaluates
+(constant loads; a normal spring as soon as the harmonic-balance contact
+evaluation takes it) is taken as it is; loads prescribed at a forcing
+frequency are refused (:func:`jointdyn.modes._free.check_free_vibration`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from .. import _validate as V
+from .. import config
+from ..continuation import ContinuationOptions, ContinuationStatus, continuation, make_options, newton
+from ..fourier import derivative_matrix
+from ..hb import HBProblem
+from ..kinematics import contact_kinematics, selection_matrix
+from ._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
+from .backbone import Backbone, ModeStatus
+
+__all__ = ["EPMCProblem", "epmc"]
+
+_LN10 = math.log(10.0)
+
+
+def mass_damping_block(M: np.ndarray, H: int) -> np.ndarray:
+    """A_M: the harmonic-balance damping block of harmonics 0..H with M for C (size n (2H + 1))."""
+    n = M.shape[0]
+    A = np.zeros((n * (2 * H + 1), n * (2 * H + 1)))
+    for k in range(1, H + 1):
+        ic = (2 * k - 1) * n
+        is_ = 2 * k * n
+        A[ic:ic + n, is_:is_ + n] = k * M
+        A[is_:is_ + n, ic:ic + n] = -k * M
+    return A
+
+
+class EPMCProblem:
+    """Scaled EPMC residual ``R(v, lam)`` and its exact Jacobians (module docstring).
+
+    Parameters
+    ----------
+    system : System
+        Structure with frictional contacts under autonomous normal loads;
+        its forcing is not used.
+    mode : int
+        Linear stuck mode to start from (1-based, increasing frequency).
+    output_dof : int, optional
+        DOF whose first-harmonic amplitude is the modal amplitude (default:
+        the system's response DOF).
+    harmonics : int
+        Highest harmonic H (>= 1).
+    samples : int
+        AFT samples per period (>= 2H + 2).
+    max_passes : int
+        Bound on the periods marched per AFT evaluation.
+
+    Attributes
+    ----------
+    hb : HBProblem
+        Harmonic balance of the unforced system (the contact evaluation).
+    linear : LinearMode
+        The linear stuck mode.
+    i_omega, i_xi : int
+        Places of omega and xi in the scaled unknowns ``v`` (those of the
+        cosine and sine coefficients of the output DOF's first harmonic).
+    w_ref, k_ref : float
+        Scales of omega and xi (rad/s) and of the residual (N/m).
+    """
+
+    def __init__(self, system, *, mode: int = 1, output_dof: int | None = None,
+                 harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
+                 max_passes: int = config.HB_MAX_PASSES):
+        check_free_vibration(system, "EPMC")
+        self.system = system
+        self.output_dof = output_dof_of(system, output_dof)
+        n = system.ndof
+        H = V.positive_int("harmonics", harmonics, 1)
+        V.positive_int("samples", samples, 2 * H + 2)
+        free = dataclasses.replace(system, force=np.zeros(n), force_phase_deg=np.zeros(n))
+        try:
+            self.hb = HBProblem(free, harmonics=harmonics, samples=samples, max_passes=max_passes)
+        except ValueError as exc:
+            raise ValueError(f"{exc} (EPMC evaluates the contacts by harmonic balance)") from None
+        self.linear = linear_stuck_mode(system, mode, self.output_dof)
+        self.n, self.H, self.size = n, self.hb.H, self.hb.size
+        self.A_M = mass_damping_block(system.M, self.H)
+        self.i_omega = n + self.output_dof
+        self.i_xi = 2 * n + self.output_dof
+        self.w_ref = self.linear.omega_rad_s
+        self.k_ref = float(np.max(np.abs(np.diag(self.linear.stiffness))))
+        self.B = selection_matrix(contact_kinematics(system), n)
+        self.last = None
+
+    # --- unknowns -----------------------------------------------------------
+    def unpack(self, v, lam):
+        """(X m, omega rad/s, xi 1/s) of the scaled unknowns ``v`` at ``lam = log10(a)``."""
+        Y = np.array(v, dtype=np.float64)
+        w = Y[self.i_omega] * self.w_ref
+        xi = Y[self.i_xi] * self.w_ref
+        Y[self.i_omega] = 1.0
+        Y[self.i_xi] = 0.0
+        return (10.0 ** lam) * Y, w, xi
+
+    def pack(self, X, omega, xi):
+        """Scaled unknowns of coefficients X (m, normalised: sine of the output DOF's first harmonic 0),
+        omega (rad/s) and xi (1/s)."""
+        a = X[self.i_omega]
+        v = np.asarray(X, dtype=np.float64) / a
+        v[self.i_omega] = omega / self.w_ref
+        v[self.i_xi] = xi / self.w_ref
+        return v
+
+    def linear_guess(self):
+        """Scaled unknowns of the linear stuck mode: shape, frequency and the viscous modal damping of C."""
+        phi = self.linear.mass_normalised
+        xi0 = float(phi @ self.system.C @ phi)  # phi^T C phi / phi^T M phi, 1/s
+        X = np.zeros(self.size)
+        X[self.n:2 * self.n] = self.linear.shape
+        return self.pack(X, self.linear.omega_rad_s, xi0)
+
+    # --- residual -----------------------------------------------------------
+    def evaluate(self, X, omega):
+        """The harmonic-balance evaluation (residual without xi, contact forces) at X (m), omega (rad/s)."""
+        return self.hb.evaluate(X, omega / self.hb.w0)
+
+    def residual(self, v, lam):
+        """``(R_s, dR_s/dv, dR_s/dlam)``: the scaled residual and its exact Jacobians."""
+        a = 10.0 ** lam
+        X, w, xi = self.unpack(v, lam)
+        Y = X / a
+        ev = self.evaluate(X, w)
+        self.last = (X, w, xi, ev)
+        cx = self.A_M @ X
+        R = ev.R - (xi * w) * cx
+        J = ev.JX - (xi * w) * self.A_M
+        ka = self.k_ref * a
+        Rs = R / ka
+        Jlam = _LN10 * (J @ Y / self.k_ref - Rs)
+        Jv = J / self.k_ref
+        Jv[:, self.i_omega] = self.w_ref * (ev.Jp / self.hb.w0 - xi * cx) / ka
+        Jv[:, self.i_xi] = -self.w_ref * w * cx / ka
+        return Rs, Jv, Jlam
+
+    def solve(self, amplitude: float, guess, options: ContinuationOptions | None = None, **overrides):
+        """Newton at a fixed amplitude (m) from scaled unknowns ``guess``: ``(v, converged, iterations)``."""
+        opt = _options(options, overrides)
+        return newton(self.residual, np.asarray(guess, dtype=np.float64), math.log10(amplitude), opt)
+
+    # --- per point ----------------------------------------------------------
+    def energies(self, X, omega, ev):
+        """Per period: (int x'^T M x' dt in J s, viscous energy J, energy of each contact J).
+
+        Integrals of products of trigonometric polynomials are exact on the
+        coefficients; the contact energies ``oint T_c du_c`` are the
+        discrete sums over the AFT samples, the quadrature the Galerkin
+        projection uses, so that the energy balance of a converged point
+        holds to its residual.
+        """
+        hb = self.hb
+        Xm = X.reshape(hb.nh, self.n)
+        DX = derivative_matrix(self.H) @ Xm  # d/dtau, m
+        M, C = self.system.M, self.system.C
+        kin = omega * math.pi * float(np.einsum("ri,ij,rj->", DX, M, DX))
+        visc = omega * math.pi * float(np.einsum("ri,ij,rj->", DX, C, DX))
+        du = hb.E @ (DX @ self.B.T)  # (Ns, contacts): du_c/dtau at the samples, m
+        contact = np.einsum("cj,jc->c", ev.T, du) * (2.0 * math.pi / hb.Ns)
+        return kin, visc, contact
+
+    def modal_amplitude(self, X) -> float:
+        """sqrt(a1^T M a1 + b1^T M b1) of the first harmonic, kg^1/2 m."""
+        Xm = X.reshape(self.hb.nh, self.n)
+        M = self.system.M
+        return math.sqrt(float(Xm[1] @ M @ Xm[1] + Xm[2] @ M @ Xm[2]))
+
+
+def _options(options, overrides) -> ContinuationOptions:
+    """The step control of EPMC: modes defaults from config, then ``options``, then ``overrides``."""
+    if options is None:
+        options = ContinuationOptions(ds=config.MODES_DS_START, ds_max=config.MODES_DS_MAX, tol=config.MODES_TOL)
+    return make_options(options, overrides)
+
+
+_STATUS = {
+    ContinuationStatus.COMPLETE: ModeStatus.COMPLETE,
+    ContinuationStatus.MAX_POINTS: ModeStatus.MAX_POINTS,
+}
+
+
+def _points(problem: EPMCProblem, lam, V, stash):
+    """Per-point arrays of the backbone from the continued unknowns (evaluations reused from ``stash``)."""
+    p = lam.size
+    nc = len(problem.system.contacts)
+    out = {k: np.empty(p) for k in ("amplitude_m", "omega_rad_s", "xi_rad_s", "damping_ratio",
+                                      "damping_ratio_contacts", "damping_ratio_viscous", "modal_amplitude",
+                                      "energy_viscous_j")}
+    out["X"] = np.empty((p, problem.size))
+    out["energy_contact_j"] = np.empty((p, nc))
+    for i in range(p):
+        X, w, xi = problem.unpack(V[i], lam[i])
+        ev = stash.get(X.tobytes())
+        if ev is None:
+            ev = problem.evaluate(X, w)
+        kin, visc, contact = problem.energies(X, w, ev)
+        out["amplitude_m"][i] = 10.0 ** lam[i]
+        out["omega_rad_s"][i] = w
+        out["xi_rad_s"][i] = xi
+        out["damping_ratio"][i] = xi / (2.0 * w)
+        out["damping_ratio_contacts"][i] = float(np.sum(contact)) / (2.0 * w * kin)
+        out["damping_ratio_viscous"][i] = visc / (2.0 * w * kin)
+        out["modal_amplitude"][i] = problem.modal_amplitude(X)
+        out["energy_viscous_j"][i] = visc
+        out["energy_contact_j"][i] = contact
+        out["X"][i] = X
+    return out
+
+
+def _backbone(problem: EPMCProblem, status, message, lam, V, stash, counters) -> Backbone:
+    pts = _points(problem, np.asarray(lam, dtype=np.float64), V, stash)
+    return Backbone(method="epmc", status=status, message=message, system=problem.system, linear=problem.linear,
+                    output_dof=problem.output_dof, harmonics=problem.H, samples=problem.hb.Ns,
+                    counters=dict(counters), problem=problem, **pts)
+
+
+def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None,
+         harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
+         options: ContinuationOptions | None = None, progress: bool | None = None, **overrides) -> Backbone:
+    """Backbone of a nonlinear mode by the extended periodic motion concept.
+
+    Parameters
+    ----------
+    system : System
+        Structure with frictional contacts; every normal load autonomous
+        (constant, or a normal spring once harmonic balance evaluates it);
+        its forcing is ignored.
+    amplitude : (float, float), optional
+        Range (min, max) of the modal amplitude, the first-harmonic
+        amplitude of the output DOF, m (default: ``config.MODES_AMPLITUDE_Q``
+        times fy / kt of the first contact). Stepped in log10.
+    mode : int
+        Linear stuck mode the backbone starts from (1-based).
+    output_dof : int, optional
+        DOF of the modal amplitude (default: the system's response DOF).
+    harmonics : int
+        Highest harmonic H (>= 1).
+    samples : int
+        AFT samples per period (>= 2H + 2).
+    options : ContinuationOptions, optional
+        Step control in the scaled unknowns (arc length in decades of
+        amplitude); default ``ds = config.MODES_DS_START``,
+        ``ds_max = config.MODES_DS_MAX``, ``tol = config.MODES_TOL``;
+        keyword arguments override its fields (``ds_max``, ``max_points``,
+        ``tol``, ...).
+    progress : bool, optional
+        Show a tqdm bar (None: only on a TTY).
+
+    Returns
+    -------
+    Backbone
+        ``status`` complete, max-points, failed (the points computed are
+        kept) or no-start (empty).
+    """
+    from tqdm.auto import tqdm
+
+    check_free_vibration(system, "EPMC")
+    lo, hi = amplitude_range(system, amplitude)
+    problem = EPMCProblem(system, mode=mode, output_dof=output_dof, harmonics=harmonics, samples=samples)
+    opt = _options(options, overrides)
+    lam0, lam1 = math.log10(lo), math.log10(hi)
+    v0, ok, _ = newton(problem.residual, problem.linear_guess(), lam0, opt, max_iter=config.MODES_START_MAX_ITER)
+    if not ok:
+        return _backbone(problem, ModeStatus.NO_START, f"Newton did not converge at the smallest amplitude "
+                         f"{lo:.6g} m from linear stuck mode {problem.linear.index}", np.empty(0),
+                         np.empty((0, problem.size)), {}, {"points": 0})
+    stash = {}
+
+    def keep(v, lam):
+        last = problem.last
+        X = problem.unpack(v, lam)[0]
+        if last is not None and last[0].tobytes() == X.tobytes():
+            stash[X.tobytes()] = last[3]
+
+    with tqdm(total=opt.max_points, desc="EPMC", disable=None if progress is None else not progress,
+              leave=False) as bar:
+        res = continuation(problem.residual, v0, lam0, lam1, opt, monitor=keep, progress=bar)
+    status = _STATUS.get(res.status, ModeStatus.FAILED if res.lam.size else ModeStatus.NO_START)
+    message = res.message.replace("lam = ", "log10(amplitude / m) = ")
+    return _backbone(problem, status, message, res.lam, res.y, stash, res.counters)
