@@ -44,6 +44,8 @@ _MATRICES = ("M", "K", "C")
 #: file suffixes holding one matrix per file, and several named ones
 _SINGLE_SUFFIXES = (".mtx", ".npy")
 _NAMED_SUFFIXES = (".npz", ".mat")
+#: first bytes of a .npy file
+_NPY_MAGIC = b"\x93NUMPY"
 
 
 @dataclass(frozen=True)
@@ -90,15 +92,19 @@ class _Where:
 
 
 def _table(where: _Where, key: str, value, allowed, required=()) -> dict:
-    """A TOML table with only ``allowed`` keys and every ``required`` one."""
+    """A TOML table with only ``allowed`` keys and every ``required`` one
+    (``key`` "" is the document itself)."""
     if not isinstance(value, dict):
         raise where.error(key, f"must be a table, got {type(value).__name__} {value!r:.60}")
+    def full(k):
+        return f"{key}.{k}" if key else k
+
     for k in value:
         if k not in allowed:
-            raise where.error(f"{key}.{k}", f"is not a known key (allowed: {', '.join(allowed)})")
+            raise where.error(full(k), f"is not a known key (allowed: {', '.join(allowed)})")
     for k in required:
         if k not in value:
-            raise where.error(f"{key}.{k}", "is missing")
+            raise where.error(full(k), "is missing")
     return value
 
 
@@ -143,13 +149,16 @@ def _dense(where: _Where, key: str, value) -> np.ndarray:
     """A real 2-D matrix as a dense float64 array (sparse ones converted)."""
     import scipy.sparse as sp
 
-    shape = getattr(value, "shape", None)
-    if shape is not None and len(shape) == 2 and max(shape) > config.FILES_MAX_DOF:
-        raise where.error(key, f"must have at most {config.FILES_MAX_DOF} rows and columns "
-                               f"(config.FILES_MAX_DOF), got shape {tuple(shape)}")
+    def bound(shape):
+        if shape is not None and len(shape) == 2 and max(shape) > config.FILES_MAX_DOF:
+            raise where.error(key, f"must have at most {config.FILES_MAX_DOF} rows and columns "
+                                   f"(config.FILES_MAX_DOF), got shape {tuple(shape)}")
+
+    bound(getattr(value, "shape", None))  # before a sparse matrix is made dense
     if sp.issparse(value):
         value = value.toarray()
     a = np.asarray(value)
+    bound(a.shape)
     if np.iscomplexobj(a):
         raise where.error(key, "must be real, got complex entries")
     try:
@@ -177,6 +186,10 @@ def _load_named(path: Path) -> dict:
         except NotImplementedError:
             raise ValueError("is a MATLAB v7.3 (HDF5) file; save it with -v7 (scipy.io reads v4 to v7)") from None
         return {k: v for k, v in data.items() if not k.startswith("__")}
+    import zipfile
+
+    if not zipfile.is_zipfile(path):
+        raise ValueError("is not a .npz archive (numpy.savez writes one)")
     with np.load(str(path), allow_pickle=False) as z:
         names = set(z.files)
         if {"format", "shape", "data"} <= names:
@@ -192,6 +205,9 @@ def _load_single(path: Path):
         import scipy.io
 
         return scipy.io.mmread(str(path))
+    with open(path, "rb") as fh:
+        if fh.read(len(_NPY_MAGIC)) != _NPY_MAGIC:
+            raise ValueError("is not a .npy file (numpy.save writes one)")
     return np.load(str(path), allow_pickle=False)
 
 
@@ -276,7 +292,8 @@ def _symmetric(where: _Where, key: str, A: np.ndarray) -> None:
     d = np.abs(A - A.T)
     if d.max() > 1e-10 * scale:
         i, j = np.unravel_index(int(np.argmax(d)), A.shape)
-        raise where.error(key, f"must be symmetric ({key}[{i},{j}] = {A[i, j]!r} but {key}[{j},{i}] = {A[j, i]!r})")
+        raise where.error(key, f"must be symmetric ({key}[{i},{j}] = {float(A[i, j])!r} but {key}[{j},{i}] = "
+                               f"{float(A[j, i])!r})")
 
 
 def _structure(where: _Where, s, folder: Path) -> dict:
@@ -501,7 +518,7 @@ def read_system_file(path) -> SystemFile:
         raise ValueError(" ".join(f"{p}: not valid TOML: {exc}".split())) from None
     except OSError as exc:
         raise ValueError(f"{p}: cannot be read: {exc.strerror or exc}") from None
-    _table(where, "(top level)", doc, _TOP_KEYS, required=("structure",))
+    _table(where, "", doc, _TOP_KEYS, required=("structure",))
     title = doc.get("title", p.stem)
     if not isinstance(title, str):
         raise where.error("title", f"must be a string, got {title!r:.60}")
