@@ -126,10 +126,10 @@ class _LineRun:
         self.arrays = empty_arrays(len(g), len(dofs), ncontacts, spec.loop_outputs)
         self.next = 0
         self.start = None
-        self.computed = False
 
     @property
     def finished(self) -> bool:
+        """Every point of the line is computed or loaded."""
         return self.next >= len(self.gammas)
 
     def next_task(self, points: int) -> ChunkTask:
@@ -442,7 +442,6 @@ def _run(runs, family, client, n_workers, out, progress, on_line) -> tuple:
             state["shown"] = now
 
     def on_chunk(run, chunk):
-        run.computed = True
         if line_root is not None and chunk.done:
             save_chunk(line_root / run.spec.key, run.spec.checkpoint_key(), chunk)
         show()

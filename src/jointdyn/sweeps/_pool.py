@@ -98,6 +98,7 @@ class _Counter:
         self.value = 0
 
     def get_lock(self):
+        """The lock guarding ``value``."""
         return self._lock
 
 
@@ -111,6 +112,7 @@ class SerialExecutor:
         self.capacity = 1
 
     def submit(self, task) -> None:
+        """Queue a chunk (it runs when its result is asked for)."""
         self.tasks.append(task)
 
     def pending(self) -> int:
@@ -118,6 +120,7 @@ class SerialExecutor:
         return len(self.tasks)
 
     def next_result(self, timeout):
+        """Run the next queued chunk here and return its result (``timeout`` unused)."""
         task = self.tasks.popleft()
         return solve_chunk(task, self.systems[task.system_index], self.ctx)
 
@@ -126,10 +129,12 @@ class SerialExecutor:
         return self.ctx.counter.value
 
     def request_stop(self) -> None:
+        """Drop the queued chunks (the running one stops at its interrupt)."""
         self.ctx.stop.set()
         self.tasks.clear()
 
     def close(self) -> None:
+        """Drop what is queued."""
         self.tasks.clear()
 
 
@@ -158,6 +163,7 @@ class LocalExecutor:
                                            initargs=(systems, self.ctx.stop, self.ctx.counter, os.getpid()))
 
     def submit(self, task) -> None:
+        """Start a chunk on the pool."""
         if self.threads:
             fut = self.pool.submit(solve_chunk, task, self.systems[task.system_index], self.ctx)
         else:
@@ -175,17 +181,20 @@ class LocalExecutor:
         done, _ = cf.wait(self.futures, timeout=timeout, return_when=cf.FIRST_COMPLETED)
         if not done:
             return None
-        fut = min(done, key=id)
+        fut = next(iter(done))
         self.futures.discard(fut)
         return fut.result()
 
     def progress(self) -> int:
+        """Points finished so far (counted by the workers)."""
         return self.ctx.counter.value
 
     def request_stop(self) -> None:
+        """Ask every running chunk to return after its current point."""
         self.ctx.stop.set()
 
     def close(self) -> None:
+        """Stop the running chunks after their current point and end the pool."""
         self.ctx.stop.set()
         for f in self.futures:
             f.cancel()
@@ -204,6 +213,7 @@ class DaskExecutor:
         self.capacity = config.SWEEP_TASKS_PER_WORKER * max(1, sum(client.nthreads().values()))
 
     def submit(self, task) -> None:
+        """Start a chunk on the cluster."""
         fut = self.client.submit(solve_chunk, task, self.systems[task.system_index], None, pure=False)
         self.futures.add(fut)
         fut.add_done_callback(self.results.put)
@@ -213,6 +223,7 @@ class DaskExecutor:
         return len(self.futures)
 
     def next_result(self, timeout):
+        """A finished chunk, or None after ``timeout`` seconds; a chunk's error is raised."""
         try:
             fut = self.results.get(timeout=timeout)
         except queue.Empty:
@@ -223,13 +234,16 @@ class DaskExecutor:
         return res
 
     def progress(self) -> int:
+        """Points of the chunks returned so far."""
         return self.done_points
 
     def request_stop(self) -> None:
+        """Cancel the chunks in flight (their points are lost)."""
         self.client.cancel(list(self.futures))
         self.futures.clear()
 
     def close(self) -> None:
+        """Cancel what is left."""
         if self.futures:
             self.client.cancel(list(self.futures))
         self.futures.clear()
