@@ -131,11 +131,11 @@ def test_normal_loads(normal, load, n_ref, tmp_path):
 
 def test_selections_n_ref_law_parameters_title_and_outputs(tmp_path):
     text = BASE.replace("tangential = { dof = 0 }", "tangential = { dof = 1, dof2 = 0 }\nn_ref = 120.0\n"
-                        "max_depth = 16")
+                        "capacity = 16")
     text = text.replace("[output]\ndof = 1", "[output]\ndof = 0\ndofs = [1, 0]")
     sf = read_system_file(_write(tmp_path, 'title = "two masses"\n' + text))
     c = sf.system.contacts[0]
-    assert (c.dof, c.dof2, c.law.n_ref, c.law.max_depth) == (1, 0, 120.0, 16)
+    assert (c.dof, c.dof2, c.law.n_ref, c.law.capacity) == (1, 0, 120.0, 16)
     assert sf.title == "two masses" and sf.dofs == (1, 0) and sf.system.response_dof == 0
     text = BASE.replace("tangential = { dof = 0 }", "tangential = { direction = [1.0, -0.5] }")
     sf = read_system_file(_write(tmp_path, text, "b.toml"))

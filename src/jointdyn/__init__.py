@@ -2,17 +2,21 @@
 
 Public API (everything else is private):
 
-- contact laws: :class:`Iwan`, :class:`DiscreteIwan`, :class:`Jenkins`,
-  :func:`make_law` (:func:`law_names`, :func:`law_parameters`), normal loads;
+- contact laws: :class:`Iwan` (the exact Iwan model, the default),
+  :class:`IwanClosedForm` (the paper's closed forms), :class:`DiscreteIwan`,
+  :class:`Jenkins`, :func:`make_law` (:func:`law_names`,
+  :func:`law_parameters`), normal loads;
 - drivers: :func:`march`, :func:`quasistatic`, :func:`harmonic_loop`;
 - systems: :class:`System`, :class:`Contact`, :func:`read_system` (TOML
   system files), :func:`read_matrices`;
 - time integration: :func:`integrate`, :func:`steady_state`;
 - harmonic balance: :func:`harmonic_balance`, :func:`frc_hb`;
+- continuation: the module :mod:`jointdyn.continuation`
+  (:class:`ContinuationOptions`);
 - sweeps: :func:`frc_sweep`.
 
-The time-integration, harmonic-balance and sweep names are imported on
-first use, so that ``import jointdyn`` (and the CLI) stays fast.
+The time-integration, harmonic-balance, continuation and sweep names are
+imported on first use, so that ``import jointdyn`` (and the CLI) stays fast.
 """
 
 from .laws import (
@@ -23,6 +27,7 @@ from .laws import (
     ContactLaw,
     DiscreteIwan,
     Iwan,
+    IwanClosedForm,
     Jenkins,
     backbone,
     law_names,
@@ -46,25 +51,31 @@ _LAZY = {
     "harmonic_balance": "hb",
     "frc_hb": "hb",
     "continue_hb": "hb",
-    "continuation": "hb",
+    "ContinuationOptions": "continuation",
     "hill_stability": "hb",
     "frc_sweep": "sweeps",
 }
 
 
+#: submodules reachable as attributes of the package (imported on first use)
+_SUBMODULES = ("continuation", "fourier")
+
+
 def __getattr__(name):
+    import importlib
+
+    if name in _SUBMODULES:
+        return importlib.import_module(f".{name}", __name__)
     sub = _LAZY.get(name)
     if sub is None:
         raise AttributeError(f"module 'jointdyn' has no attribute {name!r}")
-    import importlib
-
     value = getattr(importlib.import_module(f".{sub}", __name__), name)
     globals()[name] = value
     return value
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_LAZY))
+    return sorted(set(globals()) | set(_LAZY) | set(_SUBMODULES))
 
 __all__ = [
     "STICK_SLIP",
@@ -73,6 +84,7 @@ __all__ = [
     "STATE_NAMES",
     "ContactLaw",
     "Iwan",
+    "IwanClosedForm",
     "DiscreteIwan",
     "Jenkins",
     "backbone",
@@ -96,4 +108,5 @@ __all__ = [
     "read_system",
     "read_matrices",
     *_LAZY,
+    *_SUBMODULES,
 ]

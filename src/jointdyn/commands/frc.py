@@ -42,7 +42,7 @@ HELP = ("frequency-response curve (steady amplitude vs gamma) of the paper's fri
         "of your own (--system FILE.toml)")
 
 #: the options that describe the paper damper, with their values when not given
-PAPER_OPTIONS = {"eta": 0.5, "beta": None, "f1": None, "delta": 0.0, "model": "iwan", "law_param": None,
+PAPER_OPTIONS = {"eta": 0.5, "beta": None, "f1": None, "delta": 0.0, "model": config.MODEL, "law_param": None,
                  "n": None, "zeta": 0.0, **{key: PAPER[key] for key in ("m", "k", "kt", "kn", "mu", "n0")}}
 
 
@@ -371,16 +371,11 @@ def _run_time(args, gammas):
 
 
 def _hb_branches(ds) -> list:
-    """Split an hb Dataset (dim ``point``) into branches (by a ``branch``
-    variable if present, else one)."""
-    if "branch" in ds.variables:
-        ids = np.asarray(ds["branch"].values)
-        groups = [np.flatnonzero(ids == b) for b in dict.fromkeys(ids.tolist())]
-    else:
-        groups = [np.arange(ds.sizes["point"])]
+    """Split an hb Dataset (dim ``point``) into its branches (variable ``branch``: segment index)."""
+    ids = np.asarray(ds["branch"].values)
     out = []
-    for idx in groups:
-        sub = ds.isel(point=idx)
+    for b in dict.fromkeys(ids.tolist()):
+        sub = ds.isel(point=np.flatnonzero(ids == b))
         br = {v: _jsonable(sub[v].values) for v in ("gamma", "amplitude_q", "amplitude_m", "offset_m", "max_abs_m")}
         br["stable"] = [bool(s) for s in np.asarray(sub["stable"].values)]
         br["folds"] = [int(i) for i in np.flatnonzero(np.asarray(sub["fold"].values, bool))]
@@ -389,13 +384,8 @@ def _hb_branches(ds) -> list:
 
 
 def _run_hb(args, gammas):
-    try:
-        from ..hb import frc_hb
-    except ImportError as exc:
-        raise ValueError(
-            "--method hb needs the harmonic-balance module jointdyn.hb, which is not available in this "
-            f"installation ({exc}); use --method time"
-        ) from None
+    from ..hb import frc_hb
+
     system = _system(args)
     if gammas.size < 2:
         raise ValueError("--gamma must span a range (STOP > START) for --method hb")

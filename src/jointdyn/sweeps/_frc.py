@@ -175,7 +175,7 @@ def _family(system_or_grid, gammas, paper: dict):
             raise ValueError("n is given twice: as n and in law_params; give it once")
         law_params["n"] = paper["n"]
     fam = paper_family(etas=paper.get("etas"), betas=paper.get("betas"), f1s=paper.get("f1s"),
-                       deltas=paper.get("deltas"), model="iwan" if paper.get("model") is None else paper["model"],
+                       deltas=paper.get("deltas"), model=config.MODEL if paper.get("model") is None else paper["model"],
                        law_params=law_params, zeta=0.0 if paper.get("zeta") is None else paper["zeta"],
                        overrides={k: paper.get(k) for k in ("m", "k", "kt", "mu", "n0")})
     return fam, system_or_grid
@@ -324,7 +324,7 @@ def frc_sweep(
         Sweep directions.
     model : str
         Paper form: contact law, one of :func:`jointdyn.laws.law_names`
-        (default ``iwan``).
+        (default ``iwan``, the exact Iwan model, ``config.MODEL``).
     law_params : dict, optional
         Paper form: law-specific parameters of ``model``
         (:func:`jointdyn.laws.law_parameters`), e.g. ``{"n": 200}``.
