@@ -14,6 +14,7 @@ import pytest
 import jointdyn as jd
 from jointdyn.cli import main
 from jointdyn.sweeps import frc_sweep
+from test_files import ISSUE_EXAMPLE
 from tolerances import TEST_HB_VS_TIME_RTOL
 
 SYSTEM = """\
@@ -98,7 +99,7 @@ def test_time_json_files_and_resume(system_file, capsys, tmp_path):
 PAPER_OPTIONS = [
     ["--eta", "0.5"], ["--beta", "2"], ["--f1", "3"], ["--delta", "0"], ["--m", "1"], ["--k", "1"],
     ["--kt", "1"], ["--kn", "1"], ["--mu", "0.5"], ["--n0", "100"], ["--model", "iwan"],
-    ["--law-param", "max_depth=8"], ["--n", "20"], ["--zeta", "0"],
+    ["--law-param", "capacity=8"], ["--n", "20"], ["--zeta", "0"],
 ]
 
 
@@ -169,3 +170,47 @@ def test_hb_on_a_system_file(system_file, capsys, tmp_path):
     assert first["amplitude_m"][0] == pytest.approx(ss.amplitude_m, rel=TEST_HB_VS_TIME_RTOL)
     for name in ("frc.nc", "frc.csv", "frc.png"):
         assert (tmp_path / "hb" / name).stat().st_size > 0
+
+
+#: the issue's example with the forcing in phase (the spring alone)
+SPRING_IN_PHASE = ISSUE_EXAMPLE.replace("phase_deg = 90.0", "phase_deg = 0.0")
+
+
+def _solver_refusal(method, system):
+    """The solver's own refusal of ``system`` (its ValueError text), or None
+    when it takes it (the call is then made with the test's small settings)."""
+    try:
+        if method == "time":
+            jd.steady_state(system, 0.5, max_periods=1)
+        else:
+            from jointdyn.hb import frc_hb
+
+            frc_hb(system, 0.5, 0.6, harmonics=3, samples=64, progress=False)
+    except ValueError as exc:
+        return str(exc)
+    return None
+
+
+@pytest.mark.parametrize("text", [ISSUE_EXAMPLE, SPRING_IN_PHASE], ids=["as-written", "spring-in-phase"])
+@pytest.mark.parametrize("method", ["time", "hb"])
+def test_issue_example_runs_or_is_refused_in_one_line(method, text, capsys, tmp_path):
+    """The issue's example through the command line: a solver that does not
+    take a normal spring or forcing phases says so in one line naming the
+    method (its own words), exit 2, no file; a solver that takes them runs."""
+    p = tmp_path / "issue.toml"
+    p.write_text(text)
+    out = tmp_path / "o"
+    gamma = "0.5:0.5:0.1" if method == "time" else "0.5:0.6:0.1"
+    argv = ["frc", "--method", method, "--system", str(p), "--gamma", gamma, "--json", "--out", str(out)]
+    rc, stdout, err = _cli(capsys, argv + (["--sweep", "up", "--workers", "1"] if method == "time" else []))
+    if rc == 2:
+        refusal = _solver_refusal(method, jd.read_system(p))
+        assert refusal is not None, err
+        assert stdout == "" and err.strip() == f"jointdyn frc: error: --method {method}: {refusal}"
+        assert "Traceback" not in err and not out.exists()
+    else:
+        assert rc == 0, err
+        res = json.loads(stdout)
+        assert res["system"]["response_dof"] == 0 and res["system"]["w0_rad_s"] == pytest.approx(197.5, abs=0.05)
+        for name in ("frc.nc", "frc.csv", "frc.png"):
+            assert (out / name).stat().st_size > 0

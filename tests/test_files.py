@@ -102,8 +102,8 @@ def test_issue_example_prescribed_alternative(tmp_path):
     s = jd.read_system(_write(tmp_path, text))
     assert s.contacts[0].normal == jd.HarmonicLoad(100.0, 50.0, 0.0)
     assert s.contacts[0].law.n_ref == 100.0
-    # no spring: the reference frequency comes from (M, K) alone, whose second DOF is free
-    assert s.w0 == 0.0
+    # no spring: the second DOF is free (a rigid-body mode, skipped); w0 is the first DOF's sqrt(k/m)
+    assert s.w0 == pytest.approx(math.sqrt(3.9e5 / 10.0), rel=1e-14)
 
 
 @pytest.mark.parametrize("normal, load, n_ref", [
@@ -156,6 +156,20 @@ def test_modal_damping_and_w0_override(tmp_path):
     np.testing.assert_allclose(modal - np.diag(np.diag(modal)), 0.0, atol=1e-12 * np.abs(modal).max())
     scalar = jd.read_system(_write(tmp_path, BASE.replace("[[force]]", "zeta = 0.02\n\n[[force]]"), "c.toml"))
     np.testing.assert_allclose(scalar.C, jd.modal_damping(s.M, s.K_reference, 0.02), rtol=1e-14)
+
+
+def test_w0_skips_rigid_body_modes(tmp_path):
+    """A DOF held by nothing but a tangential contact is a rigid-body mode
+    of (M, K_reference): w0 is the lowest elastic frequency; a structure
+    held by nothing at all reads once the file gives w0."""
+    free = BASE.replace("K = [[3.0e5, -1.0e5], [-1.0e5, 1.0e5]]", "K = [[3.0e5, 0.0], [0.0, 0.0]]")
+    s = jd.read_system(_write(tmp_path, free))
+    assert s.w0 == pytest.approx(math.sqrt(3.0e5 / 2.0), rel=1e-14)
+    coupled = BASE.replace("K = [[3.0e5, -1.0e5], [-1.0e5, 1.0e5]]", "K = [[1.0e5, -1.0e5], [-1.0e5, 1.0e5]]")
+    # two masses on one spring: rigid mode plus sqrt(k (1/m1 + 1/m2))
+    assert jd.read_system(_write(tmp_path, coupled, "c.toml")).w0 == pytest.approx(math.sqrt(1.0e5 * 1.5), rel=1e-12)
+    bare = BASE.replace("K = [[3.0e5, -1.0e5], [-1.0e5, 1.0e5]]", "K = [[0.0, 0.0], [0.0, 0.0]]\nw0 = 250.0")
+    assert jd.read_system(_write(tmp_path, bare, "b.toml")).w0 == 250.0
 
 
 # --- matrix files -------------------------------------------------------------------------
@@ -260,6 +274,8 @@ BAD = [
     ("negative zeta", _add("[structure]", "zeta = -0.01"), "structure.zeta must be >= 0"),
     ("zeta per mode of the wrong length", _add("[structure]", "zeta = [0.01]"), "structure.zeta must have 2 entries"),
     ("w0 zero", _add("[structure]", "w0 = 0.0"), "structure.w0 must be > 0"),
+    ("no stiffness and no w0", _sub("K = [[3.0e5, -1.0e5], [-1.0e5, 1.0e5]]", "K = [[0.0, 0.0], [0.0, 0.0]]"),
+     "structure.w0 is needed"),
     ("force DOF out of range", _sub("dof = 1\namplitude", "dof = 2\namplitude"), "force[0].dof must be in [0, 1]"),
     ("force DOF twice", _add("amplitude = 20.0", "\n[[force]]\ndof = 1\namplitude = 3.0"),
      "force[1].dof 1 is already forced by force[0]"),

@@ -163,6 +163,11 @@ SWEEP_PROGRESS_POLL_S = 0.2
 #: fallback where the kernel's parent-death signal is not available)
 SWEEP_PARENT_POLL_S = 0.5
 
+# --- systems (jointdyn.systems) ---------------------------------------------------------
+#: eigenvalues of (M, K_reference) below this fraction of the largest are
+#: rigid-body modes (zero up to rounding), skipped by the default w0
+SYSTEM_RIGID_MODE_RTOL = 1e-10
+
 # --- system files (jointdyn.files) ------------------------------------------------------
 #: most degrees of freedom of a matrix read from a system file (its dense
 #: float64 copy takes 8 n^2 bytes: 800 MB at the bound)

@@ -538,6 +538,10 @@ def read_system_file(path) -> SystemFile:
             system = System(M, modal_damping(M, system.K_reference, st["zeta"]), K, **kw)
     except ValueError as exc:
         raise ValueError(" ".join(f"{p}: {exc}".split())) from None
+    if st["w0"] is None and not system.w0 > 0.0:
+        raise where.error("structure.w0", "is needed: every natural frequency of (M, K) with the normal springs "
+                          "in place and the tangential contacts free is 0 (nothing but the tangential contacts holds "
+                          "the structure); give w0 (rad/s) under [structure]")
     return SystemFile(system=system, path=p, title=title,
                       dofs=tuple(dofs) if dofs is not None else (system.response_dof,))
 

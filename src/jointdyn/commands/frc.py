@@ -303,7 +303,11 @@ def _sweep(args, gammas, directions, client):
     common = dict(directions=directions, steps_per_period=args.steps_per_period, client=client,
                   n_workers=args.workers, out=None if args.out is None else Path(args.out), progress=not args.json)
     if args.system_file is not None:
-        ds = frc_sweep(args.system_file.system, gammas, dofs=args.system_file.dofs, **common)
+        try:
+            ds = frc_sweep(args.system_file.system, gammas, dofs=args.system_file.dofs, **common)
+        except ValueError as exc:
+            # the options are checked already: what is left is the time integrator's refusal of the structure
+            raise ValueError(f"--method time: {exc}") from None
         return ds, ds
     ds = frc_sweep(
         gammas,
@@ -389,8 +393,12 @@ def _run_hb(args, gammas):
     system = _system(args)
     if gammas.size < 2:
         raise ValueError("--gamma must span a range (STOP > START) for --method hb")
-    ds = frc_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics, samples=args.samples,
-                response_dof=system.response_dof, progress=None if not args.json else False)
+    try:
+        ds = frc_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics, samples=args.samples,
+                    response_dof=system.response_dof, progress=None if not args.json else False)
+    except ValueError as exc:
+        # what the harmonic-balance solver refuses (a kind of normal load, forcing phases) is said as its own
+        raise ValueError(f"--method hb: {exc}") from None
     result = _header(args)
     result["harmonics"] = args.harmonics
     result["samples"] = args.samples
