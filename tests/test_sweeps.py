@@ -528,3 +528,62 @@ def test_stuck_and_slipping_limits_have_their_states():
     slip = frc_sweep(_two_dof(40.0, mu=1e-3, law="jenkins"), [1.0], directions=("up",), n_workers=1,
                      progress=False)
     assert float(slip.state_fraction.sel(direction="up", gamma=1.0, contact=0, state="macroslip")) > 0.8
+
+
+def test_system_family_pool_and_dask_equal_serial():
+    """A mapping {label: System} with per-DOF and per-contact outputs: serial
+    == local process pool == Dask, with chunks of 2 points (lines continue
+    across chunks on other workers; the Systems travel by pickle)."""
+    from unittest import mock
+
+    from distributed import Client, LocalCluster
+
+    family = {"light": _two_dof(40.0), "separating": _two_dof(150.0, law="jenkins")}
+    kw = dict(dofs=[0, 1], progress=False)
+    g = [0.8, 1.0, 1.2]
+    serial = frc_sweep(family, g, **kw, n_workers=1)
+    assert serial.sizes["system"] == 2 and list(serial.system.values) == ["light", "separating"]
+    with mock.patch.object(_frc.config, "SWEEP_CHUNK_POINTS", 2):
+        pooled = frc_sweep(family, g, **kw, n_workers=2)
+        with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
+            with Client(lc) as client:
+                dist = frc_sweep(family, g, **kw, client=client)
+    xr.testing.assert_identical(serial, pooled)
+    xr.testing.assert_identical(serial, dist)
+
+
+def test_damaged_checkpoint_is_recomputed_from_there(fake, tmp_path, monkeypatch):
+    """A truncated chunk file (a full disk, a partial copy) and the
+    temporary file a kill during an atomic write leaves behind: the chunks
+    before the damage are reused, the rest recomputed, the result unchanged."""
+    monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", 2)
+    kw = dict(directions=("up",), n_workers=1, progress=False, out=tmp_path)
+    full = frc_sweep(GAMMAS, **kw)
+    (line,) = (tmp_path / "lines").iterdir()
+    chunks = sorted(line.glob("p*.npz"))
+    assert len(chunks) == 3
+    chunks[1].write_bytes(chunks[1].read_bytes()[:100])
+    (line / ".p000004.npz.abc123.npz").write_bytes(b"half-written")
+    fake.calls.clear()
+    again = frc_sweep(GAMMAS, **kw)
+    assert again.attrs["reused_points"] == 2 and len(fake.calls) == len(GAMMAS) - 2
+    xr.testing.assert_identical(_results(again), _results(full))
+    fake.calls.clear()
+    assert frc_sweep(GAMMAS, **kw).attrs["reused_points"] == len(GAMMAS) and fake.calls == []
+
+
+def test_atomic_path_leaves_the_old_file_on_failure(tmp_path):
+    """A writer that fails half-way leaves the previous file as it was and
+    no temporary file; one that finishes replaces it."""
+    from jointdyn._io import atomic_path
+
+    target = tmp_path / "frc.csv"
+    target.write_text("old")
+    with pytest.raises(RuntimeError):
+        with atomic_path(target) as tmp:
+            tmp.write_text("half")
+            raise RuntimeError("disk full")
+    assert target.read_text() == "old" and sorted(p.name for p in tmp_path.iterdir()) == ["frc.csv"]
+    with atomic_path(target) as tmp:
+        tmp.write_text("new")
+    assert target.read_text() == "new" and sorted(p.name for p in tmp_path.iterdir()) == ["frc.csv"]

@@ -16,6 +16,7 @@ are counted as stale and recomputed, and the new chunks replace it).
 
 from __future__ import annotations
 
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -85,7 +86,7 @@ def _read(path: Path, names, line: int):
             first, done = int(z["first"]), int(z["done"])
             arrays = {n: z[n] for n in names}
             restart = None if bool(z["cold"]) else Restart(*(z[n] for n in _RESTART))
-    except (OSError, ValueError, KeyError, EOFError, TypeError):
+    except (OSError, ValueError, KeyError, EOFError, TypeError, zipfile.BadZipFile):
         return None
     if done < 1 or any(a.shape[:1] != (done,) for a in arrays.values()):
         return None
