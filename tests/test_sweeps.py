@@ -587,3 +587,43 @@ def test_atomic_path_leaves_the_old_file_on_failure(tmp_path):
     with atomic_path(target) as tmp:
         tmp.write_text("new")
     assert target.read_text() == "new" and sorted(p.name for p in tmp_path.iterdir()) == ["frc.csv"]
+
+
+class _Refusing(_Fake):
+    """The fake solver, refusing (ValueError, as a solver refuses a System)
+    the paper damper with eta = 1.5 from gamma 1.0 on."""
+
+    def __call__(self, system, gamma, **kw):
+        if system.contacts[0].eta == 1.5 and gamma >= 1.0:
+            raise ValueError("contact 0: refused by this solver")
+        return super().__call__(system, gamma, **kw)
+
+
+@pytest.mark.parametrize("pool", ["serial", "thread"])
+def test_refused_system_is_named_and_the_finished_points_kept(pool, tmp_path, monkeypatch):
+    """A solver's refusal of one System of a family: one ValueError naming
+    the System by its label; the points finished before it (the other
+    System's, and this one's first chunk) are saved and reused by a rerun,
+    which equals the uninterrupted sweep."""
+    monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", 2)
+    monkeypatch.setattr(_frc.config, "SWEEP_POOL", "thread")
+    family = {f"eta{e}": jd.System.paper_damper(eta=e, beta=2.0) for e in (0.5, 1.5)}
+    kw = dict(directions=("up",), loop_outputs=False, progress=False, n_workers=1 if pool == "serial" else 2)
+    refusing = _Refusing()
+    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: refusing)
+    with pytest.raises(ValueError) as exc:
+        frc_sweep(family, GAMMAS, **kw, out=tmp_path)
+    assert str(exc.value) == "system 'eta1.5': contact 0: refused by this solver"
+    saved = {d.name.split("_")[0]: sum(int(np.load(p)["done"]) for p in d.glob("p*.npz"))
+             for d in (tmp_path / "lines").iterdir()}
+    assert saved["eta1.5"] == 2  # the chunk before gamma 1.0
+    if pool == "serial":  # lines in order: the first one finished before the refusal
+        assert saved["eta0.5"] == len(GAMMAS)
+    assert not (tmp_path / "frc.nc").exists()
+    again = _Fake()
+    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: again)
+    ds = frc_sweep(family, GAMMAS, **kw, out=tmp_path)
+    assert ds.attrs["reused_points"] == sum(saved.values())
+    assert len(again.calls) == 2 * len(GAMMAS) - sum(saved.values())
+    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: _Fake())
+    xr.testing.assert_identical(_results(ds), _results(frc_sweep(family, GAMMAS, **kw)))

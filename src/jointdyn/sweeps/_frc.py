@@ -114,8 +114,9 @@ def _steady_state_fn():
 class _LineRun:
     """One line during a sweep: its spec, where it stands, its results so far."""
 
-    def __init__(self, index, spec, system_index, system, ncontacts, dofs):
+    def __init__(self, index, spec, system_index, system, ncontacts, dofs, where=""):
         self.index = index
+        self.where = where
         self.spec = spec
         self.system_index = system_index
         self.rdof = int(system.response_dof)
@@ -138,7 +139,7 @@ class _LineRun:
         return ChunkTask(line=self.index, system_index=self.system_index, first=self.next,
                          gammas=self.gammas[self.next:stop], start=self.start, rdof=self.rdof, dofs=self.dofs,
                          ncontacts=self.ncontacts, loop_outputs=self.spec.loop_outputs,
-                         steps_per_period=self.spec.steps_per_period)
+                         steps_per_period=self.spec.steps_per_period, where=self.where)
 
     def accept(self, chunk) -> None:
         """Store a chunk that starts where the line stands."""
@@ -259,7 +260,8 @@ def _line_runs(family, directions, g, spp, dofs, loop_outputs) -> list:
         for d in directions:
             spec = LineSpec(label=label, system=key, direction=d, gammas=g, steps_per_period=spp, dofs=dofs,
                             loop_outputs=loop_outputs)
-            runs.append(_LineRun(len(runs), spec, i, system, nc, dofs))
+            where = f"system {label!r}: " if family.dims else ""
+            runs.append(_LineRun(len(runs), spec, i, system, nc, dofs, where))
     return runs
 
 

@@ -221,6 +221,9 @@ class ChunkTask:
         Record per-DOF and per-contact outputs (keeps the steady loop).
     steps_per_period : int or None
         Integration steps per forcing period (None: solver default).
+    where : str
+        Prefix of a solver's refusal (ValueError), naming the System in its
+        family (``"system 'a': "``); empty for a System swept alone.
     """
 
     line: int
@@ -233,6 +236,7 @@ class ChunkTask:
     ncontacts: int
     loop_outputs: bool
     steps_per_period: int | None
+    where: str = ""
 
 
 @dataclass(frozen=True)
@@ -348,6 +352,10 @@ def solve_chunk(task: ChunkTask, system, ctx: Context | None = None) -> ChunkRes
                 ctx.point_done()
     except KeyboardInterrupt:
         interrupted = True
+    except ValueError as exc:
+        if not task.where:
+            raise
+        raise ValueError(f"{task.where}{exc}") from None
     arrays = {name: a[:done] for name, a in out.items()}
     return ChunkResult(line=task.line, first=task.first, done=done, arrays=arrays, restart=start,
                        interrupted=interrupted)

@@ -28,6 +28,7 @@ cluster, the chunks in progress).
 from __future__ import annotations
 
 import collections
+import contextlib
 import ctypes
 import os
 import queue
@@ -280,6 +281,10 @@ def run_chunks(lines, executor, chunk_points: int, on_chunk, on_poll=None) -> No
     ------
     KeyboardInterrupt
         After an interrupt, once the partial chunks are handed to ``on_chunk``.
+    ValueError
+        A chunk's error (a solver's refusal of a System), once the chunks
+        still running are stopped after their current point and handed to
+        ``on_chunk``.
     """
     waiting = collections.deque(line for line in lines if not line.finished)
     try:
@@ -301,6 +306,12 @@ def run_chunks(lines, executor, chunk_points: int, on_chunk, on_poll=None) -> No
     except KeyboardInterrupt:
         executor.request_stop()
         _drain(executor, lines, on_chunk)
+        raise
+    except Exception:
+        # a chunk failed (a solver's refusal of a System): keep what the others finish, report the first error
+        executor.request_stop()
+        with contextlib.suppress(Exception):
+            _drain(executor, lines, on_chunk)
         raise
     finally:
         executor.close()
