@@ -13,6 +13,7 @@ runs every script of ``examples/``.
 from __future__ import annotations
 
 import importlib
+import inspect
 import os
 import pkgutil
 import re
@@ -137,8 +138,10 @@ def _module_page(modname: str, home: dict[int, str]) -> str:
     mod = importlib.import_module(modname)
     title = f"``{modname}``"
     lines = [title, "=" * len(title), "", f".. automodule:: {modname}", "   :no-members:", ""]
-    names = list(getattr(mod, "__all__", ()))
-    if not names:
+    # exported submodules have their own pages (an autosummary entry would
+    # overwrite that page with a generated stub)
+    names = [n for n in getattr(mod, "__all__", ()) if not inspect.ismodule(getattr(mod, n))]
+    if not hasattr(mod, "__all__"):
         # no __all__: the module's documented names (docstrings, ``#:`` comments)
         lines[-2] = "   :members:"
         return "\n".join(lines)

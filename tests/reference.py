@@ -1,6 +1,6 @@
 """Slow plain-Python reference implementations of the contact laws.
 
-Written from MODEL.md (sections 2-5) and the module docstring of
+Written from docs/model.md (sections 2-5) and the module docstring of
 ``jointdyn.laws.iwan_closed``, independently of the compiled kernels' structure
 (no state vectors, no numba, no numpy): objects that hold their memory as
 Python lists and commit on every call of :meth:`step` (the exact Iwan law's
@@ -32,7 +32,7 @@ WIPE_TOL = 1e-9
 
 
 def goa(u, a):
-    """Normalised backbone G_oa(u; a) for u >= 0 and its slope dG/du (MODEL.md s. 3)."""
+    """Normalised backbone G_oa(u; a) for u >= 0 and its slope dG/du (docs/model.md s. 3)."""
     if u < 2.0 * a:
         return u - u * u / (4.0 * a), 1.0 - u / (2.0 * a)
     return a, 0.0
@@ -43,7 +43,7 @@ def _sign(v):
 
 
 class DiscreteIwanRef:
-    """n Jenkins elements, MODEL.md section 5, one element at a time.
+    """n Jenkins elements, docs/model.md section 5, one element at a time.
 
     Element i: stiffness kt/n, slip force alpha f_i / n with f_i the midpoint
     of the i-th of n equal bins of [0, 2 fy].

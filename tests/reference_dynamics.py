@@ -1,6 +1,6 @@
 """Plain reference integration of a forced structure with memoryless contacts.
 
-Written from the equation of motion (MODEL.md section 6, systems.py),
+Written from the equation of motion (docs/model.md section 6, systems.py),
 independently of jointdyn's integrator: no step grid, no events, no
 trial/commit law states, no Numba. The contact law is any smooth function
 T(u, N) of the tangential displacement and the normal load (an elastic law

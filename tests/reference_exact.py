@@ -1,7 +1,7 @@
 """Plain-Python reference of the exact Iwan law (``iwan``, the default).
 
 Written from the algorithm of ``jointdyn.laws.exact`` (module docstring) and
-MODEL.md sections 2, 3 and 5, without its state vector, its kernels or
+docs/model.md sections 2, 3 and 5, without its state vector, its kernels or
 numpy: the state is a Python list of pieces ``[lo, hi, a, b]`` (P(u) = a +
 b u on [lo, hi], u the slip strength in units of fy, P in units of fy), and
 each step is done the straightforward way:

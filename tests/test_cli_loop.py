@@ -53,7 +53,7 @@ def test_json_default_matches_closed_form(capsys):
     assert KEYS <= set(d)
     assert d["model"] == "iwan" and d["parameters"]["capacity"] == 32
     assert d["parameters"]["kt_N_per_m"] == KT and d["parameters"]["amplitude_m"] == A
-    # MODEL.md section 2, A > 2 fy / kt: E = 4 fy A - 16 fy^2 / (3 kt)
+    # docs/model.md section 2, A > 2 fy / kt: E = 4 fy A - 16 fy^2 / (3 kt)
     assert d["energy_per_cycle_J"] == pytest.approx(4 * FY * A - 16 * FY**2 / (3 * KT), rel=TEST_ENERGY_RTOL)
     assert d["force_max_N"] == pytest.approx(FY) and d["force_min_N"] == pytest.approx(-FY)
     assert d["secant_stiffness_N_per_m"] == pytest.approx(FY / A)

@@ -113,7 +113,7 @@ def test_two_dof_separating_contact_events_and_law():
 @pytest.mark.parametrize("eta", [0.0, 0.5])
 def test_lightly_damped_peak_at_stuck_frequency(eta):
     # beta = 1000: almost everything sticks, the peak is the stuck linear
-    # resonance gamma = sqrt((k + kt)/k) = 1.330 (MODEL.md section 6)
+    # resonance gamma = sqrt((k + kt)/k) = 1.330 (docs/model.md section 6)
     s = System.paper_damper(eta=eta, beta=1000.0)
     g_lin = math.sqrt((K + KT) / K)
 

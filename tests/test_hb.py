@@ -80,7 +80,7 @@ def test_jacobian_matches_central_differences(model, eta, par):
                                zeta=0.01)
     g = 1.1
     p = HBProblem(sysm, harmonics=4, samples=128, parameter=par, gamma=None if par == "gamma" else g)
-    lam = {"eta": eta, "delta": 0.3, "n0": 100.0, "gamma": g, "f1": p.f1_ref}[par]
+    lam = {"eta": eta, "delta": math.degrees(0.3), "n0": 100.0, "gamma": g, "f1": p.f1_ref}[par]
     X = harmonic_balance(sysm, g, harmonics=4, samples=128).X
     ev = p.evaluate(X, lam)
     Ja = np.c_[ev.JX, ev.Jp]
@@ -230,11 +230,11 @@ def test_generic_continuation_finds_both_folds_of_a_cubic():
     assert np.all(np.abs(r.y[:, 0] ** 3 - r.y[:, 0] + r.lam) < 1e-8)
 
 
-def _damper(eta=0.1, delta=0.0, n0=100.0, f1=25.0):
+def _damper(eta=0.1, delta=0.0, n0=100.0, f1=25.0):  # delta in degrees, like the parameter
     from jointdyn.laws import Iwan
 
     law = Iwan(kt=3e5, mu=0.5, n_ref=100.0)
-    return System.sdof(m=10.0, k=3.9e5, law=law, f1=f1, n0=n0, eta=eta, delta_deg=math.degrees(delta))
+    return System.sdof(m=10.0, k=3.9e5, law=law, f1=f1, n0=n0, eta=eta, delta_deg=delta)
 
 
 def test_turning_points_ignore_jitter_within_the_band():
@@ -243,7 +243,7 @@ def test_turning_points_ignore_jitter_within_the_band():
     assert list(turning_points(lam, band=0.0)) == [3, 4, 6, 8]
 
 
-@pytest.mark.parametrize("par,start,stop", [("eta", 0.1, 0.6), ("delta", 0.0, 1.5), ("n0", 80.0, 140.0),
+@pytest.mark.parametrize("par,start,stop", [("eta", 0.1, 0.6), ("delta", 0.0, 85.0), ("n0", 80.0, 140.0),
                                             ("f1", 10.0, 40.0)])
 def test_continuation_in_a_parameter_matches_fixed_solutions(par, start, stop):
     br = continue_hb(_damper(**{par: start}), start, stop, parameter=par, gamma=1.4, harmonics=5, samples=128)

@@ -97,7 +97,7 @@ def _reference(p, X, lam):
 def test_compiled_evaluation_equals_plain_march(model, kw, eta, par):
     s = System.paper_damper(eta=eta, beta=2.0, model=model, delta_deg=math.degrees(0.3), zeta=0.01, **kw)
     p = HBProblem(s, harmonics=3, samples=32, parameter=par, gamma=None if par == "gamma" else 1.1)
-    lam = {"gamma": 1.1, "delta": 0.3, "eta": eta}[par]
+    lam = {"gamma": 1.1, "delta": math.degrees(0.3), "eta": eta}[par]
     X0 = p.linear_guess(lam)
     rng = np.random.default_rng(7)
     slipping = 0

@@ -1,4 +1,4 @@
-"""Contact laws against closed forms of MODEL.md sections 2-3 and the
+"""Contact laws against closed forms of docs/model.md sections 2-3 and the
 discrete ground truth (section 5).
 
 * backbone: first loading follows G_oa(q; alpha) = q - q^2/(4 alpha) up to
@@ -28,14 +28,14 @@ XS = 2.0 * FY / KT
 
 
 def t_oa(x, fy=FY, kt=KT):
-    """Dimensional backbone of MODEL.md section 2 (alpha = 1), odd in x."""
+    """Dimensional backbone of docs/model.md section 2 (alpha = 1), odd in x."""
     x = np.asarray(x, dtype=float)
     a = np.abs(kt * x)
     return np.sign(x) * np.where(a <= 2 * fy, a - a * a / (4 * fy), fy)
 
 
 def g_oa(q, alpha):
-    """Normalised backbone of MODEL.md section 3, odd in q."""
+    """Normalised backbone of docs/model.md section 3, odd in q."""
     a = np.abs(q)
     return np.sign(q) * np.where(a <= 2 * alpha, a - a * a / (4 * alpha), alpha)
 
@@ -117,7 +117,7 @@ def test_energy_per_cycle(name, qa):
 
 
 def test_energy_normalised_form():
-    """MODEL.md's normalised energies q_a^3/3 and 4 q_a - 16/3 agree with the
+    """docs/model.md's normalised energies q_a^3/3 and 4 q_a - 16/3 agree with the
     dimensional ones and meet at q_a = 2 (guards energy_formula itself)."""
     for qa in (0.5, 2.0, 3.0):
         En = qa**3 / 3 if qa <= 2 else 4 * qa - 16 / 3

@@ -9,7 +9,7 @@
   the exact law shrinks like 1/n^2 (n = 500 ... 4000);
 * ``step_jvp`` against central finite differences of ``step`` marches,
   with and without merges (the derivative of a merge is exact too);
-* the describing-function energy per cycle (MODEL.md section 2) at
+* the describing-function energy per cycle (docs/model.md section 2) at
   constant load, below and beyond macroslip;
 * hypothesis properties: |T| <= alpha fy, T = 0 and SEPARATION where
   N <= 0, 0 <= kT <= kt, at most ``capacity`` pieces, no energy created

@@ -1,7 +1,7 @@
 """Compiled contact-law kernels agree with the plain-Python references.
 
 ``tests/reference.py`` re-implements every registered law from its
-specification alone (the discrete Iwan model of MODEL.md section 5, the
+specification alone (the discrete Iwan model of docs/model.md section 5, the
 exact Iwan law's pieces, the closed-form Iwan law with full Masing memory,
 the paper's last-reversal rule); a registered law without a reference fails. These tests march both over
 random histories (nested, growing, random-walk displacements; constant,

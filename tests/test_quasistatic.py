@@ -1,8 +1,8 @@
 """Quasi-static driver: histories, exact separation, loop metrics vs closed forms.
 
-Oracles: MODEL.md section 2 energy per cycle, backbone tip of a steady
+Oracles: docs/model.md section 2 energy per cycle, backbone tip of a steady
 Masing loop, analytic separation time of N = N0 (1 + eta sin), the virgin
-curve after re-contact (MODEL.md section 3), and step-halving convergence.
+curve after re-contact (docs/model.md section 3), and step-halving convergence.
 """
 
 import math
@@ -22,7 +22,7 @@ XS = 2 * FY / KT  # 0.2 mm: amplitude at which the steady loop starts to macrosl
 
 
 def energy_closed_form(A):
-    """MODEL.md section 2: energy dissipated per symmetric cycle, J."""
+    """docs/model.md section 2: energy dissipated per symmetric cycle, J."""
     if A <= XS:
         return KT**2 * A**3 / (3 * FY)
     return 4 * FY * A - 16 * FY**2 / (3 * KT)
@@ -118,7 +118,7 @@ def test_energy_per_cycle_matches_closed_form(A, name):
     E = r.last_cycle()["energy_per_cycle_J"]
     assert E == pytest.approx(energy_closed_form(A), rel=TEST_ENERGY_RTOL)
     c = r.last_cycle()
-    # steady Masing loop: its tips lie on the backbone (MODEL.md section 2)
+    # steady Masing loop: its tips lie on the backbone (docs/model.md section 2)
     tip = KT * A - (KT * A) ** 2 / (4 * FY) if A <= XS else FY
     assert c["force_max_N"] == pytest.approx(tip, rel=TEST_ENERGY_RTOL)
     assert c["force_min_N"] == pytest.approx(-tip, rel=TEST_ENERGY_RTOL)

@@ -11,18 +11,19 @@ Data layout
 -----------
 :func:`contact_kinematics` packs the contacts of a System into a frozen
 :class:`ContactKinematics`; compiled code receives its ``arrays`` tuple
-``(tan_idx, tan_w, normal_kind, normal_par)``:
+``(tan_idx, tan_w, normal_kind, normal_par)``::
 
-``tan_idx``  int64 (nc, m)    DOFs entering the tangential displacement of
-                              contact c; ``tan_idx[c, 0]`` is always a DOF,
-                              later entries may be -1 (unused)
-``tan_w``    float64 (nc, m)  their weights: u_c = sum_k tan_w[c, k] x[tan_idx[c, k]]
-                              (a contact between DOFs a and b: (a, b), (1, -1);
-                              against ground: (a, -1), (1, 0))
-``normal_kind`` int64 (nc,)   how N_c is produced (:data:`NORMAL_HARMONIC`)
-``normal_par``  float64 (nc, 3)  its parameter row; for NORMAL_HARMONIC
-                              (n0 N, n1 N, delta rad): N = n0 + n1 sin(phase + delta),
-                              phase = w t
+    tan_idx      int64 (nc, m)     DOFs entering the tangential displacement
+                                   of contact c; tan_idx[c, 0] is always a
+                                   DOF, later entries may be -1 (unused)
+    tan_w        float64 (nc, m)   their weights:
+                                   u_c = sum_k tan_w[c, k] x[tan_idx[c, k]]
+                                   (between DOFs a and b: (a, b), (1, -1);
+                                   against ground: (a, -1), (1, 0))
+    normal_kind  int64 (nc,)       how N_c is produced (NORMAL_HARMONIC)
+    normal_par   float64 (nc, 3)   its parameter row; for NORMAL_HARMONIC
+                                   (n0 N, n1 N, delta rad):
+                                   N = n0 + n1 sin(phase + delta), phase = w t
 
 The compiled helpers :func:`tangential` and :func:`apply_tangential_force`
 take the selection arrays and a contact index, :func:`normal_load` the kind

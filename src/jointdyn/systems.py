@@ -318,7 +318,7 @@ class System:
         n: int | None = None,
         **overrides,
     ) -> "System":
-        """The paper's friction damper (MODEL.md section 6) in its groups.
+        """The paper's friction damper (docs/model.md section 6) in its groups.
 
         Parameters
         ----------

@@ -7,7 +7,7 @@ the paper's harmonic shorthand (section 2.2, Figs 3-4)::
 
 with N0 = ``--n-ref``, or by a CSV file (``--input``, columns t, x, N in s,
 m, N). With ``--kn`` the normal load comes from a unilateral spring
-N = max(0, N_ref + kn v) (MODEL.md section 1) driven by the normal motion
+N = max(0, N_ref + kn v) (docs/model.md section 1) driven by the normal motion
 v = (eta N_ref / kn) sin(2 pi f t + delta): identical to the prescribed
 load in contact, 0 instead of negative while separated, so the tangential
 loop does not depend on kn.

@@ -1,7 +1,7 @@
 """Quasi-static hysteresis: march a contact law over a prescribed history.
 
 The tangential displacement x(t) and the normal load N(t) are prescribed
-(MODEL.md sections 1 and 6, paper section 2.2, Figs 2-4); inertia plays no
+(docs/model.md sections 1 and 6, paper section 2.2, Figs 2-4); inertia plays no
 part, so the force is the law's response to the history and time only
 orders the samples. This module builds the paper's harmonic history, reads
 a history from CSV, marches any registered law over it and reduces the
@@ -71,7 +71,7 @@ def harmonic_history(
     x_offset=0.0,
     kn=None,
 ):
-    """The paper's quasi-static history (paper section 2.2, MODEL.md section 6).
+    """The paper's quasi-static history (paper section 2.2, docs/model.md section 6).
 
     ``x(t) = x_offset + A sin(2 pi f t)`` and
     ``N(t) = N0 + eta N0 sin(2 pi f t + delta)`` on ``0 <= t <= cycles / f``,
@@ -102,7 +102,7 @@ def harmonic_history(
         Constant added to x, m (finite).
     kn : float, optional
         Normal stiffness, N/m (> 0). If given, N comes from the unilateral
-        spring ``N = max(0, N0 + kn v)`` (MODEL.md section 1) driven by the
+        spring ``N = max(0, N0 + kn v)`` (docs/model.md section 1) driven by the
         prescribed normal motion ``v = (eta N0 / kn) sin(2 pi f t + delta)``,
         m. This equals the prescribed load while in contact and 0 (instead
         of negative) while separated, so the tangential response does not
@@ -420,17 +420,17 @@ def cycle_count(t, period, name: str = "period") -> int:
 def quasistatic(law, t, x, N, *, period=None, state=None) -> LoopResult:
     """March ``law`` over a prescribed history and measure its loops.
 
-    The law (any registered law: the exact Iwan law, MODEL.md section 5 at
-    n -> infinity; the closed forms, paper section 2.1 / MODEL.md section 3;
-    discrete Iwan, MODEL.md section 5; Jenkins) is stepped sample by sample
+    The law (any registered law: the exact Iwan law, docs/model.md section 5 at
+    n -> infinity; the closed forms, paper section 2.1 / docs/model.md section 3;
+    discrete Iwan, docs/model.md section 5; Jenkins) is stepped sample by sample
     from its virgin state at ``x[0], N[0]`` (or ``state``).
 
-    Separation (MODEL.md section 4): wherever N changes sign strictly
+    Separation (docs/model.md section 4): wherever N changes sign strictly
     between two samples, the crossing instant (x and N linear in t) is
     inserted as a sample with N = 0. A sample with N exactly 0 followed by a
     positive load is the re-contact instant: the law is evaluated there with
     a vanishing positive load (``1e-300 * n_ref``) so that its virgin curve
-    starts at exactly that displacement (MODEL.md section 3, "virgin state");
+    starts at exactly that displacement (docs/model.md section 3, "virgin state");
     the sample is reported as separated, with T = 0. Every sample with
     N <= 0 is SEPARATION with T = 0.
 
@@ -445,7 +445,7 @@ def quasistatic(law, t, x, N, *, period=None, state=None) -> LoopResult:
 
     - ``energy_per_cycle_J``: trapezoidal integral of T dx over the window,
       J. For a closed steady cycle this is the loop area, the energy
-      dissipated per cycle (MODEL.md section 2: kt^2 A^3 / (3 fy) for
+      dissipated per cycle (docs/model.md section 2: kt^2 A^3 / (3 fy) for
       A <= 2 fy / kt, 4 fy A - 16 fy^2 / (3 kt) beyond, at constant N).
     - ``force_max_N`` / ``force_min_N``: extremes of T, N.
     - ``x_max_m`` / ``x_min_m``: extremes of x, m.

@@ -1,4 +1,4 @@
-"""Time integration of a :class:`~jointdyn.systems.System` (MODEL.md section 6).
+"""Time integration of a :class:`~jointdyn.systems.System` (docs/model.md section 6).
 
 Equation of motion (systems.py)::
 
@@ -119,7 +119,7 @@ def integrate(
     """Integrate the harmonically forced system over whole forcing periods.
 
     Solves M x'' + C x' + K x = f sin(w t) - sum_c B_c T_c(u_c, N_c(t)) with
-    N_c(t) = n0 + n1 sin(w t + delta) (MODEL.md section 6) from t = 0.
+    N_c(t) = n0 + n1 sin(w t + delta) (docs/model.md section 6) from t = 0.
 
     Parameters
     ----------

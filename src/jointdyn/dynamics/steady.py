@@ -5,8 +5,8 @@ repeats with the forcing period, or with a multiple p <= 4 of it, within
 tolerances on the half peak-to-peak amplitude, the period-boundary state
 (Poincare points) and the energy per period over K windows; otherwise it
 classifies the run as ``"unbounded"`` (amplitude still growing, e.g. the Den
-Hartog case of MODEL.md section 6) or ``"not-settled"``. When the transient
-decays slowly (lightly damped cases, MODEL.md section 7) it computes the
+Hartog case of docs/model.md section 6) or ``"not-settled"``. When the transient
+decays slowly (lightly damped cases, docs/model.md section 7) it computes the
 periodic state directly by shooting: Newton on the period map of (x, v) with
 the law state carried along, finite-difference monodromy matrix, minimum-norm
 (least-squares) steps because the offset of a partly stuck contact is
@@ -60,7 +60,7 @@ class SteadyState:
     gamma, omega : float
         Frequency ratio w / w0 and excitation frequency w (rad/s).
     amplitude_q : float
-        kt X / fy of the first contact's law (MODEL.md section 6).
+        kt X / fy of the first contact's law (docs/model.md section 6).
     amplitude_m : float
         X = half peak-to-peak of x[response_dof] over the final p periods, m.
     offset_m : float
@@ -617,7 +617,7 @@ def steady_state(
     """Steady periodic response at frequency ratio ``gamma``, classified.
 
     Integrates M x'' + C x' + K x = f sin(w t) - sum_c B_c T_c(u_c, N_c(t))
-    (MODEL.md section 6), w = gamma w0, until the response repeats with the
+    (docs/model.md section 6), w = gamma w0, until the response repeats with the
     forcing period or a multiple p <= ``config.SS_MAX_MULTIPLE``: over the
     last ``check_periods`` windows of p periods the half peak-to-peak
     amplitude of x[response_dof] and the period-boundary state agree within

@@ -1,4 +1,4 @@
-"""Figures of the forced friction damper (paper section 3-4, MODEL.md section 6).
+"""Figures of the forced friction damper (paper section 3-4, docs/model.md section 6).
 
 ``fig6``
     Frequency-response curves: normalised amplitude of q = kt x / fy vs

@@ -12,7 +12,7 @@
 - ``fig4_discrete``: the Fig 4 cases with the closed form (full Masing
   memory, ``iwan-closed``), the paper's last-reversal rule (``iwan-paper``)
   and the discrete ground truth (n = 1000 Jenkins elements) overlaid
-  (MODEL.md sections 3 and 5): the paper's closed forms on purpose.
+  (docs/model.md sections 3 and 5): the paper's closed forms on purpose.
 
 Two cycles are computed from the virgin state and the last (steady) one is
 tabulated and plotted. Tables are long format (one row per sample).

@@ -5,7 +5,7 @@ gamma = w / w0 or in another scalar parameter (see
 :mod:`jointdyn.hb.parameters`) with the generic arc-length continuation of
 :mod:`jointdyn.continuation`, marks the stability of
 every point by Hill's method (:mod:`jointdyn.hb.stability`) and the folds,
-and detects unbounded responses (MODEL.md section 6). :func:`frc_hb` is the
+and detects unbounded responses (docs/model.md section 6). :func:`frc_hb` is the
 frequency-response front end returning an :class:`xarray.Dataset`.
 
 Unbounded responses

@@ -26,7 +26,7 @@ Built-ins (exact derivatives): :data:`GAMMA` (w / w0), :data:`F1` (forcing
 amplitude, the force vector scaled so that its largest entry is f1),
 :data:`ETA` (N1 / N0 of every contact), :data:`N0` (static normal load of
 every contact, eta kept), :data:`DELTA` (phase of every contact's normal
-load). :class:`SystemParameter` continues in any value that builds a
+load, in degrees like every phase of the API). :class:`SystemParameter` continues in any value that builds a
 :class:`~jointdyn.System` (a friction coefficient, a stiffness, a mass):
 its derivative dR/dp is a central difference of the residual, not exact.
 """
@@ -158,7 +158,8 @@ class StaticLoad(HBParameter):
 
 
 class LoadPhase(HBParameter):
-    """Phase delta (rad) of every contact's normal load."""
+    """Phase delta of every contact's normal load, degrees (the parameter
+    value; the load coefficients hold it in radians)."""
 
     name = "delta"
     enters_loads = True
@@ -166,8 +167,8 @@ class LoadPhase(HBParameter):
     def contact_loads(self, problem, p):
         co = problem.load_coefficients.copy()
         d = np.zeros_like(co)
-        co[:, 2] = p
-        d[:, 2] = 1.0
+        co[:, 2] = np.deg2rad(p)
+        d[:, 2] = np.pi / 180.0
         return co, d
 
 

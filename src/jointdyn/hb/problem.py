@@ -1,6 +1,6 @@
 """Harmonic-balance residual of a :class:`~jointdyn.systems.System`.
 
-Equation of motion (MODEL.md section 6, generalised in ``systems.py``)::
+Equation of motion (docs/model.md section 6, generalised in ``systems.py``)::
 
     M x'' + C x' + K x + sum_c B_c T_c(u_c, N_c) = f sin(w t),
     u_c = B_c^T x,   N_c(t) = n0_c + n1_c sin(w t + delta_c).
@@ -221,7 +221,7 @@ class HBProblem:
     def linear_guess(self, p, stuck: bool = True):
         """Linear response with every contact stuck (stiffness kt) or absent.
 
-        Used to start Newton and continuation (MODEL.md section 6: all
+        Used to start Newton and continuation (docs/model.md section 6: all
         stuck -> linear system with K + kt).
         """
         q = self.parameter.problem_at(self, p) if isinstance(self.parameter, SystemParameter) else self

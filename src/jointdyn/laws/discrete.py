@@ -1,4 +1,4 @@
-"""Discrete Iwan model: n parallel Jenkins elements (MODEL.md section 5).
+"""Discrete Iwan model: n parallel Jenkins elements (docs/model.md section 5).
 
 The ground truth of jointdyn: exact for any history (Masing memory is
 automatic) and any normal-load variation. ``n = 1`` is a single Jenkins
@@ -112,7 +112,7 @@ def _discrete_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
 def discrete_step(params, s_old, s_new, x, N):
     """Trial step of n Jenkins elements with load-scaled slip forces.
 
-    Implements MODEL.md section 5: for each element, trial force
+    Implements docs/model.md section 5: for each element, trial force
     ``p_i + (kt/n) dx``, clipped to ``alpha f_i / n`` with
     ``alpha = N / N_ref``; all ``p_i = 0`` when ``alpha <= 0``.
 

@@ -2,7 +2,7 @@
 
 The default contact law of jointdyn (:class:`Iwan`, registered as ``iwan``).
 
-The uniform Iwan model (MODEL.md sections 2, 3, 5) is a continuum of Jenkins
+The uniform Iwan model (docs/model.md sections 2, 3, 5) is a continuum of Jenkins
 elements with slip strengths spread uniformly over [0, 2 fy] at the
 reference load, each limit scaled by alpha = N / N_ref. Its state is the
 function P(u): the force of the element of slip strength u fy (u in [0, 2]),

@@ -1,8 +1,8 @@
-"""Closed-form Iwan model with time-varying normal load (MODEL.md sections 2-4).
+"""Closed-form Iwan model with time-varying normal load (docs/model.md sections 2-4).
 
 Uniform slip density on [0, 2 alpha fy], alpha(t) = N(t)/N_ref. The force on
 a branch that started at a reversal point (q0, G0, alpha0) is the modified
-Masing rule (paper section 2.1, normalised form; MODEL.md section 3)::
+Masing rule (paper section 2.1, normalised form; docs/model.md section 3)::
 
     G = G0 + d c G_oa(|q - q0| / c; alpha),   c = 1 + alpha0 / alpha,
     G_oa(u; a) = u - u^2 / (4 a)  (u < 2a),   a  (u >= 2a),
@@ -80,7 +80,7 @@ def _goa(u, a):
 
 @jit
 def backbone(q, alpha):
-    """Normalised virgin curve G_oa(q; alpha), odd in q (MODEL.md eq. of section 3).
+    """Normalised virgin curve G_oa(q; alpha), odd in q (docs/model.md eq. of section 3).
 
     Parameters
     ----------
@@ -419,7 +419,7 @@ def closed_step(params, s_old, s_new, x, N):
     Returns
     -------
     T : float
-        Tangential force, N (paper eq. for T-> / T<-, MODEL.md section 3).
+        Tangential force, N (paper eq. for T-> / T<-, docs/model.md section 3).
     kT : float
         Tangent dT/dx at fixed N, N/m.
     code : int

@@ -212,7 +212,7 @@ def _paper_groups(etas, betas, f1s, deltas, overrides):
 
 def paper_family(*, etas, betas, f1s, deltas, model, law_params, zeta, overrides) -> Family:
     """The paper damper's grid (eta x beta or F1 x delta) as a family of
-    ``System.paper_damper`` (MODEL.md section 6)."""
+    ``System.paper_damper`` (docs/model.md section 6)."""
     from ..laws import canonical_law_params, law_names
     from ..systems import PAPER, System
 
@@ -244,7 +244,7 @@ def paper_family(*, etas, betas, f1s, deltas, model, law_params, zeta, overrides
     else:
         coords["beta"] = (("f1",), fy / np.asarray(loads, float), {"long_name": "mu N0 / F1"})
     attrs = {
-        "title": "steady-state frequency response of the friction damper (MODEL.md section 6)",
+        "title": "steady-state frequency response of the friction damper (docs/model.md section 6)",
         "model": model,
         **{f"law_param_{key}": val for key, val in lp},
         "zeta": float(zeta),

@@ -7,7 +7,7 @@ for
 
 - one :class:`~jointdyn.System` (Dataset dims ``direction, gamma``),
 - a mapping of labelled Systems (dims ``system, direction, gamma``),
-- the paper damper (MODEL.md section 6) on a grid of its groups ``eta =
+- the paper damper (docs/model.md section 6) on a grid of its groups ``eta =
   N1/N0``, ``beta = mu N0 / F1`` (or the forcing ``F1`` in N) and ``delta``:
   every grid point is ``System.paper_damper(...)`` (dims ``eta, beta, delta,
   direction, gamma``).
@@ -300,7 +300,7 @@ def frc_sweep(
     - ``frc_sweep(system, gammas, ...)``: ``system`` is a
       :class:`~jointdyn.System` or a mapping ``{label: System}``;
     - ``frc_sweep(gammas, etas=..., betas=..., ...)``: the paper damper
-      (MODEL.md section 6, ``m x'' + c x' + k x = F1 sin(w t) - T(x, N(t))``,
+      (docs/model.md section 6, ``m x'' + c x' + k x = F1 sin(w t) - T(x, N(t))``,
       ``N = N0 (1 + eta sin(w t + delta))``) on the grid of ``etas`` x
       ``betas`` (or ``f1s``) x ``deltas``, each point ``System.paper_damper``.
 
