@@ -380,7 +380,9 @@ def frc_sweep(
     ------
     ValueError
         Bad input (names the parameter and the allowed range); a solver's
-        refusal of a System (raised as the solver words it).
+        refusal of a System (raised as the solver words it, after
+        ``system 'label': `` in a family of Systems; the points finished
+        before it are saved under ``out``).
     """
     paper = dict(etas=etas, betas=betas, f1s=f1s, deltas=deltas, model=model, law_params=law_params, n=n,
                  zeta=zeta, m=m, k=k, kt=kt, mu=mu, n0=n0)
