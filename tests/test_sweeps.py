@@ -627,3 +627,30 @@ def test_refused_system_is_named_and_the_finished_points_kept(pool, tmp_path, mo
     assert len(again.calls) == 2 * len(GAMMAS) - sum(saved.values())
     monkeypatch.setattr(_frc, "_steady_state_fn", lambda: _Fake())
     xr.testing.assert_identical(_results(ds), _results(frc_sweep(family, GAMMAS, **kw)))
+
+
+def test_interrupt_on_dask_keeps_every_finished_point(tmp_path, monkeypatch):
+    """Ctrl-C during a sweep on a Dask cluster: the running chunks stop after
+    their current point (a distributed stop flag) and every point finished
+    anywhere is saved; the rerun reuses exactly them and equals the
+    uninterrupted sweep."""
+    from distributed import Client, LocalCluster
+
+    monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", 4)
+    kw = dict(etas=[0.5, 1.5], betas=[1.0, 2.0], directions=("up",), progress=False)
+    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: _Fake())
+    full = frc_sweep(GAMMAS, **kw, n_workers=1)
+    stop = _Fake(interrupt_at=9)
+    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: stop)
+    with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
+        with Client(lc) as client:
+            with pytest.raises(KeyboardInterrupt):
+                frc_sweep(GAMMAS, **kw, client=client, out=tmp_path)
+    finished = len(stop.calls)  # each recorded call returned a point (the 9th raised instead)
+    assert 0 < finished < 4 * len(GAMMAS)
+    assert _checkpoint_points(tmp_path) == finished
+    again = _Fake()
+    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: again)
+    ds = frc_sweep(GAMMAS, **kw, n_workers=1, out=tmp_path)
+    assert ds.attrs["reused_points"] == finished and len(again.calls) == 4 * len(GAMMAS) - finished
+    xr.testing.assert_identical(_results(ds), _results(full))

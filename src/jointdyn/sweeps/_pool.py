@@ -22,7 +22,8 @@ and hands every finished chunk to a callback (which saves it). On
 KeyboardInterrupt it sets the stop flag, so that each running chunk returns
 after its current point, hands those partial chunks to the callback too,
 and re-raises: an interrupt loses at most the points in progress (on a Dask
-cluster, the chunks in progress).
+cluster too: the stop flag is a ``distributed.Event``; there the progress
+bar moves per chunk).
 """
 
 from __future__ import annotations
@@ -206,8 +207,14 @@ class DaskExecutor:
     """Chunks on a Dask cluster through a connected ``distributed.Client``."""
 
     def __init__(self, systems, client):
+        import uuid
+
+        from distributed import Event
+
         self.client = client
         self.systems = client.scatter(list(systems), broadcast=True)
+        # the stop request reaches the running chunks through the scheduler, checked between points
+        self.ctx = Context(stop=Event(f"jointdyn-sweep-stop-{uuid.uuid4().hex}", client=client))
         self.results = queue.Queue()
         self.futures = set()
         self.done_points = 0
@@ -215,7 +222,7 @@ class DaskExecutor:
 
     def submit(self, task) -> None:
         """Start a chunk on the cluster."""
-        fut = self.client.submit(solve_chunk, task, self.systems[task.system_index], None, pure=False)
+        fut = self.client.submit(solve_chunk, task, self.systems[task.system_index], self.ctx, pure=False)
         self.futures.add(fut)
         fut.add_done_callback(self.results.put)
 
@@ -239,15 +246,17 @@ class DaskExecutor:
         return self.done_points
 
     def request_stop(self) -> None:
-        """Cancel the chunks in flight (their points are lost)."""
-        self.client.cancel(list(self.futures))
-        self.futures.clear()
+        """Ask every running chunk to return after its current point (queued
+        chunks return at once, empty)."""
+        self.ctx.stop.set()
 
     def close(self) -> None:
-        """Cancel what is left."""
+        """Cancel what is left and drop the stop flag from the scheduler."""
         if self.futures:
             self.client.cancel(list(self.futures))
         self.futures.clear()
+        with contextlib.suppress(Exception):  # a client already closing has nothing left to clear
+            self.ctx.stop.clear()
 
 
 def _drain(executor, lines, on_chunk) -> None:
