@@ -64,11 +64,12 @@ def _reference_periods(system, gamma, periods):
     cv = float(system.C[0, 0])
     f1 = float(system.force[0])
     w = gamma * system.w0
-    s_old = law.initial_state(0.0, c.n0 + c.n1 * math.sin(c.delta))
+    delta = math.radians(c.phase_deg)
+    s_old = law.initial_state(0.0, c.n0 + c.n1 * math.sin(delta))
     s_new = np.empty_like(s_old)
 
     def rhs(t, y):
-        N = c.n0 + c.n1 * math.sin(w * t + c.delta)
+        N = c.n0 + c.n1 * math.sin(w * t + delta)
         T, _, _ = step(params, s_old, s_new, y[0], N)
         return np.array([y[1], (f1 * math.sin(w * t) - k * y[0] - cv * y[1] - T) / m])
 
@@ -79,7 +80,7 @@ def _reference_periods(system, gamma, periods):
         solver.step()
         nsteps += 1
         # commit the law at the accepted point
-        N = c.n0 + c.n1 * math.sin(w * solver.t + c.delta)
+        N = c.n0 + c.n1 * math.sin(w * solver.t + delta)
         step(params, s_old, s_new, solver.y[0], N)
         s_old[:] = s_new
     return nsteps

@@ -55,6 +55,18 @@ TEST_HB_DF_RTOL = 1e-4
 #: harmonic balance vs time-domain steady state (relative)
 TEST_HB_VS_TIME_RTOL = 1e-2
 
+# --- sweeps: per-DOF and per-contact outputs ------------------------------------
+#: per-DOF amplitude and offset of the recorded period vs the solver's own
+#: (Hermite extremum and quadrature vs RK4 integral), relative to the amplitude
+TEST_SWEEP_SAME_RTOL = 1e-6
+#: per-contact energy (trapezoid of T du over the steps) vs the solver's
+#: total contact energy, relative, at the default steps per period
+TEST_SWEEP_CONTACT_ENERGY_RTOL = 5e-4
+#: largest normal force over the samples vs the prescribed peak, relative
+TEST_SWEEP_NORMAL_EXTREME_RTOL = 1e-4
+#: time mean of max(0, N) over the steps vs the exact mean, relative
+TEST_SWEEP_NORMAL_MEAN_RTOL = 1e-4
+
 # --- exact Iwan law (iwan) ---------------------------------------------------
 #: compiled kernel vs the plain-Python reference (absolute, units of fy / kt)
 TEST_EXACT_REFERENCE_ATOL_FY = 1e-12

@@ -7,7 +7,8 @@ Public API (everything else is private):
   :class:`Jenkins`, :func:`make_law` (:func:`law_names`,
   :func:`law_parameters`), normal loads;
 - drivers: :func:`march`, :func:`quasistatic`, :func:`harmonic_loop`;
-- systems: :class:`System`, :class:`Contact`;
+- systems: :class:`System`, :class:`Contact`, :func:`read_system` (TOML
+  system files), :func:`read_matrices`;
 - time integration: :func:`integrate`, :func:`steady_state`;
 - harmonic balance: :func:`harmonic_balance`, :func:`frc_hb`;
 - continuation: the module :mod:`jointdyn.continuation`
@@ -36,6 +37,7 @@ from .laws import (
 from .drivers import LoopResult, harmonic_history, harmonic_loop, march, quasistatic, read_history_csv
 from .kinematics import ConstantLoad, HarmonicLoad, NormalSpring, SampledLoad
 from .systems import PAPER, Contact, System, modal_damping
+from .files import read_matrices, read_system
 
 __version__ = "0.1.0"
 
@@ -103,6 +105,8 @@ __all__ = [
     "Contact",
     "PAPER",
     "modal_damping",
+    "read_system",
+    "read_matrices",
     *_LAZY,
     *_SUBMODULES,
 ]

@@ -150,6 +150,28 @@ SWEEP_POOL = "process"
 SWEEP_STATUS = ("periodic", "not-settled", "unbounded")
 #: code of a point that was not computed (never written by a finished sweep)
 SWEEP_STATUS_MISSING = -1
+#: consecutive points of a line solved as one task and saved as one resume
+#: checkpoint (an interrupt stops a task after its current point, so this
+#: bounds what a killed run loses, not what an interrupted one loses)
+SWEEP_CHUNK_POINTS = 8
+#: tasks kept queued per worker (lines in progress at once), so that no
+#: worker waits for the next chunk of a line
+SWEEP_TASKS_PER_WORKER = 2
+#: seconds between refreshes of the progress bar while chunks run
+SWEEP_PROGRESS_POLL_S = 0.2
+#: seconds between checks of a worker process that its parent is alive (the
+#: fallback where the kernel's parent-death signal is not available)
+SWEEP_PARENT_POLL_S = 0.5
+
+# --- systems (jointdyn.systems) ---------------------------------------------------------
+#: eigenvalues of (M, K_reference) below this fraction of the largest are
+#: rigid-body modes (zero up to rounding), skipped by the default w0
+SYSTEM_RIGID_MODE_RTOL = 1e-10
+
+# --- system files (jointdyn.files) ------------------------------------------------------
+#: most degrees of freedom of a matrix read from a system file (its dense
+#: float64 copy takes 8 n^2 bytes: 800 MB at the bound)
+FILES_MAX_DOF = 10_000
 
 # --- harmonic balance: discretisation and AFT ------------------------------------------
 #: harmonics 0..H of the unknowns

@@ -229,14 +229,18 @@ class System:
 
         ``w0_rad_s`` when given; else the lowest natural frequency of
         (M, :attr:`K_reference`): normal springs in place, tangential contacts
-        free. For the single-DOF damper w0 = sqrt(k/m), the paper's reference.
+        free, rigid-body modes (eigenvalues below
+        ``config.SYSTEM_RIGID_MODE_RTOL`` times the largest) skipped; 0 when
+        every mode is rigid. For the single-DOF damper w0 = sqrt(k/m), the
+        paper's reference.
         """
         if self.w0_rad_s is not None:
             return self.w0_rad_s
         from scipy.linalg import eigh
 
         lam = eigh(self.K_reference, self.M, eigvals_only=True)
-        return math.sqrt(max(lam[0], 0.0))
+        elastic = lam[lam > config.SYSTEM_RIGID_MODE_RTOL * lam[-1]]
+        return math.sqrt(elastic[0]) if elastic.size and lam[-1] > 0.0 else 0.0
 
     def require_in_phase_forcing(self, solver: str) -> None:
         """ValueError naming ``force_phase_deg`` if a forcing phase is not 0

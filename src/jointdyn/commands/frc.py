@@ -1,8 +1,13 @@
-"""``jointdyn frc``: frequency-response curve of the paper's friction damper.
+"""``jointdyn frc``: frequency-response curve of the paper's friction damper,
+or of a structure of your own (``--system FILE.toml``, docs/system-files.md).
 
 Time domain (``--method time``, default): steady states swept up and/or down
 in gamma with warm starts (:func:`jointdyn.sweeps.frc_sweep`). Harmonic
 balance (``--method hb``): :func:`jointdyn.hb.frc_hb` continuation.
+With ``--system`` the options that describe the paper damper (``--eta``,
+``--beta``, ``--f1``, ``--delta``, ``--m``, ``--k``, ``--kt``, ``--kn``,
+``--mu``, ``--n0``, ``--model``, ``--law-param``, ``--n``, ``--zeta``) are
+refused; the others work as for the damper.
 Options of one method are refused with the other (one line, exit 2):
 ``--sweep``, ``--steps-per-period``, ``--scheduler`` and ``--workers`` are
 time-domain options (the continuation follows the branch through its folds,
@@ -14,7 +19,8 @@ Everything is validated before computing (including the writability of
 connection to ``--scheduler``); ``--out`` files (``frc.nc``, ``frc.csv``,
 ``frc.png``) are written atomically after computing (time-domain sweep lines
 are also saved one by one under ``OUT/lines`` so that an interrupted run
-resumes). The table prints gamma with as many digits as distinct points need.
+resumes; a resumed run says how many points it reused). The table prints
+gamma with as many digits as distinct points need.
 """
 
 from __future__ import annotations
@@ -28,36 +34,45 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ._law_args import add_law_arguments, law_params, model_help
+from ._system_args import add_system_argument, load_system_file, refuse_paper_options
 from ..systems import PAPER
 
 NAME = "frc"
-HELP = "frequency-response curve (steady amplitude vs gamma) of the paper's friction damper"
+HELP = ("frequency-response curve (steady amplitude vs gamma) of the paper's friction damper or of a structure "
+        "of your own (--system FILE.toml)")
+
+#: the options that describe the paper damper, with their values when not given
+PAPER_OPTIONS = {"eta": 0.5, "beta": None, "f1": None, "delta": 0.0, "model": config.MODEL, "law_param": None,
+                 "n": None, "zeta": 0.0, **{key: PAPER[key] for key in ("m", "k", "kt", "kn", "mu", "n0")}}
 
 
 def add_arguments(p) -> None:
     g0 = ":".join(f"{v:g}" for v in config.SWEEP_GAMMA_DEFAULT)
+    d = PAPER_OPTIONS
     p.add_argument("--method", default="time", help="time (time-domain steady states, default) or hb (harmonic balance)")
-    p.add_argument("--eta", type=float, default=0.5, help="N1/N0, normal-load oscillation ratio (>= 0; default 0.5)")
+    add_system_argument(p)
+    p.add_argument("--eta", type=float, default=None, help=f"N1/N0, normal-load oscillation ratio (>= 0; default {d['eta']:g})")
     load = p.add_mutually_exclusive_group()
     load.add_argument("--beta", type=float, default=None, help="mu N0 / F1 (> 0; default 1.0)")
     load.add_argument("--f1", type=float, default=None, help="forcing amplitude F1 in N (> 0), instead of --beta")
     p.add_argument("--gamma", default=g0, metavar="START:STOP:STEP",
-                   help=f"frequency-ratio grid gamma = w/w0 (default {g0})")
-    p.add_argument("--delta", type=float, default=0.0, help="normal-load phase, degrees (default 0)")
+                   help=f"frequency-ratio grid gamma = w/w0 (default {g0}); with --system w0 is the file's "
+                        "reference frequency")
+    p.add_argument("--delta", type=float, default=None, help=f"normal-load phase, degrees (default {d['delta']:g})")
     p.add_argument("--sweep", default=None,
                    help="time: up, down or both (default both); hb: refused (the continuation follows the "
                         "branch through its folds, which holds the states of both sweep directions)")
-    p.add_argument("--model", default=config.MODEL, help=model_help(config.MODEL))
+    p.add_argument("--model", default=None, help=model_help(d["model"]))
     add_law_arguments(p)
-    p.add_argument("--zeta", type=float, default=0.0, help="viscous damping ratio (default 0)")
-    p.add_argument("--m", type=float, default=PAPER["m"], help=f"mass, kg (default {PAPER['m']:g})")
-    p.add_argument("--k", type=float, default=PAPER["k"], help=f"stiffness, N/m (default {PAPER['k']:g})")
-    p.add_argument("--kt", type=float, default=PAPER["kt"], help=f"tangential contact stiffness, N/m (default {PAPER['kt']:g})")
-    p.add_argument("--kn", type=float, default=PAPER["kn"],
-                   help=f"normal contact stiffness, N/m (default {PAPER['kn']:g}); recorded only: the damper's "
-                        "normal load is prescribed, N = N0 + N1 sin(w t + delta)")
-    p.add_argument("--mu", type=float, default=PAPER["mu"], help=f"friction coefficient (default {PAPER['mu']:g})")
-    p.add_argument("--n0", type=float, default=PAPER["n0"], help=f"static normal load N0, N (default {PAPER['n0']:g})")
+    p.add_argument("--zeta", type=float, default=None, help=f"viscous damping ratio (default {d['zeta']:g})")
+    p.add_argument("--m", type=float, default=None, help=f"mass, kg (default {d['m']:g})")
+    p.add_argument("--k", type=float, default=None, help=f"stiffness, N/m (default {d['k']:g})")
+    p.add_argument("--kt", type=float, default=None, help=f"tangential contact stiffness, N/m (default {d['kt']:g})")
+    p.add_argument("--kn", type=float, default=None,
+                   help=f"normal contact stiffness, N/m (default {d['kn']:g}); recorded only: the damper's "
+                        "normal load is prescribed, N = N0 + N1 sin(w t + delta) (a normal spring: --system)")
+    p.add_argument("--mu", type=float, default=None, help=f"friction coefficient (default {d['mu']:g})")
+    p.add_argument("--n0", type=float, default=None, help=f"static normal load N0, N (default {d['n0']:g})")
     p.add_argument("--steps-per-period", type=int, default=None,
                    help="time: time steps per forcing period (solver default)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
@@ -69,7 +84,9 @@ def add_arguments(p) -> None:
                    help=f"hb: number of harmonics (default {config.HB_HARMONICS})")
     p.add_argument("--samples", type=int, default=None,
                    help=f"hb: time samples per period (default {config.HB_SAMPLES})")
-    p.add_argument("--out", default=None, metavar="DIR", help="write frc.nc, frc.csv, frc.png here")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="write frc.nc, frc.csv, frc.png here (time: resume checkpoints under DIR/lines; a rerun "
+                        "reuses them and says how many points it reused)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
 
 
@@ -152,15 +169,21 @@ def _check_derived(args, gammas) -> None:
     V.derived("--kt / fy (normalised contact stiffness)", args.kt / fy)
 
 
-def _validate(args):
+def _check_system_derived(system, gammas) -> None:
+    """The grid in rad/s stays finite for the system file's reference frequency."""
+    w0 = V.derived("w0 of --system (reference frequency, rad/s)", system.w0, positive=True)
+    V.derived("--gamma STOP x w0 (highest forcing frequency, rad/s)", float(gammas[-1]) * w0)
+    V.derived("2 pi / (--gamma START x w0) (longest forcing period, s)", 2.0 * math.pi / (float(gammas[0]) * w0))
+
+
+def _validate_paper(args, gammas) -> None:
+    """The paper damper's options, with their defaults filled in."""
     from ..laws import law_names
 
-    V.choice("--method", args.method, ("time", "hb"))
-    _check_method_options(args)
-    if args.method == "time":
-        V.choice("--sweep", args.sweep, ("up", "down", "both"))
+    for dest, value in PAPER_OPTIONS.items():
+        if getattr(args, dest) is None and value is not None:
+            setattr(args, dest, value)
     V.choice("--model", args.model, law_names())
-    gammas = parse_gamma(args.gamma)
     V.nonnegative("--eta", args.eta)
     if args.f1 is not None:
         V.positive("--f1", args.f1)
@@ -171,6 +194,15 @@ def _validate(args):
     V.nonnegative("--zeta", args.zeta)
     for key in ("m", "k", "kt", "kn", "mu", "n0"):
         V.positive(f"--{key}", getattr(args, key))
+    _check_derived(args, gammas)
+
+
+def _validate(args):
+    V.choice("--method", args.method, ("time", "hb"))
+    _check_method_options(args)
+    if args.method == "time":
+        V.choice("--sweep", args.sweep, ("up", "down", "both"))
+    gammas = parse_gamma(args.gamma)
     if args.steps_per_period is not None:
         V.positive_int("--steps-per-period", args.steps_per_period, 8)
     if args.workers is not None:
@@ -178,7 +210,13 @@ def _validate(args):
     if args.method == "hb":
         V.positive_int("--harmonics", args.harmonics)
         V.positive_int("--samples", args.samples, 4)
-    _check_derived(args, gammas)
+    args.system_file = None
+    if args.system is not None:
+        refuse_paper_options(args, PAPER_OPTIONS)
+        args.system_file = load_system_file(args)
+        _check_system_derived(args.system_file.system, gammas)
+    else:
+        _validate_paper(args, gammas)
     if args.out is not None:
         subdirs = ("lines",) if args.method == "time" else ()
         V.output_dir("--out", args.out, files=("frc.nc", "frc.csv", "frc.png"), subdirs=subdirs)
@@ -210,7 +248,23 @@ def _connect(address):
         ) from None
 
 
+def _system_header(sf) -> dict:
+    """What the JSON says about a --system structure."""
+    system = sf.system
+    contacts = []
+    for c in system.contacts:
+        law = c.law
+        contacts.append({"law": type(law).__name__, "kt": law.kt, "mu": law.mu, "n_ref": law.n_ref,
+                         "fy_N": law.fy, **law.law_params(), "normal": type(c.normal).__name__,
+                         "n0": float(c.normal.n0)})
+    return {"file": str(sf.path), "title": sf.title, "ndof": int(system.ndof), "w0_rad_s": float(system.w0),
+            "response_dof": int(system.response_dof), "dofs": [int(d) for d in sf.dofs],
+            "fy_N": float(system.contacts[0].law.fy) if system.contacts else None, "contacts": contacts}
+
+
 def _header(args) -> dict:
+    if args.system_file is not None:
+        return {"method": args.method, "system": _system_header(args.system_file)}
     head = {"method": args.method, "eta": args.eta}
     if args.f1 is not None:
         head["f1"] = args.f1
@@ -223,36 +277,85 @@ def _header(args) -> dict:
     return head
 
 
+def _system(args):
+    """The System of the run: the --system file's, or the paper damper of the options."""
+    if args.system_file is not None:
+        return args.system_file.system
+    from ..systems import System
+
+    return System.paper_damper(
+        eta=args.eta,
+        beta=args.beta if args.f1 is None else 1.0,
+        f1=args.f1,
+        delta_deg=args.delta,
+        model=args.model,
+        zeta=args.zeta,
+        law_params=args.law_params,
+        m=args.m, k=args.k, kt=args.kt, mu=args.mu, n0=args.n0,
+    )
+
+
+def _sweep(args, gammas, directions, client):
+    """(Dataset, its one line per direction) of the time-domain sweep of the
+    --system structure or of the paper damper's options."""
+    from ..sweeps import frc_sweep
+
+    common = dict(directions=directions, steps_per_period=args.steps_per_period, client=client,
+                  n_workers=args.workers, out=None if args.out is None else Path(args.out), progress=not args.json)
+    if args.system_file is not None:
+        try:
+            ds = frc_sweep(args.system_file.system, gammas, dofs=args.system_file.dofs, **common)
+        except ValueError as exc:
+            # the options are checked already: what is left is the time integrator's refusal of the structure
+            raise ValueError(f"--method time: {exc}") from None
+        return ds, ds
+    ds = frc_sweep(
+        gammas,
+        etas=[args.eta],
+        betas=None if args.f1 is not None else [args.beta],
+        f1s=None if args.f1 is None else [args.f1],
+        deltas=[args.delta],
+        model=args.model,
+        law_params=args.law_params,
+        zeta=args.zeta,
+        m=args.m, k=args.k, kt=args.kt, mu=args.mu, n0=args.n0,
+        **common,
+    )
+    ds.attrs["kn"] = float(args.kn)
+    load = "beta" if args.f1 is None else "f1"
+    return ds, ds.isel(eta=0, delta=0, **{load: 0})
+
+
+def _loop_outputs(one) -> dict:
+    """Per-DOF and per-contact results of one direction (a --system sweep)."""
+    from ..laws import STATE_NAMES
+
+    dofs = {str(int(d)): {v: _jsonable(one[f"dof_{v}"].sel(dof=d).values) for v in ("amplitude_m", "offset_m")}
+            for d in one.dof.values}
+    contacts = []
+    for c in one.contact.values:
+        sub = one.sel(contact=c)
+        item = {"energy_J": _jsonable(sub.contact_energy_J.values),
+                **{v: _jsonable(sub[v].values) for v in ("normal_mean_N", "normal_min_N", "normal_max_N")},
+                "state_fraction": {s: _jsonable(sub.state_fraction.sel(state=s).values) for s in STATE_NAMES}}
+        contacts.append(item)
+    return {"dofs": dofs, "contacts": contacts}
+
+
 def _run_time(args, gammas):
-    from ..sweeps import frc_sweep, status_name
+    import sys
+
+    from ..sweeps import status_name
 
     directions = ("up", "down") if args.sweep == "both" else (args.sweep,)
     client = None if args.scheduler is None else _connect(args.scheduler)
     try:
-        ds = frc_sweep(
-            gammas,
-            etas=[args.eta],
-            betas=None if args.f1 is not None else [args.beta],
-            f1s=None if args.f1 is None else [args.f1],
-            deltas=[args.delta],
-            directions=directions,
-            model=args.model,
-            law_params=args.law_params,
-            zeta=args.zeta,
-            m=args.m, k=args.k, kt=args.kt, mu=args.mu, n0=args.n0,
-            steps_per_period=args.steps_per_period,
-            client=client,
-            n_workers=args.workers,
-            out=None if args.out is None else Path(args.out),
-            progress=not args.json,
-        )
+        ds, line = _sweep(args, gammas, directions, client)
     finally:
         if client is not None:
             client.close()
-    ds.attrs["kn"] = float(args.kn)
-    load = "beta" if args.f1 is None else "f1"
-    line = ds.isel(eta=0, delta=0, **{load: 0})
     result = _header(args)
+    result["reused_points"] = int(ds.attrs.get("reused_points", 0))
     result["directions"] = {}
     for d in directions:
         one = line.sel(direction=d)
@@ -261,6 +364,13 @@ def _run_time(args, gammas):
             **{v: _jsonable(one[v].values) for v in ("amplitude_q", "amplitude_m", "offset_m", "max_abs_m")},
             "status": [status_name(c) for c in one.status.values],
         }
+        if "contact" in one.dims or "dof" in one.dims:
+            result["directions"][d].update(_loop_outputs(one))
+    if result["reused_points"] or ds.attrs.get("stale_points"):
+        stale = int(ds.attrs.get("stale_points", 0))
+        note = f"; recomputed {stale} points saved by another solver version" if stale else ""
+        print(f"jointdyn frc: resumed from {Path(args.out) / 'lines'}: reused {result['reused_points']} of "
+              f"{ds.status.size} points{note}", file=sys.stderr)
     return ds, result
 
 
@@ -279,22 +389,16 @@ def _hb_branches(ds) -> list:
 
 def _run_hb(args, gammas):
     from ..hb import frc_hb
-    from ..systems import System
 
-    system = System.paper_damper(
-        eta=args.eta,
-        beta=args.beta if args.f1 is None else 1.0,
-        f1=args.f1,
-        delta_deg=args.delta,
-        model=args.model,
-        zeta=args.zeta,
-        law_params=args.law_params,
-        m=args.m, k=args.k, kt=args.kt, mu=args.mu, n0=args.n0,
-    )
+    system = _system(args)
     if gammas.size < 2:
         raise ValueError("--gamma must span a range (STOP > START) for --method hb")
-    ds = frc_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics, samples=args.samples,
-                progress=None if not args.json else False)
+    try:
+        ds = frc_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics, samples=args.samples,
+                    response_dof=system.response_dof, progress=None if not args.json else False)
+    except ValueError as exc:
+        # what the harmonic-balance solver refuses (a kind of normal load, forcing phases) is said as its own
+        raise ValueError(f"--method hb: {exc}") from None
     result = _header(args)
     result["harmonics"] = args.harmonics
     result["samples"] = args.samples
@@ -302,6 +406,16 @@ def _run_hb(args, gammas):
     result["status"] = str(ds.attrs.get("status", ""))
     result["message"] = str(ds.attrs.get("message", ""))
     return ds, result
+
+
+def _plot_title(result) -> str:
+    if "system" in result:
+        sysd = result["system"]
+        return (f"{result['method']}: {sysd['title']} ({Path(sysd['file']).name}), DOF {sysd['response_dof']}, "
+                f"w0 = {sysd['w0_rad_s']:.6g} rad/s")
+    load = f"beta = {result['beta']:g}" if result.get("beta") is not None else ""
+    return (f"{result['method']}: eta = {result['eta']:g}, {load}, delta = {result['delta_deg']:g} deg, "
+            f"{result['model']}")
 
 
 def _plot(result, path: Path) -> None:
@@ -333,9 +447,7 @@ def _plot(result, path: Path) -> None:
             if br["folds"]:
                 ax.plot(g[br["folds"]], a[br["folds"]], "ks", ms=4, label="fold" if i == 0 else None)
         ax.legend(fontsize=8)
-    load = f"beta = {result['beta']:g}" if result.get("beta") is not None else ""
-    ax.set_title(f"{result['method']}: eta = {result['eta']:g}, {load}, delta = {result['delta_deg']:g} deg, "
-                 f"{result['model']}", fontsize=9)
+    ax.set_title(_plot_title(result), fontsize=9)
     ax.set_xlabel("gamma = w / w0")
     ax.set_ylabel("amplitude of q = kt x / fy (half peak-to-peak)")
     ax.grid(alpha=0.3)

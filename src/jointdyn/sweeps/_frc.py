@@ -1,40 +1,48 @@
-"""Frequency-response sweeps of the paper's friction damper (docs/model.md section 6).
+"""Frequency-response sweeps of any System, and of the paper damper's grid.
 
-The damper ``m x'' + c x' + k x = F1 sin(w t) - T(x, N(t))`` with
-``N = N0 (1 + eta sin(w t + delta))`` is swept in excitation frequency
-``gamma = w / w0`` (``w0 = sqrt(k/m)``) on a grid of the paper's groups
-``eta = N1/N0``, ``beta = mu N0 / F1`` (or the forcing amplitude ``F1`` in N)
-and ``delta``. Every steady state comes from the time-domain solver
-:func:`jointdyn.dynamics.steady_state`.
+:func:`frc_sweep` computes time-domain steady states
+(:func:`jointdyn.dynamics.steady_state`) over a grid of excitation
+frequencies ``gamma = w / w0`` (``w0`` the System's reference frequency)
+for
+
+- one :class:`~jointdyn.System` (Dataset dims ``direction, gamma``),
+- a mapping of labelled Systems (dims ``system, direction, gamma``),
+- the paper damper (docs/model.md section 6) on a grid of its groups ``eta =
+  N1/N0``, ``beta = mu N0 / F1`` (or the forcing ``F1`` in N) and ``delta``:
+  every grid point is ``System.paper_damper(...)`` (dims ``eta, beta, delta,
+  direction, gamma``).
 
 Sweep lines
 -----------
-Points along gamma are chained: in an ``up`` sweep every point starts from the
-steady state of the previous (lower) gamma, in a ``down`` sweep from the next
-higher one, so that jumps and coexisting states of the nonlinear response show
-as a difference between the two directions. After an ``unbounded`` point the
-next one restarts from the solver's linear estimate (``start=None``). One line
-(fixed eta, beta or F1, delta, direction) is therefore the unit of parallel
-work; lines run on a local process/thread pool or on a Dask cluster and the
-result does not depend on where or in which order they ran.
+Points along gamma are chained: in an ``up`` sweep every point starts from
+the steady state of the previous (lower) gamma, in a ``down`` sweep from the
+next higher one, so that jumps and coexisting states of the nonlinear
+response show as a difference between the two directions. After an
+``unbounded`` point the next one restarts from the solver's linear estimate.
+A line (one System, one direction) runs as consecutive chunks of
+``config.SWEEP_CHUNK_POINTS`` points, each continuing from the previous
+chunk's last state; lines run side by side on a local process or thread
+pool or on a Dask cluster (``_pool.py``), and the result depends neither on
+where nor in which order they ran, nor on the chunking.
 
 Resume
 ------
-With ``out=DIR`` each finished line is written atomically to
-``DIR/lines/<key>.nc`` together with the full description of the line; a
-rerun loads every line whose description matches instead of recomputing it.
-The assembled Dataset goes to ``DIR/frc.nc`` and a tidy CSV ``DIR/frc.csv``.
-The description covers the parameters, not the solver's code: delete
-``DIR/lines`` after changing the solver to recompute everything.
+With ``out=DIR`` every finished chunk is written atomically under
+``DIR/lines`` (``_checkpoint.py``) with its resume key: the line's spec (the
+System's fingerprint, direction, grid, steps, outputs), the solver's results
+version (:data:`jointdyn.dynamics.version.SOLVER_VERSION`) and the jointdyn
+version. A rerun reuses every checkpoint whose key matches and computes the
+rest, continuing each line from its last saved state; checkpoints of another
+solver version are recomputed, never reused. An interrupt (Ctrl-C) stops
+every chunk after its current point and saves what finished. The assembled
+Dataset goes to ``DIR/frc.nc`` and a tidy CSV ``DIR/frc.csv``.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
 import math
 import os
-from dataclasses import asdict, dataclass
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +50,19 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from .._io import atomic_path
+from ..laws import STATE_NAMES
+from ._checkpoint import load_line, save_chunk
+from ._family import LineSpec, fingerprint, paper_family, system_family
+from ._points import (
+    CONTACT_VARIABLES,
+    DOF_VARIABLES,
+    INT_VARIABLES,
+    STATE_VARIABLE,
+    STATUS_CODES,
+    VARIABLES,
+    ChunkTask,
+    empty_arrays,
+)
 
 __all__ = [
     "frc_sweep",
@@ -49,34 +70,22 @@ __all__ = [
     "STATUS_CODES",
     "VARIABLES",
     "INT_VARIABLES",
+    "DOF_VARIABLES",
+    "CONTACT_VARIABLES",
+    "RUN_ATTRIBUTES",
     "status_name",
     "to_frame",
     "write_outputs",
     "default_workers",
 ]
 
-#: status name -> int8 code stored in the Dataset (``status`` variable)
-STATUS_CODES = {name: i for i, name in enumerate(config.SWEEP_STATUS)}
 _MISSING = config.SWEEP_STATUS_MISSING
 _LEGEND = ", ".join(f"{i}: {n}" for i, n in enumerate(config.SWEEP_STATUS)) + f", {_MISSING}: not computed"
-
-#: float result variables of a point, with units and meaning
-VARIABLES = {
-    "amplitude_q": ("1", "half peak-to-peak of q = kt x / fy over one steady period"),
-    "amplitude_m": ("m", "half peak-to-peak of x over one steady period"),
-    "offset_m": ("m", "mean of x over one steady period (history dependent while sticking)"),
-    "max_abs_m": ("m", "max |x| over one steady period"),
-    "energy_contact_J": ("J", "energy dissipated by the contact per forcing period"),
-    "energy_viscous_J": ("J", "energy dissipated by the viscous damper per forcing period"),
-    "work_force_J": ("J", "work of the external force per forcing period"),
-}
-#: integer result variables
-INT_VARIABLES = {
-    "periods": ("1", "forcing periods integrated for this point"),
-    "period_multiple": ("1", "the steady response repeats after this many forcing periods (0 if none)"),
-}
 _DIRECTIONS = ("up", "down")
-_OVERRIDES = ("m", "k", "kt", "mu", "n0")
+#: keyword arguments that describe the paper damper's grid (not a System's)
+_PAPER_KEYS = ("etas", "betas", "f1s", "deltas", "model", "law_params", "n", "zeta", "m", "k", "kt", "mu", "n0")
+#: Dataset attributes about a run rather than its results (not written to frc.nc)
+RUN_ATTRIBUTES = ("reused_points", "stale_points")
 
 
 def status_name(code: int) -> str:
@@ -95,78 +104,6 @@ def default_workers() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-@dataclass(frozen=True)
-class LineSpec:
-    """One sweep line: everything that determines its result.
-
-    Attributes
-    ----------
-    eta : float
-        N1 / N0.
-    beta : float or None
-        mu N0 / F1 (None when ``f1`` is given).
-    f1 : float or None
-        Forcing amplitude F1, N (None when ``beta`` is given).
-    delta_deg : float
-        Phase of the normal load, degrees.
-    direction : str
-        ``up`` (gamma increasing) or ``down``.
-    gammas : tuple of float
-        Grid, increasing (the line visits it in its direction).
-    model, law_params, zeta, overrides, steps_per_period
-        Contact law name, its law-specific parameters as the canonical
-        ``((name, value), ...)`` of :func:`jointdyn.laws.canonical_law_params`,
-        viscous damping ratio, paper parameter overrides as
-        ``((name, value), ...)``, integration steps per forcing period (None:
-        solver default).
-    """
-
-    eta: float
-    beta: float | None
-    f1: float | None
-    delta_deg: float
-    direction: str
-    gammas: tuple
-    model: str = config.MODEL
-    law_params: tuple = ()
-    zeta: float = 0.0
-    overrides: tuple = ()
-    steps_per_period: int | None = None
-
-    def to_json(self) -> str:
-        """Canonical JSON (exact floats via repr) used for resume checks."""
-        d = asdict(self)
-        d["gammas"] = [repr(float(g)) for g in self.gammas]
-        d["overrides"] = [[k, repr(float(v))] for k, v in self.overrides]
-        d["law_params"] = [[k, repr(v) if isinstance(v, float) else v] for k, v in self.law_params]
-        for key in ("eta", "beta", "f1", "delta_deg", "zeta"):
-            if d[key] is not None:
-                d[key] = repr(float(d[key]))
-        return json.dumps(d, sort_keys=True)
-
-    @property
-    def key(self) -> str:
-        """File stem of the line: readable prefix plus a hash of the full spec."""
-        h = hashlib.sha1(self.to_json().encode()).hexdigest()[:12]
-        load = f"beta{self.beta:g}" if self.beta is not None else f"f1{self.f1:g}N"
-        return f"eta{self.eta:g}_{load}_delta{self.delta_deg:g}_{self.direction}_{h}"
-
-    def system(self):
-        """The :class:`~jointdyn.systems.System` of this line."""
-        from ..systems import System
-
-        return System.paper_damper(
-            eta=self.eta,
-            beta=1.0 if self.beta is None else self.beta,
-            f1=self.f1,
-            delta_deg=self.delta_deg,
-            model=self.model,
-            zeta=self.zeta,
-            law_params=dict(self.law_params),
-            **dict(self.overrides),
-        )
-
-
 def _steady_state_fn():
     """The time-domain steady-state solver (resolved late; tests may swap it)."""
     from ..dynamics import steady_state
@@ -174,141 +111,90 @@ def _steady_state_fn():
     return steady_state
 
 
-def _solve_line(spec: LineSpec) -> dict:
-    """Sweep one line; returns arrays on the increasing gamma grid.
+class _LineRun:
+    """One line during a sweep: its spec, where it stands, its results so far."""
 
-    Each point starts from the previous point's steady state (``restart``);
-    after an ``unbounded`` point the next starts from the linear estimate.
+    def __init__(self, index, spec, system_index, system, ncontacts, dofs, where=""):
+        self.index = index
+        self.where = where
+        self.spec = spec
+        self.system_index = system_index
+        self.rdof = int(system.response_dof)
+        self.ncontacts = ncontacts
+        self.dofs = dofs
+        g = list(spec.gammas)
+        self.gammas = tuple(g if spec.direction == "up" else g[::-1])
+        self.arrays = empty_arrays(len(g), len(dofs), ncontacts, spec.loop_outputs)
+        self.next = 0
+        self.start = None
 
-    Returns
-    -------
-    dict
-        ``status`` (int8 codes), every name of :data:`VARIABLES` (float64)
-        and :data:`INT_VARIABLES` (int32), each of length ``len(gammas)``.
-    """
-    solve = _steady_state_fn()
-    system = spec.system()
-    g = np.asarray(spec.gammas, dtype=float)
-    m = g.size
-    out = {name: np.full(m, np.nan) for name in VARIABLES}
-    out.update({name: np.zeros(m, dtype=np.int32) for name in INT_VARIABLES})
-    out["status"] = np.full(m, _MISSING, dtype=np.int8)
-    order = range(m) if spec.direction == "up" else range(m - 1, -1, -1)
-    kwargs = {"keep_loop": False}
-    if spec.steps_per_period is not None:
-        kwargs["steps_per_period"] = spec.steps_per_period
-    prev = None
-    for i in order:
-        res = solve(system, float(g[i]), start=prev, **kwargs)
-        if res.status not in STATUS_CODES:
-            raise RuntimeError(f"steady_state returned unknown status {res.status!r}")
-        out["status"][i] = STATUS_CODES[res.status]
-        for name in VARIABLES:
-            out[name][i] = float(getattr(res, name, np.nan))
-        out["periods"][i] = int(res.periods)
-        out["period_multiple"][i] = int(getattr(res, "period_multiple", 0) or 0)
-        prev = None if res.status == "unbounded" else res
-    return out
+    @property
+    def finished(self) -> bool:
+        """Every point of the line is computed or loaded."""
+        return self.next >= len(self.gammas)
 
+    def next_task(self, points: int) -> ChunkTask:
+        """The task of the next ``points`` points of the line."""
+        stop = min(self.next + points, len(self.gammas))
+        return ChunkTask(line=self.index, system_index=self.system_index, first=self.next,
+                         gammas=self.gammas[self.next:stop], start=self.start, rdof=self.rdof, dofs=self.dofs,
+                         ncontacts=self.ncontacts, loop_outputs=self.spec.loop_outputs,
+                         steps_per_period=self.spec.steps_per_period, where=self.where)
 
-def _line_dataset(spec: LineSpec, res: dict):
-    """One finished line as a small Dataset (dim gamma) carrying its spec."""
-    import xarray as xr
+    def accept(self, chunk) -> None:
+        """Store a chunk that starts where the line stands."""
+        if chunk.first != self.next:
+            raise RuntimeError(f"chunk at position {chunk.first} of a line standing at {self.next}")
+        for name, a in chunk.arrays.items():
+            self.arrays[name][chunk.first:chunk.first + chunk.done] = a
+        self.next += chunk.done
+        self.start = chunk.restart
 
-    data = {name: ("gamma", res[name]) for name in (*VARIABLES, *INT_VARIABLES, "status")}
-    return xr.Dataset(data, coords={"gamma": np.asarray(spec.gammas, float)}, attrs={"spec": spec.to_json()})
-
-
-def _write_line(path: Path, ds) -> None:
-    with atomic_path(path) as tmp:
-        ds.to_netcdf(tmp, engine="scipy")
+    def on_grid(self) -> dict:
+        """The results on the increasing gamma grid."""
+        return {name: (a if self.spec.direction == "up" else a[::-1]) for name, a in self.arrays.items()}
 
 
-def _read_line(path: Path, spec: LineSpec) -> dict | None:
-    """Arrays of a saved line if it exists and was made from ``spec``."""
-    import xarray as xr
+def _family(system_or_grid, gammas, paper: dict):
+    """(family, gamma grid) of either call form; ValueError naming misplaced keywords."""
+    from ..systems import System
 
-    if not path.is_file():
-        return None
-    try:
-        with xr.open_dataset(path, engine="scipy") as ds:
-            if ds.attrs.get("spec") != spec.to_json():
-                return None
-            return {
-                name: np.asarray(ds[name].values).astype(
-                    np.int8 if name == "status" else (np.int32 if name in INT_VARIABLES else np.float64)
-                )
-                for name in (*VARIABLES, *INT_VARIABLES, "status")
-            }
-    except (OSError, ValueError, KeyError, TypeError):
-        return None
-
-
-def _iter_results(todo, client, n_workers, pool):
-    """Yield ``(index, result)`` for the lines ``todo`` as they finish."""
-    if not todo:
-        return
-    if client is not None:
-        from distributed import as_completed
-
-        futures = client.map(_solve_line, [s for _, s in todo], pure=False)
-        index = {f.key: i for f, (i, _) in zip(futures, todo)}
-        for fut in as_completed(futures):
-            yield index[fut.key], fut.result()
-        return
-    if n_workers <= 1 or len(todo) == 1:
-        for i, spec in todo:
-            yield i, _solve_line(spec)
-        return
-    import concurrent.futures as cf
-
-    if pool == "thread":
-        ex = cf.ThreadPoolExecutor(max_workers=n_workers)
-    else:
-        import multiprocessing as mp
-
-        # fork (Linux): workers inherit the compiled kernels and do not
-        # re-import the caller's __main__ (spawn would, breaking scripts
-        # without a main guard); spawn elsewhere
-        method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
-        ex = cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=mp.get_context(method))
-    with ex:
-        futs = {ex.submit(_solve_line, spec): i for i, spec in todo}
-        try:
-            for fut in cf.as_completed(futs):
-                yield futs[fut], fut.result()
-        finally:
-            for f in futs:
-                f.cancel()
+    if isinstance(system_or_grid, (System, Mapping)):
+        given = [k for k in _PAPER_KEYS if paper.get(k) is not None]
+        if given:
+            raise ValueError(f"{', '.join(given)} describe the paper damper's grid (frc_sweep(gammas, etas=...)); "
+                             "a System sweep takes every parameter from its System(s)")
+        if gammas is None:
+            raise ValueError("gammas must be given: frc_sweep(system, gammas)")
+        return system_family(system_or_grid), gammas
+    if gammas is not None:
+        raise ValueError("gammas is given twice: frc_sweep(gammas, ...) sweeps the paper damper's grid, "
+                         "frc_sweep(system, gammas) a System")
+    law_params = dict(paper.get("law_params") or {})
+    if paper.get("n") is not None:
+        if "n" in law_params:
+            raise ValueError("n is given twice: as n and in law_params; give it once")
+        law_params["n"] = paper["n"]
+    fam = paper_family(etas=paper.get("etas"), betas=paper.get("betas"), f1s=paper.get("f1s"),
+                       deltas=paper.get("deltas"), model=config.MODEL if paper.get("model") is None else paper["model"],
+                       law_params=law_params, zeta=0.0 if paper.get("zeta") is None else paper["zeta"],
+                       overrides={k: paper.get(k) for k in ("m", "k", "kt", "mu", "n0")})
+    return fam, system_or_grid
 
 
-def _floats(name, values, check):
-    if values is None:
-        raise ValueError(f"{name} must be a non-empty list of numbers")
-    arr = np.atleast_1d(np.asarray(values, dtype=object))
+def _grid(gammas) -> tuple:
+    if gammas is None or isinstance(gammas, (str, bytes)):
+        raise ValueError(f"gamma must be a non-empty list of numbers, got {gammas!r:.60}")
+    arr = np.atleast_1d(np.asarray(gammas, dtype=object))
     if arr.ndim != 1 or arr.size == 0:
-        raise ValueError(f"{name} must be a non-empty 1-D list of numbers")
-    out = [check(name, v) for v in arr]
-    if len(set(out)) != len(out):
-        raise ValueError(f"{name} must not contain duplicates, got {list(out)}")
-    return out
+        raise ValueError("gamma must be a non-empty 1-D list of numbers")
+    g = [V.positive("gamma", v) for v in arr]
+    if len(set(g)) != len(g):
+        raise ValueError(f"gamma must not contain duplicates, got {g}")
+    return tuple(sorted(g))
 
 
-def _check_inputs(gammas, etas, betas, f1s, deltas, directions, model, law_params, zeta, overrides,
-                  steps_per_period):
-    from ..laws import canonical_law_params, law_names
-
-    g = _floats("gamma", gammas, V.positive)
-    g = tuple(sorted(g))
-    etas = _floats("eta", etas, V.nonnegative)
-    if betas is not None and f1s is not None:
-        raise ValueError("give either beta (mu N0 / F1) or f1 (forcing amplitude, N), not both")
-    if f1s is not None:
-        f1s = _floats("f1", f1s, V.positive)
-        betas = None
-    else:
-        betas = _floats("beta", (1.0,) if betas is None else betas, V.positive)
-    deltas = _floats("delta", deltas, V.finite)
+def _directions(directions) -> list:
     if isinstance(directions, str):
         directions = (directions,)
     directions = list(directions)
@@ -318,19 +204,25 @@ def _check_inputs(gammas, etas, betas, f1s, deltas, directions, model, law_param
         V.choice("direction", d, _DIRECTIONS)
     if len(set(directions)) != len(directions):
         raise ValueError(f"direction must not contain duplicates, got {directions}")
-    V.choice("model", model, law_names())
-    law_params = canonical_law_params(model, law_params)
-    zeta = V.nonnegative("zeta", zeta)
-    ov = []
-    for key in _OVERRIDES:
-        val = overrides.get(key)
-        if val is None:
-            continue
-        val = V.positive(key, val)
-        ov.append((key, val))
-    if steps_per_period is not None:
-        steps_per_period = V.positive_int("steps_per_period", steps_per_period, 8)
-    return g, etas, betas, f1s, deltas, directions, model, law_params, zeta, tuple(ov), steps_per_period
+    return directions
+
+
+def _dofs(dofs, family) -> tuple:
+    """Requested DOFs (default: the response DOFs of the family), checked against every System."""
+    systems = [s for _, _, s in family.entries]
+    if dofs is None:
+        return tuple(sorted({int(s.response_dof) for s in systems}))
+    arr = list(np.atleast_1d(np.asarray(dofs, dtype=object)))
+    if not arr:
+        raise ValueError("dofs must be a non-empty list of DOF indices")
+    out = tuple(V.positive_int("dofs", d, 0) for d in arr)
+    nmin = min(s.ndof for s in systems)
+    bad = [d for d in out if d >= nmin]
+    if bad:
+        raise ValueError(f"dofs must be in [0, {nmin - 1}] (DOFs of every System), got {bad[0]}")
+    if len(set(out)) != len(out):
+        raise ValueError(f"dofs must not contain duplicates, got {list(out)}")
+    return out
 
 
 def _check_client(client) -> None:
@@ -348,23 +240,51 @@ def _check_client(client) -> None:
         )
 
 
+def _executor(family, client, n_workers, nlines, on_point):
+    from ._pool import DaskExecutor, LocalExecutor, SerialExecutor
+
+    systems = tuple(s for _, _, s in family.entries)
+    if client is not None:
+        return DaskExecutor(systems, client)
+    workers = default_workers() if n_workers is None else n_workers
+    if workers <= 1 or nlines == 1:
+        return SerialExecutor(systems, on_point=on_point)
+    return LocalExecutor(systems, min(workers, nlines), config.SWEEP_POOL)
+
+
+def _line_runs(family, directions, g, spp, dofs, loop_outputs) -> list:
+    nc = max((len(s.contacts) for _, _, s in family.entries), default=0)
+    runs = []
+    for i, (_, label, system) in enumerate(family.entries):
+        key = fingerprint(system)
+        for d in directions:
+            spec = LineSpec(label=label, system=key, direction=d, gammas=g, steps_per_period=spp, dofs=dofs,
+                            loop_outputs=loop_outputs)
+            where = f"system {label!r}: " if family.dims else ""
+            runs.append(_LineRun(len(runs), spec, i, system, nc, dofs, where))
+    return runs
+
+
 def frc_sweep(
-    gammas,
+    system_or_grid,
+    gammas=None,
     *,
-    etas=(0.5,),
+    etas=None,
     betas=None,
     f1s=None,
-    deltas=(0.0,),
+    deltas=None,
     directions=("up", "down"),
-    model: str = config.MODEL,
+    model: str | None = None,
     law_params: dict | None = None,
     n: int | None = None,
-    zeta: float = 0.0,
+    zeta: float | None = None,
     m: float | None = None,
     k: float | None = None,
     kt: float | None = None,
     mu: float | None = None,
     n0: float | None = None,
+    dofs=None,
+    loop_outputs: bool | None = None,
     steps_per_period: int | None = None,
     client=None,
     n_workers: int | None = None,
@@ -372,218 +292,266 @@ def frc_sweep(
     progress: bool = True,
     on_line=None,
 ):
-    """Steady-state frequency response of the paper's damper on a parameter grid.
+    """Steady-state frequency response of a System, of labelled Systems, or of
+    the paper damper on a grid of its groups.
 
-    Solves docs/model.md section 6, ``m x'' + c x' + k x = F1 sin(w t) - T(x, N(t))``,
-    ``N = N0 (1 + eta sin(w t + delta))``, for every combination of the groups
-    and ``gamma = w / sqrt(k/m)``, sweeping gamma up and/or down with warm
-    starts (see the module docstring).
+    Two call forms:
+
+    - ``frc_sweep(system, gammas, ...)``: ``system`` is a
+      :class:`~jointdyn.System` or a mapping ``{label: System}``;
+    - ``frc_sweep(gammas, etas=..., betas=..., ...)``: the paper damper
+      (docs/model.md section 6, ``m x'' + c x' + k x = F1 sin(w t) - T(x, N(t))``,
+      ``N = N0 (1 + eta sin(w t + delta))``) on the grid of ``etas`` x
+      ``betas`` (or ``f1s``) x ``deltas``, each point ``System.paper_damper``.
+
+    Each System is swept in ``gamma = w / w0`` (``w0 = system.w0``) up and/or
+    down with warm starts (see the module docstring).
 
     Parameters
     ----------
-    gammas : sequence of float
-        Frequency ratios (> 0, distinct; any order, stored increasing).
+    system_or_grid : System, mapping of str to System, or sequence of float
+        The System(s) to sweep, or the gamma grid of the paper damper form.
+    gammas : sequence of float, optional
+        Frequency ratios (> 0, distinct; any order, stored increasing) of
+        the System form.
     etas : sequence of float
-        N1 / N0 (>= 0).
+        Paper form: N1 / N0 (>= 0); default ``(0.5,)``.
     betas : sequence of float, optional
-        mu N0 / F1 (> 0); default ``(1.0,)``. Not together with ``f1s``.
+        Paper form: mu N0 / F1 (> 0); default ``(1.0,)``. Not with ``f1s``.
     f1s : sequence of float, optional
-        Forcing amplitudes F1 in N (> 0), instead of ``betas``.
+        Paper form: forcing amplitudes F1 in N (> 0), instead of ``betas``.
     deltas : sequence of float
-        Normal-load phase, **degrees**.
+        Paper form: normal-load phase, **degrees**; default ``(0.0,)``.
     directions : sequence of {"up", "down"}
         Sweep directions.
     model : str
-        Contact law, one of :func:`jointdyn.laws.law_names` (default
-        ``iwan``, the exact Iwan model, ``config.MODEL``).
+        Paper form: contact law, one of :func:`jointdyn.laws.law_names`
+        (default ``iwan``, the exact Iwan model, ``config.MODEL``).
     law_params : dict, optional
-        Law-specific parameters of ``model``
+        Paper form: law-specific parameters of ``model``
         (:func:`jointdyn.laws.law_parameters`), e.g. ``{"n": 200}``.
     n : int, optional
-        Shorthand for ``law_params={"n": n}`` (elements of ``discrete``);
-        a model without that parameter refuses it.
+        Paper form: shorthand for ``law_params={"n": n}``.
     zeta : float
-        Viscous damping ratio (paper: 0).
+        Paper form: viscous damping ratio (default 0, the paper's).
     m, k, kt, mu, n0 : float, optional
-        Overrides of the paper values (kg, N/m, N/m, -, N).
+        Paper form: overrides of the paper values (kg, N/m, N/m, -, N).
+    dofs : sequence of int, optional
+        DOFs whose amplitude and offset are recorded per point (variables
+        with dimension ``dof``); default: the response DOF of each System.
+    loop_outputs : bool, optional
+        Record the per-DOF and per-contact variables (from the steady
+        period, kept for it: about one more forcing period per point).
+        Default: True for the System form, False for the paper form (whose
+        Dataset keeps its layout and cost unless asked).
     steps_per_period : int, optional
         Integration steps per forcing period (solver default if None).
     client : distributed.Client, optional
-        Run the lines on this Dask cluster (a connected client, not an
-        address).
+        Run on this Dask cluster (a connected client, not an address).
     n_workers : int, optional
         Local parallel workers (default: all usable cores; 1 runs serially
         in this process).
     out : path, optional
-        Directory for resumable per-line files and the final ``frc.nc`` and
-        ``frc.csv`` (all written atomically); checked for writability before
-        anything is computed.
+        Directory for the resume checkpoints (``lines/``) and the final
+        ``frc.nc`` and ``frc.csv`` (all written atomically); checked for
+        writability before anything is computed.
     progress : bool
-        Show a tqdm bar over points (hidden when not a terminal).
+        Show a tqdm bar over points (hidden when not a terminal); it moves
+        per point and says how many points a resume reused.
     on_line : callable, optional
-        ``on_line(spec, computed)`` after each line is stored; ``computed``
-        is False for a line loaded from ``out``.
+        ``on_line(spec, computed)`` after each line is complete; ``computed``
+        is False for a line loaded entirely from ``out``.
 
     Returns
     -------
     xarray.Dataset
-        Dims ``(eta, beta, delta, direction, gamma)`` (``f1`` instead of
-        ``beta`` when ``f1s`` is given). Variables: see :data:`VARIABLES`
-        and :data:`INT_VARIABLES`, plus ``status`` (int8; legend in its
-        ``legend`` attribute). Only points with status 0 (periodic) carry a
-        steady amplitude; the others hold the solver's last values.
+        Dims: the family's (none, ``system``, or ``eta, beta, delta`` with
+        ``f1`` for ``beta`` when ``f1s`` is given), then ``direction,
+        gamma``. Variables: :data:`VARIABLES` (response DOF, first
+        contact's q), :data:`INT_VARIABLES`, ``status`` (int8; legend in its
+        ``legend`` attribute); with ``loop_outputs`` also
+        :data:`DOF_VARIABLES` (dim ``dof``), :data:`CONTACT_VARIABLES` (dim
+        ``contact``) and ``state_fraction`` (dims ``contact, state``).
+        Only points with status 0 (periodic) carry steady values. Attribute
+        ``reused_points``: points loaded from ``out``; ``stale_points``:
+        points of checkpoints of another solver version, recomputed.
 
     Raises
     ------
     ValueError
-        Bad input (names the parameter and the allowed range).
+        Bad input (names the parameter and the allowed range); a solver's
+        refusal of a System (raised as the solver words it, after
+        ``system 'label': `` in a family of Systems; the points finished
+        before it are saved under ``out``).
     """
-    from tqdm import tqdm
-
-    law_params = dict(law_params or {})
-    if n is not None:
-        if "n" in law_params:
-            raise ValueError("n is given twice: as n and in law_params; give it once")
-        law_params["n"] = n
-    g, etas, betas, f1s, deltas, directions, model, law_params, zeta, ov, spp = _check_inputs(
-        gammas, etas, betas, f1s, deltas, directions, model, law_params, zeta,
-        dict(m=m, k=k, kt=kt, mu=mu, n0=n0), steps_per_period,
-    )
+    paper = dict(etas=etas, betas=betas, f1s=f1s, deltas=deltas, model=model, law_params=law_params, n=n,
+                 zeta=zeta, m=m, k=k, kt=kt, mu=mu, n0=n0)
+    family, gammas = _family(system_or_grid, gammas, paper)
+    g = _grid(gammas)
+    directions = _directions(directions)
+    spp = None if steps_per_period is None else V.positive_int("steps_per_period", steps_per_period, 8)
     if n_workers is not None:
         n_workers = V.positive_int("n_workers", n_workers)
     _check_client(client)
-    if out is not None:  # before computing: no finished line is lost to an unwritable out
+    dofs = _dofs(dofs, family)
+    loop_outputs = (not family.dims or family.dims == ("system",)) if loop_outputs is None else bool(loop_outputs)
+    if out is not None:  # before computing: no finished chunk is lost to an unwritable out
         V.output_dir("out", out, files=("frc.nc", "frc.csv"), subdirs=("lines",))
-    load_name, loads = ("beta", betas) if f1s is None else ("f1", f1s)
-    if load_name == "beta" and dict(ov).get("mu", 0.5) <= 0:
-        raise ValueError("mu must be > 0 when sweeping beta = mu N0 / F1")
-
-    specs = []
-    for ie, eta in enumerate(etas):
-        for il, load in enumerate(loads):
-            for idl, delta in enumerate(deltas):
-                for idr, direction in enumerate(directions):
-                    spec = LineSpec(
-                        eta=eta,
-                        beta=load if load_name == "beta" else None,
-                        f1=load if load_name == "f1" else None,
-                        delta_deg=delta,
-                        direction=direction,
-                        gammas=g,
-                        model=model,
-                        law_params=law_params,
-                        zeta=zeta,
-                        overrides=ov,
-                        steps_per_period=spp,
-                    )
-                    specs.append(((ie, il, idl, idr), spec))
-
-    shape = (len(etas), len(loads), len(deltas), len(directions), len(g))
-    arrays = {name: np.full(shape, np.nan) for name in VARIABLES}
-    arrays.update({name: np.zeros(shape, dtype=np.int32) for name in INT_VARIABLES})
-    arrays["status"] = np.full(shape, _MISSING, dtype=np.int8)
-
-    line_dir = None if out is None else Path(out) / "lines"
-    bar = tqdm(total=len(specs) * len(g), desc="frc", unit="pt", disable=None if progress else True)
-
-    def store(idx, spec, res, computed):
-        for name in arrays:
-            arrays[name][idx] = res[name]
-        bar.update(len(g))
-        if on_line is not None:
-            on_line(spec, computed)
-
-    todo = []
-    for idx, spec in specs:
-        res = None if line_dir is None else _read_line(line_dir / f"{spec.key}.nc", spec)
-        if res is None:
-            todo.append((idx, spec))
-        else:
-            store(idx, spec, res, False)
-    by_idx = dict(todo)
-    workers = default_workers() if n_workers is None else n_workers
-    try:
-        for idx, res in _iter_results(todo, client, workers, config.SWEEP_POOL):
-            spec = by_idx[idx]
-            if line_dir is not None:
-                _write_line(line_dir / f"{spec.key}.nc", _line_dataset(spec, res))
-            store(idx, spec, res, True)
-    finally:
-        bar.close()
-
-    ds = _assemble(arrays, etas, load_name, loads, deltas, directions, g, model, law_params, zeta, ov, spp)
+    runs = _line_runs(family, directions, g, spp, dofs, loop_outputs)
+    reused, stale = _run(runs, family, client, n_workers, out, progress, on_line)
+    ds = _assemble(family, runs, directions, g, dofs, spp, loop_outputs)
+    ds.attrs["reused_points"] = int(reused)
+    ds.attrs["stale_points"] = int(stale)
     if out is not None:
         write_outputs(ds, out)
     return ds
 
 
-def _assemble(arrays, etas, load_name, loads, deltas, directions, g, model, law_params, zeta, ov, spp):
+def _resume(runs, line_root) -> tuple:
+    """Load the checkpoints of every line; returns (reused, stale) point counts."""
+    reused = stale = 0
+    if line_root is None:
+        return 0, 0
+    names = tuple(runs[0].arrays) if runs else ()
+    for run in runs:
+        ck = load_line(line_root / run.spec.key, run.spec.checkpoint_key(), names, run.index, len(run.gammas))
+        for chunk in ck.chunks:
+            run.accept(chunk)
+        reused += ck.reused
+        stale += ck.stale
+    return reused, stale
+
+
+def _run(runs, family, client, n_workers, out, progress, on_line) -> tuple:
+    """Resume, then compute the rest; returns (reused, stale) point counts."""
+    from tqdm import tqdm
+
+    from ._pool import run_chunks
+
+    line_root = None if out is None else Path(out) / "lines"
+    reused, stale = _resume(runs, line_root)
+    total = sum(len(r.gammas) for r in runs)
+    bar = tqdm(total=total, initial=reused, desc="frc", unit="pt", disable=None if progress else True)
+    if reused:
+        bar.set_postfix_str(f"reused {reused}")
+    for run in runs:
+        if run.finished and on_line is not None:
+            on_line(run.spec, False)
+    state = {"shown": reused}
+
+    def show():
+        now = reused + executor.progress()
+        if now > state["shown"]:
+            bar.update(now - state["shown"])
+            state["shown"] = now
+
+    def on_chunk(run, chunk):
+        if line_root is not None and chunk.done:
+            save_chunk(line_root / run.spec.key, run.spec.checkpoint_key(), chunk)
+        show()
+        if run.finished and on_line is not None:
+            on_line(run.spec, True)
+
+    todo = [r for r in runs if not r.finished]
+    try:
+        if todo:
+            executor = _executor(family, client, n_workers, len(todo), show)
+            run_chunks(runs, executor, config.SWEEP_CHUNK_POINTS, on_chunk, on_poll=show)
+    finally:
+        bar.close()
+    return reused, stale
+
+
+def _stack(runs, family, directions, name, shape_tail, dtype, fill):
+    arr = np.full((*family.shape, len(directions), *shape_tail), fill, dtype=dtype)
+    for run in runs:
+        idx = family.entries[run.system_index][0]
+        arr[(*idx, directions.index(run.spec.direction))] = run.on_grid()[name]
+    return arr
+
+
+def _assemble(family, runs, directions, g, dofs, spp, loop_outputs):
     import xarray as xr
 
-    from ..systems import PAPER
+    from .. import __version__
+    from ..dynamics.version import SOLVER_VERSION
 
-    dims = ("eta", load_name, "delta", "direction", "gamma")
-    p = dict(PAPER)
-    p.update(dict(ov))
-    fy = p["mu"] * p["n0"]
+    dims = (*family.dims, "direction", "gamma")
+    m = len(g)
     data = {}
     for name, (unit, desc) in {**VARIABLES, **INT_VARIABLES}.items():
-        data[name] = (dims, arrays[name], {"units": unit, "long_name": desc})
-    data["status"] = (
-        dims,
-        arrays["status"],
-        {
-            "legend": _LEGEND,
-            "flag_values": np.arange(len(config.SWEEP_STATUS), dtype=np.int8),
-            "flag_meanings": " ".join(config.SWEEP_STATUS),
-            "missing_code": _MISSING,
-        },
-    )
-    coords = {
-        "eta": ("eta", np.asarray(etas, float), {"long_name": "N1 / N0"}),
-        load_name: (
-            load_name,
-            np.asarray(loads, float),
-            {"long_name": "mu N0 / F1"} if load_name == "beta" else {"long_name": "forcing amplitude F1", "units": "N"},
-        ),
-        "delta": ("delta", np.asarray(deltas, float), {"long_name": "normal-load phase", "units": "deg"}),
-        "direction": ("direction", np.asarray(directions, dtype="U4")),
-        "gamma": ("gamma", np.asarray(g, float), {"long_name": "w / sqrt(k/m)"}),
-    }
-    if load_name == "beta":
-        coords["f1"] = ("beta", fy / np.asarray(loads, float), {"units": "N", "long_name": "forcing amplitude F1"})
-    else:
-        coords["beta"] = ("f1", fy / np.asarray(loads, float), {"long_name": "mu N0 / F1"})
-    attrs = {
-        "title": "steady-state frequency response of the friction damper (docs/model.md section 6)",
-        "model": model,
-        **{f"law_param_{key}": val for key, val in law_params},
-        "zeta": float(zeta),
-        "steps_per_period": int(spp) if spp is not None else "solver default",
-        "fy_N": float(fy),
-        "w0_rad_s": math.sqrt(p["k"] / p["m"]),
-        **{f"{key}": float(val) for key, val in p.items()},
-    }
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+        dtype = np.int32 if name in INT_VARIABLES else np.float64
+        data[name] = (dims, _stack(runs, family, directions, name, (m,), dtype, 0 if name in INT_VARIABLES
+                                   else np.nan), {"units": unit, "long_name": desc})
+    data["status"] = (dims, _stack(runs, family, directions, "status", (m,), np.int8, _MISSING), {
+        "legend": _LEGEND,
+        "flag_values": np.arange(len(config.SWEEP_STATUS), dtype=np.int8),
+        "flag_meanings": " ".join(config.SWEEP_STATUS),
+        "missing_code": _MISSING,
+    })
+    coords = dict(family.coords)
+    coords["direction"] = (("direction",), np.asarray(directions, dtype="U4"), {})
+    coords["gamma"] = (("gamma",), np.asarray(g, float), {"long_name": "w / w0"})
+    if loop_outputs:
+        nc = runs[0].ncontacts if runs else 0
+        for name, (unit, desc) in DOF_VARIABLES.items():
+            data[name] = ((*dims, "dof"), _stack(runs, family, directions, name, (m, len(dofs)), float, np.nan),
+                          {"units": unit, "long_name": desc})
+        for name, (unit, desc) in CONTACT_VARIABLES.items():
+            data[name] = ((*dims, "contact"), _stack(runs, family, directions, name, (m, nc), float, np.nan),
+                          {"units": unit, "long_name": desc})
+        name, unit, desc = STATE_VARIABLE
+        data[name] = ((*dims, "contact", "state"),
+                      _stack(runs, family, directions, name, (m, nc, len(STATE_NAMES)), float, np.nan),
+                      {"units": unit, "long_name": desc})
+        coords["dof"] = (("dof",), np.asarray(dofs, dtype=np.int64), {"long_name": "degree of freedom"})
+        coords["contact"] = (("contact",), np.arange(nc, dtype=np.int64), {"long_name": "contact index"})
+        coords["state"] = (("state",), np.asarray(STATE_NAMES, dtype=str), {"long_name": "motion state"})
+    attrs = {"title": "steady-state frequency response (time domain)", **family.attrs,
+             "steps_per_period": int(spp) if spp is not None else "solver default",
+             "solver_version": int(SOLVER_VERSION), "jointdyn_version": __version__}
+    return xr.Dataset(data, coords={k: (d, v, a) for k, (d, v, a) in coords.items()}, attrs=attrs)
 
 
 def to_frame(ds):
-    """Tidy long table of a sweep Dataset (one row per point) with a
-    ``status_name`` column."""
-    names = [v for v in ds.data_vars]
-    df = ds[names].to_dataframe().reset_index()
+    """Tidy long table of a sweep Dataset: one row per point (the dims of
+    ``status``), a ``status_name`` column, and one column per DOF, contact
+    and state for the per-DOF and per-contact variables
+    (``dof_amplitude_m_dof3``, ``contact_energy_J_c0``,
+    ``state_fraction_c0_macroslip``)."""
+    point_dims = list(ds["status"].dims)
+    flat = [v for v in ds.data_vars if set(ds[v].dims) <= set(point_dims)]
+    df = ds[flat].to_dataframe(dim_order=point_dims).reset_index()
+    for name in ds.data_vars:
+        extra = [d for d in ds[name].dims if d not in point_dims]
+        if not extra:
+            continue
+        stacked = ds[name].stack(_col=extra).transpose(*point_dims, "_col")
+        for j, key in enumerate(stacked.indexes["_col"]):
+            parts = key if isinstance(key, tuple) else (key,)
+            label = "_".join(_column_part(d, p) for d, p in zip(extra, parts))
+            df[f"{name}_{label}"] = stacked.isel(_col=j).values.reshape(-1)
     df["status_name"] = [status_name(c) for c in df["status"]]
     return df
 
 
+def _column_part(dim: str, value) -> str:
+    return {"dof": f"dof{value}", "contact": f"c{value}"}.get(dim, str(value))
+
+
 def write_outputs(ds, out) -> list[Path]:
-    """Write ``frc.nc`` (netCDF3, scipy engine) and ``frc.csv`` atomically."""
+    """Write ``frc.nc`` (netCDF3, scipy engine) and ``frc.csv`` atomically
+    (without the run attributes :data:`RUN_ATTRIBUTES`: the files hold the
+    results, the same however the run went)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    res = ds.copy()
+    for key in RUN_ATTRIBUTES:
+        res.attrs.pop(key, None)
     nc = out / "frc.nc"
     with atomic_path(nc) as tmp:
-        ds.to_netcdf(tmp, engine="scipy")
+        res.to_netcdf(tmp, engine="scipy")
     csv = out / "frc.csv"
     with atomic_path(csv) as tmp:
-        to_frame(ds).to_csv(tmp, index=False)
+        to_frame(res).to_csv(tmp, index=False)
     return [nc, csv]

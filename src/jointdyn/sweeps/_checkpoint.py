@@ -1,0 +1,117 @@
+"""Resume checkpoints of sweep lines: one small file per finished chunk.
+
+Layout under ``OUT/lines``: a folder per line (:attr:`LineSpec.key`, a
+readable label plus a hash of the line's spec) holding ``pNNNNNN.npz``, the
+chunk that starts at position NNNNNN of the line in its sweep direction.
+Each file holds the chunk's per-point arrays, the warm start of the point
+after it (x, v, law states, or ``cold``) and the resume key: the line's spec
+with the solver's results version and the jointdyn version
+(:meth:`LineSpec.checkpoint_key`). Files are written atomically.
+
+A line resumes from position 0 along the chain of chunks (each names where
+the next starts); the chain stops at the first missing or unreadable file
+or at a file whose key differs (made by another solver version: its points
+are counted as stale and recomputed, and the new chunks replace it).
+"""
+
+from __future__ import annotations
+
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .._io import atomic_path
+from ._points import ChunkResult
+
+__all__ = ["LineCheckpoints", "chunk_path", "save_chunk", "load_line"]
+
+_RESTART = ("restart_x", "restart_v", "restart_states")
+
+
+def chunk_path(line_dir: Path, first: int) -> Path:
+    """File of the chunk starting at position ``first``."""
+    return Path(line_dir) / f"p{int(first):06d}.npz"
+
+
+def save_chunk(line_dir: Path, key: str, chunk: ChunkResult) -> Path:
+    """Write ``chunk`` (atomically) with the resume ``key``."""
+    arrays = dict(chunk.arrays)
+    arrays["first"] = np.int64(chunk.first)
+    arrays["done"] = np.int64(chunk.done)
+    arrays["key"] = np.array(key)
+    arrays["cold"] = np.bool_(chunk.restart is None)
+    if chunk.restart is not None:
+        arrays["restart_x"] = np.asarray(chunk.restart.x, float)
+        arrays["restart_v"] = np.asarray(chunk.restart.v, float)
+        arrays["restart_states"] = np.asarray(chunk.restart.states, float)
+    path = chunk_path(line_dir, chunk.first)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
+    return path
+
+
+@dataclass(frozen=True)
+class LineCheckpoints:
+    """What a line's checkpoints give back.
+
+    Attributes
+    ----------
+    chunks : tuple of ChunkResult
+        Reusable chunks in line order, from position 0 without a gap.
+    stale : int
+        Points of checkpoints made by another solver or jointdyn version
+        (not reused).
+    """
+
+    chunks: tuple
+    stale: int
+
+    @property
+    def reused(self) -> int:
+        """Points reused."""
+        return sum(c.done for c in self.chunks)
+
+
+def _read(path: Path, names, line: int):
+    """(key, ChunkResult) of one file, or None if unreadable or malformed."""
+    from ..dynamics import Restart
+
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            key = str(z["key"])
+            first, done = int(z["first"]), int(z["done"])
+            arrays = {n: z[n] for n in names}
+            restart = None if bool(z["cold"]) else Restart(*(z[n] for n in _RESTART))
+    except (OSError, ValueError, KeyError, EOFError, TypeError, zipfile.BadZipFile):
+        return None
+    if done < 1 or any(a.shape[:1] != (done,) for a in arrays.values()):
+        return None
+    return key, ChunkResult(line=line, first=first, done=done, arrays=arrays, restart=restart)
+
+
+def load_line(line_dir: Path, key: str, names, line: int, length: int) -> LineCheckpoints:
+    """The reusable chunks of a line of ``length`` points whose resume key is ``key``.
+
+    ``names`` are the per-point arrays every chunk must hold.
+    """
+    chunks, stale, pos, reusing = [], 0, 0, True
+    while pos < length:
+        path = chunk_path(line_dir, pos)
+        if not path.is_file():
+            break
+        got = _read(path, names, line)
+        if got is None or got[1].first != pos or pos + got[1].done > length:
+            break
+        k, chunk = got
+        if k != key:
+            reusing = False
+        if reusing:
+            chunks.append(chunk)
+        else:
+            stale += chunk.done
+        pos += chunk.done
+    return LineCheckpoints(chunks=tuple(chunks), stale=stale)
