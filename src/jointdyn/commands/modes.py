@@ -30,6 +30,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ._law_args import add_law_arguments, law_params, model_help
+from ._system_args import load_system_file
 
 NAME = "modes"
 HELP = "backbone of a nonlinear mode (natural frequency and damping ratio against amplitude) by EPMC or QSMA"
@@ -80,61 +81,6 @@ def parse_amplitude(text: str) -> tuple[float, float]:
     return lo, hi
 
 
-def read_system_file(path):
-    """The System of a TOML system file: ``jointdyn.read_system`` where the package has it, else a
-    minimal reader of the same schema (:func:`_read_minimal`)."""
-    import jointdyn
-
-    reader = getattr(jointdyn, "read_system", None)
-    return (reader or _read_minimal)(path)
-
-
-def _read_minimal(path):
-    """Structure (``[structure]`` M, K, C), contacts (``[[contact]]``) and ``[output] dof`` of a TOML file.
-
-    The subset of the system-file schema a free vibration needs; ``[[force]]``
-    entries are read for completeness. Errors name the file and the key.
-    """
-    import tomllib
-
-    from ..kinematics import ConstantLoad, HarmonicLoad, NormalSpring
-    from ..laws import make_law
-    from ..systems import Contact, System
-
-    with open(path, "rb") as fh:
-        try:
-            doc = tomllib.load(fh)
-        except tomllib.TOMLDecodeError as exc:
-            raise ValueError(f"{path}: not valid TOML: {exc}") from None
-    try:
-        st = doc["structure"]
-        n = len(st["M"])
-        contacts = []
-        for i, c in enumerate(doc.get("contact", [])):
-            key = f"contact[{i}]"
-            extra = {k: v for k, v in c.items() if k not in ("law", "kt", "mu", "n_ref", "tangential", "normal")}
-            nrm = dict(c["normal"])
-            if "kn" in nrm:
-                load = NormalSpring(**nrm)
-            elif "n1" in nrm or "phase_deg" in nrm:
-                load = HarmonicLoad(**nrm)
-            else:
-                load = ConstantLoad(**nrm)
-            law = make_law(c["law"], kt=c["kt"], mu=c["mu"], n_ref=c.get("n_ref", load.n0), **extra)
-            contacts.append(Contact(law, normal=load, **dict(c["tangential"])))
-        force = np.zeros(n)
-        phase = np.zeros(n)
-        for f in doc.get("force", []):
-            force[int(f["dof"])] = f["amplitude"]
-            phase[int(f["dof"])] = f.get("phase_deg", 0.0)
-        return System(st["M"], st.get("C"), st["K"], contacts=tuple(contacts), force=force, force_phase_deg=phase,
-                      output_dof=doc.get("output", {}).get("dof"))
-    except KeyError as exc:
-        raise ValueError(f"{path}: key {exc.args[0]!r} is missing") from None
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{path}: {' '.join(str(exc).split())}") from None
-
-
 def _validate(args):
     """Options checked and the System built; returns ``(system, amplitude range, label)``."""
     from ..laws import law_names
@@ -150,7 +96,7 @@ def _validate(args):
         if args.model is not None or args.law_param or args.n is not None:
             raise ValueError("--model, --law-param and --n cannot be combined with --system: the system file "
                              "names the law of each contact")
-        system = read_system_file(V.input_file("--system", args.system))
+        system = load_system_file(args).system
         label = Path(args.system).name
     else:
         args.model = config.MODEL if args.model is None else V.choice("--model", args.model, law_names())
