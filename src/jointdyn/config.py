@@ -255,3 +255,20 @@ HB_STABILITY_RTOL = 1e-6
 HB_SMALL_EIG = 200
 #: turning points of a branch (secant): dead band as a fraction of the range
 HB_TURNING_BAND = 5e-4
+
+# --- harmonic balance: condensation onto the contact DOFs (jointdyn.hb.condense) -------
+#: automatic choice: condense systems of at least this many DOFs ...
+HB_CONDENSE_MIN_DOFS = 12
+#: ... whose retained DOFs (contacts, DOF 0, response DOFs) are at most this
+#: fraction of all DOFs
+HB_CONDENSE_MAX_FRACTION = 0.5
+#: the damping is modal (receptance by the undamped modes) when the
+#: off-diagonal entries of Phi^T C Phi are at most this fraction of its
+#: largest entry; otherwise the damped (state-space) eigenproblem is used
+HB_CONDENSE_MODAL_RTOL = 1e-12
+#: the spectral expansion of the receptance must reproduce a direct solve of
+#: the dynamic stiffness to this (relative to its largest entry)
+HB_CONDENSE_CHECK_RTOL = 1e-9
+#: a condensed problem computes Hill stability (on the full Jacobian it
+#: assembles) when the full companion matrix has at most this many rows
+HB_CONDENSED_HILL_ROWS = 200

@@ -1,0 +1,472 @@
+"""Harmonic balance condensed exactly onto the contact DOFs.
+
+A structure of n linear DOFs with a few contacts has all its nonlinearity
+on the m DOFs that the contacts' selections touch. Per harmonic k the
+linear part is eliminated exactly (the Schur complement of the dynamic
+stiffness, as pyHarm's substructuring does): with the retained DOFs c and
+the others o, in complex form ``x_k = a_k - i b_k`` (the coefficients of
+cos k tau and sin k tau)::
+
+    Z(W) = K - W^2 M + i W C,   H(W) = Z(W)^-1 (receptance),  W = k w,
+    Z_red(W) = H_cc(W)^-1,      F_red = Z_red H_c:(W) F_k,
+    R_c = Z_red x_c - F_red + g(x_c) = 0,
+
+g the Fourier coefficients of the contact forces (the AFT of
+:mod:`jointdyn.hb._aft`, unchanged). ``R_c`` is in newtons like the full
+residual, with the same scaling and tolerances; its solution is the full
+problem's solution restricted to c (equal to rounding). The unknowns are
+the harmonics of the retained DOFs only, so a structure of 1000 DOFs with
+two contacts solves systems of the size of the two contacts.
+
+The receptance comes from a once-per-system eigen-decomposition
+(:func:`receptance`), H(W) = Psi diag(g(W)) Psi^T:
+
+* ``modal`` (C diagonal in the mass-normalised modes Phi of (M, K), which
+  includes C = 0, Rayleigh damping and :func:`jointdyn.modal_damping`):
+  Psi = Phi, g_r = 1 / (w_r^2 - W^2 + i W c_r), c_r = (Phi^T C Phi)_rr;
+* ``state-space`` (any other C): the 2n eigenpairs (lambda_r, y_r) of the
+  quadratic problem (lambda^2 I + lambda Phi^T C Phi + diag(w_r^2)) y = 0
+  in modal coordinates, Psi_r = Phi y_r / sqrt(y_r^T (2 lambda_r I +
+  Phi^T C Phi) y_r), g_r = 1 / (i W - lambda_r) (the spectral expansion of
+  a symmetric quadratic pencil; Tisseur & Meerbergen, SIAM Rev. 43, 2001).
+
+So an evaluation costs O(R m^2) per harmonic (R = n or 2n terms) plus
+m x m inverses, and dZ_red/dw = -Z_red (dH_cc/dw) Z_red is exact. The
+static harmonic (W = 0) uses the static Schur complement
+K_cc - K_co K_oo^-1 K_oc, computed once (a structure whose K is singular
+only through the retained DOFs, e.g. a damper held by its contacts, is
+allowed). The decomposition is checked once against a direct solve of
+Z(W) at a frequency between natural frequencies (``config.HB_CONDENSE_CHECK_RTOL``).
+
+Retained DOFs: every DOF of a contact's tangential selection, DOF 0 (the
+DOF the branch monitor of :mod:`jointdyn.hb.frc` measures) and the
+response DOFs asked for; any other DOF's response is recovered from the
+solution (:meth:`CondensedHBProblem.dof_coefficients` with the parameter
+value, :meth:`CondensedHBProblem.full_coefficients`).
+
+Stability: Hill's method needs the full-size Jacobian. A condensed problem
+assembles it exactly (:meth:`CondensedHBProblem.full_jacobian`) and runs
+Hill's method when the full companion matrix has at most
+``config.HB_CONDENSED_HILL_ROWS`` rows; beyond, stability is not computed
+(growth NaN; the branch's Dataset says so in its ``stability`` attribute).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import config
+from .._cache import by_identity
+from ..kinematics import contact_kinematics, selection_matrix
+from ..systems import System
+from .problem import HBProblem, _linear_blocks
+from .stability import hill_growth, hill_stability
+
+__all__ = ["Receptance", "receptance", "retained_dofs", "CondensedHBProblem", "make_problem", "use_condensed"]
+
+#: kinds of spectral expansion of the receptance
+MODAL, STATE_SPACE = "modal", "state-space"
+
+
+@dataclass(frozen=True)
+class Receptance:
+    """Spectral expansion H(W) = Psi diag(g(W)) Psi^T of a structure's receptance.
+
+    Attributes
+    ----------
+    kind : str
+        ``"modal"`` or ``"state-space"`` (module docstring).
+    vectors : ndarray (n, R)
+        Psi (real for ``modal``, complex for ``state-space``), in 1/sqrt(kg).
+    a, b : ndarray (R,)
+        ``modal``: w_r^2 (rad^2/s^2) and c_r (rad/s); ``state-space``:
+        the eigenvalues lambda_r (1/s) and unused zeros.
+    seconds : float
+        CPU seconds the decomposition took.
+    """
+
+    kind: str
+    vectors: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    seconds: float
+
+    def factors(self, W):
+        """(g, dg/dW) at the angular frequencies W (array (k,), rad/s): arrays (k, R) complex."""
+        W = np.asarray(W, dtype=np.float64)[:, None]
+        if self.kind == MODAL:
+            g = 1.0 / (self.a[None, :] - W * W + 1j * W * self.b[None, :])
+            return g, (2.0 * W - 1j * self.b[None, :]) * g * g
+        g = 1.0 / (1j * W - self.a[None, :])
+        return g, -1j * g * g
+
+    def block(self, W, rows, cols):
+        """H(W)[rows][:, cols] (complex, m/N) at one angular frequency W (rad/s)."""
+        g, _ = self.factors(np.array([W]))
+        return (self.vectors[rows] * g[0]) @ self.vectors[cols].T
+
+
+def _is_modal(Ct) -> bool:
+    """True when the modal damping matrix Phi^T C Phi is diagonal to ``config.HB_CONDENSE_MODAL_RTOL``."""
+    off = Ct - np.diag(np.diag(Ct))
+    scale = float(np.max(np.abs(Ct))) if Ct.size else 0.0
+    return float(np.max(np.abs(off), initial=0.0)) <= config.HB_CONDENSE_MODAL_RTOL * scale
+
+
+def _state_space(w2, Ct):
+    """(lambda, Y) of the quadratic pencil lambda^2 I + lambda Ct + diag(w2), Y normalised (module docstring)."""
+    from scipy.linalg import eig
+
+    R = w2.size
+    A = np.zeros((2 * R, 2 * R))
+    A[:R, R:] = np.eye(R)
+    A[R:, :R] = -np.diag(w2)
+    A[R:, R:] = -Ct
+    lam, V = eig(A)
+    Y = V[:R]
+    a = np.einsum("ir,ir->r", Y, Y) * (2.0 * lam) + np.einsum("ir,ij,jr->r", Y, Ct, Y)
+    if np.any(a == 0.0):
+        raise ValueError("condense: the structure's damped eigenproblem is defective (a repeated eigenvalue "
+                         "without a full set of eigenvectors); use condense=False")
+    return lam, Y / np.sqrt(a)[None, :]
+
+
+def _check_frequency(w2) -> float:
+    """A frequency (rad/s) between the two lowest distinct natural frequencies (or above the only one)."""
+    w = np.unique(np.sqrt(np.maximum(w2, 0.0)))
+    w = w[w > 0.0]
+    if w.size == 0:
+        return 1.0
+    if w.size == 1:
+        return 1.5 * float(w[0])
+    return math.sqrt(float(w[0] * w[1]))
+
+
+@by_identity
+def receptance(system: System) -> Receptance:
+    """The spectral expansion of ``system``'s receptance (once per System; module docstring).
+
+    Raises ValueError naming ``condense`` when the expansion does not
+    reproduce a direct solve of Z(W) (a defective damped eigenproblem) to
+    ``config.HB_CONDENSE_CHECK_RTOL``.
+    """
+    from scipy.linalg import eigh
+
+    t0 = time.process_time()
+    M, C, K = system.M, system.C, system.K
+    w2, Phi = eigh(K, M)
+    Ct = Phi.T @ C @ Phi
+    if _is_modal(Ct):
+        rec = (MODAL, Phi, w2, np.diag(Ct).copy())
+    else:
+        lam, Y = _state_space(w2, Ct)
+        rec = (STATE_SPACE, Phi @ Y, lam, np.zeros(lam.size))
+    out = Receptance(*rec, seconds=0.0)
+    # the expansion against a direct solve at one frequency (a few columns)
+    W = _check_frequency(w2)
+    cols = np.unique(np.linspace(0, system.ndof - 1, min(system.ndof, 4)).astype(int))
+    direct = np.linalg.solve(K - W * W * M + 1j * W * C, np.eye(system.ndof)[:, cols])
+    err = float(np.max(np.abs(out.block(W, np.arange(system.ndof), cols) - direct)))
+    if not err <= config.HB_CONDENSE_CHECK_RTOL * float(np.max(np.abs(direct))):
+        raise ValueError(f"condense: the {out.kind} expansion of the receptance misses a direct solve by "
+                         f"{err:.3g} (relative {err / float(np.max(np.abs(direct))):.3g}); use condense=False")
+    return Receptance(*rec, seconds=time.process_time() - t0)
+
+
+def retained_dofs(system: System, response_dofs=()) -> np.ndarray:
+    """Sorted DOFs kept by a condensed problem: contact selections, DOF 0 and ``response_dofs``."""
+    kin = contact_kinematics(system)
+    B = selection_matrix(kin, system.ndof)
+    keep = set(np.flatnonzero(np.any(B != 0.0, axis=0)).tolist()) | {0}
+    for d in response_dofs:
+        d = int(d)
+        if not 0 <= d < system.ndof:
+            raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {d!r}")
+        keep.add(d)
+    return np.array(sorted(keep), dtype=np.int64)
+
+
+def _static_parts(K, c):
+    """(Z0, S0): the static Schur complement K_cc - K_co K_oo^-1 K_oc and the static recovery
+    S0 (n x m): x = S0 x_c for a static load on the retained DOFs c only (rows c: identity,
+    other rows o: -K_oo^-1 K_oc).
+
+    ValueError naming ``condense`` when K_oo is not positive definite
+    (a static load on the other DOFs would have no unique response).
+    """
+    from scipy.linalg import LinAlgError, cho_factor, cho_solve
+
+    n = K.shape[0]
+    o = np.setdiff1d(np.arange(n), c)
+    S0 = np.zeros((n, c.size))
+    S0[c, np.arange(c.size)] = 1.0
+    if o.size == 0:
+        return K[np.ix_(c, c)].copy(), S0
+    try:
+        cf = cho_factor(K[np.ix_(o, o)])
+    except LinAlgError:
+        raise ValueError("condense: K restricted to the DOFs that are not retained must be positive definite "
+                         "(the structure must be held when the contact DOFs are fixed)") from None
+    T0 = -cho_solve(cf, K[np.ix_(o, c)])
+    S0[o] = T0
+    return K[np.ix_(c, c)] + K[np.ix_(c, o)] @ T0, S0
+
+
+def _real_blocks(Z0, Zk, out):
+    """Real block matrix of the harmonics into ``out`` (m(2H+1) square): Z0 (m, m) for k = 0 and
+    ``[[Re Zk, Im Zk], [-Im Zk, Re Zk]]`` for k >= 1 (``Zk`` (H, m, m) complex)."""
+    m = Z0.shape[0]
+    out[:m, :m] = Z0
+    for k in range(1, Zk.shape[0] + 1):
+        zr, zi = Zk[k - 1].real, Zk[k - 1].imag
+        a, b = (2 * k - 1) * m, 2 * k * m
+        out[a:a + m, a:a + m] = zr
+        out[a:a + m, b:b + m] = zi
+        out[b:b + m, a:a + m] = -zi
+        out[b:b + m, b:b + m] = zr
+    return out
+
+
+def _to_complex(v, nh, m):
+    """Real harmonic coefficients (nh m) -> (static (m,), harmonics (H, m) complex a - i b)."""
+    V = np.asarray(v).reshape(nh, m)
+    return V[0], V[1::2] - 1j * V[2::2]
+
+
+def _to_real(x0, xk):
+    """Inverse of :func:`_to_complex` for (x0 (q,), xk (H, q)): array (nh, q)."""
+    out = np.empty((1 + 2 * xk.shape[0], x0.shape[0]))
+    out[0] = x0
+    out[1::2] = xk.real
+    out[2::2] = -xk.imag
+    return out
+
+
+class CondensedHBProblem(HBProblem):
+    """Harmonic-balance residual condensed exactly onto the retained DOFs.
+
+    Same interface as :class:`~jointdyn.hb.problem.HBProblem` (``evaluate``,
+    ``linear_guess``, ``amplitudes``, ...); the unknowns are the harmonics
+    of ``dofs`` (:func:`retained_dofs`) only. See the module docstring.
+
+    Parameters
+    ----------
+    system, harmonics, samples, parameter, gamma, max_passes
+        As for :class:`~jointdyn.hb.problem.HBProblem`.
+    response_dofs : sequence of int
+        DOFs kept among the unknowns besides the contact DOFs and DOF 0.
+    """
+
+    def __init__(self, system: System, *, harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
+                 parameter="gamma", gamma: float | None = None, max_passes: int = config.HB_MAX_PASSES,
+                 response_dofs=()):
+        if not isinstance(system, System):
+            raise ValueError("system must be a jointdyn.System")
+        c = retained_dofs(system, response_dofs)
+        self._setup(system, harmonics, samples, parameter, gamma, max_passes, c)
+        self._Z0, self._S0 = _static_parts(system.K, c)
+        self.receptance = receptance(system)
+        self._Psi_c = np.ascontiguousarray(self.receptance.vectors[c])
+        self._k = np.arange(1, self.H + 1, dtype=np.float64)
+        self._zero = np.zeros((self.size, self.size))
+        self._at_w = None
+        self._modal_force = (None, None)
+        self._fixed_forcing = None
+        self._fixed_loads = None if self.parameter.enters_loads else self._loads_at(0.0)
+
+    @property
+    def condensed(self) -> bool:
+        return True
+
+    # --- linear part at a frequency -----------------------------------------
+    def _linear_at(self, w: float):
+        """(Zb, dZb, Zk, dZk, g1, dg1) at w (rad/s), kept for the last w.
+
+        Zb, dZb: real block matrices of Z_red and dZ_red/dw; Zk, dZk: the
+        complex (H, m, m) harmonics; g1, dg1: expansion factors of the
+        first harmonic and their w-derivative (for the forcing).
+        """
+        if self._at_w is not None and self._at_w[0] == w:
+            return self._at_w[1]
+        g, dg = self.receptance.factors(self._k * w)
+        dg = dg * self._k[:, None]  # d/dw of g(k w)
+        P = self._Psi_c
+        Hc = (P[None, :, :] * g[:, None, :]) @ P.T
+        dHc = (P[None, :, :] * dg[:, None, :]) @ P.T
+        Zk = np.linalg.inv(Hc)
+        dZk = -Zk @ dHc @ Zk
+        Zb = _real_blocks(self._Z0, Zk, np.zeros((self.size, self.size)))
+        dZb = _real_blocks(np.zeros_like(self._Z0), dZk, np.zeros((self.size, self.size)))
+        out = (Zb, dZb, Zk, dZk, g[0], dg[0])
+        self._at_w = (w, out)
+        return out
+
+    def _linear_terms(self, w):
+        # the compiled evaluation forms AK + w AC + w^2 AM and dwdp (AC + 2 w AM) X:
+        # with AK = Z_red(w), AC = dZ_red/dw, AM = 0 and 0 in place of w it forms
+        # exactly Z_red(w) and dwdp dZ_red/dw X
+        Zb, dZb = self._linear_at(float(w))[:2]
+        return Zb, dZb, self._zero, 0.0
+
+    def linear_matrix(self, w):
+        """Block matrix of Z_red(w) (size m(2H+1)): the condensed linear terms."""
+        return self._linear_at(float(w))[0].copy()
+
+    # --- forcing ------------------------------------------------------------
+    def _modal(self, f):
+        """Psi^T F1 for amplitudes f (N) with the system's phases (F1 = f sin(phi) - i f cos(phi)); last kept."""
+        key, q = self._modal_force
+        if key is not None and np.array_equal(key, f):
+            return q
+        f = np.asarray(f, dtype=np.float64)
+        nz = np.flatnonzero(f)
+        F1 = f[nz] * (self.phase_sin[nz] - 1j * self.phase_cos[nz])
+        q = self.receptance.vectors[nz].T @ F1
+        self._modal_force = (f.copy(), q)
+        return q
+
+    def _forcing_pair(self, f, w):
+        """(F_red, dF_red/dw) coefficient vectors of the forcing f (N) at w (rad/s)."""
+        _, _, Zk, dZk, g1, dg1 = self._linear_at(float(w))
+        q = self._modal(f)
+        y = self._Psi_c @ (g1 * q)
+        dy = self._Psi_c @ (dg1 * q)
+        Fr, dFr = np.zeros(self.size), np.zeros(self.size)
+        m = self.n
+        z, dz = Zk[0] @ y, dZk[0] @ y + Zk[0] @ dy
+        Fr[m:2 * m], Fr[2 * m:3 * m] = z.real, -z.imag
+        dFr[m:2 * m], dFr[2 * m:3 * m] = dz.real, -dz.imag
+        return Fr, dFr
+
+    def forcing(self, f, w: float | None = None):
+        """Condensed coefficient vector F_red of the forcing f_i sin(tau + phi_i) at w (rad/s)."""
+        if w is None:
+            raise ValueError("w must be given: the condensed forcing depends on the frequency")
+        return self._forcing_pair(f, w)[0]
+
+    def _forcing_at(self, p):
+        f, df = self.parameter.forcing(self, p)
+        w, dwdp = self.parameter.frequency(self, p)
+        Fe, dFe = self._forcing_pair(f, w)
+        Fp = dwdp * dFe
+        if df is not None:
+            Fp = Fp + self._forcing_pair(df, w)[0]
+        return Fe, Fp
+
+    # --- recovery -------------------------------------------------------------
+    def _recover(self, X, p, rows):
+        """Coefficients (nh, len(rows)) of the system DOFs ``rows`` at the condensed X, parameter p.
+
+        Per harmonic k >= 1, x = H(k w) (F_k - S^T gamma_k) with the contact
+        forces on the retained DOFs gamma = F_red - Z_red X (so that the
+        retained rows reproduce X); statically x = S0 x_c. Retained rows are
+        X itself.
+        """
+        rows = np.asarray(rows, dtype=np.int64)
+        X = np.asarray(X, dtype=np.float64)
+        w = self.omega(p)
+        f = self.parameter.forcing(self, p)[0]
+        gamma = self.forcing(f, w) - self._linear_at(w)[0] @ X
+        x0, _ = _to_complex(X, self.nh, self.n)
+        _, gk = _to_complex(gamma, self.nh, self.n)
+        g, _ = self.receptance.factors(self._k * w)
+        modal = -(gk @ self._Psi_c)  # (H, R): -Psi_c^T gamma_k
+        modal[0] += self._modal(f)
+        out = _to_real(self._S0[rows] @ x0, (g * modal) @ self.receptance.vectors[rows].T)
+        kept = np.flatnonzero(np.isin(rows, self.dofs))
+        Xm = X.reshape(self.nh, self.n)
+        for j in kept:
+            out[:, j] = Xm[:, self.dof_index(int(rows[j]))]
+        return out
+
+    def dof_coefficients(self, X, dof: int, p=None):
+        X = np.asarray(X, dtype=np.float64)
+        if np.any(self.dofs == dof):
+            return super().dof_coefficients(X, dof)
+        if not 0 <= dof < self.system.ndof:
+            raise ValueError(f"dof must be in [0, {self.system.ndof - 1}], got {dof!r}")
+        if p is None:
+            raise ValueError(f"dof {dof} is not retained by the condensed problem: give the parameter value p "
+                             "to recover it (or keep it with response_dof)")
+        if X.ndim == 1:
+            return self._recover(X, float(p), [dof])[:, 0]
+        ps = np.broadcast_to(np.asarray(p, dtype=np.float64), X.shape[:1])
+        return np.array([self._recover(x, float(q), [dof])[:, 0] for x, q in zip(X, ps)]).reshape(X.shape[0], -1)
+
+    def full_coefficients(self, X, p):
+        """Coefficients of every DOF (harmonic-major, ndof (2H+1)) recovered from the condensed X, m."""
+        return self._recover(X, float(p), np.arange(self.system.ndof)).ravel()
+
+    # --- stability ------------------------------------------------------------
+    def full_jacobian(self, JX, w):
+        """The full problem's dR/dX (ndof(2H+1) square) from the condensed one at w (rad/s).
+
+        The contact part ``JX - Z_red(w)`` acts on the retained DOFs only; the
+        linear part is the full A(w) of :func:`~jointdyn.hb.problem._linear_blocks`.
+        """
+        n, nh, m = self.system.ndof, self.nh, self.n
+        AK, AC, AM = _linear_blocks(self.system, self.H)
+        J = AK + w * AC + (w * w) * AM
+        G = np.asarray(JX) - self._linear_at(float(w))[0]
+        idx = (np.arange(nh)[:, None] * n + self.dofs[None, :]).ravel()
+        J[np.ix_(idx, idx)] += G.reshape(nh * m, nh * m)
+        return J
+
+    def hill_affordable(self) -> bool:
+        """True when the full companion matrix (2 ndof (2H+1) rows) is small enough for Hill's method here."""
+        return 2 * self.system.ndof * self.nh <= config.HB_CONDENSED_HILL_ROWS
+
+    def hill_growth(self, JXs, ws):
+        """Hill's method on the full Jacobians when affordable (:meth:`hill_affordable`), else NaN."""
+        if not self.hill_affordable():
+            return np.full(len(ws), np.nan)
+        full = np.array([self.full_jacobian(J, w) for J, w in zip(JXs, ws)])
+        return hill_growth(full, self.system.M, self.system.C, ws, self.H)
+
+    def hill_stability(self, JX, w):
+        """(stable, growth, multipliers) by Hill's method on the full Jacobian, or (False, NaN, empty)."""
+        if not self.hill_affordable():
+            return False, math.nan, np.empty(0, dtype=complex)
+        return hill_stability(self.full_jacobian(JX, w), self.system.M, self.system.C, w, self.H)
+
+
+def use_condensed(system: System, condense=None, response_dofs=()) -> bool:
+    """Whether harmonic balance condenses ``system``: ``condense`` if True/False, else automatic.
+
+    Automatic: condensed when the system has at least
+    ``config.HB_CONDENSE_MIN_DOFS`` DOFs, retains at most
+    ``config.HB_CONDENSE_MAX_FRACTION`` of them, and K is positive definite
+    on the DOFs that are not retained.
+    """
+    if condense is not None:
+        if condense not in (True, False):
+            raise ValueError(f"condense must be True, False or None (automatic), got {condense!r}")
+        return bool(condense)
+    if system.ndof < config.HB_CONDENSE_MIN_DOFS:
+        return False
+    c = retained_dofs(system, response_dofs)
+    if c.size > config.HB_CONDENSE_MAX_FRACTION * system.ndof:
+        return False
+    try:
+        _static_parts(system.K, c)
+    except ValueError:
+        return False
+    return True
+
+
+def make_problem(system: System, *, condense=None, response_dofs=(), **kwargs) -> HBProblem:
+    """The harmonic-balance problem of ``system``: condensed (:class:`CondensedHBProblem`) or full.
+
+    ``condense``: True, False, or None for the automatic choice of
+    :func:`use_condensed`; ``response_dofs`` are kept among the unknowns of
+    a condensed problem; other keyword arguments go to the problem.
+    """
+    if not isinstance(system, System):
+        raise ValueError("system must be a jointdyn.System")
+    if use_condensed(system, condense, response_dofs):
+        return CondensedHBProblem(system, response_dofs=response_dofs, **kwargs)
+    return HBProblem(system, **kwargs)

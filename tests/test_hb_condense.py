@@ -1,0 +1,186 @@
+"""Harmonic balance of general structures: per-DOF forcing phases against the
+exact linear FRF (stuck and slipping limits), and the exact condensation onto
+the contact DOFs against the uncondensed problem."""
+
+import math
+
+import numpy as np
+import pytest
+
+import tolerances
+from jointdyn import config
+from jointdyn import System
+from jointdyn.hb import continue_hb, frc_hb, harmonic_balance
+from jointdyn.hb.condense import CondensedHBProblem, make_problem, receptance, retained_dofs, use_condensed
+from jointdyn.hb.problem import HBProblem
+from jointdyn.kinematics import HarmonicLoad
+from jointdyn.laws import Iwan, Jenkins
+from jointdyn.systems import Contact
+
+KT = 3e5
+
+
+def _chain(n, *, mu=0.5, law_class=Jenkins, proportional=True, phases=True):
+    """n masses in a chain (ends to ground), two contacts:
+    DOF 1 to ground and DOF n-2 against DOF n-1; forcing on DOF 0 and n // 2."""
+    k = 2e5 * np.linspace(1.0, 1.6, n + 1)
+    K = np.zeros((n, n))
+    for i in range(n + 1):
+        a, b = i - 1, i
+        if a >= 0:
+            K[a, a] += k[i]
+        if b < n:
+            K[b, b] += k[i]
+        if a >= 0 and b < n:
+            K[a, b] = K[b, a] = -k[i]
+    M = np.diag(np.linspace(1.0, 2.0, n))
+    C = 1e-5 * K + 0.5 * M
+    if not proportional:
+        C[0, 0] += 30.0  # a local damper: not diagonal in the modes
+    law = law_class(kt=KT, mu=mu, n_ref=100.0)
+    contacts = (Contact(law=law, dof=1, normal=HarmonicLoad(100.0, 30.0, 20.0)),
+                Contact(law=law, dof=n - 2, dof2=n - 1, normal=HarmonicLoad(80.0, 0.0, 0.0)))
+    f = np.zeros(n)
+    f[0], f[n // 2] = 40.0, 25.0
+    ph = np.zeros(n)
+    if phases:
+        ph[0], ph[n // 2] = -30.0, 70.0
+    return System(M=M, C=C, K=K, contacts=contacts, force=f, force_phase_deg=ph)
+
+
+def _linear_coefficients(s, w, K):
+    """(a, b) per DOF of the exact steady state of M x'' + C x' + K x = f sin(w t + phi): x = a cos + b sin."""
+    F = s.force * np.exp(1j * np.radians(s.force_phase_deg))
+    Xc = np.linalg.solve(K - w * w * s.M + 1j * w * s.C, F)
+    return Xc.imag, Xc.real
+
+
+@pytest.mark.parametrize("condense", [False, True])
+@pytest.mark.parametrize("limit", ["stuck", "slipping"])
+def test_forcing_phases_give_the_exact_linear_frf_in_the_limits(limit, condense):
+    # stuck: slip force far above the contact forces, the contacts are springs kt;
+    # slipping: slip force ~1e-10 N, the contacts carry nothing
+    s = _chain(6, mu=1e7 if limit == "stuck" else 1e-12)
+    K = s.K.copy()
+    if limit == "stuck":
+        for c in s.contacts:
+            b = np.zeros(s.ndof)
+            b[c.dof] = 1.0
+            if c.dof2 >= 0:
+                b[c.dof2] = -1.0
+            K += KT * np.outer(b, b)
+    for g in (0.7, 1.0, 1.6):
+        sol = harmonic_balance(s, g, harmonics=3, samples=64, condense=condense)
+        assert sol.converged
+        a, b = _linear_coefficients(s, g * s.w0, K)
+        Xm = sol.problem.full_coefficients(sol.X, sol.problem.f1_ref).reshape(7, s.ndof)
+        scale = np.max(np.abs(np.r_[a, b]))
+        assert np.max(np.abs(Xm[1] - a)) <= tolerances.TEST_HB_LINEAR_LIMIT_RTOL * scale
+        assert np.max(np.abs(Xm[2] - b)) <= tolerances.TEST_HB_LINEAR_LIMIT_RTOL * scale
+        assert np.max(np.abs(Xm[[0, 3, 4, 5, 6]])) <= tolerances.TEST_HB_LINEAR_LIMIT_RTOL * scale
+        amp = math.hypot(a[0], b[0])
+        assert abs(sol.amplitude_m - amp) <= tolerances.TEST_HB_LINEAR_LIMIT_RTOL * amp
+
+
+def test_phase_shift_of_every_force_shifts_the_response_in_time():
+    # shifting every phase (forces and normal loads) by the same angle shifts the periodic
+    # response by it in time; 45 degrees is 16 of the 128 AFT samples, so the sampled
+    # loops are the same
+    s = _chain(4, law_class=Iwan)
+    s2 = System(M=s.M, C=s.C, K=s.K, contacts=tuple(
+        Contact(law=c.law, dof=c.dof, dof2=c.dof2,
+                normal=HarmonicLoad(c.normal.n0, c.normal.n1, c.normal.phase_deg + 45.0)) for c in s.contacts),
+        force=s.force, force_phase_deg=s.force_phase_deg + 45.0)
+    a = harmonic_balance(s, 1.1, harmonics=5, samples=128)
+    b = harmonic_balance(s2, 1.1, harmonics=5, samples=128)
+    assert a.converged and b.converged
+    assert abs(a.amplitude_m - b.amplitude_m) <= 1e-9 * a.amplitude_m
+    assert abs(a.offset_m - b.offset_m) <= 1e-9 * a.amplitude_m
+
+
+@pytest.mark.parametrize("proportional", [True, False])
+@pytest.mark.parametrize("law_class", [Jenkins, Iwan])
+def test_condensed_equals_uncondensed(law_class, proportional):
+    s = _chain(9, law_class=law_class, proportional=proportional)
+    rec = receptance(s)
+    assert rec.kind == ("modal" if proportional else "state-space")
+    for g in (0.8, 1.05, 1.4):
+        full = harmonic_balance(s, g, harmonics=5, samples=128, condense=False)
+        cond = harmonic_balance(s, g, harmonics=5, samples=128, condense=True)
+        assert full.converged and cond.converged
+        p = cond.problem
+        assert isinstance(p, CondensedHBProblem) and p.dofs.tolist() == [0, 1, 7, 8]
+        Xf = full.X.reshape(p.nh, s.ndof)
+        scale = np.max(np.abs(full.X))
+        assert np.max(np.abs(Xf[:, p.dofs].ravel() - cond.X)) <= tolerances.TEST_HB_CONDENSED_RTOL * scale
+        rec_all = p.full_coefficients(cond.X, p.f1_ref)
+        assert np.max(np.abs(rec_all - full.X)) <= tolerances.TEST_HB_CONDENSED_RTOL * scale
+        assert abs(full.amplitude_m - cond.amplitude_m) <= tolerances.TEST_HB_CONDENSED_RTOL * full.amplitude_m
+        # the recovered response of a DOF that is not retained
+        d = 4
+        assert abs(cond.problem.amplitudes(cond.X, d, p.f1_ref)[0] - full.problem.amplitudes(full.X, d)[0]) \
+            <= tolerances.TEST_HB_CONDENSED_RTOL * scale
+        # Hill stability on the assembled full Jacobian
+        assert cond.stable == full.stable
+        assert abs(cond.growth - full.growth) <= 1e-7
+
+
+def test_condensed_jacobian_matches_central_differences():
+    s = _chain(7, law_class=Iwan, proportional=False)
+    p = CondensedHBProblem(s, harmonics=3, samples=128)
+    g = 1.1
+    X = harmonic_balance(s, g, harmonics=3, samples=128, condense=True).X
+    ev = p.evaluate(X, g)
+    Ja = np.c_[ev.JX, ev.Jp]
+    Jfd = np.empty_like(Ja)
+    for j in range(X.size + 1):
+        Xp, Xm, lp, lm = X.copy(), X.copy(), g, g
+        if j < X.size:
+            h = 1e-6 * np.abs(X).max()
+            Xp[j] += h
+            Xm[j] -= h
+        else:
+            h = 1e-6 * g
+            lp, lm = g + h, g - h
+        Jfd[:, j] = (p.evaluate(Xp, lp).R - p.evaluate(Xm, lm).R) / (2 * h)
+    assert np.max(np.abs(Ja - Jfd)) <= tolerances.TEST_HB_JACOBIAN_RTOL * np.max(np.abs(Ja))
+
+
+def test_condensed_branch_solves_the_uncondensed_equations():
+    # every point of a condensed branch, recovered on all DOFs, solves the full
+    # problem (to the continuation's tolerance) with the full problem's stability
+    s = _chain(9, law_class=Iwan)
+    br = continue_hb(s, 0.7, 1.5, harmonics=5, samples=128, condense=True, progress=False)
+    assert br.status == "complete" and br.problem.condensed
+    full = HBProblem(s, harmonics=5, samples=128)
+    fs = max(full.f1_ref, max(c.law.mu * c.law.n_ref for c in s.contacts))
+    picks = np.unique(np.r_[np.arange(0, br.lam.size, 15), br.lam.size - 1])
+    for i in picks:
+        X = br.problem.full_coefficients(br.X[i], br.lam[i])
+        ev = full.evaluate(X, br.lam[i])
+        assert np.max(np.abs(ev.R)) <= 10 * config.CONT_TOL * fs
+        stable, growth, _ = full.hill_stability(ev.JX, full.omega(br.lam[i]))
+        assert stable == br.stable[i] and abs(growth - br.growth[i]) <= 1e-7
+    ds = frc_hb(s, 0.7, 0.8, harmonics=5, samples=128, condense=True, response_dof=4, progress=False)
+    assert ds.attrs["condensed"] == 1 and ds.attrs["stability"] == "hill"
+
+
+def test_automatic_choice_and_bad_input():
+    small, large = _chain(4), _chain(30)
+    assert not use_condensed(small) and use_condensed(large)
+    assert isinstance(make_problem(large), CondensedHBProblem)
+    assert type(make_problem(small)) is HBProblem
+    assert retained_dofs(large).tolist() == [0, 1, 28, 29]
+    assert retained_dofs(large, (7,)).tolist() == [0, 1, 7, 28, 29]
+    with pytest.raises(ValueError, match="condense"):
+        harmonic_balance(small, 1.0, condense="yes")
+    with pytest.raises(ValueError, match="response_dof"):
+        retained_dofs(large, (30,))
+    p = CondensedHBProblem(large, harmonics=2, samples=32)
+    X = np.zeros(p.size)
+    with pytest.raises(ValueError, match="parameter value"):
+        p.dof_coefficients(X, 10)
+    with pytest.raises(ValueError, match="w must be given"):
+        p.forcing(large.force)
+    br = continue_hb(large, 0.9, 1.0, harmonics=2, samples=32, condense=True, max_points=5)
+    assert br.problem.condensed
