@@ -262,12 +262,13 @@ HB_CONDENSE_MIN_DOFS = 12
 #: ... whose retained DOFs (contacts, DOF 0, response DOFs) are at most this
 #: fraction of all DOFs
 HB_CONDENSE_MAX_FRACTION = 0.5
-#: the damping is modal (receptance by the undamped modes) when the
-#: off-diagonal entries of Phi^T C Phi are at most this fraction of its
-#: largest entry; otherwise the damped (state-space) eigenproblem is used
+#: the damping is modal (receptance by the undamped modes) when C = alpha M +
+#: beta K to this fraction of max |C|, or when the off-diagonal entries of
+#: Phi^T C Phi are at most this fraction of its largest entry; otherwise the
+#: damped (state-space) eigenproblem is used
 HB_CONDENSE_MODAL_RTOL = 1e-12
-#: the spectral expansion of the receptance must reproduce a direct solve of
-#: the dynamic stiffness to this (relative to its largest entry)
+#: the spectral expansion H of the receptance must satisfy Z(W) H(W) = I at one
+#: frequency to this, relative to max |Z| max |H| (backward error)
 HB_CONDENSE_CHECK_RTOL = 1e-9
 #: a condensed problem computes Hill stability (on the full Jacobian it
 #: assembles) when the full companion matrix has at most this many rows

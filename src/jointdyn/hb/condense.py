@@ -35,8 +35,11 @@ m x m inverses, and dZ_red/dw = -Z_red (dH_cc/dw) Z_red is exact. The
 static harmonic (W = 0) uses the static Schur complement
 K_cc - K_co K_oo^-1 K_oc, computed once (a structure whose K is singular
 only through the retained DOFs, e.g. a damper held by its contacts, is
-allowed). The decomposition is checked once against a direct solve of
-Z(W) at a frequency between natural frequencies (``config.HB_CONDENSE_CHECK_RTOL``).
+allowed). The decomposition is checked once at a frequency W between
+natural frequencies: Z(W) H(W) = I on a few columns (:func:`receptance`).
+Rayleigh damping (C = alpha M + beta K, found by an O(n^2) fit) skips the
+dense product Phi^T C Phi; the decomposition also gives ``System.w0`` when
+the system has no normal springs, so the n x n eigenproblem is solved once.
 
 Retained DOFs: every DOF of a contact's tangential selection, DOF 0 (the
 DOF the branch monitor of :mod:`jointdyn.hb.frc` measures) and the
@@ -61,6 +64,7 @@ import numpy as np
 
 from .. import config
 from .._cache import by_identity
+from .._jit import jit
 from ..kinematics import contact_kinematics, selection_matrix
 from ..systems import System
 from .problem import HBProblem, _linear_blocks
@@ -70,6 +74,8 @@ __all__ = ["Receptance", "receptance", "retained_dofs", "CondensedHBProblem", "m
 
 #: kinds of spectral expansion of the receptance
 MODAL, STATE_SPACE = "modal", "state-space"
+#: the same kinds as codes of the compiled reduced receptance
+MODAL_CODE, STATE_SPACE_CODE = 0, 1
 
 
 @dataclass(frozen=True)
@@ -107,7 +113,97 @@ class Receptance:
     def block(self, W, rows, cols):
         """H(W)[rows][:, cols] (complex, m/N) at one angular frequency W (rad/s)."""
         g, _ = self.factors(np.array([W]))
-        return (self.vectors[rows] * g[0]) @ self.vectors[cols].T
+        right = g[0][:, None] * self.vectors[cols].T
+        if np.isrealobj(self.vectors):
+            return _real_times(self.vectors[rows], right)
+        return self.vectors[rows] @ right
+
+
+@jit
+def _expansion_factors(kind, a, b, W, k, g, dg):  # pragma: no cover - compiled
+    """The expansion factors g_r(W_h) and d g_r(k_h w) / dw into ``g``, ``dg`` (H, R) complex.
+
+    ``a`` (R,) complex, ``b`` (R,) real: the expansion's constants
+    (:class:`Receptance`) of kind ``MODAL_CODE`` (g = 1 / (a - W^2 + i W b))
+    or ``STATE_SPACE_CODE`` (g = 1 / (i W - a)); ``W = k w`` (H,) rad/s with
+    the harmonic numbers ``k``. Reciprocals as conj(d) / |d|^2.
+    """
+    for h in range(W.shape[0]):
+        Wh = W[h]
+        for r in range(a.shape[0]):
+            if kind == MODAL_CODE:
+                dr, di = a[r].real - Wh * Wh, Wh * b[r]
+            else:
+                dr, di = -a[r].real, Wh - a[r].imag
+            s = 1.0 / (dr * dr + di * di)
+            gr = complex(dr * s, -di * s)
+            g[h, r] = gr
+            if kind == MODAL_CODE:
+                dg[h, r] = k[h] * complex(2.0 * Wh, -b[r]) * gr * gr
+            else:
+                dg[h, r] = -1j * k[h] * gr * gr
+
+
+@jit
+def _block_sums(g, dg, Q, iu, ju, h, Hc, dHc):  # pragma: no cover - compiled
+    """H_cc and dH_cc/dw of harmonic h into ``Hc``, ``dHc`` (m, m) from their distinct entries
+    (pair p = (iu[p], ju[p])): sum_r Q[r, p] g[h, r] (``Q`` the products Psi_ir Psi_jr)."""
+    for p in range(iu.shape[0]):
+        acc = 0j
+        dacc = 0j
+        for r in range(Q.shape[0]):
+            acc += g[h, r] * Q[r, p]
+            dacc += dg[h, r] * Q[r, p]
+        Hc[iu[p], ju[p]] = acc
+        Hc[ju[p], iu[p]] = acc
+        dHc[iu[p], ju[p]] = dacc
+        dHc[ju[p], iu[p]] = dacc
+
+
+@jit
+def _put_block(Z, row, col, sign, out):  # pragma: no cover - compiled
+    """The real and imaginary parts of harmonic block Z (m, m) at (row, col) of ``out``:
+    [[Re Z, Im Z], [-Im Z, Re Z]] with rows/cols (row, row + m) and (col, col + m); sign +-1 scales it."""
+    m = Z.shape[0]
+    for i in range(m):
+        for j in range(m):
+            zr, zi = sign * Z[i, j].real, sign * Z[i, j].imag
+            out[row + i, col + j] = zr
+            out[row + i, col + m + j] = zi
+            out[row + m + i, col + j] = -zi
+            out[row + m + i, col + m + j] = zr
+
+
+@jit
+def _condensed_blocks(exp, pairs, w, Z0, out):  # pragma: no cover - compiled
+    """Z_red(w) and dZ_red/dw of every harmonic (module docstring), in one pass.
+
+    ``exp = (kind, a, b, Q, k)``: the expansion (:func:`_expansion_factors`)
+    with the pair products ``Q`` (R, pairs) and harmonic numbers ``k``;
+    ``pairs = (iu, ju)``; ``Z0`` (m, m) the static Schur complement. ``out =
+    (g, dg, Zk, dZk, Zb, dZb)``: the factors (H, R), the complex blocks
+    (H, m, m), and the real block matrices m(2H+1) square (written on the
+    diagonal blocks only; the rest must be zero).
+    """
+    kind, a, b, Q, k = exp
+    iu, ju = pairs
+    g, dg, Zk, dZk, Zb, dZb = out
+    _expansion_factors(kind, a, b, k * w, k, g, dg)
+    m = Z0.shape[0]
+    Hc = np.empty((m, m), dtype=np.complex128)
+    dHc = np.empty((m, m), dtype=np.complex128)
+    for i in range(m):
+        for j in range(m):
+            Zb[i, j] = Z0[i, j]
+    for h in range(k.shape[0]):
+        _block_sums(g, dg, Q, iu, ju, h, Hc, dHc)
+        Z = np.linalg.inv(Hc)
+        dZ = -(Z @ dHc @ Z)
+        Zk[h] = Z
+        dZk[h] = dZ
+        row = (2 * h + 1) * m
+        _put_block(Z, row, row, 1.0, Zb)
+        _put_block(dZ, row, row, 1.0, dZb)
 
 
 def _is_modal(Ct) -> bool:
@@ -146,34 +242,82 @@ def _check_frequency(w2) -> float:
     return math.sqrt(float(w[0] * w[1]))
 
 
+def _rayleigh(M, C, K):
+    """(alpha, beta) when C = alpha M + beta K to ``config.HB_CONDENSE_MODAL_RTOL`` (0, 0 for C = 0), else None.
+
+    A least-squares fit on the entries (2 x 2 normal equations), O(n^2):
+    Rayleigh damping (and no damping) needs no product Phi^T C Phi of the
+    dense modes.
+    """
+    scale = float(np.max(np.abs(C)))
+    if scale == 0.0:
+        return 0.0, 0.0
+    m, k, c = M.ravel(), K.ravel(), C.ravel()
+    G = np.array([[m @ m, m @ k], [m @ k, k @ k]])
+    try:
+        alpha, beta = np.linalg.solve(G, np.array([m @ c, k @ c]))
+    except np.linalg.LinAlgError:  # K a multiple of M
+        return None
+    if float(np.max(np.abs(C - alpha * M - beta * K))) <= config.HB_CONDENSE_MODAL_RTOL * scale:
+        return float(alpha), float(beta)
+    return None
+
+
+def _expansion(system: System):
+    """(kind, vectors, a, b) of the receptance expansion and the undamped w_r^2 (module docstring)."""
+    from scipy.linalg import eigh
+
+    M, C, K = system.M, system.C, system.K
+    w2, Phi = eigh(K, M)
+    ab = _rayleigh(M, C, K)
+    if ab is not None:
+        return (MODAL, Phi, w2, ab[0] + ab[1] * w2), w2
+    Ct = Phi.T @ C @ Phi
+    if _is_modal(Ct):
+        return (MODAL, Phi, w2, np.diag(Ct).copy()), w2
+    lam, Y = _state_space(w2, Ct)
+    return (STATE_SPACE, Phi @ Y, lam, np.zeros(lam.size)), w2
+
+
+def _real_times(A, B):
+    """A @ B for a real A and a complex B without a complex copy of A."""
+    return A @ B.real + 1j * (A @ B.imag)
+
+
+def _share_w0(system: System, w2) -> None:
+    """Give ``system.w0`` (a cached property: lowest natural frequency of (M, K_reference))
+    the value of the decomposition just made when K_reference is K, so that the
+    same n x n eigenproblem is not solved twice."""
+    if system.w0_rad_s is None and "w0" not in vars(system) and np.array_equal(system.K_reference, system.K):
+        vars(system)["w0"] = math.sqrt(max(float(w2[0]), 0.0))
+
+
 @by_identity
 def receptance(system: System) -> Receptance:
     """The spectral expansion of ``system``'s receptance (once per System; module docstring).
 
-    Raises ValueError naming ``condense`` when the expansion does not
-    reproduce a direct solve of Z(W) (a defective damped eigenproblem) to
-    ``config.HB_CONDENSE_CHECK_RTOL``.
+    Checked at one frequency W between natural frequencies: the residual
+    Z(W) H(W)[:, cols] - I[:, cols] of a few columns (O(n^2)) must be at most
+    ``config.HB_CONDENSE_CHECK_RTOL`` times max|Z(W)| max|H(W)[:, cols]| (a
+    backward-error test, rounding being ~1e-16 n of that); ValueError naming ``condense`` otherwise
+    (a defective damped eigenproblem).
     """
-    from scipy.linalg import eigh
-
     t0 = time.process_time()
-    M, C, K = system.M, system.C, system.K
-    w2, Phi = eigh(K, M)
-    Ct = Phi.T @ C @ Phi
-    if _is_modal(Ct):
-        rec = (MODAL, Phi, w2, np.diag(Ct).copy())
-    else:
-        lam, Y = _state_space(w2, Ct)
-        rec = (STATE_SPACE, Phi @ Y, lam, np.zeros(lam.size))
+    rec, w2 = _expansion(system)
+    _share_w0(system, w2)
     out = Receptance(*rec, seconds=0.0)
-    # the expansion against a direct solve at one frequency (a few columns)
+    n = system.ndof
     W = _check_frequency(w2)
-    cols = np.unique(np.linspace(0, system.ndof - 1, min(system.ndof, 4)).astype(int))
-    direct = np.linalg.solve(K - W * W * M + 1j * W * C, np.eye(system.ndof)[:, cols])
-    err = float(np.max(np.abs(out.block(W, np.arange(system.ndof), cols) - direct)))
-    if not err <= config.HB_CONDENSE_CHECK_RTOL * float(np.max(np.abs(direct))):
-        raise ValueError(f"condense: the {out.kind} expansion of the receptance misses a direct solve by "
-                         f"{err:.3g} (relative {err / float(np.max(np.abs(direct))):.3g}); use condense=False")
+    cols = np.unique(np.linspace(0, n - 1, min(n, 4)).astype(int))
+    Zr = system.K - W * W * system.M
+    Hb = out.block(W, np.arange(n), cols)
+    ZH = _real_times(Zr, Hb) + 1j * W * _real_times(system.C, Hb)
+    err = float(np.max(np.abs(ZH - np.eye(n)[:, cols])))
+    zmax = float(np.max(np.abs(Zr) + W * np.abs(system.C)))
+    bound = config.HB_CONDENSE_CHECK_RTOL * zmax * float(np.max(np.abs(Hb)))
+    if not err <= bound:
+        raise ValueError(f"condense: the {out.kind} expansion of the receptance misses Z(W) H(W) = I by "
+                         f"{err:.3g} (allowed {bound:.3g}); use condense=False")
     return Receptance(*rec, seconds=time.process_time() - t0)
 
 
@@ -216,21 +360,6 @@ def _static_parts(K, c):
     return K[np.ix_(c, c)] + K[np.ix_(c, o)] @ T0, S0
 
 
-def _real_blocks(Z0, Zk, out):
-    """Real block matrix of the harmonics into ``out`` (m(2H+1) square): Z0 (m, m) for k = 0 and
-    ``[[Re Zk, Im Zk], [-Im Zk, Re Zk]]`` for k >= 1 (``Zk`` (H, m, m) complex)."""
-    m = Z0.shape[0]
-    out[:m, :m] = Z0
-    for k in range(1, Zk.shape[0] + 1):
-        zr, zi = Zk[k - 1].real, Zk[k - 1].imag
-        a, b = (2 * k - 1) * m, 2 * k * m
-        out[a:a + m, a:a + m] = zr
-        out[a:a + m, b:b + m] = zi
-        out[b:b + m, a:a + m] = -zi
-        out[b:b + m, b:b + m] = zr
-    return out
-
-
 def _to_complex(v, nh, m):
     """Real harmonic coefficients (nh m) -> (static (m,), harmonics (H, m) complex a - i b)."""
     V = np.asarray(v).reshape(nh, m)
@@ -267,11 +396,24 @@ class CondensedHBProblem(HBProblem):
         if not isinstance(system, System):
             raise ValueError("system must be a jointdyn.System")
         c = retained_dofs(system, response_dofs)
+        self.receptance = receptance(system)  # first: it also gives system.w0 (_share_w0)
         self._setup(system, harmonics, samples, parameter, gamma, max_passes, c)
         self._Z0, self._S0 = _static_parts(system.K, c)
-        self.receptance = receptance(system)
         self._Psi_c = np.ascontiguousarray(self.receptance.vectors[c])
+        self._a = self.receptance.a.astype(np.complex128)
         self._k = np.arange(1, self.H + 1, dtype=np.float64)
+        self._kind = MODAL_CODE if self.receptance.kind == MODAL else STATE_SPACE_CODE
+        #: distinct entries (i <= j) of the symmetric m x m blocks and the products
+        #: Psi_ir Psi_jr (R, pairs) that H_cc = Psi_c diag(g) Psi_c^T sums
+        self._pairs = tuple(np.ascontiguousarray(v, dtype=np.int64) for v in np.triu_indices(c.size))
+        self._Q = np.ascontiguousarray((self._Psi_c[self._pairs[0]] * self._Psi_c[self._pairs[1]]).T,
+                                       dtype=np.complex128)
+        R, m = self._Psi_c.shape[1], c.size
+        self._exp = (self._kind, self._a, self.receptance.b, self._Q, self._k)
+        # workspace of _condensed_blocks (the real block matrices stay zero off their blocks)
+        self._work = (np.empty((self.H, R), complex), np.empty((self.H, R), complex),
+                      np.empty((self.H, m, m), complex), np.empty((self.H, m, m), complex),
+                      np.zeros((self.size, self.size)), np.zeros((self.size, self.size)))
         self._zero = np.zeros((self.size, self.size))
         self._at_w = None
         self._modal_force = (None, None)
@@ -292,16 +434,10 @@ class CondensedHBProblem(HBProblem):
         """
         if self._at_w is not None and self._at_w[0] == w:
             return self._at_w[1]
-        g, dg = self.receptance.factors(self._k * w)
-        dg = dg * self._k[:, None]  # d/dw of g(k w)
-        P = self._Psi_c
-        Hc = (P[None, :, :] * g[:, None, :]) @ P.T
-        dHc = (P[None, :, :] * dg[:, None, :]) @ P.T
-        Zk = np.linalg.inv(Hc)
-        dZk = -Zk @ dHc @ Zk
-        Zb = _real_blocks(self._Z0, Zk, np.zeros((self.size, self.size)))
-        dZb = _real_blocks(np.zeros_like(self._Z0), dZk, np.zeros((self.size, self.size)))
-        out = (Zb, dZb, Zk, dZk, g[0], dg[0])
+        ws = self._work
+        _condensed_blocks(self._exp, self._pairs, float(w), self._Z0, ws)
+        g, dg, Zk, dZk, Zb, dZb = ws
+        out = (Zb, dZb, Zk, dZk, g[0].copy(), dg[0].copy())  # harmonic 1: k = 1
         self._at_w = (w, out)
         return out
 
