@@ -9,7 +9,7 @@ import pytest
 
 import tolerances
 from jointdyn import config
-from jointdyn import System
+from jointdyn import System, modal_damping
 from jointdyn.hb import continue_hb, frc_hb, harmonic_balance
 from jointdyn.hb.condense import CondensedHBProblem, make_problem, receptance, retained_dofs, use_condensed
 from jointdyn.hb.problem import HBProblem
@@ -20,8 +20,9 @@ from jointdyn.systems import Contact
 KT = 3e5
 
 
-def _chain(n, *, mu=0.5, law_class=Jenkins, proportional=True, phases=True):
-    """n masses in a chain (ends to ground), two contacts:
+def _chain(n, *, mu=0.5, law_class=Jenkins, damping="rayleigh", phases=True, lumped=True):
+    """n masses in a chain (ends to ground), two contacts (damping ``rayleigh``, ``modal``
+    ratios or ``local`` at DOF 0; ``lumped`` or coupled mass matrix):
     DOF 1 to ground and DOF n-2 against DOF n-1; forcing on DOF 0 and n // 2."""
     k = 2e5 * np.linspace(1.0, 1.6, n + 1)
     K = np.zeros((n, n))
@@ -34,9 +35,13 @@ def _chain(n, *, mu=0.5, law_class=Jenkins, proportional=True, phases=True):
         if a >= 0 and b < n:
             K[a, b] = K[b, a] = -k[i]
     M = np.diag(np.linspace(1.0, 2.0, n))
+    if not lumped:  # a consistent-mass-like coupling
+        M += 0.1 * (np.eye(n, k=1) + np.eye(n, k=-1))
     C = 1e-5 * K + 0.5 * M
-    if not proportional:
-        C[0, 0] += 30.0  # a local damper: not diagonal in the modes
+    if damping == "modal":  # diagonal in the modes, not a combination of M and K
+        C = modal_damping(M, K, np.linspace(0.01, 0.05, n))
+    elif damping == "local":  # a local damper: not diagonal in the modes
+        C[0, 0] += 30.0
     law = law_class(kt=KT, mu=mu, n_ref=100.0)
     contacts = (Contact(law=law, dof=1, normal=HarmonicLoad(100.0, 30.0, 20.0)),
                 Contact(law=law, dof=n - 2, dof2=n - 1, normal=HarmonicLoad(80.0, 0.0, 0.0)))
@@ -98,12 +103,14 @@ def test_phase_shift_of_every_force_shifts_the_response_in_time():
     assert abs(a.offset_m - b.offset_m) <= 1e-9 * a.amplitude_m
 
 
-@pytest.mark.parametrize("proportional", [True, False])
-@pytest.mark.parametrize("law_class", [Jenkins, Iwan])
-def test_condensed_equals_uncondensed(law_class, proportional):
-    s = _chain(9, law_class=law_class, proportional=proportional)
+@pytest.mark.parametrize("damping,lumped,law_class", [
+    ("rayleigh", True, Jenkins), ("rayleigh", True, Iwan), ("rayleigh", False, Iwan),
+    ("modal", True, Iwan), ("local", True, Jenkins), ("local", False, Iwan)])
+def test_condensed_equals_uncondensed(damping, lumped, law_class):
+    s = _chain(9, law_class=law_class, damping=damping, lumped=lumped)
     rec = receptance(s)
-    assert rec.kind == ("modal" if proportional else "state-space")
+    assert rec.kind == ("state-space" if damping == "local" else "modal")
+    assert (rec.basis is not None) == (damping == "rayleigh")  # factored modes: Rayleigh damping only
     for g in (0.8, 1.05, 1.4):
         full = harmonic_balance(s, g, harmonics=5, samples=128, condense=False)
         cond = harmonic_balance(s, g, harmonics=5, samples=128, condense=True)
@@ -126,7 +133,7 @@ def test_condensed_equals_uncondensed(law_class, proportional):
 
 
 def test_condensed_jacobian_matches_central_differences():
-    s = _chain(7, law_class=Iwan, proportional=False)
+    s = _chain(7, law_class=Iwan, damping="local")
     p = CondensedHBProblem(s, harmonics=3, samples=128)
     g = 1.1
     X = harmonic_balance(s, g, harmonics=3, samples=128, condense=True).X
@@ -184,3 +191,30 @@ def test_automatic_choice_and_bad_input():
         p.forcing(large.force)
     br = continue_hb(large, 0.9, 1.0, harmonics=2, samples=32, condense=True, max_points=5)
     assert br.problem.condensed
+
+
+@pytest.mark.parametrize("damping,lumped", [("rayleigh", True), ("rayleigh", False), ("modal", True),
+                                            ("local", False)])
+def test_receptance_equals_a_direct_solve(damping, lumped):
+    s = _chain(11, damping=damping, lumped=lumped)
+    rec = receptance(s)
+    cols = [0, 3, 10]
+    for W in (37.0, 0.9 * s.w0, 5.0 * s.w0):
+        direct = np.linalg.solve(s.K - W * W * s.M + 1j * W * s.C, np.eye(s.ndof)[:, cols])
+        H = rec.block(W, np.arange(s.ndof), cols)
+        assert np.max(np.abs(H - direct)) <= 1e-11 * np.max(np.abs(direct))
+    F = np.linspace(-1.0, 2.0, s.ndof) + 1j * np.linspace(0.5, 0.0, s.ndof)
+    assert np.allclose(rec.project(F), rec.rows(np.arange(s.ndof)).T @ F, rtol=0, atol=1e-12 * np.abs(F).max())
+
+
+def test_a_wrong_expansion_is_refused(monkeypatch):
+    import jointdyn.hb.condense as cd
+
+    def unnormalised(w2, Ct):
+        lam, Y = real_state_space(w2, Ct)
+        return lam, 2.0 * Y
+
+    real_state_space = cd._state_space
+    monkeypatch.setattr(cd, "_state_space", unnormalised)
+    with pytest.raises(ValueError, match="condense"):
+        cd.receptance(_chain(5, damping="local"))

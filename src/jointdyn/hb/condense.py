@@ -58,6 +58,7 @@ from __future__ import annotations
 
 import math
 import time
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -86,20 +87,62 @@ class Receptance:
     ----------
     kind : str
         ``"modal"`` or ``"state-space"`` (module docstring).
-    vectors : ndarray (n, R)
-        Psi (real for ``modal``, complex for ``state-space``), in 1/sqrt(kg).
+    vectors : ndarray (n, R) or None
+        Psi (real for ``modal``, complex for ``state-space``), in
+        1/sqrt(kg); None when only its factors are kept (``basis``).
     a, b : ndarray (R,)
         ``modal``: w_r^2 (rad^2/s^2) and c_r (rad/s); ``state-space``:
         the eigenvalues lambda_r (1/s) and unused zeros.
     seconds : float
         CPU seconds the decomposition took.
+    basis : tuple or None
+        Psi in factored form (``modal`` with Rayleigh damping):
+        Psi = L^-T Q S with M = L L^T (``L`` lower triangular, or the vector
+        sqrt(diag M) for a diagonal M), Q the Householder reflectors of
+        LAPACK's dsytrd (``(reflectors, tau)``) and S the eigenvectors of the
+        tridiagonal matrix: rows of Psi cost O(n^2) each
+        (:meth:`rows`, :meth:`project`), not the O(n^3) of forming Q S.
     """
 
     kind: str
-    vectors: np.ndarray
+    vectors: np.ndarray | None
     a: np.ndarray
     b: np.ndarray
     seconds: float
+    basis: tuple | None = None
+
+    def _coordinates(self, B):
+        """S^T Q^T L^-1 B = Psi^T B for a real B (n, r) (``basis`` form)."""
+        from scipy.linalg import solve_triangular
+        from scipy.linalg.lapack import dormqr
+
+        L, refl, tau, S = self.basis
+        U = B / L[:, None] if L.ndim == 1 else solve_triangular(L, B, lower=True)
+        if tau.size:
+            cq, _, info = dormqr(b"L", b"T", refl, tau, U[1:], max(1, 64 * U.shape[1]))
+            if info != 0:
+                raise RuntimeError(f"LAPACK dormqr failed (info = {info})")
+            U = np.vstack([U[:1], cq])
+        return S.T @ U
+
+    def rows(self, idx):
+        """Psi[idx] (len(idx), R): the rows of the DOFs ``idx``."""
+        idx = np.atleast_1d(np.asarray(idx, dtype=np.int64))
+        if self.basis is None:
+            return self.vectors[idx]
+        E = np.zeros((self.basis[3].shape[0], idx.size))
+        E[idx, np.arange(idx.size)] = 1.0
+        return self._coordinates(E).T
+
+    def project(self, F):
+        """Psi^T F (R,) for a load vector F (n,), real or complex, N."""
+        F = np.asarray(F)
+        if self.basis is None:
+            return self.vectors.T @ F
+        out = self._coordinates(np.ascontiguousarray(F.real)[:, None])[:, 0]
+        if np.iscomplexobj(F):
+            out = out + 1j * self._coordinates(np.ascontiguousarray(F.imag)[:, None])[:, 0]
+        return out
 
     def factors(self, W):
         """(g, dg/dW) at the angular frequencies W (array (k,), rad/s): arrays (k, R) complex."""
@@ -113,10 +156,11 @@ class Receptance:
     def block(self, W, rows, cols):
         """H(W)[rows][:, cols] (complex, m/N) at one angular frequency W (rad/s)."""
         g, _ = self.factors(np.array([W]))
-        right = g[0][:, None] * self.vectors[cols].T
-        if np.isrealobj(self.vectors):
-            return _real_times(self.vectors[rows], right)
-        return self.vectors[rows] @ right
+        left = self.rows(rows)
+        right = g[0][:, None] * self.rows(cols).T
+        if np.isrealobj(left):
+            return _real_times(left, right)
+        return left @ right
 
 
 @jit
@@ -263,20 +307,52 @@ def _rayleigh(M, C, K):
     return None
 
 
+def _tridiagonal_modes(M, K):
+    """(w2, basis) of (M, K): eigenvalues w_r^2 (ascending) and Psi in the factored form of
+    :class:`Receptance` (``basis``), by Householder tridiagonalisation (dsytrd) and a
+    tridiagonal eigensolver; O(n^3) only in the reduction."""
+    from scipy.linalg import cholesky, eigh_tridiagonal, solve_triangular
+    from scipy.linalg import lapack
+
+    if np.any(M != np.diag(np.diag(M))):
+        L = cholesky(M, lower=True)
+        A = solve_triangular(L, solve_triangular(L, K, lower=True).T, lower=True)
+        A = 0.5 * (A + A.T)
+    else:
+        L = np.sqrt(np.diag(M))
+        A = K / L[:, None] / L[None, :]
+    lwork, _ = lapack.dsytrd_lwork(A.shape[0], lower=1)
+    c, d, e, tau, info = lapack.dsytrd(A, lower=1, lwork=int(lwork))
+    if info != 0:
+        raise RuntimeError(f"LAPACK dsytrd failed (info = {info})")
+    stevd = getattr(lapack, "dstevd", None)  # divide and conquer, when scipy wraps it
+    w2, S, info = stevd(d, e) if stevd is not None else (None, None, 1)
+    if info != 0:
+        w2, S = eigh_tridiagonal(d, e, lapack_driver="stemr")
+    return w2, (L, np.asfortranarray(c[1:, :-1]), tau, S)
+
+
 def _expansion(system: System):
-    """(kind, vectors, a, b) of the receptance expansion and the undamped w_r^2 (module docstring)."""
+    """(kind, vectors, a, b, basis) of the receptance expansion and the undamped w_r^2 (module docstring).
+
+    Rayleigh (or no) damping keeps Psi factored (:func:`_tridiagonal_modes`);
+    other damping needs the dense modes for Phi^T C Phi.
+    """
     from scipy.linalg import eigh
 
     M, C, K = system.M, system.C, system.K
-    w2, Phi = eigh(K, M)
     ab = _rayleigh(M, C, K)
+    if ab is not None and system.ndof > 1:
+        w2, basis = _tridiagonal_modes(M, K)
+        return (MODAL, None, w2, ab[0] + ab[1] * w2, basis), w2
+    w2, Phi = eigh(K, M)
     if ab is not None:
-        return (MODAL, Phi, w2, ab[0] + ab[1] * w2), w2
+        return (MODAL, Phi, w2, ab[0] + ab[1] * w2, None), w2
     Ct = Phi.T @ C @ Phi
     if _is_modal(Ct):
-        return (MODAL, Phi, w2, np.diag(Ct).copy()), w2
+        return (MODAL, Phi, w2, np.diag(Ct).copy(), None), w2
     lam, Y = _state_space(w2, Ct)
-    return (STATE_SPACE, Phi @ Y, lam, np.zeros(lam.size)), w2
+    return (STATE_SPACE, Phi @ Y, lam, np.zeros(lam.size), None), w2
 
 
 def _real_times(A, B):
@@ -296,29 +372,38 @@ def _share_w0(system: System, w2) -> None:
 def receptance(system: System) -> Receptance:
     """The spectral expansion of ``system``'s receptance (once per System; module docstring).
 
-    Checked at one frequency W between natural frequencies: the residual
-    Z(W) H(W)[:, cols] - I[:, cols] of a few columns (O(n^2)) must be at most
+    A dense expansion (damping other than Rayleigh) is checked at one
+    frequency W between natural frequencies: the residual Z(W) H(W)[:, cols]
+    - I[:, cols] of a few columns (O(n^2)) must be at most
     ``config.HB_CONDENSE_CHECK_RTOL`` times max|Z(W)| max|H(W)[:, cols]| (a
-    backward-error test, rounding being ~1e-16 n of that); ValueError naming ``condense`` otherwise
-    (a defective damped eigenproblem).
+    backward-error test, rounding being ~1e-16 n of that); ValueError
+    naming ``condense`` otherwise (a defective damped eigenproblem). The
+    factored form (orthogonal reductions, backward stable) is not checked:
+    forming its columns would cost the O(n^3) it avoids.
     """
     t0 = time.process_time()
-    rec, w2 = _expansion(system)
+    (kind, vectors, a, b, basis), w2 = _expansion(system)
     _share_w0(system, w2)
-    out = Receptance(*rec, seconds=0.0)
+    out = Receptance(kind, vectors, a, b, 0.0, basis)
+    if basis is None:
+        _check(system, out, w2)
+    return dataclasses.replace(out, seconds=time.process_time() - t0)
+
+
+def _check(system: System, rec: Receptance, w2) -> None:
+    """The test of :func:`receptance` (ValueError naming ``condense`` on failure)."""
     n = system.ndof
     W = _check_frequency(w2)
     cols = np.unique(np.linspace(0, n - 1, min(n, 4)).astype(int))
     Zr = system.K - W * W * system.M
-    Hb = out.block(W, np.arange(n), cols)
+    Hb = rec.block(W, np.arange(n), cols)
     ZH = _real_times(Zr, Hb) + 1j * W * _real_times(system.C, Hb)
     err = float(np.max(np.abs(ZH - np.eye(n)[:, cols])))
     zmax = float(np.max(np.abs(Zr) + W * np.abs(system.C)))
     bound = config.HB_CONDENSE_CHECK_RTOL * zmax * float(np.max(np.abs(Hb)))
     if not err <= bound:
-        raise ValueError(f"condense: the {out.kind} expansion of the receptance misses Z(W) H(W) = I by "
+        raise ValueError(f"condense: the {rec.kind} expansion of the receptance misses Z(W) H(W) = I by "
                          f"{err:.3g} (allowed {bound:.3g}); use condense=False")
-    return Receptance(*rec, seconds=time.process_time() - t0)
 
 
 def retained_dofs(system: System, response_dofs=()) -> np.ndarray:
@@ -399,7 +484,7 @@ class CondensedHBProblem(HBProblem):
         self.receptance = receptance(system)  # first: it also gives system.w0 (_share_w0)
         self._setup(system, harmonics, samples, parameter, gamma, max_passes, c)
         self._Z0, self._S0 = _static_parts(system.K, c)
-        self._Psi_c = np.ascontiguousarray(self.receptance.vectors[c])
+        self._Psi_c = np.ascontiguousarray(self.receptance.rows(c))
         self._a = self.receptance.a.astype(np.complex128)
         self._k = np.arange(1, self.H + 1, dtype=np.float64)
         self._kind = MODAL_CODE if self.receptance.kind == MODAL else STATE_SPACE_CODE
@@ -461,7 +546,9 @@ class CondensedHBProblem(HBProblem):
         f = np.asarray(f, dtype=np.float64)
         nz = np.flatnonzero(f)
         F1 = f[nz] * (self.phase_sin[nz] - 1j * self.phase_cos[nz])
-        q = self.receptance.vectors[nz].T @ F1
+        F = np.zeros(self.system.ndof, complex)
+        F[nz] = F1
+        q = self.receptance.project(F)
         self._modal_force = (f.copy(), q)
         return q
 
@@ -512,7 +599,7 @@ class CondensedHBProblem(HBProblem):
         g, _ = self.receptance.factors(self._k * w)
         modal = -(gk @ self._Psi_c)  # (H, R): -Psi_c^T gamma_k
         modal[0] += self._modal(f)
-        out = _to_real(self._S0[rows] @ x0, (g * modal) @ self.receptance.vectors[rows].T)
+        out = _to_real(self._S0[rows] @ x0, (g * modal) @ self.receptance.rows(rows).T)
         kept = np.flatnonzero(np.isin(rows, self.dofs))
         Xm = X.reshape(self.nh, self.n)
         for j in kept:
