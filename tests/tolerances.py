@@ -59,6 +59,9 @@ TEST_HB_VS_TIME_RTOL = 1e-2
 TEST_HB_LINEAR_LIMIT_RTOL = 1e-9
 #: condensed vs uncondensed harmonic balance (relative to the largest coefficient)
 TEST_HB_CONDENSED_RTOL = 1e-9
+#: one-harmonic balance of a Jenkins contact with an in-phase normal load vs
+#: the quadrature of the exact loop (relative to the amplitude)
+TEST_HB_YCM_RTOL = 1e-6
 
 # --- exact Iwan law (iwan) ---------------------------------------------------
 #: compiled kernel vs the plain-Python reference (absolute, units of fy / kt)
