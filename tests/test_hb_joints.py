@@ -134,25 +134,45 @@ def test_condensed_equals_uncondensed(damping, lumped, law_class):
         assert abs(cond.growth - full.growth) <= 1e-7
 
 
-def test_condensed_jacobian_matches_central_differences():
+@pytest.mark.parametrize("par", ["gamma", "f1", "eta", "delta", "n0"])
+def test_condensed_jacobian_matches_central_differences(par):
     s = _chain(7, law_class=Iwan, damping="local")
-    p = CondensedHBProblem(s, harmonics=3, samples=128)
     g = 1.1
+    p = CondensedHBProblem(s, harmonics=3, samples=128, parameter=par, gamma=None if par == "gamma" else g)
+    lam = {"gamma": g, "f1": p.f1_ref, "eta": 0.3, "delta": math.radians(20.0), "n0": 100.0}[par]
     X = harmonic_balance(s, g, harmonics=3, samples=128, condense=True).X
-    ev = p.evaluate(X, g)
+    ev = p.evaluate(X, lam)
     Ja = np.c_[ev.JX, ev.Jp]
     Jfd = np.empty_like(Ja)
     for j in range(X.size + 1):
-        Xp, Xm, lp, lm = X.copy(), X.copy(), g, g
+        Xp, Xm, lp, lm = X.copy(), X.copy(), lam, lam
         if j < X.size:
             h = 1e-6 * np.abs(X).max()
             Xp[j] += h
             Xm[j] -= h
         else:
-            h = 1e-6 * g
-            lp, lm = g + h, g - h
+            h = 1e-6 * abs(lam)
+            lp, lm = lam + h, lam - h
         Jfd[:, j] = (p.evaluate(Xp, lp).R - p.evaluate(Xm, lm).R) / (2 * h)
     assert np.max(np.abs(Ja - Jfd)) <= tolerances.TEST_HB_JACOBIAN_RTOL * np.max(np.abs(Ja))
+
+
+def test_condensed_continuation_in_a_system_parameter():
+    # a SystemParameter rebuilds (and condenses) the system at each value: the branch in mu
+    # at a fixed frequency equals fixed-mu solutions of the uncondensed problem
+    from jointdyn.hb.parameters import SystemParameter
+
+    def build(mu):
+        return _chain(7, law_class=Jenkins, mu=mu)
+
+    par = SystemParameter("mu", build, lower=1e-3)
+    br = continue_hb(build(0.5), 0.5, 0.8, parameter=par, gamma=1.1, harmonics=3, samples=64, condense=True,
+                     progress=False)
+    assert br.status == "complete" and br.problem.condensed
+    for i in (0, br.lam.size // 2, br.lam.size - 1):
+        full = harmonic_balance(build(br.lam[i]), 1.1, harmonics=3, samples=64, condense=False)
+        Xf = full.X.reshape(br.problem.nh, 7)[:, br.problem.dofs].ravel()
+        assert np.max(np.abs(Xf - br.X[i])) <= 1e-7 * np.max(np.abs(Xf))
 
 
 def test_condensed_branch_solves_the_uncondensed_equations():
