@@ -290,3 +290,26 @@ def test_one_harmonic_jenkins_with_in_phase_normal_load_matches_the_exact_loop(A
     assert sol.converged
     expected = np.array([-ref[0] / k, 0.0, A])
     assert np.max(np.abs(sol.X - expected)) <= tolerances.TEST_HB_YCM_RTOL * A
+
+
+@pytest.mark.parametrize("damping", ["rayleigh", "local"])
+def test_static_condensation_by_modes_equals_cholesky(damping):
+    from jointdyn.hb.condense import _static_cholesky, _static_parts
+
+    s = _chain(10, damping=damping)
+    c = retained_dofs(s)
+    Z0m, S0m = _static_parts(s.K, c, receptance(s))
+    Z0c, S0c = _static_cholesky(s.K, c)
+    assert np.max(np.abs(Z0m - Z0c)) <= 1e-9 * np.max(np.abs(Z0c))
+    rows = np.arange(s.ndof)
+    assert np.max(np.abs(S0m(rows) - S0c(rows))) <= 1e-9
+    # a structure held only through the retained DOFs (K singular): the Cholesky route
+    free = s.K.copy()
+    free[0, 0] -= 2e5 * 1.0  # DOF 0 loses its spring to ground
+    free[-1, -1] -= 2e5 * 1.6
+    assert np.linalg.eigvalsh(free)[0] < 1e-8 * np.max(np.abs(free))
+    Z0, S0 = _static_parts(free, c, None)
+    x = S0(rows) @ np.array([1.0, 0.0, 0.0, -1.0])
+    f = free @ x
+    assert np.max(np.abs(np.delete(f, c))) <= 1e-9 * np.max(np.abs(f))  # no load on the other DOFs
+    assert np.allclose(f[c], Z0 @ np.array([1.0, 0.0, 0.0, -1.0]), rtol=1e-9, atol=1e-9 * np.max(np.abs(f)))

@@ -267,6 +267,10 @@ HB_CONDENSE_MAX_FRACTION = 0.5
 #: Phi^T C Phi are at most this fraction of its largest entry; otherwise the
 #: damped (state-space) eigenproblem is used
 HB_CONDENSE_MODAL_RTOL = 1e-12
+#: the static Schur complement comes from the expansion (H_cc(0)^-1) when every
+#: static factor |1 / g_r(0)| is at least this fraction of the largest (K
+#: positive definite); otherwise from a Cholesky factorisation of K_oo
+HB_CONDENSE_STATIC_RTOL = 1e-6
 #: the spectral expansion H of the receptance must satisfy Z(W) H(W) = I at one
 #: frequency to this, relative to max |Z| max |H| (backward error)
 HB_CONDENSE_CHECK_RTOL = 1e-9

@@ -419,14 +419,32 @@ def retained_dofs(system: System, response_dofs=()) -> np.ndarray:
     return np.array(sorted(keep), dtype=np.int64)
 
 
-def _static_parts(K, c):
-    """(Z0, S0): the static Schur complement K_cc - K_co K_oo^-1 K_oc and the static recovery
-    S0 (n x m): x = S0 x_c for a static load on the retained DOFs c only (rows c: identity,
-    other rows o: -K_oo^-1 K_oc).
+def _static_parts(K, c, rec: Receptance | None = None):
+    """(Z0, S0): the static Schur complement Z0 = K_cc - K_co K_oo^-1 K_oc and the static
+    recovery: x = S0(rows) x_c for a static load on the retained DOFs c only.
 
-    ValueError naming ``condense`` when K_oo is not positive definite
-    (a static load on the other DOFs would have no unique response).
+    With a receptance ``rec`` whose static factors g(0) are all finite and no
+    smaller than ``config.HB_CONDENSE_STATIC_RTOL`` of the largest (K positive
+    definite), Z0 = H_cc(0)^-1 from the expansion and S0 is a function
+    ``rows -> H(0)[rows, c] Z0`` (O(n^2) per row, nothing O(n^3)). Otherwise by
+    a Cholesky factorisation of K_oo: S0 is then the array (n, m) (rows c:
+    identity, other rows o: -K_oo^-1 K_oc) indexed by rows; ValueError naming
+    ``condense`` when K_oo is not positive definite (a static load on the other
+    DOFs would have no unique response).
     """
+    if rec is not None:
+        g0 = rec.factors(np.zeros(1))[0][0]
+        inv = np.abs(1.0 / g0) if np.all(np.isfinite(g0)) and np.all(g0 != 0.0) else None
+        if inv is not None and float(inv.min()) > config.HB_CONDENSE_STATIC_RTOL * float(inv.max()):
+            Pc = rec.rows(c)
+            Z0 = np.linalg.inv(((Pc * g0) @ Pc.T).real)
+            right = g0[:, None] * (Pc.T @ Z0)
+            return Z0, lambda rows: (rec.rows(rows) @ right).real
+    return _static_cholesky(K, c)
+
+
+def _static_cholesky(K, c):
+    """(Z0, S0) of :func:`_static_parts` by a Cholesky factorisation of K_oo."""
     from scipy.linalg import LinAlgError, cho_factor, cho_solve
 
     n = K.shape[0]
@@ -434,7 +452,7 @@ def _static_parts(K, c):
     S0 = np.zeros((n, c.size))
     S0[c, np.arange(c.size)] = 1.0
     if o.size == 0:
-        return K[np.ix_(c, c)].copy(), S0
+        return K[np.ix_(c, c)].copy(), S0.__getitem__
     try:
         cf = cho_factor(K[np.ix_(o, o)])
     except LinAlgError:
@@ -442,7 +460,7 @@ def _static_parts(K, c):
                          "(the structure must be held when the contact DOFs are fixed)") from None
     T0 = -cho_solve(cf, K[np.ix_(o, c)])
     S0[o] = T0
-    return K[np.ix_(c, c)] + K[np.ix_(c, o)] @ T0, S0
+    return K[np.ix_(c, c)] + K[np.ix_(c, o)] @ T0, S0.__getitem__
 
 
 def _to_complex(v, nh, m):
@@ -483,7 +501,7 @@ class CondensedHBProblem(HBProblem):
         c = retained_dofs(system, response_dofs)
         self.receptance = receptance(system)  # first: it also gives system.w0 (_share_w0)
         self._setup(system, harmonics, samples, parameter, gamma, max_passes, c)
-        self._Z0, self._S0 = _static_parts(system.K, c)
+        self._Z0, self._S0 = _static_parts(system.K, c, self.receptance)
         self._Psi_c = np.ascontiguousarray(self.receptance.rows(c))
         self._a = self.receptance.a.astype(np.complex128)
         self._k = np.arange(1, self.H + 1, dtype=np.float64)
@@ -599,7 +617,7 @@ class CondensedHBProblem(HBProblem):
         g, _ = self.receptance.factors(self._k * w)
         modal = -(gk @ self._Psi_c)  # (H, R): -Psi_c^T gamma_k
         modal[0] += self._modal(f)
-        out = _to_real(self._S0[rows] @ x0, (g * modal) @ self.receptance.rows(rows).T)
+        out = _to_real(self._S0(rows) @ x0, (g * modal) @ self.receptance.rows(rows).T)
         kept = np.flatnonzero(np.isin(rows, self.dofs))
         Xm = X.reshape(self.nh, self.n)
         for j in kept:
@@ -675,7 +693,7 @@ def use_condensed(system: System, condense=None, response_dofs=()) -> bool:
     if c.size > config.HB_CONDENSE_MAX_FRACTION * system.ndof:
         return False
     try:
-        _static_parts(system.K, c)
+        _static_parts(system.K, c, receptance(system))
     except ValueError:
         return False
     return True
