@@ -8,12 +8,17 @@ import math
 
 import numpy as np
 import pytest
-
 import tolerances
-from jointdyn import config
-from jointdyn import System, modal_damping
+
+from jointdyn import System, config, modal_damping
 from jointdyn.hb import continue_hb, frc_hb, harmonic_balance
-from jointdyn.hb.condense import CondensedHBProblem, make_problem, receptance, retained_dofs, use_condensed
+from jointdyn.hb.condense import (
+    CondensedHBProblem,
+    make_problem,
+    receptance,
+    retained_dofs,
+    use_condensed,
+)
 from jointdyn.hb.problem import HBProblem
 from jointdyn.kinematics import HarmonicLoad
 from jointdyn.laws import Iwan, Jenkins
@@ -267,7 +272,7 @@ def _first_harmonic(pieces):
     from scipy.integrate import quad
 
     def integral(weight):
-        return sum(quad(lambda t: f(t) * weight(t), a, b, epsabs=0.0, epsrel=1e-12)[0] for a, b, f in pieces)
+        return sum(quad(lambda t, f=f: f(t) * weight(t), a, b, epsabs=0.0, epsrel=1e-12)[0] for a, b, f in pieces)
 
     return np.array([integral(lambda t: 1.0) / (2.0 * math.pi), integral(math.cos) / math.pi,
                      integral(math.sin) / math.pi])

@@ -56,9 +56,9 @@ Hill's method when the full companion matrix has at most
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
-import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -311,8 +311,7 @@ def _tridiagonal_modes(M, K):
     """(w2, basis) of (M, K): eigenvalues w_r^2 (ascending) and Psi in the factored form of
     :class:`Receptance` (``basis``), by Householder tridiagonalisation (dsytrd) and a
     tridiagonal eigensolver; O(n^3) only in the reduction."""
-    from scipy.linalg import cholesky, eigh_tridiagonal, solve_triangular
-    from scipy.linalg import lapack
+    from scipy.linalg import cholesky, eigh_tridiagonal, lapack, solve_triangular
 
     if np.any(M != np.diag(np.diag(M))):
         L = cholesky(M, lower=True)

@@ -277,7 +277,7 @@ def _problem_at(parameter, H, Ns, max_passes, w, ndof, ncontacts, p, dofs):
         raise ValueError(f"build({parameter.name} = {p!r}) must return a jointdyn.System")
     if system.ndof != ndof or len(system.contacts) != ncontacts:
         raise ValueError(f"build({parameter.name} = {p!r}) must keep {ndof} DOFs and {ncontacts} contacts")
-    kw = dict(harmonics=H, samples=Ns, parameter=_FixedFrequency(w), max_passes=max_passes)
+    kw = {"harmonics": H, "samples": Ns, "parameter": _FixedFrequency(w), "max_passes": max_passes}
     if dofs is None:
         return HBProblem(system, **kw)
     q = CondensedHBProblem(system, response_dofs=dofs, **kw)
