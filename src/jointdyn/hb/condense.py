@@ -30,16 +30,21 @@ The receptance comes from a once-per-system eigen-decomposition
   Phi^T C Phi) y_r), g_r = 1 / (i W - lambda_r) (the spectral expansion of
   a symmetric quadratic pencil; Tisseur & Meerbergen, SIAM Rev. 43, 2001).
 
-So an evaluation costs O(R m^2) per harmonic (R = n or 2n terms) plus
-m x m inverses, and dZ_red/dw = -Z_red (dH_cc/dw) Z_red is exact. The
-static harmonic (W = 0) uses the static Schur complement
-K_cc - K_co K_oo^-1 K_oc, computed once (a structure whose K is singular
+So an evaluation costs O(R m^2) per harmonic (R = n or 2n terms, one
+compiled pass over all harmonics: :func:`_condensed_blocks`) plus m x m
+inverses, and dZ_red/dw = -Z_red (dH_cc/dw) Z_red is exact. The static
+harmonic (W = 0) uses the static Schur complement K_cc - K_co K_oo^-1 K_oc,
+computed once: H_cc(0)^-1 from the expansion when K is positive definite,
+else by a Cholesky factorisation of K_oo (a structure whose K is singular
 only through the retained DOFs, e.g. a damper held by its contacts, is
-allowed). The decomposition is checked once at a frequency W between
-natural frequencies: Z(W) H(W) = I on a few columns (:func:`receptance`).
-Rayleigh damping (C = alpha M + beta K, found by an O(n^2) fit) skips the
-dense product Phi^T C Phi; the decomposition also gives ``System.w0`` when
-the system has no normal springs, so the n x n eigenproblem is solved once.
+allowed). Rayleigh (or no) damping (C = alpha M + beta K, found by an
+O(n^2) fit) keeps the modes factored (Householder tridiagonalisation and a
+tridiagonal eigensolver, :func:`_tridiagonal_modes`; rows of Psi cost
+O(n^2)), about a third of a dense eigen-decomposition; other damping forms
+the dense modes, and that expansion is checked once at a frequency W
+between natural frequencies: Z(W) H(W) = I on a few columns
+(:func:`receptance`). The decomposition also gives ``System.w0`` when the
+system has no normal springs, so the n x n eigenproblem is solved once.
 
 Retained DOFs: every DOF of a contact's tangential selection, DOF 0 (the
 DOF the branch monitor of :mod:`jointdyn.hb.frc` measures) and the
