@@ -168,7 +168,7 @@ class Receptance:
         return left @ right
 
 
-@jit
+@jit(inline="always")
 def _expansion_factors(kind, a, b, W, k, g, dg):  # pragma: no cover - compiled
     """The expansion factors g_r(W_h) and d g_r(k_h w) / dw into ``g``, ``dg`` (H, R) complex.
 
@@ -193,7 +193,7 @@ def _expansion_factors(kind, a, b, W, k, g, dg):  # pragma: no cover - compiled
                 dg[h, r] = -1j * k[h] * gr * gr
 
 
-@jit
+@jit(inline="always")
 def _block_sums(g, dg, Q, iu, ju, h, Hc, dHc):  # pragma: no cover - compiled
     """H_cc and dH_cc/dw of harmonic h into ``Hc``, ``dHc`` (m, m) from their distinct entries
     (pair p = (iu[p], ju[p])): sum_r Q[r, p] g[h, r] (``Q`` the products Psi_ir Psi_jr)."""
@@ -209,7 +209,52 @@ def _block_sums(g, dg, Q, iu, ju, h, Hc, dHc):  # pragma: no cover - compiled
         dHc[ju[p], iu[p]] = dacc
 
 
-@jit
+@jit(inline="always")
+def _invert(A, Z, work):  # pragma: no cover - compiled
+    """Z = A^-1 (m x m complex) by Gauss-Jordan elimination with partial pivoting, ``work`` a
+    scratch copy of A (a singular A gives non-finite entries, which the residual carries)."""
+    m = A.shape[0]
+    for i in range(m):
+        for j in range(m):
+            work[i, j] = A[i, j]
+            Z[i, j] = 1.0 if i == j else 0.0
+    for col in range(m):
+        piv = col
+        for r in range(col + 1, m):
+            if abs(work[r, col]) > abs(work[piv, col]):
+                piv = r
+        if piv != col:
+            for j in range(m):
+                work[col, j], work[piv, j] = work[piv, j], work[col, j]
+                Z[col, j], Z[piv, j] = Z[piv, j], Z[col, j]
+        d = 1.0 / work[col, col]
+        for j in range(m):
+            work[col, j] *= d
+            Z[col, j] *= d
+        for r in range(m):
+            if r != col:
+                f = work[r, col]
+                for j in range(m):
+                    work[r, j] -= f * work[col, j]
+                    Z[r, j] -= f * Z[col, j]
+
+
+@jit(inline="always")
+def _sandwich(Z, D, out):  # pragma: no cover - compiled
+    """out = -Z D Z (m x m complex): the derivative of Z = H^-1 for dH = D."""
+    m = Z.shape[0]
+    for i in range(m):
+        for j in range(m):
+            acc = 0j
+            for k in range(m):
+                zd = 0j
+                for q in range(m):
+                    zd += Z[i, q] * D[q, k]
+                acc += zd * Z[k, j]
+            out[i, j] = -acc
+
+
+@jit(inline="always")
 def _put_block(Z, row, col, sign, out):  # pragma: no cover - compiled
     """The real and imaginary parts of harmonic block Z (m, m) at (row, col) of ``out``:
     [[Re Z, Im Z], [-Im Z, Re Z]] with rows/cols (row, row + m) and (col, col + m); sign +-1 scales it."""
@@ -241,18 +286,17 @@ def _condensed_blocks(exp, pairs, w, Z0, out):  # pragma: no cover - compiled
     m = Z0.shape[0]
     Hc = np.empty((m, m), dtype=np.complex128)
     dHc = np.empty((m, m), dtype=np.complex128)
+    work = np.empty((m, m), dtype=np.complex128)
     for i in range(m):
         for j in range(m):
             Zb[i, j] = Z0[i, j]
     for h in range(k.shape[0]):
         _block_sums(g, dg, Q, iu, ju, h, Hc, dHc)
-        Z = np.linalg.inv(Hc)
-        dZ = -(Z @ dHc @ Z)
-        Zk[h] = Z
-        dZk[h] = dZ
+        _invert(Hc, Zk[h], work)
+        _sandwich(Zk[h], dHc, dZk[h])
         row = (2 * h + 1) * m
-        _put_block(Z, row, row, 1.0, Zb)
-        _put_block(dZ, row, row, 1.0, dZb)
+        _put_block(Zk[h], row, row, 1.0, Zb)
+        _put_block(dZk[h], row, row, 1.0, dZb)
 
 
 def _is_modal(Ct) -> bool:
