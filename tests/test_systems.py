@@ -189,5 +189,3 @@ def test_solvers_refuse_what_they_do_not_take_yet():
                    force_phase_deg=[0.0, 90.0])
     with pytest.raises(ValueError, match="force_phase_deg"):
         jd.steady_state(s2, 1.0)
-    with pytest.raises(ValueError, match="force_phase_deg"):
-        jd.frc_hb(s2, 0.8, 1.2)

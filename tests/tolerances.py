@@ -54,6 +54,14 @@ TEST_HB_JACOBIAN_RTOL = 1e-6
 TEST_HB_DF_RTOL = 1e-4
 #: harmonic balance vs time-domain steady state (relative)
 TEST_HB_VS_TIME_RTOL = 1e-2
+#: stuck (mu huge) and slipping (mu tiny) limits vs the exact linear FRF with
+#: forcing phases (relative to the largest first-harmonic coefficient)
+TEST_HB_LINEAR_LIMIT_RTOL = 1e-9
+#: condensed vs uncondensed harmonic balance (relative to the largest coefficient)
+TEST_HB_CONDENSED_RTOL = 1e-9
+#: one-harmonic balance of a Jenkins contact with an in-phase normal load vs
+#: the quadrature of the exact loop (relative to the amplitude)
+TEST_HB_YCM_RTOL = 1e-6
 
 # --- sweeps: per-DOF and per-contact outputs ------------------------------------
 #: per-DOF amplitude and offset of the recorded period vs the solver's own

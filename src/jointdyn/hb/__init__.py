@@ -1,8 +1,11 @@
 """Harmonic balance for jointdyn systems: AFT with exact forward-mode
 Jacobians, arc-length continuation (:mod:`jointdyn.continuation`) in a
 parameter object (:mod:`jointdyn.hb.parameters`), Hill stability,
-unbounded-response detection (see docs/harmonic-balance.md)."""
+unbounded-response detection, per-DOF forcing phases, and exact
+condensation onto the contact DOFs for large structures
+(:mod:`jointdyn.hb.condense`; see docs/harmonic-balance.md)."""
 
+from .condense import CondensedHBProblem, Receptance, make_problem, receptance
 from .frc import HBBranch, HBSolution, branch_dataset, continue_hb, frc_hb, harmonic_balance
 from .parameters import DELTA, ETA, F1, GAMMA, N0, PARAMETERS, HBParameter, SystemParameter, parameter_named
 from .problem import HBProblem
@@ -17,6 +20,10 @@ __all__ = [
     "branch_dataset",
     "HBBranch",
     "HBProblem",
+    "CondensedHBProblem",
+    "make_problem",
+    "receptance",
+    "Receptance",
     "HBParameter",
     "SystemParameter",
     "PARAMETERS",

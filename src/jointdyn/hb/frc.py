@@ -56,9 +56,9 @@ from ..fourier import derivative_matrix
 from ..laws import MACROSLIP, SEPARATION
 from ..systems import System
 from ._aft import INFO_ERROR, INFO_PASSES, INFO_PERIOD
+from .condense import make_problem
 from .parameters import GAMMA, parameter_named
 from .problem import HBProblem, contact_of
-from .stability import hill_growth, hill_stability
 
 __all__ = ["HBBranch", "HBSolution", "continue_hb", "frc_hb", "branch_dataset", "harmonic_balance"]
 
@@ -129,7 +129,7 @@ class HBBranch:
         out = self.response0.copy() if dof == 0 else np.full((self.lam.size, 3), np.nan)
         # rows computed by the monitor for the same X are kept; the others computed here
         for i in np.flatnonzero(np.isnan(out[:, 0])):
-            out[i] = self.problem.amplitudes(self.X[i], dof)
+            out[i] = self.problem.amplitudes(self.X[i], dof, self.lam[i])
         return out[:, 0], out[:, 1], out[:, 2]
 
 
@@ -157,9 +157,8 @@ def _make_branch(problem, status, message, lam, X, segment, fold, gap, counters,
         passes[i] = int(ev.info[INFO_PASSES])
         periodic_error[i] = ev.info[INFO_ERROR]
         force_period[i] = int(ev.info[INFO_PERIOD])
-    # Hill stability of every point (hill_stability's criterion), one compiled loop
-    sysm = problem.system
-    growth = hill_growth(JXs, sysm.M, sysm.C, np.array([problem.omega(v) for v in lam]), problem.H)
+    # Hill stability of every point (hill_stability's criterion; NaN where a condensed problem does not compute it)
+    growth = problem.hill_growth(JXs, np.array([problem.omega(v) for v in lam]))
     return HBBranch(problem=problem, parameter=problem.parameter.name, status=status, message=message, lam=lam,
                     X=X, segment=segment, fold=fold, gap=gap, counters=counters,
                     stable=growth <= config.HB_STABILITY_RTOL, growth=growth, passes=passes,
@@ -176,7 +175,7 @@ def _scales(problem: HBProblem, start: float):
 
 def _saturation_test(problem: HBProblem, ev, X, q, lam):
     """Describing-function saturation test (module docstring); None or reason."""
-    if q < config.HB_SATURATION_Q or np.any(problem.system.C != 0.0) or problem.n != 1:
+    if q < config.HB_SATURATION_Q or np.any(problem.system.C != 0.0) or problem.system.ndof != 1:
         return None
     for code in ev.code:
         slip = np.mean((code == MACROSLIP) | (code == SEPARATION))
@@ -271,7 +270,8 @@ def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress) -> 
                 and not newton(tr.residual, y0, lam_a / ps, opt, max_iter=config.HB_START_MAX_ITER)[1]):
             # start by a homotopy in the forcing amplitude at this gamma
             # when Newton from the stuck-contact solution fails
-            sol = harmonic_balance(problem.system, lam_a, harmonics=problem.H, samples=problem.Ns, tol=opt.tol)
+            sol = harmonic_balance(problem.system, lam_a, harmonics=problem.H, samples=problem.Ns, tol=opt.tol,
+                                   condense=problem.condensed)
             if sol.converged:
                 y0 = sol.X / xs
         return tr.relabel(continuation(tr.residual, y0, lam_a / ps, lam_b / ps, opt, monitor=tr.monitor,
@@ -281,7 +281,7 @@ def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress) -> 
 def continue_hb(system: System, start: float, stop: float, *, parameter="gamma", gamma: float | None = None,
                 harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
                 options: ContinuationOptions | None = None, backward_after_unbounded: bool = True,
-                progress: bool | None = None, **overrides) -> HBBranch:
+                progress: bool | None = None, condense: bool | None = None, **overrides) -> HBBranch:
     """Continue harmonic-balance solutions in a scalar parameter.
 
     Parameters
@@ -312,6 +312,10 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         ``stop`` backwards, so that both ends of the range are covered.
     progress : bool, optional
         Show a tqdm bar (None: only on a TTY).
+    condense : bool, optional
+        Condense the problem exactly onto the contact DOFs
+        (:mod:`jointdyn.hb.condense`); None chooses by size
+        (:func:`~jointdyn.hb.condense.use_condensed`).
 
     Returns
     -------
@@ -328,7 +332,8 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
     par.check_range(start, stop)
     opt = make_options(options, overrides)
     V.positive_int("max_points", opt.max_points, 2)
-    problem = HBProblem(system, harmonics=harmonics, samples=samples, parameter=par, gamma=gamma)
+    problem = make_problem(system, condense=condense, harmonics=harmonics, samples=samples, parameter=par,
+                           gamma=gamma)
     tr = _Tracker(problem, _scales(problem, start))
     res = _segment(tr, start, stop, opt, progress)
     parts = [res]
@@ -395,11 +400,11 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
     import xarray as xr
 
     p = branch.problem
-    if not 0 <= response_dof < p.n:
-        raise ValueError(f"response_dof must be in [0, {p.n - 1}], got {response_dof!r}")
+    if not 0 <= response_dof < p.system.ndof:
+        raise ValueError(f"response_dof must be in [0, {p.system.ndof - 1}], got {response_dof!r}")
     law = contact_of(p.system).law
     amp, off, mx = branch.response(response_dof)
-    Xd = branch.X.reshape(-1, p.nh, p.n)[:, :, response_dof] if branch.X.size else np.empty((0, p.nh))
+    Xd = p.dof_coefficients(branch.X, response_dof, branch.lam) if branch.X.size else np.empty((0, p.nh))
     harm = np.empty((Xd.shape[0], p.H + 1))
     harm[:, 0] = np.abs(Xd[:, 0])
     for k in range(1, p.H + 1):
@@ -439,7 +444,10 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
         points=int(branch.lam.size),
         folds=int(branch.fold.sum()),
         turning_points=int(turning.sum()),
-        unstable_points=int((~branch.stable).sum()),
+        unstable_points=int(np.sum(branch.growth > config.HB_STABILITY_RTOL)),
+        stability="hill" if np.all(np.isfinite(branch.growth)) else "not-computed",
+        condensed=int(p.condensed),
+        unknown_dofs=int(p.n),
         max_aft_passes=int(branch.passes.max()) if branch.passes.size else 0,
         force_period_2_points=int((branch.force_period == 2).sum()),
         force_not_periodic_points=int((branch.force_period == 0).sum()),
@@ -450,7 +458,7 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
 
 def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: int = config.HB_HARMONICS,
            samples: int = config.HB_SAMPLES, response_dof: int = 0, options: ContinuationOptions | None = None,
-           progress: bool | None = None, **overrides):
+           progress: bool | None = None, condense: bool | None = None, **overrides):
     """Frequency-response curve by harmonic balance and arc-length continuation.
 
     Harmonics 0..H of every DOF (normalised time tau = w t), contact forces
@@ -474,6 +482,9 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
     options : ContinuationOptions, optional
         Step control; keyword arguments override its fields (``ds``,
         ``ds_max``, ``max_points``, ``predictor``, ...).
+    condense : bool, optional
+        Condense exactly onto the contact DOFs (None: by size; see
+        :func:`continue_hb`).
 
     Returns
     -------
@@ -493,7 +504,7 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
         raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {response_dof!r}")
     br = continue_hb(system, V.positive("gamma_start", gamma_start), V.positive("gamma_stop", gamma_stop),
                      parameter=GAMMA, harmonics=harmonics, samples=samples, options=options, progress=progress,
-                     **overrides)
+                     condense=condense, **overrides)
     return branch_dataset(br, response_dof)
 
 
@@ -540,8 +551,8 @@ def _make_solution(problem: HBProblem, X, converged, iterations, response_dof) -
     """HBSolution at X: residual, amplitudes of ``response_dof`` and Hill stability."""
     lam = problem.f1_ref
     ev = problem.evaluate(X, lam)
-    amp, off, mx = problem.amplitudes(X, response_dof)
-    stable, growth, mult = hill_stability(ev.JX, problem.system.M, problem.system.C, problem.omega(lam), problem.H)
+    amp, off, mx = problem.amplitudes(X, response_dof, lam)
+    stable, growth, mult = problem.hill_stability(ev.JX, problem.omega(lam))
     return HBSolution(problem=problem, X=X, converged=bool(converged), iterations=int(iterations),
                       residual_norm=float(np.max(np.abs(ev.R))), amplitude_m=amp, offset_m=off, max_abs_m=mx,
                       stable=stable, growth=growth, multipliers=mult, aft_info=ev.info)
@@ -549,7 +560,8 @@ def _make_solution(problem: HBProblem, X, converged, iterations, response_dof) -
 
 def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB_HARMONICS,
                      samples: int = config.HB_SAMPLES, guess=None, response_dof: int = 0,
-                     tol: float = config.CONT_TOL, max_iter: int = config.HB_SOLVE_MAX_ITER) -> HBSolution:
+                     tol: float = config.CONT_TOL, max_iter: int = config.HB_SOLVE_MAX_ITER,
+                     condense: bool | None = None) -> HBSolution:
     """Solve the HB equations at one frequency by damped Newton.
 
     Parameters
@@ -569,6 +581,12 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
         Tolerance on the residual scaled by max(F1, fy).
     max_iter : int
         Newton iterations.
+    condense : bool, optional
+        Condense exactly onto the contact DOFs (None: by size; see
+        :func:`continue_hb`). The unknowns X (and ``guess``) are then the
+        harmonics of the retained DOFs ``problem.dofs``; stability is
+        computed only when the full problem is small
+        (:mod:`jointdyn.hb.condense`).
 
     Returns
     -------
@@ -577,7 +595,8 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
     """
     gamma = V.positive("gamma", gamma)
     # the forcing amplitude as the (fixed) parameter: a problem at this gamma
-    problem = HBProblem(system, harmonics=harmonics, samples=samples, parameter="f1", gamma=gamma)
+    problem = make_problem(system, condense=condense, harmonics=harmonics, samples=samples, parameter="f1",
+                           gamma=gamma)
     f1 = problem.f1_ref
     xs, fs, _ = _scales(problem, f1)
 
@@ -594,7 +613,7 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
         # where the stuck-contact linear solution is a good start
         br = continue_hb(system, config.HB_HOMOTOPY_START * f1, f1, parameter="f1", gamma=gamma,
                          harmonics=harmonics, samples=samples, tol=tol, backward_after_unbounded=False,
-                         progress=False)
+                         progress=False, condense=problem.condensed)
         if br.status is ContinuationStatus.COMPLETE and br.lam.size and br.lam[-1] == f1:
             y, ok, it = newton(residual, br.X[-1] / xs, 0.0, tol=tol, max_iter=max_iter)
     return _make_solution(problem, y * xs, ok, it, response_dof)

@@ -33,7 +33,7 @@ def _system_at(problem, f, loads) -> System:
     s = problem.system
     contacts = tuple(dataclasses.replace(c, normal=HarmonicLoad(n0, n1, math.degrees(dl)))
                      for c, (n0, n1, dl, _) in zip(problem.contacts, loads))  # fmt: skip
-    return System(M=s.M, C=s.C, K=s.K, contacts=contacts, force=f)
+    return System(M=s.M, C=s.C, K=s.K, contacts=contacts, force=f, force_phase_deg=s.force_phase_deg)
 
 
 def _section_phase(problem, X, p) -> float:
@@ -83,8 +83,8 @@ def monodromy_multipliers(problem, X, p, *, steps_per_period: int | None = None,
     w, f, loads = problem._split(p)
     system = _system_at(problem, f, loads)
     kin = contact_kinematics(system)
-    H, n = problem.H, problem.n
-    Xm = np.asarray(X, dtype=float).reshape(problem.nh, n)
+    H, n = problem.H, system.ndof
+    Xm = problem.full_coefficients(X, p).reshape(problem.nh, n)
     tau0 = _section_phase(problem, X, p)
     e0 = basis(H, np.array([tau0]))[0]
     x0 = e0 @ Xm

@@ -253,9 +253,11 @@ class SystemParameter(HBParameter):
             V.in_range(f"{self.name} {what}", v, self.lower, self.upper)
 
     def problem_at(self, problem, p: float):
-        """The harmonic-balance problem of ``build(p)`` at the problem's fixed frequency (cached)."""
+        """The harmonic-balance problem of ``build(p)`` at the problem's fixed frequency (cached);
+        condensed onto the same DOFs when ``problem`` is."""
         return _problem_at(self, problem.H, problem.Ns, problem.max_passes, problem.gamma_fixed * problem.w0,
-                           problem.n, len(problem.contacts), float(p))
+                           problem.system.ndof, len(problem.contacts), float(p),
+                           tuple(int(d) for d in problem.dofs) if problem.condensed else None)
 
     def step(self, p: float) -> float:
         """Central-difference step h at p: ``config.HB_PARAMETER_FD_STEP`` times the scale (or |p|, or 1)."""
@@ -264,9 +266,11 @@ class SystemParameter(HBParameter):
 
 
 @by_value(maxsize=8)
-def _problem_at(parameter, H, Ns, max_passes, w, ndof, ncontacts, p):
-    """HBProblem of ``parameter.build(p)`` at frequency w (the last few values of p are kept)."""
+def _problem_at(parameter, H, Ns, max_passes, w, ndof, ncontacts, p, dofs):
+    """HBProblem of ``parameter.build(p)`` at frequency w (the last few values of p are kept),
+    condensed onto ``dofs`` unless None."""
     from ..systems import System
+    from .condense import CondensedHBProblem
     from .problem import HBProblem
 
     system = parameter.build(p)
@@ -274,4 +278,11 @@ def _problem_at(parameter, H, Ns, max_passes, w, ndof, ncontacts, p):
         raise ValueError(f"build({parameter.name} = {p!r}) must return a jointdyn.System")
     if system.ndof != ndof or len(system.contacts) != ncontacts:
         raise ValueError(f"build({parameter.name} = {p!r}) must keep {ndof} DOFs and {ncontacts} contacts")
-    return HBProblem(system, harmonics=H, samples=Ns, parameter=_FixedFrequency(w), max_passes=max_passes)
+    kw = {"harmonics": H, "samples": Ns, "parameter": _FixedFrequency(w), "max_passes": max_passes}
+    if dofs is None:
+        return HBProblem(system, **kw)
+    q = CondensedHBProblem(system, response_dofs=dofs, **kw)
+    if tuple(int(d) for d in q.dofs) != dofs:
+        raise ValueError(f"build({parameter.name} = {p!r}) must keep the contacts on the same DOFs "
+                         f"(condensed onto {list(dofs)}, got {q.dofs.tolist()})")
+    return q

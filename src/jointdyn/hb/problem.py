@@ -2,7 +2,8 @@
 
 Equation of motion (docs/model.md section 6, generalised in ``systems.py``)::
 
-    M x'' + C x' + K x + sum_c B_c T_c(u_c, N_c) = f sin(w t),
+    M x'' + C x' + K x + sum_c B_c T_c(u_c, N_c) = F(t),
+    F_i(t) = f_i sin(w t + phi_i) = f_i sin(phi_i) cos(w t) + f_i cos(phi_i) sin(w t),
     u_c = B_c^T x,   N_c(t) = n0_c + n1_c sin(w t + delta_c).
 
 In normalised time tau = w t, x(tau) = sum_h Q_h(tau) X_h with the real
@@ -11,16 +12,20 @@ Fourier basis Q = (1, cos tau, sin tau, ..., cos H tau, sin H tau) of
 Galerkin projection on the same basis gives, for harmonic k (coefficients
 a_k of cos, b_k of sin)::
 
-    (K - k^2 w^2 M) a_k + k w C b_k + F_a,k(X) = 0
-    (K - k^2 w^2 M) b_k - k w C a_k + F_b,k(X) = f delta_{k1}
+    (K - k^2 w^2 M) a_k + k w C b_k + F_a,k(X) = f sin(phi) delta_{k1}
+    (K - k^2 w^2 M) b_k - k w C a_k + F_b,k(X) = f cos(phi) delta_{k1}
 
 and K a_0 + F_0(X) = 0 for the constant term (the offset). F(X) are the
 Fourier coefficients of the contact forces, evaluated by alternating
 frequency-time (:mod:`jointdyn.hb._aft`) with exact forward-mode
 Jacobians. The unknowns are ordered harmonic-major:
-``X[h * n + i]`` is coefficient h of DOF i. How the continuation
-parameter enters (frequency, forcing, normal loads) is the business of a
-parameter object (:mod:`jointdyn.hb.parameters`).
+``X[h * n + i]`` is coefficient h of unknown DOF i (here every DOF of the
+system: ``dofs[i] == i``; the condensed problem of
+:mod:`jointdyn.hb.condense` keeps the contact DOFs only). How the
+continuation parameter enters (frequency, forcing amplitudes, normal
+loads) is the business of a parameter object
+(:mod:`jointdyn.hb.parameters`); the forcing phases phi are the system's
+and stay fixed.
 """
 
 from __future__ import annotations
@@ -38,6 +43,7 @@ from ..kinematics import NORMAL_HARMONIC, contact_kinematics, no_contact_init_jv
 from ..systems import Contact, System
 from ._aft import eval_kernel
 from .parameters import SystemParameter, parameter_named
+from .stability import hill_growth, hill_stability
 
 __all__ = ["HBProblem"]
 
@@ -124,9 +130,19 @@ class HBProblem:
 
     def __init__(self, system: System, *, harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
                  parameter="gamma", gamma: float | None = None, max_passes: int = config.HB_MAX_PASSES):
+        self._setup(system, harmonics, samples, parameter, gamma, max_passes, None)
+        self._lin = _linear_blocks(system, self.H)
+        # what the parameter does not move is built once
+        self._fixed_forcing = None if self.parameter.enters_forcing else self._forcing_at(0.0)
+        self._fixed_loads = None if self.parameter.enters_loads else self._loads_at(0.0)
+
+    def _setup(self, system, harmonics, samples, parameter, gamma, max_passes, dofs) -> None:
+        """Validation and everything but the linear part, for the unknown DOFs ``dofs``
+        (system DOF numbers; None: every DOF)."""
         if not isinstance(system, System):
             raise ValueError("system must be a jointdyn.System")
-        system.require_in_phase_forcing("harmonic balance")
+        if dofs is None:
+            dofs = np.arange(system.ndof)
         self.H = V.positive_int("harmonics", harmonics, 1)
         self.Ns = V.positive_int("samples", samples, 2 * self.H + 2)
         self.parameter = parameter_named(parameter)
@@ -137,7 +153,9 @@ class HBProblem:
             self.gamma_fixed = V.positive("gamma", gamma)
         self.max_passes = V.positive_int("max_passes", max_passes, 2)
         self.system = system
-        self.n = system.ndof
+        #: system DOF of each unknown DOF (X[h * n + i] is harmonic h of DOF dofs[i])
+        self.dofs = np.asarray(dofs, dtype=np.int64)
+        self.n = self.dofs.size
         self.nh = 2 * self.H + 1
         self.size = self.n * self.nh
         self.w0 = system.w0
@@ -149,14 +167,18 @@ class HBProblem:
         fmax = float(np.max(np.abs(system.force))) if system.force.size else 0.0
         self.f_dir = system.force / fmax if fmax > 0 else system.force.copy()
         self.f1_ref = fmax
+        phi = np.radians(system.force_phase_deg)
+        #: per system DOF, sin and cos of the forcing phase: f sin(w t + phi) has the
+        #: coefficients f sin(phi) of cos(w t) and f cos(phi) of sin(w t)
+        self.phase_sin, self.phase_cos = np.sin(phi), np.cos(phi)
         kin = contact_kinematics(system)
         if np.any(kin.normal_kind != NORMAL_HARMONIC):
             raise ValueError("contacts: harmonic balance takes constant and harmonic normal loads")
         #: per contact (n0, n1, delta) of its normal load as given in the system (N, N, rad)
         self.load_coefficients = kin.normal_par.copy()
-        self.B = list(selection_matrix(kin, self.n))
-        # inputs of the compiled evaluation, built once: selection rows,
-        # kernel parameters padded to a common length, linear blocks
+        self.B = list(selection_matrix(kin, system.ndof)[:, self.dofs])
+        # inputs of the compiled evaluation, built once: selection rows and
+        # kernel parameters padded to a common length
         nc = len(self.contacts)
         self._Bm = np.array(self.B, dtype=np.float64).reshape(nc, self.n)
         self._Pm = _pad_rows([c.law.params for c in self.contacts])
@@ -165,14 +187,22 @@ class HBProblem:
         law = self.contacts[0].law if nc else None
         self._kernel = (eval_kernel(law.step_jvp, law.init_jvp) if nc
                         else eval_kernel(no_contact_step_jvp, no_contact_init_jvp))
-        self._lin = _linear_blocks(system, self.H)
-        # what the parameter does not move is built once
-        self._fixed_forcing = None if self.parameter.enters_forcing else self._forcing_at(0.0)
-        self._fixed_loads = None if self.parameter.enters_loads else self._loads_at(0.0)
         self._dummy = np.zeros((1, 1))
         self._zero1 = np.zeros(1)
         self._noscale = np.zeros(3)
         self._scales_seen = None
+
+    @property
+    def condensed(self) -> bool:
+        """True when the unknowns are the harmonics of some DOFs only (:mod:`jointdyn.hb.condense`)."""
+        return False
+
+    def dof_index(self, dof: int) -> int:
+        """Position among the unknown DOFs of system DOF ``dof`` (ValueError naming it if absent)."""
+        hit = np.flatnonzero(self.dofs == dof)
+        if hit.size == 0:
+            raise ValueError(f"dof {dof!r} is not among the unknowns of this problem ({self.dofs.tolist()})")
+        return int(hit[0])
 
     # --- parameter ----------------------------------------------------------
     def omega(self, p) -> float:
@@ -212,10 +242,21 @@ class HBProblem:
         AK, AC, AM = self._lin
         return AK + w * AC + (w * w) * AM
 
-    def forcing(self, f):
-        """Coefficient vector of f sin(tau)."""
+    def _linear_terms(self, w):
+        """(AK, AC, AM, w) of the compiled evaluation: A(w) = AK + w AC + w^2 AM."""
+        return (*self._lin, float(w))
+
+    def forcing(self, f, w: float | None = None):
+        """Coefficient vector of the forcing f_i sin(tau + phi_i), amplitudes f (N) per DOF.
+
+        The phases phi are the system's. ``w`` (rad/s) is not needed here
+        (the condensed problem's forcing depends on it).
+        """
+        n = self.n
         Fe = np.zeros(self.size)
-        Fe[2 * self.n:3 * self.n] = f
+        s = self.phase_sin
+        Fe[n:2 * n] = np.where(s != 0.0, f * s, 0.0)
+        Fe[2 * n:3 * n] = f * self.phase_cos
         return Fe
 
     def linear_guess(self, p, stuck: bool = True):
@@ -232,7 +273,7 @@ class HBProblem:
                 Kc = c.law.kt * np.outer(b, b)
                 for h in range(q.nh):
                     A[h * q.n:(h + 1) * q.n, h * q.n:(h + 1) * q.n] += Kc
-        return np.linalg.solve(A, q.forcing(q.parameter.forcing(q, p)[0]))
+        return np.linalg.solve(A, q.forcing(q.parameter.forcing(q, p)[0], w))
 
     # --- residual -----------------------------------------------------------
     def evaluate(self, X, p, scales=None) -> _Eval:
@@ -276,7 +317,7 @@ class HBProblem:
                 self._scl = np.array([fs, xs / fs, ps / fs])
                 self._scales_seen = scales
             scaled = (self._scl, np.empty(size), np.empty((size, size)), np.empty(size))
-        self._kernel((*self._lin, float(w), float(dwdp), X, Fe, Fp), (self._Bm, self._Pm, self._ssz),
+        self._kernel((*self._linear_terms(w), float(dwdp), X, Fe, Fp), (self._Bm, self._Pm, self._ssz),
                      (Nsamp, dN if has_p else self._dummy, has_p), (self.E, self.P),
                      (int(self.max_passes), float(config.HB_PERIODIC_RTOL)), (R, JX, Jp, T, code, info), scaled)
         return _Eval(R, JX, Jp, T, code, info, None if scales is None else scaled[1:])
@@ -296,21 +337,46 @@ class HBProblem:
         return dataclasses.replace(ev, Jp=Jp, scaled=scaled)
 
     # --- post-processing ----------------------------------------------------
-    def amplitudes(self, X, dof: int):
+    def dof_coefficients(self, X, dof: int, p=None):
+        """Harmonic coefficients (2H+1) of system DOF ``dof`` at the coefficients X, m.
+
+        ``X`` is one coefficient vector or a stack (points, size); the result
+        is (2H+1,) or (points, 2H+1). ``p`` (the parameter value, one per
+        point) is needed only by a condensed problem for a DOF that is not
+        among its unknowns.
+        """
+        X = np.asarray(X, dtype=np.float64)
+        return X.reshape(X.shape[:-1] + (self.nh, self.n))[..., self.dof_index(dof)]
+
+    def full_coefficients(self, X, p):
+        """Coefficients of every DOF of the system (harmonic-major, ``ndof * (2H+1)``), m."""
+        return np.array(X, dtype=np.float64)
+
+    def amplitudes(self, X, dof: int, p=None):
         """(half peak-to-peak, mean, max |x|) of x_dof(t), m.
 
         Extrema located on ``config.HB_FINE_SAMPLES`` samples per period
-        and refined by a parabola (:func:`jointdyn.fourier.extrema`).
+        and refined by a parabola (:func:`jointdyn.fourier.extrema`). ``p``
+        as in :meth:`dof_coefficients`.
         """
-        Xm = np.asarray(X, dtype=np.float64).reshape(self.nh, self.n)
-        hi, lo = extrema(Xm[:, dof], self.H)
-        c0 = float(Xm[0, dof])
+        c = self.dof_coefficients(X, dof, p)
+        hi, lo = extrema(c, self.H)
+        c0 = float(c[0])
         return 0.5 * (hi - lo), c0, max(abs(hi), abs(lo))
 
-    def first_harmonic_amplitude(self, X, dof: int) -> float:
+    def first_harmonic_amplitude(self, X, dof: int, p=None) -> float:
         """sqrt(a_1^2 + b_1^2) of DOF ``dof``, m."""
-        Xm = X.reshape(self.nh, self.n)
-        return math.hypot(Xm[1, dof], Xm[2, dof])
+        c = self.dof_coefficients(X, dof, p)
+        return math.hypot(c[1], c[2])
+
+    # --- stability ----------------------------------------------------------
+    def hill_growth(self, JXs, ws):
+        """max Re(s) / w of the Floquet exponents (Hill's method) at many points (:func:`~jointdyn.hb.stability.hill_growth`)."""
+        return hill_growth(JXs, self.system.M, self.system.C, ws, self.H)
+
+    def hill_stability(self, JX, w):
+        """(stable, growth, multipliers) of one solution (:func:`~jointdyn.hb.stability.hill_stability`)."""
+        return hill_stability(JX, self.system.M, self.system.C, w, self.H)
 
 
 def contact_of(system: System) -> Contact:
