@@ -25,7 +25,7 @@ from .. import config
 from .._jit import jit
 from ..systems import System
 from ._core import N_SUMMARY, S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
-from ._model import Model, make_model
+from ._model import Model, make_model, refine_if_opened
 from ._start import clean_states, linear_start
 from .integrate import Restart, Trajectory, _omega, _trajectory
 from .monodromy import fd_monodromy
@@ -541,18 +541,25 @@ def _need_shoot(hist, model, growing, amp_rtol, chunk) -> bool:
 def _settle(model, st: _March, K, maxp, amp_rtol, energy_rtol, rdof, shooting):
     """Integrate chunks of periods (shooting over slow transients) until classified.
 
-    Returns (status or None when max_periods ran out, detail, p).
+    Once a normal spring opens, the model is replaced by its refined twin
+    (:func:`~jointdyn.dynamics._model.refine_if_opened`) and the history
+    starts again. Returns (status or None when max_periods ran out, detail,
+    p, the model in use).
     """
     chunk = max(config.SS_CHUNK, K)
     while True:
         nrun = int(min(chunk, maxp - st.counters["periods"]))
         if nrun <= 0:
-            return None, "", 0
+            return None, "", 0, model
         res = model.run_periods(st.x, st.v, st.S, nrun, rdof=rdof)
         _booker(st.counters)(res)
         st.hist.add(res.summary, res.z_end)
         if not res.status.ok:
-            return SteadyStatus.UNBOUNDED, "blow-up", 0
+            return SteadyStatus.UNBOUNDED, "blow-up", 0, model
+        finer = refine_if_opened(model, res.summary)
+        if finer is not None:
+            model, st.hist = finer, _History(np.concatenate([st.x, st.v]))
+            continue
         p_found = _period_multiple(st.hist, model, K, amp_rtol, energy_rtol)
         long_p = 0 if p_found else _long_period(st.hist, K, model, amp_rtol, energy_rtol)
         growing = False if (p_found or long_p) else _growing(st.hist, model, amp_rtol)
@@ -565,13 +572,13 @@ def _settle(model, st: _March, K, maxp, amp_rtol, energy_rtol, rdof, shooting):
             if st.shoot(model, rdof, amp_rtol):
                 continue
         if p_found:
-            return SteadyStatus.PERIODIC, "shooting" if st.counters["shoot"] else "integration", p_found
+            return SteadyStatus.PERIODIC, "shooting" if st.counters["shoot"] else "integration", p_found, model
         if long_p:
-            return SteadyStatus.NOT_SETTLED, f"period-{long_p}", 0
+            return SteadyStatus.NOT_SETTLED, f"period-{long_p}", 0, model
         if growing and not can_shoot:
-            return SteadyStatus.UNBOUNDED, "growing", 0
+            return SteadyStatus.UNBOUNDED, "growing", 0, model
         if st.counters["periods"] >= maxp or (not can_shoot and _stalled(st.hist, model)):
-            return None, "", 0
+            return None, "", 0, model
         if can_shoot and _need_shoot(st.hist, model, growing, amp_rtol, chunk):
             st.shoot(model, rdof, amp_rtol)
 
@@ -672,7 +679,7 @@ def steady_state(
     model = make_model(system, w, spp, events=_events)
     x, v, S = _first_state(model, start)
     st = _March(x, v, S, _History(np.concatenate([x, v])), {"periods": 0, "steps": 0, "shoot": 0})
-    status, detail, p_found = _settle(model, st, K, maxp, amp_rtol, energy_rtol, rdof, shooting)
+    status, detail, p_found, model = _settle(model, st, K, maxp, amp_rtol, energy_rtol, rdof, shooting)
     if status is None:
         # did not settle within max_periods: say why if we can
         status = SteadyStatus.NOT_SETTLED

@@ -120,6 +120,7 @@ class HBProblem:
         if not isinstance(system, System):
             raise ValueError("system must be a jointdyn.System")
         system.require_in_phase_forcing("harmonic balance")
+        system.require_prescribed_single_law("harmonic balance")
         self.H = V.positive_int("harmonics", harmonics, 1)
         self.Ns = V.positive_int("samples", samples, 2 * self.H + 2)
         self.parameter = V.choice("parameter", parameter, PARAMETERS)
