@@ -49,9 +49,9 @@ hand-written one (both measured):
   the reference counts of its arguments, which Numba updates at every
   inlined call, are not optimised away (1.3 to 2x slower).
 
-The spring and phase work is skipped when the system has no spring and
-in-phase forcing (flags computed once per run), so such systems run the
-same arithmetic as without it.
+The spring and phase work is compiled only for systems that have normal
+springs or forcing phases (global flags ``SPRINGS`` and ``PHASED`` bound
+with the kernel), so other systems run the loop they ran without it.
 
 The runner takes five grouped arguments (tuples of arrays):
 
@@ -77,7 +77,7 @@ The runner takes five grouped arguments (tuples of arrays):
 It returns ``(samples recorded, run status RUN_*, repetitions done)``
 (samples: ``capacity + 1`` with RUN_OVERFLOW when the buffers were full).
 The template calls the global placeholders ``STEP`` (the law kernel, or
-the mixed-law dispatcher) and ``PRESCRIBED_LOAD``
+the mixed-law dispatcher), reads ``SPRINGS`` and ``PHASED`` and calls ``PRESCRIBED_LOAD``
 (:func:`jointdyn.kinematics.prescribed_load`, bound so that the compiled
 copy's cache name follows the kinematics source, whose helpers are
 compiled into it) and is compiled per kernel with
@@ -249,7 +249,7 @@ def _spring_event(n_par, n_idx, n_w, c, y0, y1, h, n):  # pragma: no cover - com
 
 
 @jit(inline="always")
-def _split_fraction(tan_idx, tan_w, n_kind, n_par, n_idx, n_w, nspring, y0, y1, h, n, recontact):  # pragma: no cover
+def _split_fraction(tan_idx, tan_w, n_kind, n_par, n_idx, n_w, y0, y1, h, n, springs, recontact):  # pragma: no cover
     """Earliest event inside the step where it must be split: a velocity
     reversal of a contact or the opening/closing of a normal spring.
 
@@ -260,7 +260,7 @@ def _split_fraction(tan_idx, tan_w, n_kind, n_par, n_idx, n_w, nspring, y0, y1, 
     sbest = _reversal_fraction(tan_idx, tan_w, y0, y1, h, n)
     ev_c = -1
     ev_n = 0.0
-    if nspring > 0:
+    if springs:
         for c in range(n_kind.shape[0]):
             if n_kind[c] == NORMAL_SPRING:
                 sr, rising = _spring_event(n_par, n_idx, n_w, c, y0, y1, h, n)
@@ -275,49 +275,22 @@ def _split_fraction(tan_idx, tan_w, n_kind, n_par, n_idx, n_w, nspring, y0, y1, 
 
 
 @jit(inline="always")
-def _harmonic_forcing(fsin, fcos, sp, cp, phased, Fv):  # pragma: no cover - compiled
-    """F_i = f_i sin(w t + phi_i) = fsin_i sin(w t) + fcos_i cos(w t), N
-    (``sp``, ``cp``: sin and cos of w t; in-phase forcing: fsin_i sp alone)."""
-    if phased:
-        for i in range(Fv.shape[0]):
-            Fv[i] = fsin[i] * sp + fcos[i] * cp
-    else:
-        for i in range(Fv.shape[0]):
-            Fv[i] = fsin[i] * sp
+def _add_cosines(fcos, cp, Fv):  # pragma: no cover - compiled
+    """Fv_i += fcos_i cos(w t) (``cp`` = cos(w t)): the out-of-phase part of the forcing, N."""
+    for i in range(Fv.shape[0]):
+        Fv[i] += fcos[i] * cp
 
 
 @jit(inline="always")
-def _spring_loads(n_kind, n_par, n_idx, n_w, ys, Nv, ev_c, ev_n):  # pragma: no cover - compiled
-    """Loads of the spring contacts from the state ys; contact ``ev_c`` (>= 0
-    at the end of a step split at its spring event) gets ``ev_n`` instead
-    (exactly open at a separation, about to load at a re-contact)."""
+def _springs(n_kind, n_par, n_idx, n_w, ys, Nv, ev_c, ev_n, work):  # pragma: no cover - compiled
+    """Loads of the spring contacts from the state ys, and their reactions:
+    work -= Bn_c (N_c - P_c) (N). Contact ``ev_c`` (>= 0 at the end of a
+    step split at its spring event) gets ``ev_n`` instead (exactly open at a
+    separation, about to load at a re-contact)."""
     for c in range(Nv.shape[0]):
         if n_kind[c] == NORMAL_SPRING:
-            Nv[c] = spring_load(n_par, n_idx, n_w, c, ys)
-    if ev_c >= 0:
-        Nv[ev_c] = ev_n
-
-
-@jit(inline="always")
-def _spring_reactions(n_kind, n_par, n_idx, n_w, Nv, work):  # pragma: no cover - compiled
-    """work -= Bn_c (N_c - P_c) for every spring contact, N."""
-    for c in range(Nv.shape[0]):
-        if n_kind[c] == NORMAL_SPRING:
+            Nv[c] = ev_n if c == ev_c else spring_load(n_par, n_idx, n_w, c, ys)
             apply_normal_force(n_idx, n_w, c, Nv[c] - n_par[c, 0], work)
-
-
-@jit(inline="always")
-def _features(n_kind, fcos):  # pragma: no cover - compiled
-    """(number of spring contacts, True when a forcing phase is not 0)."""
-    nspring = 0
-    for c in range(n_kind.shape[0]):
-        if n_kind[c] == NORMAL_SPRING:
-            nspring += 1
-    phased = False
-    for i in range(fcos.shape[0]):
-        if fcos[i] != 0.0:
-            phased = True
-    return nspring, phased
 
 
 @jit(inline="always")
@@ -558,7 +531,6 @@ def _run_template(system, grid, control, io, out):  # pragma: no cover - compile
     n, nc, J = x_io.shape[0], S_io.shape[0], tgrid.shape[0] - 1
     Sa, Sb = S_io.copy(), S_io.copy()
     y0, y1, ys, kk, work, Fv, Nv, Tc, codes, code_c = _workspace(x_io, v_io, nc)
-    nspring, phased = _features(n_kind, fcos)
     blo, bhi, bit, sm, located, e, ev_c, ev_n = 0.0, 1.0, 0, 0.0, False, EVAL_START, -1, 0.0
     nrec, status, done, k, j, attempt, nsplit, nsteps, nopen = 0, RUN_OK, 0, 0, 0, 0, 0, 0, 0
     tc, t_end, end_idx, h, period = tgrid[0], tgrid[1], 1, tgrid[1] - tgrid[0], tgrid[J] - tgrid[0]
@@ -567,8 +539,8 @@ def _run_template(system, grid, control, io, out):  # pragma: no cover - compile
         if e == EVAL_END:
             _rk4_combine(y0, kk, h, y1, ys)
             if attempt == 0 and nsplit < max_split:
-                sbest, ev_c, ev_n = _split_fraction(tan_idx, tan_w, n_kind, n_par, n_idx, n_w, nspring, y0, y1, h,
-                                                    n, recontact)  # fmt: skip
+                sbest, ev_c, ev_n = _split_fraction(tan_idx, tan_w, n_kind, n_par, n_idx, n_w, y0, y1, h, n,
+                                                    SPRINGS, recontact)  # noqa: F821  # fmt: skip
                 if sbest < 1.0:  # redo the step up to the velocity reversal or spring event
                     h, end_idx, attempt, e = sbest * h, -1, 1, EVAL_STAGE2
                     continue
@@ -585,10 +557,11 @@ def _run_template(system, grid, control, io, out):  # pragma: no cover - compile
         fresh = mode == LOADS_HARMONIC and e >= EVAL_STAGE2 and e <= EVAL_END and attempt == 0 and nsplit == 0
         if mode == LOADS_HARMONIC:
             sp = (sin_mid[j] if e < EVAL_STAGE4 else sin_end[j]) if fresh else math.sin(phase0 + w * tau)
-            cp = 0.0
-            if phased:
-                cp = (cos_mid[j] if e < EVAL_STAGE4 else cos_end[j]) if fresh else math.cos(phase0 + w * tau)
-            _harmonic_forcing(fsin, fcos, sp, cp, phased, Fv)
+            for i in range(n):
+                Fv[i] = fsin[i] * sp
+            if PHASED:  # noqa: F821 - bound by specialize; F_i = f_i sin(w t + phi_i) = fsin_i sin(w t) + fcos_i cos(w t)
+                _add_cosines(fcos, (cos_mid[j] if e < EVAL_STAGE4 else cos_end[j]) if fresh
+                             else math.cos(phase0 + w * tau), Fv)  # fmt: skip
         else:
             _sampled_row(tgrid, Fgrid, tau, gidx, j, Fv)
         if gidx >= 0 or fresh:
@@ -599,12 +572,10 @@ def _run_template(system, grid, control, io, out):  # pragma: no cover - compile
         else:
             for c in range(nc):
                 Nv[c] = PRESCRIBED_LOAD(n_kind[c], n_par, n_tab, c, phase0 + w * tau)  # noqa: F821 - bound by specialize
-        if nspring > 0:  # loads from the state; the located spring event at the end of its step
-            _spring_loads(n_kind, n_par, n_idx, n_w, ys, Nv, ev_c if e == EVAL_END else -1, ev_n)
         # ---- right-hand side (the law kernel here: inside an inlined helper 3.5x slower)
         _linear_forces(K, C, ys, Fv, n, work)
-        if nspring > 0:
-            _spring_reactions(n_kind, n_par, n_idx, n_w, Nv, work)
+        if SPRINGS:  # noqa: F821 - bound by specialize; spring loads from the state, and their reactions
+            _springs(n_kind, n_par, n_idx, n_w, ys, Nv, ev_c if e == EVAL_END else -1, ev_n, work)
         pc = 0.0
         for c in range(nc):
             u, du = tangential(tan_idx, tan_w, c, ys, 0), tangential(tan_idx, tan_w, c, ys, n)
@@ -683,11 +654,15 @@ def grid_trig(tgrid, w, phase0):  # pragma: no cover - compiled
     return sin_mid, sin_end, cos_mid, cos_end
 
 
-def compiled_runner(step):
-    """The RK4 runner with ``step`` (a law kernel or a mixed-law dispatcher) bound, compiled and cached."""
+def compiled_runner(step, springs: bool = False, phased: bool = False):
+    """The RK4 runner with ``step`` (a law kernel or a mixed-law dispatcher)
+    bound, compiled and cached; ``springs`` (a contact has a normal spring)
+    and ``phased`` (a forcing phase is not 0) are compile-time constants, so
+    that systems without them compile none of that work."""
     from .._jit import specialize
 
-    return specialize(_run_template, STEP=step, PRESCRIBED_LOAD=prescribed_load)
+    return specialize(_run_template, STEP=step, PRESCRIBED_LOAD=prescribed_load, SPRINGS=bool(springs),
+                      PHASED=bool(phased))  # fmt: skip
 
 
 __all__ = [

@@ -134,7 +134,7 @@ def pack_system(system) -> PackedSystem:
     return PackedSystem(
         ndof=n, ncontacts=len(cs), M=M, Minv=Minv, K=K, C=C, fvec=fvec, fsin=fsin, fcos=fcos, kin=kin, B=B,
         Bn=Bn, kt=kt, P=P, slen=slen, laws=tuple(c.law for c in cs), step=step, init=init,
-        runner=compiled_runner(step), K_closed=np.ascontiguousarray(Kcl), K_stuck=np.ascontiguousarray(Kst),
+        runner=compiled_runner(step, kin.springs.size > 0, bool(np.any(fcos != 0.0))), K_closed=np.ascontiguousarray(Kcl), K_stuck=np.ascontiguousarray(Kst),
         w_max=w_max, w_min_stuck=w_min, xlin=sum(c.law.fy / c.law.kt for c in cs), fmax=fmax,
         kmin=max(w_min**2 * float(np.min(np.diag(system.M))), 1e-300),
         arrays=(Minv, K, C, (fsin, fcos), kin.arrays, P), nobufs=_buffers(1, n, len(cs)),
