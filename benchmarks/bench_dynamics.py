@@ -42,7 +42,9 @@ def run(quick: bool) -> dict:
     gammas = np.linspace(0.5, 2.0, ng)
     cases = [("eta0.5_beta2", dict(eta=0.5, beta=2.0)), ("eta1.5_beta2", dict(eta=1.5, beta=2.0)),
              ("eta0.5_beta1000", dict(eta=0.5, beta=1000.0))]  # fmt: skip
-    out = {"gammas_per_direction": ng}
+    from jointdyn import config
+
+    out = {"gammas_per_direction": ng, "model": config.MODEL}
     for name, kw in cases:
         s = System.paper_damper(**kw)
         steady_state(s, 1.0, max_periods=10)  # compile / load the cache

@@ -5,7 +5,9 @@ N/m, mu = 0.5, N = 100 N (slip force 50 N), zeta = 1e-3, F1 = 20 N;
 harmonics 0..7, 128 samples per period, gamma from 0.6 to 1.8.
 
 Reported: seconds per branch after JIT warm-up (best of repeats), points,
-first call in a fresh process (compilation cached on disk), and the ratio
+first call in a fresh process (compilation cached on disk), cold compile
+(fresh ``NUMBA_CACHE_DIR``, CPU seconds: the first residual evaluation with
+the law's kernels, then the rest of the first branch), and the ratio
 against the time-domain sweep (jointdyn.sweeps.frc_sweep, one direction,
 serial, warm starts) on the same gamma grid (the HB branch's own points),
 measured in the same run: ``ROUNDS`` rounds, each ``HB_PER_ROUND`` branches
@@ -36,6 +38,22 @@ s = System.sdof(m=10.0, k=3.9e5, law=law, f1=20.0, zeta=1e-3)
 ds = frc_hb(s, 0.6, 1.8, harmonics=7, samples=128, progress=False)
 t2 = time.perf_counter()
 print(t1 - t0, t2 - t1, ds.attrs["status"])
+"""
+
+
+_COLD = r"""
+import time
+from jointdyn import System
+from jointdyn.laws import Jenkins
+from jointdyn.hb import HBProblem, frc_hb
+law = Jenkins(kt=3e5, mu=0.5, n_ref=100.0)
+s = System.sdof(m=10.0, k=3.9e5, law=law, f1=20.0, zeta=1e-3)
+t = time.process_time()
+p = HBProblem(s, harmonics=7, samples=128)
+p.evaluate(p.linear_guess(1.1), 1.1)
+t1 = time.process_time()
+frc_hb(s, 0.6, 1.8, harmonics=7, samples=128, progress=False)
+print(t1 - t, time.process_time() - t1)
 """
 
 
@@ -97,6 +115,15 @@ def run(quick: bool = False) -> dict:
     out["fresh_process_import_seconds"] = float(imp)
     out["fresh_process_first_call_seconds"] = float(call)
     out["fresh_process_status"] = status
+    if not quick:
+        import tempfile
+
+        with tempfile.TemporaryDirectory() as cache:
+            r = subprocess.run([sys.executable, "-c", _COLD], capture_output=True, text=True,
+                               env={**env, "NUMBA_CACHE_DIR": cache}, check=True)
+        ev, rest = r.stdout.split()
+        out["cold_compile_evaluation_seconds"] = float(ev)
+        out["cold_compile_rest_of_branch_seconds"] = float(rest)
     if td is None:  # pragma: no cover
         out["time_domain"] = "jointdyn.sweeps not available"
         return out

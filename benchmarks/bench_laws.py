@@ -2,9 +2,11 @@
 
 Measured, each beside a reference taken in the same run:
 
-* closed-form Iwan (both memory rules): kernel steps per second over a long
-  steady cycle with macroslip (x = 1.5 x_slip sin, 2000 samples per cycle),
-  best of several repeats of ``jointdyn.march``;
+* the exact Iwan law (``iwan``, the default) and the closed-form Iwan law
+  (``iwan-closed``: full memory; ``iwan-paper``: the paper's last-reversal
+  rule): kernel steps per second over a long steady cycle with macroslip
+  (x = 1.5 x_slip sin, 2000 samples per cycle), best of several repeats of
+  ``jointdyn.march``;
 * discrete Iwan with n = 1000 elements: steps per second (and element steps);
 * the ratio of each against a straightforward pure-Python implementation of
   the same law (``tests/reference.py``) on a shorter history;
@@ -15,7 +17,8 @@ Measured, each beside a reference taken in the same run:
   first compilation of a trivial function) is measured before and reported
   apart as ``numba_startup_s``.
 
-Targets (issue 2): closed form >= 3e7 steps/s, discrete n = 1000 >= 1e6 steps/s.
+Targets (issue 2): closed form (and the exact law that replaces it as the
+default) >= 3e7 steps/s, discrete n = 1000 >= 1e6 steps/s.
 """
 
 from __future__ import annotations
@@ -76,7 +79,7 @@ _COMPILE_SCRIPT = r"""
 import json, sys, time
 t0 = time.perf_counter()
 import numpy as np
-from jointdyn import DiscreteIwan, Iwan, march
+from jointdyn import DiscreteIwan, Iwan, IwanClosedForm, march
 t_import = time.perf_counter() - t0
 import numba
 t0 = time.perf_counter()
@@ -84,6 +87,7 @@ numba.njit(lambda v: v + 1.0)(1.0)  # Numba's one-off start-up, not the laws'
 out = {"import_s": t_import, "numba_startup_s": time.perf_counter() - t0}
 x = np.linspace(0.0, 1e-4, 16); N = np.full(16, 100.0)
 for name, law in (("iwan", Iwan(kt=1e5, mu=0.1, n_ref=100.0)),
+                  ("iwan_closed", IwanClosedForm(kt=1e5, mu=0.1, n_ref=100.0)),
                   ("discrete", DiscreteIwan(kt=1e5, mu=0.1, n_ref=100.0, n=10))):
     t0 = time.perf_counter(); march(law, x, N); t1 = time.perf_counter()
     march(law, x, N); t2 = time.perf_counter()
@@ -113,8 +117,9 @@ def _compile_times():
 
 def run(quick: bool) -> dict:
     """Kernel speeds, ratios to pure Python, compile times (see module docstring)."""
-    from jointdyn import DiscreteIwan, Iwan
+    from jointdyn import DiscreteIwan, Iwan, IwanClosedForm
     from reference import DiscreteIwanRef, IwanPaperRef, IwanRef
+    from reference_exact import ExactIwanRef
 
     n_long = 200_000 if quick else 2_000_000
     n_disc = 20_000 if quick else 200_000
@@ -123,11 +128,17 @@ def run(quick: bool) -> dict:
     n_py_disc = 100 if quick else 500
 
     out = {"history": "x = 1.5 x_slip sin(2 pi t), 2000 samples/cycle, constant N (macroslip every half cycle)"}
-    for memory, ref in (("full", IwanRef), ("last", IwanPaperRef)):
-        law = Iwan(kt=KT, mu=MU, n_ref=NREF, memory=memory)
+    exact = Iwan(kt=KT, mu=MU, n_ref=NREF)
+    cases = (
+        ("iwan", exact, lambda: ExactIwanRef(KT, MU, NREF, exact.capacity, 0.0, NREF)),
+        ("iwan_closed", IwanClosedForm(kt=KT, mu=MU, n_ref=NREF), lambda: IwanRef(KT, MU, NREF, 0.0, NREF)),
+        ("iwan_paper", IwanClosedForm(kt=KT, mu=MU, n_ref=NREF, memory="last"),
+         lambda: IwanPaperRef(KT, MU, NREF, 0.0, NREF)),
+    )
+    for label, law, ref in cases:
         rate = _compiled_rate(law, n_long, repeats)
-        py = _python_rate(lambda: ref(KT, MU, NREF, 0.0, NREF), n_py, max(1, repeats // 2))
-        out[f"iwan_{memory}"] = {
+        py = _python_rate(ref, n_py, max(1, repeats // 2))
+        out[label] = {
             "steps_per_s": rate,
             "ns_per_step": 1e9 / rate,
             "python_reference_steps_per_s": py,

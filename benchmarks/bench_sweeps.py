@@ -4,8 +4,10 @@ against a plain ``scipy.integrate.solve_ivp``-style integration.
 ``run(quick)`` returns
 
 - ``fig6_seconds``: wall time of the Fig 6 sweep (4 eta x 6 beta x gamma grid,
-  up and down) on all local cores; ``quick`` uses a reduced gamma grid and
-  says so (``grid``);
+  up and down, the default contact model named in ``model``) on all local
+  cores; ``quick`` uses a reduced gamma grid and says so (``grid``); the
+  default model against the closed form in the same run is
+  ``bench_exact.py``'s ``fig6_time_domain``;
 - ``seconds_per_point``: mean steady-state point cost (wall time x workers /
   points, i.e. CPU-seconds per point) of that sweep;
 - ``baseline``: for a subset of points, the seconds of ``jointdyn``'s
@@ -106,6 +108,7 @@ def run(quick: bool = False) -> dict:
     npts = len(df)
     out["grid"] = (f"{'REDUCED (quick) ' if quick else ''}{len(FIG6_ETAS)} eta x {len(FIG6_BETAS)} beta x "
                    f"{len(gammas)} gamma x 2 directions = {npts} points")
+    out["model"] = str(df.model.iloc[0])
     out["fig6_seconds"] = wall
     out["fig6_target_seconds"] = 60.0
     out["workers"] = workers

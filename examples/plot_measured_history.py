@@ -15,18 +15,17 @@ cycle), and a little noise on both channels.
 from pathlib import Path
 
 import matplotlib.pyplot as plt
-import numpy as np
 
 import jointdyn as jd
 
 # %%
 # Read the history (columns ``t, x, N`` in SI units; other columns are
-# ignored) and choose the contact: the exact discrete Iwan model, with the
-# preload as reference load.
+# ignored) and choose the contact: the exact Iwan model (the default law,
+# every slip force following N(t)), with the preload as reference load.
 
 here = Path(__file__).parent if "__file__" in globals() else Path.cwd()
 t, x, N = jd.read_history_csv(here / "data" / "history.csv")
-law = jd.DiscreteIwan(kt=2e5, mu=0.3, n_ref=120.0, n=500)
+law = jd.Iwan(kt=2e5, mu=0.3, n_ref=120.0)
 print(f"{t.size} samples over {t[-1] - t[0]:.2f} s; N from {N.min():.0f} to {N.max():.0f} N")
 
 # %%

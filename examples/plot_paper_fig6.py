@@ -5,7 +5,8 @@ The paper's Fig 6 in a few lines
 Steady response of the paper's friction damper against the frequency ratio
 gamma, swept up and down, for two normal-load ratios eta (in contact and with
 separation) and two forcing levels beta. The full figure (4 x 6 curves) is
-``jointdyn figures --only fig6``; this is a small grid of it.
+``jointdyn figures --only fig6``; this is a small grid of it, with the
+default contact law (``ds.attrs["model"]``: the exact Iwan model).
 """
 
 import matplotlib.pyplot as plt
@@ -31,7 +32,7 @@ for ax, (eta, sub) in zip(axes, df.groupby("eta")):
             ax.plot(d.gamma, d.amplitude_q, style, color=f"C{k}",
                     label=f"beta = {beta:g}, sweep {direction}")
     ax.set_yscale("log")
-    ax.set_title(f"eta = {eta:g}")
+    ax.set_title(f"eta = {eta:g}, contact model {ds.attrs['model']}")
     ax.set_xlabel("gamma = w / w0")
     ax.grid(alpha=0.3, which="both")
 axes[0].set_ylabel("half peak-to-peak amplitude of q = kt x / fy")

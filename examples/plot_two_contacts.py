@@ -17,7 +17,7 @@ import jointdyn as jd
 M = np.diag([2.0, 1.0])                                  # kg
 K = np.array([[3.0e5, -1.0e5], [-1.0e5, 1.0e5]])         # N/m
 C = 2e-5 * K                                             # N s/m, light stiffness-proportional damping
-law = jd.DiscreteIwan(kt=5e4, mu=0.3, n_ref=200.0, n=100)
+law = jd.Iwan(kt=5e4, mu=0.3, n_ref=200.0)                # the exact Iwan model (the default law)
 contacts = (
     jd.Contact(law=law, dof=0, normal=jd.HarmonicLoad(200.0, 60.0)),  # against the ground, N = 200 + 60 sin(w t)
     jd.Contact(law=law, dof=1, dof2=0, normal=jd.ConstantLoad(150.0)),  # between the two DOFs, constant 150 N

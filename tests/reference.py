@@ -1,9 +1,11 @@
 """Slow plain-Python reference implementations of the contact laws.
 
 Written from MODEL.md (sections 2-5) and the module docstring of
-``jointdyn.laws.iwan``, independently of the compiled kernels' structure
+``jointdyn.laws.iwan_closed``, independently of the compiled kernels' structure
 (no state vectors, no numba, no numpy): objects that hold their memory as
-Python lists and commit on every call of :meth:`step`. They are oracles for
+Python lists and commit on every call of :meth:`step` (the exact Iwan law's
+reference, written from ``jointdyn.laws.exact``, is in ``reference_exact.py``).
+They are oracles for
 the tests (``test_laws_reference.py``) and the pure-Python baseline of
 ``benchmarks/bench_laws.py``.
 
@@ -16,6 +18,8 @@ comparable with ``jointdyn.march(law, x, N)``.
 
 from __future__ import annotations
 
+from reference_exact import ExactIwanRef
+
 STICK_SLIP, MACROSLIP, SEPARATION = 0, 1, 2
 
 #: a branch value with |G| >= alpha (1 - SAT_RTOL) counts as macroslip (the
@@ -23,7 +27,7 @@ STICK_SLIP, MACROSLIP, SEPARATION = 0, 1, 2
 #: as the compiled law, documented there as part of the clip
 SAT_RTOL = 1e-12
 #: a branch within this distance (normalised q) of an earlier reversal point
-#: has reached it (Masing rejoin): the tolerance documented in laws/iwan.py
+#: has reached it (Masing rejoin): the tolerance documented in laws/iwan_closed.py
 WIPE_TOL = 1e-9
 
 
@@ -77,9 +81,9 @@ class DiscreteIwanRef:
 
 
 class IwanRef:
-    """Closed-form Iwan law with full Masing memory (``Iwan(memory="full")``).
+    """Closed-form Iwan law with full Masing memory (``IwanClosedForm(memory="full")``).
 
-    Memory (laws/iwan.py docstring): a stack of reversal points
+    Memory (laws/iwan_closed.py docstring): a stack of reversal points
     ``(q, G, alpha)``; the current branch starts at the top one. Below the
     stack lies the *base*: the virgin curve from the contact point q_c, or
     the saturation point (q_s, alpha_s) of the last macroslip.
@@ -213,7 +217,7 @@ class IwanRef:
 
 
 class IwanPaperRef:
-    """The paper's last-reversal rule (``Iwan(memory="last")``), written alone.
+    """The paper's last-reversal rule (``IwanClosedForm(memory="last")``), written alone.
 
     Only the last reversal point (q0, G0, alpha0) is kept::
 
@@ -272,7 +276,8 @@ class IwanPaperRef:
 #: every law in ``jointdyn.laws.law_names()`` needs an entry (the reference
 #: comparison fails for a law without one)
 REFERENCES = {
-    "iwan": lambda law, x0, n0: IwanRef(law.kt, law.mu, law.n_ref, x0, n0, max_depth=law.max_depth),
+    "iwan": lambda law, x0, n0: ExactIwanRef(law.kt, law.mu, law.n_ref, law.capacity, x0, n0),
+    "iwan-closed": lambda law, x0, n0: IwanRef(law.kt, law.mu, law.n_ref, x0, n0, max_depth=law.max_depth),
     "iwan-paper": lambda law, x0, n0: IwanPaperRef(law.kt, law.mu, law.n_ref, x0, n0),
     "discrete": lambda law, x0, n0: DiscreteIwanRef(law.kt, law.mu, law.n_ref, law.n, x0, n0),
     "jenkins": lambda law, x0, n0: DiscreteIwanRef(law.kt, law.mu, law.n_ref, 1, x0, n0),

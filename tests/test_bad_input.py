@@ -16,8 +16,6 @@ malformed input files, contradictory options, wrong types in the API.
 
 from __future__ import annotations
 
-import json
-import math
 import os
 import subprocess
 import sys

@@ -51,7 +51,7 @@ def loop_json(capsys, *args):
 def test_json_default_matches_closed_form(capsys):
     d = loop_json(capsys)
     assert KEYS <= set(d)
-    assert d["model"] == "iwan"
+    assert d["model"] == "iwan" and d["parameters"]["capacity"] == 32
     assert d["parameters"]["kt_N_per_m"] == KT and d["parameters"]["amplitude_m"] == A
     # MODEL.md section 2, A > 2 fy / kt: E = 4 fy A - 16 fy^2 / (3 kt)
     assert d["energy_per_cycle_J"] == pytest.approx(4 * FY * A - 16 * FY**2 / (3 * KT), rel=TEST_ENERGY_RTOL)
@@ -63,7 +63,7 @@ def test_json_default_matches_closed_form(capsys):
     assert 0 < d["loss_factor"] < 1
 
 
-@pytest.mark.parametrize("model", ["iwan", "iwan-paper", "discrete", "jenkins"])
+@pytest.mark.parametrize("model", ["iwan", "iwan-closed", "iwan-paper", "discrete", "jenkins"])
 def test_json_separation(capsys, model):
     n = ("--n", "200") if model == "discrete" else ()
     d = loop_json(capsys, "--model", model, "--eta", "1.2", "--delta", "90", *n)

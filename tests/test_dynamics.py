@@ -323,13 +323,15 @@ def test_loop_is_one_closed_period_and_warm_start_is_cheap():
 
 def test_unsettled_response_is_not_reported_as_a_number():
     # near the jump of the eta = 0.5, beta = 2 curve the closed-form Iwan law
-    # (not the discrete one, which is period-1 there) settles to a period-7
-    # response, beyond p <= SS_MAX_MULTIPLE: "not-settled", amplitudes NaN
-    s = System.paper_damper(eta=0.5, beta=2.0)
+    # (not the discrete one nor the exact law, which are period-1 there)
+    # settles to a period-7 response, beyond p <= SS_MAX_MULTIPLE:
+    # "not-settled", amplitudes NaN
+    s = System.paper_damper(eta=0.5, beta=2.0, model="iwan-closed")
     r = steady_state(s, 1.15)
     assert r.status == "not-settled"
     assert math.isnan(r.amplitude_q) and math.isnan(r.amplitude_m)
     assert r.periods < config.SS_MAX_PERIODS
+    assert steady_state(System.paper_damper(eta=0.5, beta=2.0), 1.15).status == "periodic"
 
 
 # --- statuses and the runner's buffers ------------------------------------------

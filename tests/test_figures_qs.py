@@ -37,19 +37,25 @@ def test_fig3_fig4_tables(name, delta):
         eta = row["eta"]
         expected = 0.0 if eta <= 1 else (math.pi - 2 * math.asin(1 / eta)) / (2 * math.pi)
         assert row["separation_fraction"] == pytest.approx(expected, abs=TEST_QS_FRACTION_ATOL)
-    # one steady cycle per eta, T = 0 where separated, peak force mu N0 (1 + eta)
+    # one steady cycle per eta, T = 0 where separated; peak force mu N0 (1 +
+    # eta) in phase (macroslip at the largest load), at most that at 90 deg
+    # (the exact law: elements re-stick while the load rises)
     for eta, g in loops.groupby("eta"):
         assert g["t"].max() - g["t"].min() == pytest.approx(1.0)
         assert np.all(g.loc[g["state"] == "separation", "T"] == 0.0)
-        assert g["T"].max() == pytest.approx(10.0 * (1 + eta), rel=1e-3)
+        if delta == 0.0:
+            assert g["T"].max() == pytest.approx(10.0 * (1 + eta), rel=1e-3)
+        else:
+            assert 0.99 * 10.0 * (1 + eta) <= g["T"].max() <= 10.0 * (1 + eta) * (1 + 1e-12)
+    assert set(m["model"]) == {"iwan"}
 
 
 def test_fig4_discrete_has_three_models():
     m = FIGURES["fig4_discrete"].compute()["metrics"]
-    assert set(m["model"]) == {"iwan", "iwan-paper", "discrete"}
+    assert set(m["model"]) == {"iwan-closed", "iwan-paper", "discrete"}
     e = m.pivot(index="eta", columns="model", values="energy_per_cycle_J")
     # eta = 0: all agree with the closed form; eta > 0: the closed forms dissipate less
-    assert e.loc[0.0, "iwan"] == pytest.approx(e.loc[0.0, "discrete"], rel=TEST_ENERGY_RTOL)
+    assert e.loc[0.0, "iwan-closed"] == pytest.approx(e.loc[0.0, "discrete"], rel=TEST_ENERGY_RTOL)
     assert (e.loc[[0.3, 0.6, 0.9, 1.2], "iwan-paper"] < e.loc[[0.3, 0.6, 0.9, 1.2], "discrete"]).all()
 
 

@@ -110,3 +110,55 @@ def test_hill_parity_split_matches_lapack(eta, splits):
         assert (not np.array_equal(lam, whole)) == splits
         ref = np.linalg.eigvals(_hill_matrix(ev.JX, p.system.M, p.system.C, w, p.H))
         assert _match_error(lam, ref) <= 1e-12 * w
+
+
+@pytest.mark.parametrize("eta", [0.0, 0.5])
+def test_lapack_and_compiled_hill_paths_agree(eta):
+    # the two paths of Hill's eigenvalues (compiled EISPACK for small
+    # companions, LAPACK above config.HB_SMALL_EIG): same spectrum to rounding,
+    # same parity split decision
+    from jointdyn.hb import continue_hb
+    from jointdyn.hb.stability import _hill_eigvals, _hill_eigvals_lapack, _hill_matrix, _hill_parts, _parity_blocks
+
+    br = continue_hb(System.paper_damper(eta=eta, beta=2.0, model="iwan"), 0.9, 1.5, progress=False)
+    p = br.problem
+    M, C = p.system.M, p.system.C
+    D2iJ, B1, _, parity = _hill_parts(M, C, p.H)
+    for i in range(0, br.lam.size, 4):
+        ev = p.evaluate(br.X[i], br.lam[i])
+        w = p.omega(br.lam[i])
+        lam, ok = _hill_eigvals(D2iJ, ev.JX, B1[0], B1[1], w, parity)
+        whole, _ = _hill_eigvals(D2iJ, ev.JX, B1[0], B1[1], w, np.zeros_like(parity))
+        split = _parity_blocks(_hill_matrix(ev.JX, M, C, w, p.H), parity) is not None
+        assert ok and split == (not np.array_equal(lam, whole))
+        assert _match_error(_hill_eigvals_lapack(ev.JX, M, C, w, p.H), lam) <= 1e-12 * w
+
+
+@pytest.mark.parametrize("eta", [0.0, 0.5])
+def test_hill_growth_of_a_large_system(eta):
+    # 10 DOFs, H = 7: a companion of 300 rows, above config.HB_SMALL_EIG,
+    # assembled with NumPy and solved by parity blocks of 150 rows (compiled
+    # EISPACK, eta = 0) or whole (LAPACK, eta > 0); the growth rates equal
+    # those of the all-compiled batch to rounding
+    from jointdyn import config
+    from jointdyn.hb import HBProblem
+    from jointdyn.hb.stability import _hill_growth_batch, _hill_parts, hill_growth
+
+    n = 10
+    K = 3.9e5 * (2 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1))
+    K[-1, -1] = 3.9e5
+    law = Jenkins(kt=3e5, mu=0.5, n_ref=100.0)
+    from jointdyn.kinematics import HarmonicLoad
+    from jointdyn.systems import Contact
+
+    s = System(M=10.0 * np.eye(n), C=1e-4 * K, K=K, force=np.r_[40.0, np.zeros(n - 1)],
+               contacts=(Contact(law=law, dof=0, normal=HarmonicLoad(100.0, eta * 100.0)),))
+    p = HBProblem(s, harmonics=7, samples=64)
+    assert 2 * p.size > config.HB_SMALL_EIG
+    gammas = (0.5, 1.1, 1.7)
+    JXs = np.array([p.evaluate(p.linear_guess(g) * 30.0, g).JX for g in gammas])
+    ws = np.array([p.omega(g) for g in gammas])
+    got = hill_growth(JXs, s.M, s.C, ws, p.H)
+    D2iJ, B1, _, parity = _hill_parts(s.M, s.C, p.H)
+    ref, ok = _hill_growth_batch(D2iJ, JXs, B1[0], B1[1], ws, parity, 2 * n)
+    assert ok.all() and np.allclose(got, ref, rtol=0, atol=1e-9)

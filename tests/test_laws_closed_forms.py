@@ -6,8 +6,9 @@ discrete ground truth (section 5).
 * Masing (eta = 0): the branch after a reversal at (x0, T0) is
   T0 - 2 T_oa((x0 - x)/2), the backbone scaled by 2;
 * energy per steady cycle: kt^2 A^3/(3 fy) below macroslip, 4 fy A -
-  16 fy^2/(3 kt) beyond, for both memory rules and for DiscreteIwan(4000)
-  (whose discretisation error must stay within the same tolerance);
+  16 fy^2/(3 kt) beyond, for the exact Iwan law, both closed-form memory
+  rules and DiscreteIwan(4000) (whose discretisation error must stay within
+  the same tolerance);
 * constant normal load: the closed form with full memory equals the discrete
   model for nested, growing and random histories; the paper's
   last-reversal rule does not (which is why "full" is the default).
@@ -18,7 +19,7 @@ import pytest
 
 import law_histories as H
 
-from jointdyn import DiscreteIwan, Iwan, backbone, march
+from jointdyn import DiscreteIwan, Iwan, IwanClosedForm, backbone, march
 import tolerances as C
 
 KT, MU, NREF = 1e5, 0.1, 100.0
@@ -51,15 +52,16 @@ def loop_area(x, T):
 
 
 LAWS = {
-    "iwan-full": Iwan(kt=KT, mu=MU, n_ref=NREF),
-    "iwan-last": Iwan(kt=KT, mu=MU, n_ref=NREF, memory="last"),
+    "iwan": Iwan(kt=KT, mu=MU, n_ref=NREF),
+    "iwan-full": IwanClosedForm(kt=KT, mu=MU, n_ref=NREF),
+    "iwan-last": IwanClosedForm(kt=KT, mu=MU, n_ref=NREF, memory="last"),
     "discrete-4000": DiscreteIwan(kt=KT, mu=MU, n_ref=NREF, n=4000),
 }
 
 
 @pytest.mark.parametrize("alpha", [1.0, 0.3, 2.5])
 @pytest.mark.parametrize("sign", [1.0, -1.0])
-@pytest.mark.parametrize("name", ["iwan-full", "iwan-last", "discrete-4000"])
+@pytest.mark.parametrize("name", ["iwan", "iwan-full", "iwan-last", "discrete-4000"])
 def test_backbone(alpha, sign, name):
     law = LAWS[name]
     q = np.linspace(0.0, 3.0 * alpha, 301)
@@ -80,7 +82,7 @@ def test_backbone_function_and_dimensional_form():
     np.testing.assert_allclose(FY * np.array([backbone(KT * v / FY, 1.0) for v in x]), t_oa(x), atol=1e-12)
 
 
-@pytest.mark.parametrize("name", ["iwan-full", "iwan-last", "discrete-4000"])
+@pytest.mark.parametrize("name", ["iwan", "iwan-full", "iwan-last", "discrete-4000"])
 @pytest.mark.parametrize("qa", [0.4, 1.5])
 def test_masing_branch_eta0(name, qa):
     """Reversal at (x0, T0) after first loading: T = T0 - 2 T_oa((x0 - x)/2),
@@ -100,7 +102,7 @@ def test_masing_branch_eta0(name, qa):
     np.testing.assert_allclose(T[up], T1 + 2 * t_oa((x[up] + A) / 2), rtol=0, atol=tol)
 
 
-@pytest.mark.parametrize("name", ["iwan-full", "iwan-last", "discrete-4000"])
+@pytest.mark.parametrize("name", ["iwan", "iwan-full", "iwan-last", "discrete-4000"])
 @pytest.mark.parametrize("qa", [0.3, 1.0, 1.9, 2.0, 2.5, 4.0, 8.0])
 def test_energy_per_cycle(name, qa):
     """Loop area of the second (steady) cycle of x = A sin(2 pi t)."""

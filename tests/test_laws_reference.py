@@ -2,8 +2,8 @@
 
 ``tests/reference.py`` re-implements every registered law from its
 specification alone (the discrete Iwan model of MODEL.md section 5, the
-closed-form Iwan law with full Masing memory, the paper's last-reversal
-rule); a registered law without a reference fails. These tests march both over
+exact Iwan law's pieces, the closed-form Iwan law with full Masing memory,
+the paper's last-reversal rule); a registered law without a reference fails. These tests march both over
 random histories (nested, growing, random-walk displacements; constant,
 varying and separating normal loads) and require the same force (to
 ``TEST_REFERENCE_ATOL_FY * fy``), the same tangent and the same motion state
@@ -17,7 +17,7 @@ import law_histories as H
 from law_cases import registry_laws
 from reference import REFERENCES, march_ref, reference_for
 
-from jointdyn import Iwan, make_law, march
+from jointdyn import IwanClosedForm, make_law, march
 from jointdyn.laws import law_names
 import tolerances as C
 
@@ -26,7 +26,7 @@ XS = 2.0 * MU * NREF / KT  # macroslip displacement 2 fy / kt of the closed form
 
 #: every registered law with every parameter set of law_cases.variants
 LAWS = {case: (name, law) for case, name, law in registry_laws(KT, MU, NREF)}
-FULL = Iwan(kt=KT, mu=MU, n_ref=NREF)
+FULL = IwanClosedForm(kt=KT, mu=MU, n_ref=NREF)
 
 
 def _histories():
@@ -75,7 +75,7 @@ def test_histories_exercise_every_state():
     seen = set()
     for p in _histories():
         x, N = p.values
-        _, code = _compare("iwan", FULL, x, N)
+        _, code = _compare("iwan-closed", FULL, x, N)
         seen.update(np.unique(code).tolist())
     assert seen == {0, 1, 2}
     x = H.nested_then_growing(12, 1.5 * XS, steps=7, shrink=0.8)
@@ -89,7 +89,7 @@ def test_reference_stack_overflow_differs_only_when_deeper_than_capacity():
     x = H.nested_then_growing(10, 1.5 * XS, steps=9, shrink=0.85)
     N = np.full(x.size, NREF)
     T64 = march(FULL, x, N)[0]
-    T4 = march(Iwan(kt=KT, mu=MU, n_ref=NREF, max_depth=4), x, N)[0]
+    T4 = march(IwanClosedForm(kt=KT, mu=MU, n_ref=NREF, max_depth=4), x, N)[0]
     first_overflow = 1 + 9 * 5  # the fifth reversal point is pushed at the 5th one
     np.testing.assert_array_equal(T64[:first_overflow], T4[:first_overflow])
     assert np.max(np.abs(T64 - T4)) > 1e-3 * MU * NREF

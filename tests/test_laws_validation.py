@@ -12,7 +12,7 @@ import pytest
 
 from law_cases import registry_laws
 
-from jointdyn import DiscreteIwan, Iwan, Jenkins, make_law, march
+from jointdyn import DiscreteIwan, Iwan, IwanClosedForm, Jenkins, make_law, march
 from jointdyn.laws import canonical_law_params, law_names, law_parameters
 
 GOOD = dict(kt=1e5, mu=0.1, n_ref=100.0)
@@ -32,7 +32,7 @@ def test_bad_common_parameters(name, param, value):
         make_law(name, **{**GOOD, param: value})
 
 
-@pytest.mark.parametrize("cls", [Iwan, DiscreteIwan, Jenkins])
+@pytest.mark.parametrize("cls", [Iwan, IwanClosedForm, DiscreteIwan, Jenkins])
 @pytest.mark.parametrize("param,value", [("kt", 0.0), ("mu", -1.0), ("n_ref", math.nan)])
 def test_bad_common_parameters_classes(cls, param, value):
     with pytest.raises(ValueError, match=param):
@@ -143,11 +143,13 @@ def test_good_parameters_accepted():
         assert make_law(name, **GOOD).fy == pytest.approx(10.0)
     assert make_law("discrete", **GOOD, n=10).n == 10
     assert make_law("iwan-paper", **GOOD).memory == "last"
-    assert make_law("iwan", **GOOD).memory == "full"
+    assert make_law("iwan-closed", **GOOD).memory == "full"
+    assert isinstance(make_law("iwan", **GOOD), Iwan)
     assert Iwan(kt=1e5, mu=0.0, n_ref=100.0).fy == 0.0  # mu = 0 is allowed
 
 
-LAW = Iwan(**GOOD)
+#: the closed form, whose state has integer fields (stack depth, base code, direction)
+LAW = IwanClosedForm(**GOOD)
 
 
 def test_march_different_lengths():
@@ -200,7 +202,7 @@ def test_march_bad_state(case):
 
 def test_march_state_from_issue_12():
     with pytest.raises(ValueError, match="state"):
-        march(Iwan(1e5, 0.1, 100), [0, 1e-4], [100, 100], state=np.full(201, np.nan))
+        march(IwanClosedForm(1e5, 0.1, 100), [0, 1e-4], [100, 100], state=np.full(201, np.nan))
     with pytest.raises(ValueError, match="state"):
         march(DiscreteIwan(1e5, 0.1, 100, n=5), [0, 1e-4], [100, 100], state=np.full(6, np.nan))
 

@@ -20,7 +20,6 @@ truth is converged in n, ``discrete`` with n = 4000.
 
 from __future__ import annotations
 
-import math
 import sys
 from pathlib import Path
 
@@ -42,7 +41,7 @@ MARKERS = {A_PAPER: "table", A_SMALL: "table-small"}
 
 
 def last_cycle(model, A, eta, delta_deg, n=1000):
-    law = make_law(model, kt=KT, mu=MU, n_ref=N0, n=n)
+    law = make_law(model, kt=KT, mu=MU, n_ref=N0, **({"n": n} if model == "discrete" else {}))
     r = harmonic_loop(law, A, 1.0, N0, eta=eta, delta_deg=delta_deg, cycles=CYCLES,
                       steps_per_cycle=STEPS)
     sl = r.cycle_slice(-1)
@@ -53,7 +52,7 @@ def rows(A):
     out = []
     cases = [(d, e) for d in DELTAS for e in ETAS]
     for delta, eta in tqdm(cases, desc=f"A = {A * 1e3:g} mm", disable=None):
-        full, t1, T1 = last_cycle("iwan", A, eta, delta)
+        full, t1, T1 = last_cycle("iwan-closed", A, eta, delta)
         paper, t2, T2 = last_cycle("iwan-paper", A, eta, delta)
         disc, t3, T3 = last_cycle("discrete", A, eta, delta)
         fine, _, _ = last_cycle("discrete", A, eta, delta, n=4000)

@@ -31,8 +31,8 @@ from jointdyn.dynamics import steady_state  # noqa: E402
 from jointdyn.systems import System  # noqa: E402
 
 CASES = [
-    ("contact", dict(eta=0.5, beta=2.0), 1.1),
-    ("separation", dict(eta=1.5, beta=2.0), 1.1),
+    ("contact", dict(eta=0.5, beta=2.0, model="iwan-closed"), 1.1),
+    ("separation", dict(eta=1.5, beta=2.0, model="iwan-closed"), 1.1),
 ]
 STEPS = [32, 64, 128, 256, 512, 1024]
 REF_STEPS = 8192

@@ -4,7 +4,8 @@ Usage::
 
     PYTHONPATH=src python docs/scripts/hb_convergence.py [--write]
 
-For a few stable points of the paper's damper (closed-form Iwan law, no
+For a few stable points of the paper's damper (closed-form Iwan law
+``iwan-closed``, the law of the study when it was written; no
 viscous damping) and of the Jenkins benchmark oscillator, solves HB with
 H = 1, 2, 3, 5, 7, 11, 15 harmonics (max(256, 16 H) samples per period)
 and compares the amplitude (half peak-to-peak of x) with the time-domain
@@ -42,11 +43,11 @@ def _jenkins():
 
 CASES = (
     ("Jenkins benchmark", _jenkins, 1.25),
-    ("iwan eta=0.01 beta=1", lambda: System.paper_damper(eta=0.01, beta=1.0), 1.1),
-    ("iwan eta=0.5 beta=2", lambda: System.paper_damper(eta=0.5, beta=2.0), 1.1),
-    ("iwan eta=0.5 beta=2", lambda: System.paper_damper(eta=0.5, beta=2.0), 1.5),
-    ("iwan eta=1.5 beta=5", lambda: System.paper_damper(eta=1.5, beta=5.0), 1.4),
-    ("iwan eta=10 beta=2", lambda: System.paper_damper(eta=10.0, beta=2.0), 1.5),
+    ("iwan-closed eta=0.01 beta=1", lambda: System.paper_damper(eta=0.01, beta=1.0, model="iwan-closed"), 1.1),
+    ("iwan-closed eta=0.5 beta=2", lambda: System.paper_damper(eta=0.5, beta=2.0, model="iwan-closed"), 1.1),
+    ("iwan-closed eta=0.5 beta=2", lambda: System.paper_damper(eta=0.5, beta=2.0, model="iwan-closed"), 1.5),
+    ("iwan-closed eta=1.5 beta=5", lambda: System.paper_damper(eta=1.5, beta=5.0, model="iwan-closed"), 1.4),
+    ("iwan-closed eta=10 beta=2", lambda: System.paper_damper(eta=10.0, beta=2.0, model="iwan-closed"), 1.5),
 )
 
 

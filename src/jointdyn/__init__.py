@@ -2,16 +2,20 @@
 
 Public API (everything else is private):
 
-- contact laws: :class:`Iwan`, :class:`DiscreteIwan`, :class:`Jenkins`,
-  :func:`make_law` (:func:`law_names`, :func:`law_parameters`), normal loads;
+- contact laws: :class:`Iwan` (the exact Iwan model, the default),
+  :class:`IwanClosedForm` (the paper's closed forms), :class:`DiscreteIwan`,
+  :class:`Jenkins`, :func:`make_law` (:func:`law_names`,
+  :func:`law_parameters`), normal loads;
 - drivers: :func:`march`, :func:`quasistatic`, :func:`harmonic_loop`;
 - systems: :class:`System`, :class:`Contact`;
 - time integration: :func:`integrate`, :func:`steady_state`;
 - harmonic balance: :func:`harmonic_balance`, :func:`frc_hb`;
+- continuation: the module :mod:`jointdyn.continuation`
+  (:class:`ContinuationOptions`);
 - sweeps: :func:`frc_sweep`.
 
-The time-integration, harmonic-balance and sweep names are imported on
-first use, so that ``import jointdyn`` (and the CLI) stays fast.
+The time-integration, harmonic-balance, continuation and sweep names are
+imported on first use, so that ``import jointdyn`` (and the CLI) stays fast.
 """
 
 from .laws import (
@@ -22,6 +26,7 @@ from .laws import (
     ContactLaw,
     DiscreteIwan,
     Iwan,
+    IwanClosedForm,
     Jenkins,
     backbone,
     law_names,
@@ -44,25 +49,31 @@ _LAZY = {
     "harmonic_balance": "hb",
     "frc_hb": "hb",
     "continue_hb": "hb",
-    "continuation": "hb",
+    "ContinuationOptions": "continuation",
     "hill_stability": "hb",
     "frc_sweep": "sweeps",
 }
 
 
+#: submodules reachable as attributes of the package (imported on first use)
+_SUBMODULES = ("continuation", "fourier")
+
+
 def __getattr__(name):
+    import importlib
+
+    if name in _SUBMODULES:
+        return importlib.import_module(f".{name}", __name__)
     sub = _LAZY.get(name)
     if sub is None:
         raise AttributeError(f"module 'jointdyn' has no attribute {name!r}")
-    import importlib
-
     value = getattr(importlib.import_module(f".{sub}", __name__), name)
     globals()[name] = value
     return value
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_LAZY))
+    return sorted(set(globals()) | set(_LAZY) | set(_SUBMODULES))
 
 __all__ = [
     "STICK_SLIP",
@@ -71,6 +82,7 @@ __all__ = [
     "STATE_NAMES",
     "ContactLaw",
     "Iwan",
+    "IwanClosedForm",
     "DiscreteIwan",
     "Jenkins",
     "backbone",
@@ -92,4 +104,5 @@ __all__ = [
     "PAPER",
     "modal_damping",
     *_LAZY,
+    *_SUBMODULES,
 ]

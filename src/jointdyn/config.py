@@ -9,14 +9,23 @@ where a number has one; "relative" numbers are fractions of the scale named.
 from __future__ import annotations
 
 # --- contact-law models ------------------------------------------------------
+#: registered name of the contact law every front end uses when none is
+#: given (CLI ``--model``, ``System.paper_damper``, sweeps, figures): the
+#: exact Iwan model with varying normal load
+MODEL = "iwan"
+#: linear pieces kept by the exact Iwan law (``iwan``) after a step; beyond,
+#: three adjacent pieces are merged into two (results within 0.1 % of the
+#: converged limit, measured 3e-3 % at most on the Fig 6 grid:
+#: docs/exact-iwan.md)
+IWAN_CAPACITY = 32
 #: Jenkins elements of the discrete Iwan model
 LAW_DISCRETE_N = 1000
 #: capacity of the reversal-point stack of the closed-form Iwan law
-IWAN_MAX_DEPTH = 64
-#: a branch closer than this to an earlier reversal point (normalised
-#: displacement kt x / fy) has reached it (Masing rejoin); the force error
-#: is of the same order in units of fy
-IWAN_WIPE_TOL = 1e-9
+IWAN_CLOSED_MAX_DEPTH = 64
+#: a branch of the closed-form Iwan law closer than this to an earlier
+#: reversal point (normalised displacement kt x / fy) has reached it (Masing
+#: rejoin); the force error is of the same order in units of fy
+IWAN_CLOSED_WIPE_TOL = 1e-9
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history
@@ -154,31 +163,91 @@ SWEEP_STATUS_MISSING = -1
 HB_HARMONICS = 7
 #: AFT time samples per period
 HB_SAMPLES = 128
+#: uniform samples per period of the fine grid on which amplitudes and
+#: extrema of a harmonic-balance response are located
+HB_FINE_SAMPLES = 1024
 #: bound on the periods marched per AFT evaluation (two normally suffice
 #: for Masing-type laws; the force must repeat to HB_PERIODIC_RTOL)
 HB_MAX_PASSES = 8
 #: two consecutive marched periods agree when max|T_p - T_(p-1)| <= rtol max|T|
 HB_PERIODIC_RTOL = 1e-10
 
-# --- harmonic balance: Newton and continuation ---------------------------------------
-#: Newton converged when max|R| <= this, R scaled by max(F1, fy)
-HB_NEWTON_RTOL = 1e-9
+# --- continuation (jointdyn.continuation; unknowns, parameter and residual scaled) ----
+#: Newton converged when max|R| <= this (scaled residual; harmonic balance
+#: scales R by max(F1, fy))
+CONT_TOL = 1e-9
 #: Newton iterations per correction
-HB_NEWTON_MAX_ITER = 12
-#: arc-length step (scaled unknowns): first, smallest, largest
-HB_DS_START = 0.05
-HB_DS_MIN = 1e-6
-HB_DS_MAX = 0.1
-#: step growth factor after an easy correction
-HB_DS_GROW = 1.6
-#: Newton iterations aimed at per correction (step control)
-HB_TARGET_NEWTON_ITER = 4
+CONT_MAX_ITER = 12
+#: arc-length step: first, smallest, largest
+CONT_DS_START = 0.05
+CONT_DS_MIN = 1e-6
+CONT_DS_MAX = 0.1
 #: bound on the points of a branch
-HB_MAX_POINTS = 2000
+CONT_MAX_POINTS = 2000
+#: predictor direction: "tangent" or "secant"
+CONT_PREDICTOR = "tangent"
+#: Newton iterations aimed at per correction; the step grows by CONT_GROW
+#: after a correction in fewer, shrinks by CONT_SHRINK after one in more
+CONT_TARGET_ITER = 4
+CONT_GROW = 1.6
+CONT_SHRINK = 0.6
+#: the step is multiplied by CONT_TURN_SHRINK after the unit tangent turned
+#: by more than ~10 degrees (cosine below CONT_TURN_COS): folds are resolved
+CONT_TURN_COS = 0.985
+CONT_TURN_SHRINK = 0.5
+#: step factor after a rejected step (corrector failed)
+CONT_REJECT_SHRINK = 0.5
+#: trial steps of the damped Newton line search (the full step, then
+#: halved each time) before the iteration counts as failed
+CONT_LINE_SEARCH_STEPS = 9
+#: above CONT_CORNER_DS, a corrector is stopped after this many times
+#: CONT_TARGET_ITER residual evaluations (retrying smaller is cheaper)
+CONT_MAX_EVALS_FACTOR = 2
+#: below this step a sharp turn or a long correction is a corner of a
+#: piecewise-smooth branch, not a jump to another branch
+CONT_CORNER_DS = 2e-3
+#: step factor after a rejection for a sharp turn or a far-away correction
+#: (a step accepted only at corner size, reached in fewer rejections)
+CONT_CORNER_SHRINK = 0.25
+#: above CONT_CORNER_DS a step is rejected when the new unit tangent's dot
+#: product with the previous one is below this (a turn by more than 60 deg)
+CONT_MIN_TANGENT_DOT = 0.5
+#: ... or when the corrector moved farther than this many steps from the
+#: predicted point
+CONT_MAX_DISTANCE = 2.0
+#: jumps over a discontinuity of the residual (corrector failed at the
+#: smallest step): Newton at fixed parameter tried this far beyond the last
+#: point (fractions of the parameter range), at most CONT_MAX_JUMPS times
+CONT_JUMP_FRACTIONS = (1e-4, 1e-3, 1e-2)
+CONT_MAX_JUMPS = 5
+#: a jump's guess follows the tangent when its parameter component exceeds
+#: this (else the last point's unknowns)
+CONT_JUMP_TANGENT_MIN = 1e-3
+#: bordered linear systems (Newton corrections, tangents) of at most this
+#: many unknowns are solved by the compiled elimination of
+#: jointdyn.continuation, larger ones by LAPACK (benchmarks/bench_linalg.py:
+#: the compiled elimination is 1.2-3.5x faster at 16 to 751 unknowns with
+#: single-threaded BLAS; beyond the sizes measured, LAPACK)
+CONT_SMALL_SOLVE = 800
+
+# --- harmonic balance: starts and single solutions -------------------------------------
+#: Newton iterations of the start of a branch (from the stuck linear solution)
+HB_START_MAX_ITER = 30
+#: Newton iterations of a single solution (harmonic_balance)
+HB_SOLVE_MAX_ITER = 50
+#: a homotopy in the forcing amplitude starts at this fraction of F1
+HB_HOMOTOPY_START = 1e-3
+#: central-difference step, relative to the parameter's scale, of dR/dp for
+#: a parameter that builds a System (jointdyn.hb.parameters.SystemParameter):
+#: about eps^(1/3), which balances the O(h^2) error and rounding
+HB_PARAMETER_FD_STEP = 6e-6
 
 # --- harmonic balance: classification of points ---------------------------------------
 #: response declared unbounded when q = kt X / fy exceeds this (hard bound)
 HB_UNBOUNDED_Q = 1e5
+#: ... or when the corrector fails at the smallest step with q above this
+#: fraction of HB_UNBOUNDED_Q
+HB_UNBOUNDED_FAIL_FRACTION = 0.1
 #: describing-function saturation test (Den Hartog): applied once q exceeds
 #: HB_SATURATION_Q, when the contact slips at least this fraction of the
 #: period and C = 0 (single DOF)
@@ -186,5 +255,10 @@ HB_SATURATION_Q = 30.0
 HB_SATURATION_SLIP_FRACTION = 0.9
 #: a Floquet exponent with Re(s) > HB_STABILITY_RTOL * w marks instability
 HB_STABILITY_RTOL = 1e-6
+#: Hill companion matrices (2 n (2H+1) rows), or their parity blocks, of at
+#: most this many rows go through the compiled EISPACK eigenvalue solver,
+#: larger ones through LAPACK (benchmarks/bench_linalg.py: the compiled
+#: solver is 1.3-3.7x faster up to 150 rows, LAPACK 1.1-1.3x faster from 300)
+HB_SMALL_EIG = 200
 #: turning points of a branch (secant): dead band as a fraction of the range
 HB_TURNING_BAND = 5e-4

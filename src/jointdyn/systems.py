@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _validate as V
+from . import config
 from .kinematics import ConstantLoad, HarmonicLoad, NormalLoad, NormalSpring, _selection
 from .laws import ContactLaw, make_law
 
@@ -322,7 +323,7 @@ class System:
         eta: float = 0.5,
         beta: float = 1.0,
         delta_deg: float = 0.0,
-        model: str = "iwan",
+        model: str = config.MODEL,
         zeta: float = 0.0,
         f1: float | None = None,
         law_params: dict | None = None,
@@ -359,7 +360,9 @@ class System:
         delta_deg : float
             Normal-load (normal-force) phase relative to the forcing, degrees.
         model : str
-            Contact-law name (``iwan``, ``iwan-paper``, ``discrete``, ``jenkins``).
+            Contact-law name (:func:`jointdyn.laws.law_names`; default
+            ``iwan``, the exact Iwan model; ``iwan-closed``, ``iwan-paper``,
+            ``discrete``, ``jenkins``).
         zeta : float
             Viscous damping ratio of x (paper: 0).
         f1 : float, optional

@@ -24,7 +24,7 @@ def add_law_arguments(p) -> None:
     """``--law-param`` and ``--n`` (``--model`` is the command's own, with :func:`model_help`)."""
     p.add_argument("--law-param", action="append", default=None, metavar="NAME=VALUE", dest="law_param",
                    help="law-specific parameter of --model (repeatable); see jointdyn.laws.law_parameters, "
-                        "e.g. --law-param n=200 for discrete, --law-param max_depth=16 for iwan")
+                        "e.g. --law-param capacity=64 for iwan, --law-param n=200 for discrete")
     p.add_argument("--n", type=int, default=None,
                    help="shorthand for --law-param n=N (number of Jenkins elements of --model discrete)")
 

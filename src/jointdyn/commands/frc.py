@@ -47,7 +47,7 @@ def add_arguments(p) -> None:
     p.add_argument("--sweep", default=None,
                    help="time: up, down or both (default both); hb: refused (the continuation follows the "
                         "branch through its folds, which holds the states of both sweep directions)")
-    p.add_argument("--model", default="iwan", help=model_help("iwan"))
+    p.add_argument("--model", default=config.MODEL, help=model_help(config.MODEL))
     add_law_arguments(p)
     p.add_argument("--zeta", type=float, default=0.0, help="viscous damping ratio (default 0)")
     p.add_argument("--m", type=float, default=PAPER["m"], help=f"mass, kg (default {PAPER['m']:g})")
@@ -265,16 +265,11 @@ def _run_time(args, gammas):
 
 
 def _hb_branches(ds) -> list:
-    """Split an hb Dataset (dim ``point``) into branches (by a ``branch``
-    variable if present, else one)."""
-    if "branch" in ds.variables:
-        ids = np.asarray(ds["branch"].values)
-        groups = [np.flatnonzero(ids == b) for b in dict.fromkeys(ids.tolist())]
-    else:
-        groups = [np.arange(ds.sizes["point"])]
+    """Split an hb Dataset (dim ``point``) into its branches (variable ``branch``: segment index)."""
+    ids = np.asarray(ds["branch"].values)
     out = []
-    for idx in groups:
-        sub = ds.isel(point=idx)
+    for b in dict.fromkeys(ids.tolist()):
+        sub = ds.isel(point=np.flatnonzero(ids == b))
         br = {v: _jsonable(sub[v].values) for v in ("gamma", "amplitude_q", "amplitude_m", "offset_m", "max_abs_m")}
         br["stable"] = [bool(s) for s in np.asarray(sub["stable"].values)]
         br["folds"] = [int(i) for i in np.flatnonzero(np.asarray(sub["fold"].values, bool))]
@@ -283,13 +278,7 @@ def _hb_branches(ds) -> list:
 
 
 def _run_hb(args, gammas):
-    try:
-        from ..hb import frc_hb
-    except ImportError as exc:
-        raise ValueError(
-            "--method hb needs the harmonic-balance module jointdyn.hb, which is not available in this "
-            f"installation ({exc}); use --method time"
-        ) from None
+    from ..hb import frc_hb
     from ..systems import System
 
     system = System.paper_damper(

@@ -58,7 +58,7 @@ _HARMONIC = {
 def add_arguments(p) -> None:
     from ..laws import law_names
 
-    p.add_argument("--model", default="iwan", choices=law_names(), help=model_help("iwan"))
+    p.add_argument("--model", default=config.MODEL, choices=law_names(), help=model_help(config.MODEL))
     add_law_arguments(p)
     p.add_argument("--kt", type=float, default=1e5, help="total tangential stiffness kt, N/m (default 1e5)")
     p.add_argument("--mu", type=float, default=0.1, help="friction coefficient mu (default 0.1)")

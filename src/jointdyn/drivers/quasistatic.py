@@ -420,7 +420,8 @@ def cycle_count(t, period, name: str = "period") -> int:
 def quasistatic(law, t, x, N, *, period=None, state=None) -> LoopResult:
     """March ``law`` over a prescribed history and measure its loops.
 
-    The law (closed-form Iwan, paper section 2.1 / MODEL.md section 3;
+    The law (any registered law: the exact Iwan law, MODEL.md section 5 at
+    n -> infinity; the closed forms, paper section 2.1 / MODEL.md section 3;
     discrete Iwan, MODEL.md section 5; Jenkins) is stepped sample by sample
     from its virgin state at ``x[0], N[0]`` (or ``state``).
 

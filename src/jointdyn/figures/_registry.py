@@ -22,7 +22,25 @@ import pandas as pd
 
 from .._io import atomic_path
 
-__all__ = ["Figure", "register_figure", "figure_names", "make_figure", "FIGURES", "pyplot", "save_figure"]
+__all__ = ["Figure", "register_figure", "figure_names", "make_figure", "FIGURES", "pyplot", "save_figure",
+           "model_label"]
+
+#: how figure titles and legends name the registered contact laws
+MODEL_LABELS = {
+    "iwan": "exact Iwan model",
+    "iwan-closed": "closed-form Iwan, full memory",
+    "iwan-paper": "closed-form Iwan, paper's last-reversal rule",
+    "discrete": "discrete Iwan",
+    "jenkins": "Jenkins element",
+}
+
+
+def model_label(model: str) -> str:
+    """Name of a contact law in a figure: its description and registered
+    name, e.g. ``"exact Iwan model (iwan)"``."""
+    label = MODEL_LABELS.get(model)
+    return f"{label} ({model})" if label else str(model)
+
 
 class _Registry(dict):
     """Name -> Figure; reading it first imports every figure module, so a

@@ -13,11 +13,15 @@
     normal load against the motion.
 ``fig8``
     Steady loops for delta from 0 to 180 deg, in contact (eta = 0.5) and with
-    separation (eta = 1.5), with the exact discrete model beside the closed
-    form, and the energy per cycle of both against delta.
+    separation (eta = 1.5), with the exact Iwan model beside the paper's
+    closed form (full memory, on purpose), and the energy per cycle of both
+    against delta.
 ``energy_delta``
     Energy dissipated by the contact per cycle vs delta, in contact and with
     separation.
+
+Every figure uses the default contact law (``config.MODEL``, the exact Iwan
+model) except fig8's comparison panel, and names its model in its title.
 """
 
 from __future__ import annotations
@@ -27,7 +31,8 @@ import math
 import numpy as np
 import pandas as pd
 
-from ._registry import pyplot, register_figure, save_figure
+from .. import config
+from ._registry import model_label, pyplot, register_figure, save_figure
 
 #: Fig 6 grid (the paper's groups)
 FIG6_ETAS = (0.01, 0.5, 1.5, 10.0)
@@ -66,7 +71,7 @@ def fig6_data(gammas=None, etas=FIG6_ETAS, betas=FIG6_BETAS, **kw):
 
 
 @register_figure("fig6", "Paper Fig 6: amplitude of q vs gamma; eta in {0.01, 0.5, 1.5, 10} by panel, beta 0.1..1000 "
-                 "by colour", 60)
+                 "by colour; exact Iwan model", 60)
 def fig6():
     return {"curves": fig6_data()}
 
@@ -156,13 +161,13 @@ def _plot_fig6(tables, out_dir):
         ax.set_ylabel("half peak-to-peak amplitude\nof q = kt x / fy")
         if k == 0:
             _fig6_legend(fig, ax)
-    model = f", contact model {df['model'].iloc[0]}" if "model" in df else ""
+    model = f"; {model_label(df['model'].iloc[0])}" if "model" in df else ""
     fig.suptitle("Paper Fig 6: steady response vs frequency ratio gamma; eta = N1/N0 varied by panel, "
                  f"beta = mu N0 / F1 by colour (delta = 0{model})", fontsize=10)
     return save_figure(fig, out_dir, "fig6")
 
 
-def steady_loop(eta, beta, gamma, delta_deg, *, model="iwan", **kw):
+def steady_loop(eta, beta, gamma, delta_deg, *, model=config.MODEL, **kw):
     """One steady period (t, x, T, N, code) of the damper, or the solver's
     status when there is none.
 
@@ -227,7 +232,7 @@ def _opening_drop(df):
     return float(T[j]), float(abs(x[i] - x[j]) / amp) if amp > 0 else math.nan
 
 
-def _loops(cases, model="iwan"):
+def _loops(cases, model=config.MODEL):
     """Steady loops of ``cases`` ((label, eta, beta, gamma, delta_deg) each)
     with contact model ``model``: the loops as one long table and one row of
     results per case."""
@@ -248,7 +253,7 @@ def _loops(cases, model="iwan"):
 
 
 @register_figure("fig7", "Paper Fig 7: loops under a small tangential load with separation, delta varied: force jump "
-                 "vs continuous", 70)
+                 "vs continuous; exact Iwan model", 70)
 def fig7():
     loops, info = _loops(FIG7_CASES)
     return {"loops": loops, "cases": info}
@@ -319,20 +324,21 @@ def _plot_fig7(tables, out_dir):
         ax.grid(alpha=0.3)
     row = info.iloc[0]
     fig.suptitle(f"Paper Fig 7: steady loops under a small tangential load with separation, phase delta varied "
-                 f"(eta = {row.eta:g}, beta = {row.beta:g}, gamma = {row.gamma:g}, closed-form Iwan)\n"
+                 f"(eta = {row.eta:g}, beta = {row.beta:g}, gamma = {row.gamma:g}; {model_label(row.model)})\n"
                  "arrows: direction of time; A: the contact starts to lose its load; S: separated (T = 0, dots); "
                  "B: contact returns", fontsize=9)
     return save_figure(fig, out_dir, "fig7")
 
 
-#: Fig 8: the paper's closed form beside the exact model
-FIG8_MODELS = (("discrete", "exact discrete Iwan (n = 1000)", "exact"), ("iwan", "closed-form Iwan", "closed form"))
+#: Fig 8: the exact model beside the paper's closed form (full memory)
+FIG8_MODELS = ((config.MODEL, model_label(config.MODEL), "exact"),
+               ("iwan-closed", model_label("iwan-closed"), "closed form"))
 #: phases of the energy-per-cycle panel (the loop panels show FIG8_DELTAS)
 FIG8_ENERGY_DELTAS = tuple(float(d) for d in range(0, 181, 15))
 
 
 @register_figure("fig8", "Paper Fig 8: steady loops for delta = 0..180 deg, in contact (eta 0.5) and with separation "
-                 "(eta 1.5); exact model beside the closed form, energy per cycle vs delta", 80)
+                 "(eta 1.5); exact Iwan model beside the paper's closed form, energy per cycle vs delta", 80)
 def fig8():
     deltas = sorted(set(FIG8_DELTAS) | set(FIG8_ENERGY_DELTAS))
     loops, info = [], []
@@ -398,15 +404,16 @@ def _plot_fig8(tables, out_dir):
 
 
 @register_figure("energy_delta", "Beyond paper Fig 8: energy dissipated per cycle vs delta, in contact and with "
-                 "separation", 85)
+                 "separation; exact Iwan model", 85)
 def energy_delta():
     from ..sweeps import frc_sweep, to_frame
 
     ds = frc_sweep(list(ENERGY_GAMMAS), etas=FIG8_ETAS, betas=ENERGY_BETAS, deltas=ENERGY_DELTAS,
                    directions=("up",))
     df = to_frame(ds)
+    df["model"] = ds.attrs.get("model", "")
     return {"energy": df[["eta", "beta", "delta", "gamma", "energy_contact_J", "work_force_J", "amplitude_q",
-                          "offset_m", "status", "status_name"]]}
+                          "offset_m", "status", "status_name", "model"]]}
 
 
 @energy_delta.plotter
@@ -443,7 +450,8 @@ def _plot_energy(tables, out_dir):
     h.append(Line2D([], [], color="k", marker="x", ls="none", ms=8, mew=1.6))
     lab.append("no steady state (on the bottom edge)")
     fig.legend(h, lab, loc="outside lower center", ncol=4, fontsize=8, frameon=False)
+    model = f"; {model_label(df['model'].iloc[0])}" if "model" in df else ""
     fig.suptitle("Beyond paper Fig 8: energy dissipated by the contact per cycle, phase delta of the normal load "
                  "varied,\nfor several forcing levels beta (line style) and frequencies gamma (colour) of the forced "
-                 "damper", fontsize=10)
+                 f"damper{model}", fontsize=10)
     return save_figure(fig, out_dir, "energy_delta")

@@ -2,8 +2,9 @@
 
 ``fig6_hb``
     The Fig 6 cases (eta = 0.01, 0.5, 1.5, 10; a few beta) by harmonic
-    balance and arc-length continuation (:func:`jointdyn.hb.frc_hb`, model
-    ``iwan``, 7 harmonics, 128 samples; 512 with separation, eta > 1),
+    balance and arc-length continuation (:func:`jointdyn.hb.frc_hb`, the
+    default model ``iwan``, the exact Iwan model; 7 harmonics, 128 samples;
+    512 with separation, eta > 1),
     stable parts solid, unstable parts
     dashed, folds marked, overlaid on the time-domain steady states of
     up and down sweeps (:func:`jointdyn.sweeps.frc_sweep`) on a coarse grid.
@@ -16,7 +17,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ._registry import pyplot, register_figure, save_figure
+from .. import config
+from ._registry import model_label, pyplot, register_figure, save_figure
 
 #: cases of fig6_hb (kept small: one HB branch is ~0.1-1 s, the time-domain
 #: sweep dominates the compute time)
@@ -28,7 +30,7 @@ HB_SAMPLES_SEPARATION = 512
 
 
 def fig6_hb_data(etas=HB_ETAS, betas=HB_BETAS, gamma=HB_GAMMA, time_step=HB_TIME_GAMMA_STEP, time_domain=True,
-                 model="iwan"):
+                 model=config.MODEL):
     """HB branches and time-domain points of the Fig 6 cases as two tables."""
     from ..hb import frc_hb
     from ..systems import System
@@ -58,7 +60,7 @@ def fig6_hb_data(etas=HB_ETAS, betas=HB_BETAS, gamma=HB_GAMMA, time_step=HB_TIME
 
 
 @register_figure("fig6_hb", "Paper Fig 6 cases by harmonic balance (stable solid, unstable dashed, folds) over "
-                 "time-domain sweeps; eta by panel, beta by colour", 65)
+                 "time-domain sweeps; eta by panel, beta by colour; exact Iwan model", 65)
 def fig6_hb():
     return fig6_hb_data()
 
@@ -140,7 +142,7 @@ def _plot_fig6_hb(tables, out_dir):
     for ax in axes[:, 0]:
         ax.set_ylabel("half peak-to-peak amplitude\nof q = kt x / fy")
     _hb_legend(fig, betas, statuses)
-    model = f", contact model {hb['model'].iloc[0]}" if "model" in hb else ""
+    model = f"; {model_label(hb['model'].iloc[0])}" if "model" in hb else ""
     fig.suptitle("Paper Fig 6 cases by harmonic balance over time-domain steady states; eta varied by panel, "
                  f"beta by colour\n(H = 7, 128 samples per period, 512 for eta > 1; stability by Hill's method{model})",
                  fontsize=10)

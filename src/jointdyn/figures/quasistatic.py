@@ -3,13 +3,16 @@
 - ``fig2``: the two kinds of Iwan loop at constant normal load (paper Fig 2):
   a small-amplitude loop in stick-slip (microslip) only and a
   large-amplitude loop that reaches macroslip, with the backbone.
+  Figs 2-4 use the default contact law (``config.MODEL``, the exact Iwan
+  model), which at constant load and in phase equals the paper's closed form.
 - ``fig3``: paper Fig 3, kt = 100 kN/m, mu = 0.1, N0 = 100 N,
   x = 0.5 mm sin(2 pi t), N = N0 + eta N0 sin(2 pi t + delta), delta = 0,
   eta = 0, 0.3, 0.6, 0.9, 1.2 (1.2 separates: region S).
 - ``fig4``: the same at delta = 90 deg (paper Fig 4).
 - ``fig4_discrete``: the Fig 4 cases with the closed form (full Masing
-  memory), the paper's last-reversal rule and the discrete ground truth
-  (n = 1000 Jenkins elements) overlaid (MODEL.md sections 3 and 5).
+  memory, ``iwan-closed``), the paper's last-reversal rule (``iwan-paper``)
+  and the discrete ground truth (n = 1000 Jenkins elements) overlaid
+  (MODEL.md sections 3 and 5): the paper's closed forms on purpose.
 
 Two cycles are computed from the virgin state and the last (steady) one is
 tabulated and plotted. Tables are long format (one row per sample).
@@ -21,9 +24,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from .. import config
 from ..drivers import harmonic_loop
 from ..laws import law_parameters, make_law
-from ._registry import pyplot, register_figure, save_figure
+from ._registry import model_label, pyplot, register_figure, save_figure
 
 #: paper section 2.2 (Figs 3-4)
 PAPER_QS = dict(kt=1.0e5, mu=0.1, n0=100.0, amplitude=0.5e-3, frequency=1.0)
@@ -32,8 +36,8 @@ _CYCLES = 2
 _STEPS = 2000
 _N_DISCRETE = 1000
 _MODEL_LABEL = {
-    "iwan": "closed form (full memory)",
-    "iwan-paper": "closed form (paper: last reversal)",
+    "iwan-closed": "closed form (full memory, iwan-closed)",
+    "iwan-paper": "closed form (paper: last reversal, iwan-paper)",
     "discrete": f"discrete, n = {_N_DISCRETE}",
 }
 
@@ -143,9 +147,10 @@ def _legend_below(fig, ax, loops, colors, ncol=3):
 FIG2_AMPLITUDES = (0.1e-3, 0.5e-3)
 
 
-@register_figure("fig2", "Paper Fig 2: Iwan loops at constant normal load, amplitude varied (microslip only, with macroslip)", order=20)
+@register_figure("fig2", "Paper Fig 2: Iwan loops at constant normal load, amplitude varied (microslip only, with "
+                 "macroslip); exact Iwan model", order=20)
 def fig2():
-    return _cases(["iwan"], [0.0], 0.0, amplitudes=FIG2_AMPLITUDES)
+    return _cases([config.MODEL], [0.0], 0.0, amplitudes=FIG2_AMPLITUDES)
 
 
 def _branch_labels(x, st):
@@ -203,7 +208,7 @@ def _plot_fig2(tables, out_dir):
     ax.set_ylabel("tangential force T (N)")
     ax.set_title("Paper Fig 2: Iwan hysteresis loops at constant normal load, amplitude A varied\n"
                  f"kt = {p['kt'] / 1e3:g} kN/m, fy = {fy:g} N, x = A sin(2 pi t); steady cycle "
-                 f"(last of {_CYCLES})", fontsize=10)
+                 f"(last of {_CYCLES})\n{model_label(loops['model'].iloc[0])}", fontsize=10)
     ax.grid(True, alpha=0.3)
     _legend_below(fig, ax, loops, colors, ncol=2)
     return save_figure(fig, out_dir, "fig2", dpi=150)
@@ -229,18 +234,19 @@ def _plot_eta_family(tables, out_dir, name, delta_deg, paper_fig):
     ax.set_ylabel("tangential force T (N)")
     phase = _PHASE_WORDS.get(float(delta_deg), f"delta = {delta_deg:g} deg")
     ax.set_title(
-        f"Paper Fig {paper_fig}: normal load {phase} with the motion (delta = {delta_deg:g} deg), "
-        f"eta = N1/N0 varied\nx = {p['amplitude'] * 1e3:g} mm sin(2 pi t), N = N0 (1 + eta sin(2 pi t + delta)), "
-        f"N0 = {p['n0']:g} N, closed-form Iwan", fontsize=9,
+        f"Paper Fig {paper_fig}: normal load {phase} with the motion, eta = N1/N0 varied\n"
+        f"x = {p['amplitude'] * 1e3:g} mm sin(2 pi t), N = N0 (1 + eta sin(2 pi t + delta)), "
+        f"delta = {delta_deg:g} deg, N0 = {p['n0']:g} N\n{model_label(loops['model'].iloc[0])}", fontsize=9,
     )
     ax.grid(True, alpha=0.3)
     _legend_below(fig, ax, loops, colors, ncol=4)
     return save_figure(fig, out_dir, name, dpi=150)
 
 
-@register_figure("fig3", "Paper Fig 3: loops, normal load in phase (delta = 0), eta = 0 ... 1.2 varied", order=30)
+@register_figure("fig3", "Paper Fig 3: loops, normal load in phase (delta = 0), eta = 0 ... 1.2 varied; exact Iwan "
+                 "model", order=30)
 def fig3():
-    return _cases(["iwan"], ETAS, 0.0)
+    return _cases([config.MODEL], ETAS, 0.0)
 
 
 @fig3.plotter
@@ -248,9 +254,10 @@ def _plot_fig3(tables, out_dir):
     return _plot_eta_family(tables, out_dir, "fig3", 0.0, 3)
 
 
-@register_figure("fig4", "Paper Fig 4: loops, normal load 90 deg out of phase, eta = 0 ... 1.2 varied", order=40)
+@register_figure("fig4", "Paper Fig 4: loops, normal load 90 deg out of phase, eta = 0 ... 1.2 varied; exact Iwan "
+                 "model", order=40)
 def fig4():
-    return _cases(["iwan"], ETAS, 90.0)
+    return _cases([config.MODEL], ETAS, 90.0)
 
 
 @fig4.plotter
@@ -258,9 +265,10 @@ def _plot_fig4(tables, out_dir):
     return _plot_eta_family(tables, out_dir, "fig4", 90.0, 4)
 
 
-@register_figure("fig4_discrete", "Paper Fig 4 cases, eta varied: closed forms vs the exact discrete Iwan model (n = 1000)", order=41)
+@register_figure("fig4_discrete", "Paper Fig 4 cases, eta varied: the paper's closed forms (iwan-closed, iwan-paper) vs "
+                 "the exact discrete Iwan model (n = 1000)", order=41)
 def fig4_discrete():
-    return _cases(["iwan", "iwan-paper", "discrete"], ETAS, 90.0)
+    return _cases(["iwan-closed", "iwan-paper", "discrete"], ETAS, 90.0)
 
 
 def _pct(value: float) -> str:
@@ -269,7 +277,7 @@ def _pct(value: float) -> str:
     return ("0.00" if float(text) == 0.0 else text) + " %"
 
 
-_DISCRETE_STYLE = {"discrete": ("0.15", "-", 2.6), "iwan": ("C0", "-", 1.3), "iwan-paper": ("C3", "--", 1.3)}
+_DISCRETE_STYLE = {"discrete": ("0.15", "-", 2.6), "iwan-closed": ("C0", "-", 1.3), "iwan-paper": ("C3", "--", 1.3)}
 
 
 def _energy_title(metrics, eta):
@@ -277,7 +285,7 @@ def _energy_title(metrics, eta):
     m = metrics[metrics["eta"] == eta].set_index("model")["energy_per_cycle_J"]
     parts = [f"eta = {eta:g}"]
     if "discrete" in m:
-        for model, short in (("iwan", "full memory"), ("iwan-paper", "paper rule")):
+        for model, short in (("iwan-closed", "full memory"), ("iwan-paper", "paper rule")):
             if model in m:
                 parts.append(f"{short}: {_pct(100 * (m[model] / m['discrete'] - 1))}")
     return "\n".join(parts)
@@ -296,7 +304,7 @@ def _plot_fig4_discrete(tables, out_dir):
         ax, axd = axes[0, j], axes[1, j]
         sub = loops[loops["eta"] == eta]
         ref = sub[sub["model"] == "discrete"].reset_index(drop=True)
-        for model in ("discrete", "iwan", "iwan-paper"):
+        for model in ("discrete", "iwan-closed", "iwan-paper"):
             g = sub[sub["model"] == model].reset_index(drop=True)
             if g.empty:
                 continue
@@ -317,7 +325,8 @@ def _plot_fig4_discrete(tables, out_dir):
     h, lab = axes[0, 0].get_legend_handles_labels()
     h2, lab2, hmap = _state_handles(loops[loops["model"] == "discrete"], [])
     fig.legend(h + h2, lab + lab2, loc="outside lower center", ncol=4, fontsize=10, frameon=False, handler_map=hmap)
-    fig.suptitle("Paper Fig 4 cases (normal load 90 deg out of phase, eta varied): the closed forms against the "
-                 "exact discrete Iwan model\npanel titles: energy per cycle relative to the discrete model",
+    fig.suptitle("Paper Fig 4 cases (normal load 90 deg out of phase, eta varied): the paper's closed forms "
+                 "(iwan-closed, iwan-paper) against the exact discrete Iwan model\npanel titles: energy per cycle "
+                 "relative to the discrete model",
                  fontsize=11)
     return save_figure(fig, out_dir, "fig4_discrete", dpi=150)

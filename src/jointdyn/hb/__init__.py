@@ -1,10 +1,11 @@
 """Harmonic balance for jointdyn systems: AFT with exact forward-mode
-Jacobians, arc-length continuation, Hill stability, unbounded-response
-detection (see docs/harmonic-balance.md)."""
+Jacobians, arc-length continuation (:mod:`jointdyn.continuation`) in a
+parameter object (:mod:`jointdyn.hb.parameters`), Hill stability,
+unbounded-response detection (see docs/harmonic-balance.md)."""
 
-from .continuation import ContinuationResult, continuation, newton, turning_points
 from .frc import HBBranch, HBSolution, branch_dataset, continue_hb, frc_hb, harmonic_balance
-from .problem import PARAMETERS, HBProblem
+from .parameters import DELTA, ETA, F1, GAMMA, N0, PARAMETERS, HBParameter, SystemParameter, parameter_named
+from .problem import HBProblem
 from .monodromy import monodromy_multipliers
 from .stability import hill_exponents, hill_growth, hill_stability
 
@@ -16,11 +17,15 @@ __all__ = [
     "branch_dataset",
     "HBBranch",
     "HBProblem",
+    "HBParameter",
+    "SystemParameter",
     "PARAMETERS",
-    "continuation",
-    "newton",
-    "turning_points",
-    "ContinuationResult",
+    "GAMMA",
+    "F1",
+    "ETA",
+    "N0",
+    "DELTA",
+    "parameter_named",
     "hill_exponents",
     "hill_stability",
     "hill_growth",

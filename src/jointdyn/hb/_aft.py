@@ -1,25 +1,28 @@
-"""Alternating frequency-time (AFT) evaluation of contact forces.
+"""Alternating frequency-time (AFT) evaluation of the harmonic-balance residual.
 
-Harmonic coefficients of a periodic signal in normalised time tau = w t::
+Harmonic coefficients of a periodic signal in normalised time tau = w t
+(:mod:`jointdyn.fourier`) are sampled at ``tau_j = 2 pi j / Ns``
+(``E @ U``), the contact law is marched over the samples (over whole
+periods, repeatedly, until the force repeats: a hysteretic law needs its
+periodic internal state), and the force samples are projected back
+(``P @ T``). Derivatives are carried forward through the same march with
+the law's ``step_jvp`` kernel, starting from the exact derivative of the
+virgin state (the law's ``init_jvp``), so the Jacobian of the force
+coefficients with respect to the displacement coefficients (and to a
+scalar parameter entering the normal load) is exact for the computed
+residual.
 
-    u(tau) = U_0 + sum_{k=1}^{H} U_{2k-1} cos(k tau) + U_{2k} sin(k tau)
-
-are sampled at ``tau_j = 2 pi j / Ns`` (``E @ U``), the contact law is
-marched over the samples (over whole periods, repeatedly, until the force
-repeats: a hysteretic law needs its periodic internal state), and the
-force samples are projected back (``P @ T``; ``P @ E = I`` when
-``Ns > 2 H``). Derivatives are carried forward through the same march with
-the law's ``step_jvp`` kernel, so the Jacobian of the coefficients of the
-force with respect to the coefficients of the displacement (and a scalar
-parameter entering the normal load) is exact for the computed residual.
-
-The whole harmonic-balance evaluation (linear part, AFT of every contact,
-scatter into the residual and its Jacobians) is one compiled call per
-residual evaluation (:func:`_eval_template`), so Newton and continuation
-pay no Python per contact or per harmonic.
+The whole evaluation (linear part, AFT of every contact, scatter into the
+residual and its Jacobians) is one compiled call per residual evaluation
+(:func:`_eval_template`), so Newton and continuation pay no Python per
+contact or per harmonic. It is assembled from small helpers inlined by
+Numba, each doing one job: linear part, samples of a contact's
+displacement, restart of the law at the mean displacement, one marched
+period, the periodicity tests, projection and scatter.
 
 Nothing here knows the physics of a law: the kernels are called unchanged
-through a compiled loop bound with :func:`jointdyn._jit.specialize`.
+through the compiled template bound with :func:`jointdyn._jit.specialize`
+(``STEP_JVP``, ``INIT_JVP``) and passed on to the helpers that call them.
 """
 
 from __future__ import annotations
@@ -28,56 +31,52 @@ import numpy as np
 
 from .._jit import jit, specialize
 
-__all__ = ["fourier_matrices"]
+__all__ = ["eval_kernel"]
+
+#: the march keeps the first pass's states (and derivatives) at every
+#: sample, to stop marching once they repeat, for laws with states of at
+#: most this many entries (storing is then cheaper than the kernel calls)
+_HIST_MAX_STATE = 16
+
+#: ``info`` entries of an evaluation: largest number of marched periods,
+#: largest change of the force between the last two periods (N), and the
+#: worst period of the marched force over the contacts (1, 2 or 0)
+INFO_PASSES, INFO_ERROR, INFO_PERIOD = 0, 1, 2
+#: force periods in forcing periods: repeated every period, every second
+#: period (the mean of both is used), or not repeated within the bound
+PERIOD_ONE, PERIOD_TWO, PERIOD_NONE = 1.0, 2.0, 0.0
 
 
-def fourier_matrices(harmonics: int, samples: int):
-    """Synthesis ``E`` (Ns, 2H+1) and analysis ``P`` (2H+1, Ns) matrices.
-
-    Columns of ``E`` are ``1, cos(tau), sin(tau), ..., cos(H tau), sin(H tau)``
-    at ``tau_j = 2 pi j / Ns``; ``P`` is the discrete Fourier projection
-    (trapezoidal rule), ``P @ E = I`` for ``Ns > 2H``.
-    """
-    tau = 2.0 * np.pi * np.arange(samples) / samples
-    E = np.empty((samples, 2 * harmonics + 1))
-    E[:, 0] = 1.0
-    for k in range(1, harmonics + 1):
-        E[:, 2 * k - 1] = np.cos(k * tau)
-        E[:, 2 * k] = np.sin(k * tau)
-    P = np.ascontiguousarray(E.T * (2.0 / samples))
-    P[0] *= 0.5
-    return E, P
-
-
-_FOURIER: dict = {}
-
-
-def _fourier_shared(harmonics: int, samples: int):
-    """:func:`fourier_matrices`, built once per (H, Ns) and shared (callers must not write to them)."""
-    key = (int(harmonics), int(samples))
-    hit = _FOURIER.get(key)
-    if hit is None:
-        if len(_FOURIER) > 64:
-            _FOURIER.clear()
-        hit = _FOURIER[key] = fourier_matrices(*key)
-    return hit
-
-
-def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, ssz, SX, SN, E, P, Nsamp, dN, has_p, max_passes, rtol,
-                   R, JX, Jp, T, code, info, scl, Rs, JXs, Jps):  # pragma: no cover - compiled
+def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover - compiled
     """Whole HB residual and Jacobian in one call: linear part + AFT of every contact.
 
-    Linear part (``problem.py``): ``A = AK + w AC + w^2 AM``, ``R = A X - Fe``,
-    ``JX = A``, ``Jp = dwdp (AC + 2 w AM) X - Fp``. Then, per contact c
-    (selection row ``Bm[c]``, kernel parameters ``Pm[c]``, virgin state
-    (law kernel ``INIT``, padded to ``ssz`` entries) at the mean displacement
-    and the first load sample, with derivatives ``SX[c]`` per unit mean
-    displacement and ``SN[c]`` per unit load): ``U = Xm Bm[c]``, AFT march of ``STEP_JVP``
-    until the force repeats, projection, and scatter ``R += b F``,
-    ``JX += b b^T dF/dU``, ``Jp += b dF/dp``.
+    Arguments are tuples of arrays (and scalars):
 
-    AFT directions: the 2H+1 coefficients of u (du_i = E[i, d]) and, when
-    ``has_p``, one parameter entering the normal load (dN_i = dN[c, i]).
+    * ``lin = (AK, AC, AM, w, dwdp, X, Fe, Fp)``: ``A = AK + w AC + w^2 AM``,
+      ``R = A X - Fe``, ``JX = A``, ``Jp = dwdp (AC + 2 w AM) X - Fp``
+      (see ``problem.py``);
+    * ``con = (Bm, Pm, ssz)``: selection row ``Bm[c]`` and kernel
+      parameters ``Pm[c]`` of each contact, state length ``ssz``;
+    * ``load = (Nsamp, dN, has_p)``: normal-load samples (contacts, Ns) and,
+      when ``has_p``, their derivative along the continuation parameter;
+    * ``four = (E, P)``: synthesis and analysis matrices;
+    * ``ctl = (max_passes, rtol)``: bound on the marched periods and the
+      periodicity tolerance;
+    * ``out = (R, JX, Jp, T, code, info)``: outputs, ``T[c]`` and
+      ``code[c]`` the force samples and motion codes of the last pass,
+      ``info`` as described by ``INFO_*``;
+    * ``scaled = (scl, Rs, JXs, Jps)``: when ``scl[0] > 0`` also
+      ``Rs = R / scl[0]``, ``JXs = JX * scl[1]``, ``Jps = Jp * scl[2]``
+      (the continuation's unknowns and residual in units of order one).
+
+    Per contact c: ``U = Xm Bm[c]``, restart of the law at the mean
+    displacement ``U[0]`` and the first load sample (``INIT_JVP``), AFT
+    passes of ``STEP_JVP`` (:func:`_pass`) until the force repeats,
+    projection, and scatter ``R += b F``, ``JX += b b^T dF/dU``,
+    ``Jp += b dF/dp``. AFT directions: the 2H+1 coefficients of u
+    (du_i = E[i, d]) and, when ``has_p``, the parameter entering the
+    normal load (dN_i = dN[c, i]).
+
     The march stops when two consecutive passes agree to ``rtol * max|T|``,
     or when the committed state at the end of a pass equals (to ``rtol``,
     entry by entry) the one at the end of the previous pass, so that the
@@ -85,28 +84,77 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, ssz, SX, SN, E, P, Ns
     passes p and p-2 agree (the law's state alternates between two cycles:
     a period-2 force under a period-1 displacement), the force and its
     derivatives are the mean of the last two passes, which is the exact
-    projection of the 2T-periodic force on the T-periodic harmonics.
-    For laws with small states (at most ``_HIST_MAX_STATE`` entries) the
-    first pass's committed states and derivatives are kept at every
-    sample; once the second pass reaches, at some sample, the same state
-    and derivatives (to ``rtol``, entry by entry, the criterion of the
-    end-of-pass test), the rest of the pass would repeat the first one
-    and is copied from it instead of marched (saves most of the second
-    pass: the result agrees with the full march to rounding).
-    ``T[c]``, ``code[c]``: force samples and motion codes of the last
-    pass; ``info = [max passes, max |T_p - T_(p-1)| (0 when the end states
-    repeated), worst period (1, 2; 0 if a force did not repeat within
-    max_passes)]`` over the contacts. When ``scl[0] > 0`` the scaled copies
-    ``Rs = R / scl[0]``, ``JXs = JX * scl[1]``, ``Jps = Jp * scl[2]`` are
-    written too (the continuation's unknowns and residual in units of
-    order one).
+    projection of the 2T-periodic force on the T-periodic harmonics
+    (:func:`_period_test`).
+
+    Structure, and what it costs to compile: the loops over contacts and
+    passes are written here and the helpers are inlined by Numba. Deeper
+    chains of inlined functions (a march function inlining the pass,
+    inlined into a per-contact function) measured about 50 % more cold
+    compile than the single function this replaces, because Numba's
+    inliner re-runs its front end on each level; with one level it is
+    about 15 %. Variants that compiled the march as a function of its own,
+    or wrote the pass out here around more inlined helpers, were
+    miscompiled by Numba 0.68 (out-of-bounds writes, wrong forces); this
+    structure agrees with the plain-Python reference of
+    ``tests/test_hb_aft.py`` for every law, also with bounds checking.
     """
-    size = X.shape[0]
-    n = Bm.shape[1]
+    R, JX, Jp, T, code, info = out
+    _linear_part(lin, R, JX, Jp)
+    info[INFO_PASSES] = 0.0
+    info[INFO_ERROR] = 0.0
+    info[INFO_PERIOD] = PERIOD_ONE
+    Bm, Pm, _ = con
     nc = Bm.shape[0]
-    ns = E.shape[0]
-    nh = E.shape[1]
-    nd = nh + (1 if has_p else 0)
+    if nc == 0:
+        _scale_outputs(R, JX, Jp, scaled)
+        return
+    Nsamp, dN, has_p = load
+    E, P = four
+    max_passes, rtol = ctl
+    sig, dirs, st, pw, hist, proj = _workspace(con, four, has_p, code)
+    U, u = sig
+    a, bb, da, dbb, s_end = st
+    for c in range(nc):
+        # the law restarted at the mean displacement, marched until its force repeats
+        _contact_samples(lin[5], Bm, c, E, U, u)
+        prm = Pm[c]
+        _restart(INIT_JVP, prm, U[0], Nsamp[c, 0], dN[c, 0] if has_p else 0.0, has_p, E.shape[1], dirs,  # noqa: F821
+                 (a, bb, da, dbb))
+        Tc, dT, T1, T2, dT1, cprev = pw
+        for i in range(u.shape[0]):
+            T1[i] = 0.0
+            T2[i] = 0.0
+        passes = 0
+        err = np.inf
+        period = PERIOD_NONE
+        while passes < max_passes:
+            err, err2, tmax, cur = _pass(STEP_JVP, prm, u, Nsamp[c], dN, c, has_p, E, dirs,  # noqa: F821
+                                         (a, bb, da, dbb), (Tc, dT, T1, T2, dT1, cprev), hist, code, passes, rtol)
+            if cur == 1:  # committed state back in (a, da), once per pass
+                a, bb = bb, a
+                da, dbb = dbb, da
+            passes += 1
+            done, period, err = _period_test(passes, err, err2, tmax, rtol, a, s_end, Tc, dT, T1, dT1)
+            if done:
+                break
+            # history of the last two passes (buffers swapped, not copied)
+            T1, T2 = T2, T1
+            for i in range(u.shape[0]):
+                T1[i] = Tc[i]
+                cprev[i] = code[c, i]
+            dT, dT1 = dT1, dT
+        _project(c, P, Tc, dT, T, proj)
+        _scatter(c, Bm, proj, has_p, R, JX, Jp)
+        _update_info(info, passes, err, period)
+    _scale_outputs(R, JX, Jp, scaled)
+
+
+@jit(inline="always")
+def _linear_part(lin, R, JX, Jp):  # pragma: no cover - compiled
+    """R = A X - Fe, JX = A, Jp = dwdp (AC + 2 w AM) X - Fp with A = AK + w AC + w^2 AM."""
+    AK, AC, AM, w, dwdp, X, Fe, Fp = lin
+    size = X.shape[0]
     w2 = w * w
     w2x = 2.0 * w
     for i in range(size):
@@ -119,180 +167,184 @@ def _eval_template(AK, AC, AM, w, dwdp, X, Fe, Fp, Bm, Pm, ssz, SX, SN, E, P, Ns
             jp += (AC[i, j] + w2x * AM[i, j]) * X[j]
         R[i] = r - Fe[i]
         Jp[i] = jp * dwdp - Fp[i]
-    info[0] = 0.0
-    info[1] = 0.0
-    info[2] = 1.0
-    if nc == 0:
-        _scale_outputs(R, JX, Jp, scl, Rs, JXs, Jps)
-        return
-    # directions of a sample: dx = E[i] (and 0 for the parameter), dN = dN[c, i]
-    # on the parameter direction; copied into fixed buffers (cheaper than views)
-    dxj = np.zeros(nd)
-    dNj = np.zeros(nd)
-    dTj = np.empty(nd)
-    U = np.empty(nh)
-    u = np.empty(ns)
-    F = np.empty(nh)
-    G = np.empty((nh, nd))
-    s_end = np.empty(ssz)
-    Tc = np.empty(ns)
-    dT = np.empty((ns, nd))
-    T1 = np.empty(ns)
-    T2 = np.empty(ns)
-    dT1 = np.empty((ns, nd))
-    # committed states of the first pass at every sample (small states only):
-    # the second pass (usually the last) stops marching once they repeat
-    hist = ssz <= _HIST_MAX_STATE
-    Sh = np.empty((ns if hist else 0, ssz))
-    dSh = np.empty((ns if hist else 0, ssz, nd))
-    cprev = np.empty(ns, dtype=code.dtype)
-    for c in range(nc):
+
+
+@jit(inline="always")
+def _workspace(con, four, has_p, code):  # pragma: no cover - compiled
+    """Buffers of the AFT, allocated once per evaluation and grouped by use.
+
+    ``(sig, dirs, st, pw, hist, proj)``: displacement coefficients and
+    samples of a contact; sample and restart directions; committed and
+    trial states (and derivatives) and the state at the end of the last
+    pass; force samples of the current and the last two passes; first-pass
+    states at every sample (small states only); projected force and
+    derivatives.
+    """
+    E = four[0]
+    ssz = con[2]
+    ns = E.shape[0]
+    nh = E.shape[1]
+    nd = nh + (1 if has_p else 0)
+    sig = (np.empty(nh), np.empty(ns))
+    # directions of a sample: dx = E[i] (0 on the parameter), dN = dN[c, i] on the parameter
+    dirs = (np.zeros(nd), np.zeros(nd), np.empty(nd), np.zeros(nd), np.zeros(nd))
+    # zeros, not garbage: entries of a state that a law leaves unwritten in a step
+    # keep a defined value, so the end-of-pass comparison of states is deterministic
+    st = (np.zeros(ssz), np.zeros(ssz), np.zeros((ssz, nd)), np.zeros((ssz, nd)), np.zeros(ssz))
+    pw = (np.empty(ns), np.empty((ns, nd)), np.empty(ns), np.empty(ns), np.empty((ns, nd)),
+          np.empty(ns, dtype=code.dtype))
+    nhist = ns if ssz <= _HIST_MAX_STATE else 0
+    hist = (np.empty((nhist, ssz)), np.empty((nhist, ssz, nd)))
+    proj = (np.empty(nh), np.empty((nh, nd)))
+    return sig, dirs, st, pw, hist, proj
+
+
+@jit(inline="always")
+def _contact_samples(X, Bm, c, E, U, u):  # pragma: no cover - compiled
+    """Coefficients ``U`` (2H+1) and samples ``u = E U`` (Ns) of contact c's displacement."""
+    n = Bm.shape[1]
+    nh = E.shape[1]
+    for h in range(nh):
+        acc = 0.0
+        for i in range(n):
+            acc += X[h * n + i] * Bm[c, i]
+        U[h] = acc
+    for i in range(E.shape[0]):
+        acc = 0.0
         for h in range(nh):
-            acc = 0.0
-            for i in range(n):
-                acc += X[h * n + i] * Bm[c, i]
-            U[h] = acc
-        for i in range(ns):
-            acc = 0.0
-            for h in range(nh):
-                acc += E[i, h] * U[h]
-            u[i] = acc
-        # virgin state at the mean displacement and the first load sample:
-        # direction 0 (the constant term) moves the mean, the parameter the load
-        Nc = Nsamp[c]
-        prm = Pm[c]
-        a = np.empty(ssz)
-        INIT(prm, U[0], Nc[0], a)  # noqa: F821 - bound by specialize
-        bb = np.empty(ssz)
-        da = np.zeros((ssz, nd))
-        dbb = np.empty((ssz, nd))
-        for r_ in range(ssz):
-            da[r_, 0] = SX[c, r_]
-            if has_p:
-                da[r_, nh] = SN[c, r_] * dN[c, 0]
-        for i in range(ns):
-            T1[i] = 0.0
-            T2[i] = 0.0
-        passes = 0
-        err = np.inf
-        period = 0.0
-        while passes < max_passes:
-            err = 0.0
-            err2 = 0.0
-            tmax = 0.0
-            # committed state in (a, da) when cur == 0, in (bb, dbb) when cur == 1:
-            # the kernel writes the other pair; no array variables are
-            # reassigned per sample (that costs reference counting)
-            cur = 0
-            for i in range(ns):
-                for d in range(nh):
-                    dxj[d] = E[i, d]
-                if has_p:
-                    dNj[nh] = dN[c, i]
+            acc += E[i, h] * U[h]
+        u[i] = acc
+
+
+@jit(inline="always")
+def _restart(init_jvp, prm, U0, N0, dN0, has_p, nh, dirs, st):  # pragma: no cover - compiled
+    """Virgin state of the law at the mean displacement ``U0`` and load ``N0``, with its exact derivative.
+
+    Direction 0 (the constant coefficient of u) moves the mean
+    displacement; the parameter direction (index ``nh``) moves the load by
+    ``dN0``. The state goes to ``st[0]``, its derivative to ``st[2]``.
+    """
+    dx0 = dirs[3]
+    dn0 = dirs[4]
+    dx0[0] = 1.0
+    if has_p:
+        dn0[nh] = dN0
+    init_jvp(prm, U0, dx0, N0, dn0, st[0], st[2])
+
+
+@jit(inline="always")
+def _project(c, P, Tc, dT, T, proj):  # pragma: no cover - compiled
+    """T[c] = Tc; F = P Tc, G = P dT (force coefficients and their derivatives) into ``proj``."""
+    for i in range(Tc.shape[0]):
+        T[c, i] = Tc[i]
+    F, G = proj
+    F[:] = np.dot(P, Tc)
+    G[:, :] = np.dot(P, dT)
+
+
+@jit(inline="always")
+def _pass(step_jvp, prm, u, Nc, dN, c, has_p, E, dirs, st, pw, hist, code, passes, rtol):  # pragma: no cover
+    """One marched period: force samples ``Tc``, derivatives ``dT`` and codes of contact c.
+
+    The committed state is in ``(a, da)`` when ``cur == 0``, in
+    ``(bb, dbb)`` when ``cur == 1``: the kernel writes the other pair, so
+    no array variable is reassigned per sample (that costs reference
+    counting). For laws with small states the first pass stores its
+    committed states at every sample; once the second pass reaches, at
+    some sample, the same state and derivatives (to ``rtol``, entry by
+    entry, the criterion of the end-of-pass test), the rest of the pass
+    would repeat the first one (same kernel, same inputs) and is copied
+    from it instead of marched (:func:`_copy_rest`). Returns
+    ``(err, err2, tmax, cur)``: max change against the last pass and the
+    one before, max |T|, and where the committed state ended.
+    """
+    a, bb, da, dbb = st
+    Tc, dT, T1, T2, dT1, cprev = pw
+    Sh, dSh = hist
+    dxj, dNj, dTj = dirs[0], dirs[1], dirs[2]
+    ns = u.shape[0]
+    nh = E.shape[1]
+    nd = dxj.shape[0]
+    err = 0.0
+    err2 = 0.0
+    tmax = 0.0
+    cur = 0
+    for i in range(ns):
+        for d in range(nh):
+            dxj[d] = E[i, d]
+        if has_p:
+            dNj[nh] = dN[c, i]
+        if cur == 0:
+            t_, k_, c_ = step_jvp(prm, a, da, bb, dbb, u[i], dxj, Nc[i], dNj, dTj)
+        else:
+            t_, k_, c_ = step_jvp(prm, bb, dbb, a, da, u[i], dxj, Nc[i], dNj, dTj)
+        cur = 1 - cur
+        for d in range(nd):
+            dT[i, d] = dTj[d]
+        e = abs(t_ - T1[i])
+        if e > err:
+            err = e
+        err2, tmax = _track(t_, T2[i], err2, tmax)
+        Tc[i] = t_
+        code[c, i] = c_
+        if Sh.shape[0] > 0:
+            if cur == 0:
+                hit = _history(a, da, Sh, dSh, i, passes, rtol)
+            else:
+                hit = _history(bb, dbb, Sh, dSh, i, passes, rtol)
+            if hit:
+                err2, tmax = _copy_rest(i, Tc, dT, T1, T2, dT1, cprev, code, c, err2, tmax)
                 if cur == 0:
-                    t_, k_, c_ = STEP_JVP(prm, a, da, bb, dbb, u[i], dxj, Nc[i], dNj, dTj)  # noqa: F821
+                    _load_state(a, da, Sh, dSh, ns - 1)
                 else:
-                    t_, k_, c_ = STEP_JVP(prm, bb, dbb, a, da, u[i], dxj, Nc[i], dNj, dTj)  # noqa: F821
-                cur = 1 - cur
-                for d in range(nd):
-                    dT[i, d] = dTj[d]
-                e = abs(t_ - T1[i])
-                if e > err:
-                    err = e
-                err2, tmax = _track(t_, T2[i], err2, tmax)
-                Tc[i] = t_
-                code[c, i] = c_
-                if hist:
-                    if cur == 0:
-                        hit = _history(a, da, Sh, dSh, i, passes, rtol)
-                    else:
-                        hit = _history(bb, dbb, Sh, dSh, i, passes, rtol)
-                    if hit:
-                        # the state and its derivatives after sample i are those of
-                        # the first pass after sample i (to rtol, entry by entry,
-                        # as the end-of-pass test below): the rest of this pass
-                        # repeats the first one (same kernel, same inputs), so it
-                        # is copied instead of marched
-                        for j in range(i + 1, ns):
-                            t_ = T1[j]
-                            err2, tmax = _track(t_, T2[j], err2, tmax)
-                            Tc[j] = t_
-                            for d in range(nd):
-                                dT[j, d] = dT1[j, d]
-                            code[c, j] = cprev[j]
-                        if cur == 0:
-                            _load_state(a, da, Sh, dSh, ns - 1)
-                        else:
-                            _load_state(bb, dbb, Sh, dSh, ns - 1)
-                        break
-            if cur == 1:  # committed state back in (a, da), once per pass
-                a, bb = bb, a
-                da, dbb = dbb, da
-            passes += 1
-            if passes >= 2 and err <= rtol * tmax:
-                period = 1.0
+                    _load_state(bb, dbb, Sh, dSh, ns - 1)
                 break
-            if passes >= 2:
-                # the committed state at the end of this pass equals the one at
-                # the end of the previous pass: the next pass would repeat this
-                # one exactly, so this pass is the periodic force already
-                same = True
-                for r_ in range(ssz):
-                    m = max(abs(a[r_]), abs(s_end[r_]))
-                    if abs(a[r_] - s_end[r_]) > rtol * m:
-                        same = False
-                        break
-                if same:
-                    period = 1.0
-                    err = 0.0  # the next pass would repeat this one exactly
-                    break
-            for r_ in range(ssz):
-                s_end[r_] = a[r_]
-            if passes >= 4 and err2 <= rtol * tmax:
-                period = 2.0
-                for i in range(ns):
-                    Tc[i] = 0.5 * (Tc[i] + T1[i])
-                    for d in range(nd):
-                        dT[i, d] = 0.5 * (dT[i, d] + dT1[i, d])
-                break
-            # history of the last two passes (buffers swapped, not copied)
-            T1, T2 = T2, T1
-            for i in range(ns):
-                T1[i] = Tc[i]
-                cprev[i] = code[c, i]
-            dT, dT1 = dT1, dT
-        for i in range(ns):
-            T[c, i] = Tc[i]
-        F[:] = np.dot(P, Tc)
-        G[:, :] = np.dot(P, dT)
-        # scatter: R[h*n + i] += b_i F_h ; JX[(h,i),(g,j)] += b_i b_j G_hg
-        for h in range(nh):
-            for i in range(n):
-                bi = Bm[c, i]
-                if bi == 0.0:
-                    continue
-                R[h * n + i] += F[h] * bi
-                if has_p:
-                    Jp[h * n + i] += G[h, nh] * bi
-                for g in range(nh):
-                    for j in range(n):
-                        bj = Bm[c, j]
-                        if bj != 0.0:
-                            JX[h * n + i, g * n + j] += G[h, g] * (bi * bj)
-        if passes > info[0]:
-            info[0] = passes
-        if err > info[1]:
-            info[1] = err
-        # worst case over the contacts: 0 (not repeated) < 2 < 1
-        if period == 0.0 or (period == 2.0 and info[2] == 1.0):
-            info[2] = period
-    _scale_outputs(R, JX, Jp, scl, Rs, JXs, Jps)
+    return err, err2, tmax, cur
 
 
-#: the march keeps the previous pass's states (and derivatives) at every
-#: sample, to stop marching once they repeat, for laws with states of at
-#: most this many entries (storing is then cheaper than the kernel calls)
-_HIST_MAX_STATE = 16
+@jit(inline="always")
+def _copy_rest(i, Tc, dT, T1, T2, dT1, cprev, code, c, err2, tmax):  # pragma: no cover - compiled
+    """Samples i+1.. of this pass copied from the first pass (the march repeats it)."""
+    for j in range(i + 1, Tc.shape[0]):
+        t_ = T1[j]
+        err2, tmax = _track(t_, T2[j], err2, tmax)
+        Tc[j] = t_
+        for d in range(dT.shape[1]):
+            dT[j, d] = dT1[j, d]
+        code[c, j] = cprev[j]
+    return err2, tmax
+
+
+@jit(inline="always")
+def _period_test(passes, err, err2, tmax, rtol, a, s_end, Tc, dT, T1, dT1):  # pragma: no cover - compiled
+    """Periodicity tests after a pass: ``(done, period, err)`` (see :func:`_eval_template`).
+
+    Updates the end-of-pass state ``s_end``; for a period-2 force, ``Tc``
+    and ``dT`` become the mean of the last two passes.
+    """
+    if passes >= 2 and err <= rtol * tmax:
+        return True, PERIOD_ONE, err
+    if passes >= 2:
+        # the committed state at the end of this pass equals the one at the end of the
+        # previous pass (entry by entry, to rtol): the next pass would repeat this one
+        # exactly, so this pass is the periodic force already
+        same = True
+        for r in range(a.shape[0]):
+            m = max(abs(a[r]), abs(s_end[r]))
+            if abs(a[r] - s_end[r]) > rtol * m:
+                same = False
+                break
+        if same:
+            return True, PERIOD_ONE, 0.0
+    for r in range(a.shape[0]):
+        s_end[r] = a[r]
+    if passes >= 4 and err2 <= rtol * tmax:
+        for i in range(Tc.shape[0]):
+            Tc[i] = 0.5 * (Tc[i] + T1[i])
+            for d in range(dT.shape[1]):
+                dT[i, d] = 0.5 * (dT[i, d] + dT1[i, d])
+        return True, PERIOD_TWO, err
+    return False, PERIOD_NONE, err
 
 
 @jit(inline="always")
@@ -346,7 +398,41 @@ def _load_state(s, ds, Sh, dSh, i):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _scale_outputs(R, JX, Jp, scl, Rs, JXs, Jps):  # pragma: no cover - compiled
+def _scatter(c, Bm, proj, has_p, R, JX, Jp):  # pragma: no cover - compiled
+    """R[h n + i] += b_i F_h; JX[(h, i), (g, j)] += b_i b_j G_hg; Jp[h n + i] += b_i G_h,p."""
+    F, G = proj
+    n = Bm.shape[1]
+    nh = F.shape[0]
+    for h in range(nh):
+        for i in range(n):
+            bi = Bm[c, i]
+            if bi == 0.0:
+                continue
+            R[h * n + i] += F[h] * bi
+            if has_p:
+                Jp[h * n + i] += G[h, nh] * bi
+            for g in range(nh):
+                for j in range(n):
+                    bj = Bm[c, j]
+                    if bj != 0.0:
+                        JX[h * n + i, g * n + j] += G[h, g] * (bi * bj)
+
+
+@jit(inline="always")
+def _update_info(info, passes, err, period):  # pragma: no cover - compiled
+    """Worst case over the contacts: most passes, largest error, period 0 < 2 < 1."""
+    if passes > info[INFO_PASSES]:
+        info[INFO_PASSES] = passes
+    if err > info[INFO_ERROR]:
+        info[INFO_ERROR] = err
+    if period == PERIOD_NONE or (period == PERIOD_TWO and info[INFO_PERIOD] == PERIOD_ONE):
+        info[INFO_PERIOD] = period
+
+
+@jit(inline="always")
+def _scale_outputs(R, JX, Jp, scaled):  # pragma: no cover - compiled
+    """Rs = R / scl[0], JXs = JX scl[1], Jps = Jp scl[2] when scl[0] > 0."""
+    scl, Rs, JXs, Jps = scaled
     if scl[0] > 0.0:
         size = R.shape[0]
         for i in range(size):
@@ -356,31 +442,6 @@ def _scale_outputs(R, JX, Jp, scl, Rs, JXs, Jps):  # pragma: no cover - compiled
                 JXs[i, j] = JX[i, j] * scl[1]
 
 
-def _eval_kernel(law):
-    """The compiled HB evaluation with ``law.step_jvp`` and ``law.init`` bound (disk-cached)."""
-    return specialize(_eval_template, STEP_JVP=law.step_jvp, INIT=law.init)
-
-
-_DS0_CACHE: dict = {}
-
-
-def _initial_state_derivatives(law, x0, n0):
-    """Derivatives (sx, sn) of the virgin state w.r.t. x0 and n0.
-
-    A central difference of ``law.initial_state`` (the virgin state is an
-    affine function of x0 and n0 for every law of the contract: it stores
-    the displacement and the load ratio), so the harmonic-balance code needs
-    no knowledge of the state layout. It is computed once per law (and side
-    of n0 = 0) and reused.
-    """
-    key = (id(law), n0 > 0.0)
-    hit = _DS0_CACHE.get(key)
-    if hit is None or hit[0] is not law:
-        hx = 1e-3 * (law.x_slip if np.isfinite(law.x_slip) and law.x_slip > 0 else 1.0)
-        hn = 1e-3 * max(abs(n0), 1.0)
-        sx = (law.initial_state(x0 + hx, n0) - law.initial_state(x0 - hx, n0)) / (2 * hx)
-        sn = (law.initial_state(x0, n0 + hn) - law.initial_state(x0, n0 - hn)) / (2 * hn)
-        if len(_DS0_CACHE) > 256:
-            _DS0_CACHE.clear()
-        hit = _DS0_CACHE[key] = (law, sx, sn)
-    return hit[1], hit[2]
+def eval_kernel(step_jvp, init_jvp):
+    """The compiled HB evaluation with a law's ``step_jvp`` and ``init_jvp`` bound (disk-cached)."""
+    return specialize(_eval_template, STEP_JVP=step_jvp, INIT_JVP=init_jvp)

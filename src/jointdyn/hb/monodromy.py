@@ -20,21 +20,12 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ..drivers import march
+from ..fourier import basis, derivative_matrix
 from ..kinematics import HarmonicLoad, contact_kinematics, normal_load_samples, tangential_history
 from ..laws import MACROSLIP, SEPARATION
 from ..systems import System
-from .stability import derivative_matrix
 
 __all__ = ["monodromy_multipliers"]
-
-
-def _basis(tau, H):
-    """Real Fourier basis (1, cos tau, sin tau, ..., sin H tau) at the phases tau, (len(tau), 2H+1)."""
-    E = np.ones((tau.size, 2 * H + 1))
-    for k in range(1, H + 1):
-        E[:, 2 * k - 1] = np.cos(k * tau)
-        E[:, 2 * k] = np.sin(k * tau)
-    return E
 
 
 def _system_at(problem, f, loads) -> System:
@@ -95,11 +86,11 @@ def monodromy_multipliers(problem, X, p, *, steps_per_period: int | None = None,
     H, n = problem.H, problem.n
     Xm = np.asarray(X, dtype=float).reshape(problem.nh, n)
     tau0 = _section_phase(problem, X, p)
-    e0 = _basis(np.array([tau0]), H)[0]
+    e0 = basis(H, np.array([tau0]))[0]
     x0 = e0 @ Xm
     v0 = w * (e0 @ (derivative_matrix(H) @ Xm))
     tt = tau0 + np.arange(warm * ns + 1) * (2.0 * np.pi / ns)
-    xs = _basis(tt, H) @ Xm
+    xs = basis(H, tt) @ Xm
     U = tangential_history(kin.arrays, np.ascontiguousarray(xs))
     N = normal_load_samples(kin, tt)
     S = np.zeros((len(system.contacts), max([c.law.state_size for c in system.contacts], default=1)))

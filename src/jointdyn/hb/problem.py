@@ -6,9 +6,10 @@ Equation of motion (MODEL.md section 6, generalised in ``systems.py``)::
     u_c = B_c^T x,   N_c(t) = n0_c + n1_c sin(w t + delta_c).
 
 In normalised time tau = w t, x(tau) = sum_h Q_h(tau) X_h with the real
-Fourier basis Q = (1, cos tau, sin tau, ..., cos H tau, sin H tau); the
-normal load N_c(tau) does not depend on w. Galerkin projection on the same
-basis gives, for harmonic k (coefficients a_k of cos, b_k of sin)::
+Fourier basis Q = (1, cos tau, sin tau, ..., cos H tau, sin H tau) of
+:mod:`jointdyn.fourier`; the normal load N_c(tau) does not depend on w.
+Galerkin projection on the same basis gives, for harmonic k (coefficients
+a_k of cos, b_k of sin)::
 
     (K - k^2 w^2 M) a_k + k w C b_k + F_a,k(X) = 0
     (K - k^2 w^2 M) b_k - k w C a_k + F_b,k(X) = f delta_{k1}
@@ -17,11 +18,14 @@ and K a_0 + F_0(X) = 0 for the constant term (the offset). F(X) are the
 Fourier coefficients of the contact forces, evaluated by alternating
 frequency-time (:mod:`jointdyn.hb._aft`) with exact forward-mode
 Jacobians. The unknowns are ordered harmonic-major:
-``X[h * n + i]`` is coefficient h of DOF i.
+``X[h * n + i]`` is coefficient h of DOF i. How the continuation
+parameter enters (frequency, forcing, normal loads) is the business of a
+parameter object (:mod:`jointdyn.hb.parameters`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -29,15 +33,13 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from .._jit import jit
-from ..laws.discrete import discrete_init, discrete_step_jvp
+from ..fourier import extrema, fourier_matrices, phases
+from ..kinematics import NORMAL_HARMONIC, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
 from ..systems import Contact, System
-from ._aft import _eval_kernel, _fourier_shared, _initial_state_derivatives
+from ._aft import eval_kernel
+from .parameters import SystemParameter, parameter_named
 
-__all__ = ["HBProblem", "PARAMETERS"]
-
-#: scalar parameters that harmonic balance can be continued in
-PARAMETERS = ("gamma", "f1", "eta", "n0", "delta")
+__all__ = ["HBProblem"]
 
 
 @dataclass(slots=True)
@@ -47,6 +49,7 @@ class _Eval:
     Jp: np.ndarray
     T: np.ndarray  # (contacts, Ns): force samples of each contact, N (a row per contact)
     code: np.ndarray  # (contacts, Ns): motion-state codes of each contact
+    #: [periods marched, last change of the force (N), force period]: see jointdyn.hb._aft.INFO_*
     info: np.ndarray
     #: (R, JX, Jp) scaled as asked by ``HBProblem.evaluate(..., scales=)`` (else None)
     scaled: tuple | None = None
@@ -61,34 +64,41 @@ def _pad_rows(rows, width=None):
     return out
 
 
-@jit
-def _extrema(Ef, c):  # pragma: no cover - compiled
-    """(max, min) of x = Ef c with the parabolic refinement of HBProblem._peak."""
-    x = Ef @ c
-    n = x.size
-    hi_i = np.argmax(x)
-    lo_i = np.argmin(x)
-    out = np.empty(2)
-    for k in range(2):
-        i = hi_i if k == 0 else lo_i
-        xm = x[(i - 1) % n]
-        x0 = x[i]
-        xp = x[(i + 1) % n]
-        den = xm - 2.0 * x0 + xp
-        pk = x0 if den == 0.0 else x0 - 0.125 * (xp - xm) ** 2 / den
-        if k == 0:
-            out[0] = x0 if pk < x0 else pk  # max(peak, grid max)
-        else:
-            out[1] = x0 if pk > x0 else pk  # min(peak, grid min)
-    return out[0], out[1]
+def _load_samples(tau, n0, n1, delta, d=None):
+    """Normal load N = n0 + n1 sin(tau + delta) at the phases ``tau`` (N), and its derivative.
+
+    ``d = (dn0, dn1, ddelta)``: derivatives of the coefficients along a
+    parameter; the derivative of the samples is returned with them (None
+    without ``d``). The one place where harmonic balance writes the
+    harmonic normal load out.
+    """
+    ph = tau + delta
+    N = n0 + n1 * np.sin(ph)
+    if d is None:
+        return N, None
+    dn0, dn1, ddelta = d
+    dN = dn0 + dn1 * np.sin(ph)
+    if ddelta != 0.0:
+        dN = dN + (n1 * ddelta) * np.cos(ph)
+    return N, dN
 
 
-def _eval_kernel_no_contact():
-    """Evaluation kernel for a system without contacts (the march is never reached)."""
-    from .._jit import specialize
-    from ._aft import _eval_template
-
-    return specialize(_eval_template, STEP_JVP=discrete_step_jvp, INIT=discrete_init)
+def _linear_blocks(system: System, H: int):
+    """(AK, AC, AM) with A(w) = AK + w AC + w^2 AM the linear terms of harmonics 0..H."""
+    n = system.ndof
+    nh = 2 * H + 1
+    M, C, K = system.M, system.C, system.K
+    AK = np.kron(np.eye(nh), K)
+    AC = np.zeros((n * nh, n * nh))
+    AM = np.zeros((n * nh, n * nh))
+    for k in range(1, H + 1):
+        ic = (2 * k - 1) * n
+        is_ = 2 * k * n
+        AM[ic:ic + n, ic:ic + n] = -(k * k) * M
+        AM[is_:is_ + n, is_:is_ + n] = -(k * k) * M
+        AC[ic:ic + n, is_:is_ + n] = k * C
+        AC[is_:is_ + n, ic:ic + n] = -k * C
+    return AK, AC, AM
 
 
 class HBProblem:
@@ -102,12 +112,10 @@ class HBProblem:
         Highest harmonic H (>= 1); the constant term is always included.
     samples : int
         Time samples per period for the AFT (>= 2H + 2).
-    parameter : str
-        Continuation parameter, one of :data:`PARAMETERS`: ``gamma``
-        (w / w0), ``f1`` (forcing amplitude: the force vector is scaled so
-        that its largest entry is f1, N), ``eta`` (N1/N0 of every contact),
-        ``n0`` (static normal load of every contact, N; eta kept) or
-        ``delta`` (phase of every contact's normal load, rad).
+    parameter : str or HBParameter
+        Continuation parameter: a built-in name (``gamma``, ``f1``,
+        ``eta``, ``n0``, ``delta``; see :mod:`jointdyn.hb.parameters`) or a
+        parameter object (e.g. :class:`~jointdyn.hb.parameters.SystemParameter`).
     gamma : float, optional
         Fixed w / w0 when the parameter is not ``gamma``.
     max_passes : int
@@ -115,21 +123,19 @@ class HBProblem:
     """
 
     def __init__(self, system: System, *, harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
-                 parameter: str = "gamma", gamma: float | None = None,
-                 max_passes: int = config.HB_MAX_PASSES):
+                 parameter="gamma", gamma: float | None = None, max_passes: int = config.HB_MAX_PASSES):
         if not isinstance(system, System):
             raise ValueError("system must be a jointdyn.System")
         system.require_in_phase_forcing("harmonic balance")
         system.require_prescribed_single_law("harmonic balance")
         self.H = V.positive_int("harmonics", harmonics, 1)
         self.Ns = V.positive_int("samples", samples, 2 * self.H + 2)
-        self.parameter = V.choice("parameter", parameter, PARAMETERS)
-        if parameter != "gamma":
+        self.parameter = parameter_named(parameter)
+        self.gamma_fixed = None
+        if self.parameter.needs_gamma:
             if gamma is None:
                 raise ValueError("gamma must be given (> 0) when the parameter is not gamma")
             self.gamma_fixed = V.positive("gamma", gamma)
-        else:
-            self.gamma_fixed = None
         self.max_passes = V.positive_int("max_passes", max_passes, 2)
         self.system = system
         self.n = system.ndof
@@ -138,104 +144,74 @@ class HBProblem:
         self.w0 = system.w0
         if not self.w0 > 0:
             raise ValueError("system must have a positive lowest natural frequency w0 (K positive definite)")
-        self.E, self.P = _fourier_shared(self.H, self.Ns)
-        self.tau = 2.0 * np.pi * np.arange(self.Ns) / self.Ns
-        self._fine = {}
-        self._lin = None
+        self.E, self.P = fourier_matrices(self.H, self.Ns)
+        self.tau = phases(self.Ns)
         self.contacts = list(system.contacts)
         fmax = float(np.max(np.abs(system.force))) if system.force.size else 0.0
         self.f_dir = system.force / fmax if fmax > 0 else system.force.copy()
         self.f1_ref = fmax
-        # contact selection vectors B_c (dof minus dof2)
-        self.B = []
-        for c in self.contacts:
-            b = np.zeros(self.n)
-            b[c.dof] += 1.0
-            if c.dof2 >= 0:
-                b[c.dof2] -= 1.0
-            self.B.append(b)
+        kin = contact_kinematics(system)
+        if np.any(kin.normal_kind != NORMAL_HARMONIC):
+            raise ValueError("contacts: harmonic balance takes constant and harmonic normal loads")
+        #: per contact (n0, n1, delta) of its normal load as given in the system (N, N, rad)
+        self.load_coefficients = kin.normal_par.copy()
+        self.B = list(selection_matrix(kin, self.n))
         # inputs of the compiled evaluation, built once: selection rows,
-        # kernel parameters and virgin states padded to common lengths
+        # kernel parameters padded to a common length, linear blocks
         nc = len(self.contacts)
         self._Bm = np.array(self.B, dtype=np.float64).reshape(nc, self.n)
         self._Pm = _pad_rows([c.law.params for c in self.contacts])
         self._ssz = max([c.law.state_size for c in self.contacts], default=1)
         # one law class per System (checked there): one kernel for every contact
-        self._kernel = _eval_kernel(self.contacts[0].law) if nc else _eval_kernel_no_contact()
-        self._fixed_loads = None
-        self._zero = np.zeros(self.size)
+        law = self.contacts[0].law if nc else None
+        self._kernel = (eval_kernel(law.step_jvp, law.init_jvp) if nc
+                        else eval_kernel(no_contact_step_jvp, no_contact_init_jvp))
+        self._lin = _linear_blocks(system, self.H)
+        # what the parameter does not move is built once
+        self._fixed_forcing = None if self.parameter.enters_forcing else self._forcing_at(0.0)
+        self._fixed_loads = None if self.parameter.enters_loads else self._loads_at(0.0)
         self._dummy = np.zeros((1, 1))
         self._zero1 = np.zeros(1)
         self._noscale = np.zeros(3)
+        self._scales_seen = None
 
-    # --- parameter handling -------------------------------------------------
-    def parameter_value(self) -> float:
-        """Current value of the continuation parameter in ``system``."""
-        p = self.parameter
-        if p == "gamma":
-            return float("nan")
-        if p == "f1":
-            return self.f1_ref
-        c = self.contacts[0]
-        return {"eta": c.eta, "n0": c.n0, "delta": c.normal.phase_rad}[p]
+    # --- parameter ----------------------------------------------------------
+    def omega(self, p) -> float:
+        """Angular frequency w (rad/s) at parameter p."""
+        return self.parameter.frequency(self, p)[0]
+
+    def contact_loads(self, p):
+        """Per contact (n0, n1, delta) of the normal load at parameter p: array (contacts, 3) (N, N, rad)."""
+        return self.parameter.contact_loads(self, p)[0]
 
     def _split(self, p):
-        """(w, f, contact loads [(n0, n1, delta)], dN/dp per contact or None)."""
-        par = self.parameter
-        gamma = p if par == "gamma" else self.gamma_fixed
-        w = gamma * self.w0
-        f = self.f_dir * (p if par == "f1" else self.f1_ref)
-        loads = []
-        for c in self.contacts:
-            n0, n1, dl = c.n0, c.n1, math.radians(c.phase_deg)
-            dn = None
-            if par == "eta":
-                n1 = p * n0
-                dn = n0 * np.sin(self.tau + dl)
-            elif par == "n0":
-                eta = c.eta
-                n0, n1 = p, eta * p
-                dn = 1.0 + eta * np.sin(self.tau + dl)
-            elif par == "delta":
-                dl = p
-                dn = n1 * np.cos(self.tau + dl)
-            loads.append((n0, n1, dl, dn))
-        return w, f, loads
+        """(w, f, [(n0, n1, delta, None)] per contact) at parameter p (the monodromy check's inputs)."""
+        loads = [(float(a), float(b), float(c), None) for a, b, c in self.contact_loads(p)]
+        return self.omega(p), self.parameter.forcing(self, p)[0], loads
 
-    def normal_loads(self, p):
-        """Normal-load samples N_c(tau_j) per contact, N."""
-        _, _, loads = self._split(p)
-        return [n0 + n1 * np.sin(self.tau + dl) for (n0, n1, dl, _) in loads]
+    def _forcing_at(self, p):
+        """(Fe, Fp): coefficient vectors of the forcing and of its derivative along p."""
+        f, df = self.parameter.forcing(self, p)
+        return self.forcing(f), (np.zeros(self.size) if df is None else self.forcing(df))
+
+    def _loads_at(self, p):
+        """(Nsamp, dN): normal-load samples (contacts, Ns) and their derivative along p (or None)."""
+        co, d = self.parameter.contact_loads(self, p)
+        nc = len(self.contacts)
+        Nsamp = np.empty((nc, self.Ns))
+        dN = None if d is None else np.empty((nc, self.Ns))
+        for k in range(nc):
+            Nsamp[k], dn = _load_samples(self.tau, co[k, 0], co[k, 1], co[k, 2], None if d is None else d[k])
+            if dN is not None:
+                dN[k] = dn
+        return Nsamp, dN
 
     # --- linear part --------------------------------------------------------
-    def _linear_parts(self):
-        """A(w) = A_K + w A_C + w^2 A_M (built once)."""
-        if getattr(self, "_lin", None) is None:
-            n = self.n
-            M, C, K = self.system.M, self.system.C, self.system.K
-            AK = np.kron(np.eye(self.nh), K)
-            AC = np.zeros((self.size, self.size))
-            AM = np.zeros((self.size, self.size))
-            for k in range(1, self.H + 1):
-                ic = (2 * k - 1) * n
-                is_ = 2 * k * n
-                AM[ic:ic + n, ic:ic + n] = -(k * k) * M
-                AM[is_:is_ + n, is_:is_ + n] = -(k * k) * M
-                AC[ic:ic + n, is_:is_ + n] = k * C
-                AC[is_:is_ + n, ic:ic + n] = -k * C
-            self._lin = (AK, AC, AM)
-        return self._lin
-
     def linear_matrix(self, w):
         """Block matrix A(w) of the linear terms (size n(2H+1)): per harmonic k
         ``[[K - k^2 w^2 M, k w C], [-k w C, K - k^2 w^2 M]]``, K for k = 0."""
-        AK, AC, AM = self._linear_parts()
+        AK, AC, AM = self._lin
         return AK + w * AC + (w * w) * AM
-
-    def linear_matrix_dw(self, w):
-        """dA/dw."""
-        _, AC, AM = self._linear_parts()
-        return AC + (2.0 * w) * AM
 
     def forcing(self, f):
         """Coefficient vector of f sin(tau)."""
@@ -249,133 +225,86 @@ class HBProblem:
         Used to start Newton and continuation (MODEL.md section 6: all
         stuck -> linear system with K + kt).
         """
-        w, f, _ = self._split(p)
-        A = self.linear_matrix(w)
+        q = self.parameter.problem_at(self, p) if isinstance(self.parameter, SystemParameter) else self
+        w = self.omega(p)
+        A = q.linear_matrix(w)
         if stuck:
-            for c, b in zip(self.contacts, self.B):
+            for c, b in zip(q.contacts, q.B):
                 Kc = c.law.kt * np.outer(b, b)
-                for h in range(self.nh):
-                    A[h * self.n:(h + 1) * self.n, h * self.n:(h + 1) * self.n] += Kc
-        return np.linalg.solve(A, self.forcing(f))
+                for h in range(q.nh):
+                    A[h * q.n:(h + 1) * q.n, h * q.n:(h + 1) * q.n] += Kc
+        return np.linalg.solve(A, q.forcing(q.parameter.forcing(q, p)[0]))
 
     # --- residual -----------------------------------------------------------
-    def _eval_inputs(self, p):
-        """(w, dw/dp, Fe, Fp, Nsamp (nc, Ns), dN (nc, Ns) or None, (sx, sn) rows).
-
-        Loads independent of p (parameters gamma and f1) are built once.
-        """
-        par = self.parameter
-        if par == "gamma" and self._fixed_inputs is not None:
-            dwdp, Fe, Fp, Nsamp, dN, SX, SN = self._fixed_inputs
-            return p * self.w0, dwdp, Fe, Fp, Nsamp, dN, SX, SN
-        if par in ("gamma", "f1") and self._fixed_loads is not None:
-            Nsamp, SX, SN = self._fixed_loads
-            dN = None
-        else:
-            _, _, loads = self._split(p)
-            nc = len(self.contacts)
-            Nsamp = np.empty((nc, self.Ns))
-            dN = None if par in ("gamma", "f1") else np.empty((nc, self.Ns))
-            sx, sn = [], []
-            for k, (c, (n0, n1, dl, dn)) in enumerate(zip(self.contacts, loads)):
-                Nsamp[k] = n0 + n1 * np.sin(self.tau + dl)
-                if dN is not None:
-                    dN[k] = dn
-                dx_, dn_ = _initial_state_derivatives(c.law, 0.0, float(Nsamp[k, 0]))
-                sx.append(dx_)
-                sn.append(dn_)
-            SX = _pad_rows(sx, self._ssz)
-            SN = _pad_rows(sn, self._ssz)
-            if par in ("gamma", "f1"):
-                self._fixed_loads = (Nsamp, SX, SN)
-        gamma = p if par == "gamma" else self.gamma_fixed
-        w = gamma * self.w0
-        if par == "f1":
-            Fe = self.forcing(self.f_dir * p)
-            Fp = self.forcing(self.f_dir)
-        else:
-            if self._forcing_fixed is None:
-                self._forcing_fixed = self.forcing(self.f_dir * self.f1_ref)
-            Fe = self._forcing_fixed
-            Fp = self._zero
-        dwdp = self.w0 if par == "gamma" else 0.0
-        if par == "gamma":
-            self._fixed_inputs = (dwdp, Fe, Fp, Nsamp, dN, SX, SN)
-        return w, dwdp, Fe, Fp, Nsamp, dN, SX, SN
-
-    _forcing_fixed = None
-    _fixed_inputs = None
-    _scales_seen = None
-
     def evaluate(self, X, p, scales=None) -> _Eval:
         """Residual R (N), dR/dX (N/m) and dR/dp at coefficients X and parameter p.
 
         One compiled call (:func:`jointdyn.hb._aft._eval_template`): linear
         part, AFT of every contact with exact forward-mode derivatives, and
-        the scatter into R, dR/dX, dR/dp. With ``scales = (xs, fs, ps)``
+        the scatter into R, dR/dX, dR/dp (for a
+        :class:`~jointdyn.hb.parameters.SystemParameter`, dR/dp is a central
+        difference of the residual). With ``scales = (xs, fs, ps)``
         (unknowns, forces and parameter scales) the same call also fills
         ``scaled = (R / fs, JX * (xs / fs), Jp * (ps / fs))``.
         """
-        X = np.ascontiguousarray(X, dtype=np.float64)
-        w, dwdp, Fe, Fp, Nsamp, dN, SX, SN = self._eval_inputs(p)
-        AK, AC, AM = self._linear_parts()
+        if isinstance(self.parameter, SystemParameter):
+            return self._evaluate_central(X, p, scales)
+        return self._run(np.ascontiguousarray(X, dtype=np.float64), *self._inputs(p), scales)
+
+    def _inputs(self, p):
+        """(w, dw/dp, Fe, Fp, Nsamp, dN) at parameter p: what the parameter fixes, as the evaluation takes it."""
+        w, dwdp = self.parameter.frequency(self, p)
+        Fe, Fp = self._fixed_forcing if self._fixed_forcing is not None else self._forcing_at(p)
+        Nsamp, dN = self._fixed_loads if self._fixed_loads is not None else self._loads_at(p)
+        return w, dwdp, Fe, Fp, Nsamp, dN
+
+    def _run(self, X, w, dwdp, Fe, Fp, Nsamp, dN, scales) -> _Eval:
+        """The compiled evaluation at the given frequency, forcing and loads."""
         nc = len(self.contacts)
-        R = np.empty(self.size)
-        JX = np.empty((self.size, self.size))
-        Jp = np.empty(self.size)
+        size = self.size
+        R = np.empty(size)
+        JX = np.empty((size, size))
+        Jp = np.empty(size)
         T = np.empty((nc, self.Ns))
         code = np.empty((nc, self.Ns), dtype=np.int64)
         info = np.empty(3)
         has_p = dN is not None
         if scales is None:
-            scl, Rs, JXs, Jps = self._noscale, self._zero1, self._dummy, self._zero1
+            scaled = (self._noscale, self._zero1, self._dummy, self._zero1)
         else:
             if scales is not self._scales_seen:
                 xs, fs, ps = scales
                 self._scl = np.array([fs, xs / fs, ps / fs])
                 self._scales_seen = scales
-            scl = self._scl
-            Rs, JXs, Jps = np.empty(self.size), np.empty((self.size, self.size)), np.empty(self.size)
-        self._kernel(AK, AC, AM, float(w), float(dwdp), X, Fe, Fp, self._Bm, self._Pm, self._ssz, SX, SN, self.E, self.P,
-                     Nsamp, dN if has_p else self._dummy, has_p, int(self.max_passes),
-                     float(config.HB_PERIODIC_RTOL), R, JX, Jp, T, code, info, scl, Rs, JXs, Jps)
-        return _Eval(R, JX, Jp, T, code, info, None if scales is None else (Rs, JXs, Jps))
+            scaled = (self._scl, np.empty(size), np.empty((size, size)), np.empty(size))
+        self._kernel((*self._lin, float(w), float(dwdp), X, Fe, Fp), (self._Bm, self._Pm, self._ssz),
+                     (Nsamp, dN if has_p else self._dummy, has_p), (self.E, self.P),
+                     (int(self.max_passes), float(config.HB_PERIODIC_RTOL)), (R, JX, Jp, T, code, info), scaled)
+        return _Eval(R, JX, Jp, T, code, info, None if scales is None else scaled[1:])
+
+    def _evaluate_central(self, X, p, scales) -> _Eval:
+        """Residual of the System built at p; dR/dp by a central difference (SystemParameter)."""
+        par = self.parameter
+        h = par.step(p)
+        ev = par.problem_at(self, p).evaluate(X, p)
+        Rp = par.problem_at(self, p + h).evaluate(X, p + h).R
+        Rm = par.problem_at(self, p - h).evaluate(X, p - h).R
+        Jp = (Rp - Rm) / (2.0 * h)
+        scaled = None
+        if scales is not None:
+            xs, fs, ps = scales
+            scaled = (ev.R / fs, ev.JX * (xs / fs), Jp * (ps / fs))
+        return dataclasses.replace(ev, Jp=Jp, scaled=scaled)
 
     # --- post-processing ----------------------------------------------------
-    def reconstruct(self, X, dof: int, points: int = 1024):
-        """x_dof(tau) on a fine grid of ``points`` samples over one period, m."""
-        Ef = self._fine.get(points)
-        if Ef is None:
-            Ef = self._fine[points] = _fourier_shared(self.H, points)[0]
-        return Ef @ X.reshape(self.nh, self.n)[:, dof]
-
-    @staticmethod
-    def _peak(x, i):
-        """Parabolic refinement of the grid extremum x[i] (periodic samples).
-
-        The error of the vertex of the parabola through three samples is
-        O(h^4) for a smooth peak: with 1024 samples per period about 1e-9
-        of the amplitude (the raw grid value is up to 5e-6 off).
-        """
-        n = x.size
-        xm, x0, xp = x[(i - 1) % n], x[i], x[(i + 1) % n]
-        den = xm - 2.0 * x0 + xp
-        if den == 0.0:
-            return float(x0)
-        return float(x0 - 0.125 * (xp - xm) ** 2 / den)
-
     def amplitudes(self, X, dof: int):
         """(half peak-to-peak, mean, max |x|) of x_dof(t), m.
 
-        Extrema located on 1024 samples per period and refined by a
-        parabola through the three samples around each (:meth:`_peak`;
-        compiled in :func:`_extrema`).
+        Extrema located on ``config.HB_FINE_SAMPLES`` samples per period
+        and refined by a parabola (:func:`jointdyn.fourier.extrema`).
         """
-        Ef = self._fine.get(1024)
-        if Ef is None:
-            Ef = self._fine[1024] = _fourier_shared(self.H, 1024)[0]
         Xm = np.asarray(X, dtype=np.float64).reshape(self.nh, self.n)
-        hi, lo = _extrema(Ef, np.ascontiguousarray(Xm[:, dof]))
+        hi, lo = extrema(Xm[:, dof], self.H)
         c0 = float(Xm[0, dof])
         return 0.5 * (hi - lo), c0, max(abs(hi), abs(lo))
 
@@ -383,10 +312,6 @@ class HBProblem:
         """sqrt(a_1^2 + b_1^2) of DOF ``dof``, m."""
         Xm = X.reshape(self.nh, self.n)
         return math.hypot(Xm[1, dof], Xm[2, dof])
-
-    def omega(self, p) -> float:
-        """Angular frequency w (rad/s) at parameter p."""
-        return (p if self.parameter == "gamma" else self.gamma_fixed) * self.w0
 
 
 def contact_of(system: System) -> Contact:

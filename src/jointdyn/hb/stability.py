@@ -14,8 +14,11 @@ with J_X the HB Jacobian dR/dX (the contact part is the AFT-derived
 derivative of the periodic force coefficients, the standard choice for
 hysteretic forces, which are not differentiable in velocity) and nabla the
 d/dtau operator on the coefficients. It is solved in first-order (companion)
-form, size 2 n (2H+1) (all its eigenvalues by the compiled EISPACK QR
-iteration of :mod:`jointdyn.hb._eig`). Each Floquet exponent s appears there as a family
+form, size 2 n (2H+1) (all its eigenvalues by LAPACK ``dgeev``, except
+for matrices (or parity blocks, below) of at most ``config.HB_SMALL_EIG``
+rows: the compiled EISPACK QR iteration of :mod:`jointdyn.hb._eig` is
+faster there, ``benchmarks/bench_linalg.py``).
+Each Floquet exponent s appears there as a family
 s + i k w (k = -H..H), of which the truncation resolves well only the
 members whose eigenvectors are centred on the low harmonics. Following
 Moore (Int. J. Numer. Meth. Eng. 62, 2005) and the comparison of Peletan,
@@ -36,22 +39,17 @@ The independent monodromy check lives in :mod:`jointdyn.hb.monodromy`.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .. import config
+from .._cache import by_value
 from .._jit import jit
+from ..fourier import derivative_matrix
 from ._eig import eigvals_inplace
 
-__all__ = ["hill_exponents", "hill_stability", "hill_growth", "derivative_matrix"]
-
-
-def derivative_matrix(H: int) -> np.ndarray:
-    """d/dtau on the real coefficients (1, cos tau, sin tau, ..., sin H tau)."""
-    D = np.zeros((2 * H + 1, 2 * H + 1))
-    for k in range(1, H + 1):
-        D[2 * k - 1, 2 * k] = k
-        D[2 * k, 2 * k - 1] = -k
-    return D
+__all__ = ["hill_exponents", "hill_stability", "hill_growth"]
 
 
 def _centroids(V, n, H):
@@ -70,25 +68,24 @@ def _centroids(V, n, H):
     return num / np.where(den > 0, den, 1.0)
 
 
-_PARTS: dict = {}
-
-
 def _hill_parts(M, C, H):
-    """(I (x) M^-1, [I (x) M^-1 (I (x) C), I (x) M^-1 (2 nabla (x) M)], companion template, harmonic parity of each unknown), cached."""
-    key = (M.tobytes(), C.tobytes(), M.shape[0], H)
-    hit = _PARTS.get(key)
-    if hit is None:
-        nh = 2 * H + 1
-        D2i = np.kron(np.eye(nh), np.linalg.inv(M))
-        B1 = (np.ascontiguousarray(D2i @ np.kron(np.eye(nh), C)),
-              np.ascontiguousarray(D2i @ (2.0 * np.kron(derivative_matrix(H), M))))
-        N = M.shape[0] * nh
-        A0 = np.zeros((2 * N, 2 * N))
-        A0[:N, N:] = np.eye(N)
-        if len(_PARTS) > 64:
-            _PARTS.clear()
-        hit = _PARTS[key] = (D2i, B1, A0, _parity(M.shape[0], H))
-    return hit
+    """(I (x) M^-1, [I (x) M^-1 (I (x) C), I (x) M^-1 (2 nabla (x) M)], companion template,
+    harmonic parity of each unknown), built once per (M, C, H) and shared."""
+    return _hill_parts_of(M.tobytes(), C.tobytes(), M.shape[0], int(H))
+
+
+@by_value()
+def _hill_parts_of(Mb: bytes, Cb: bytes, n: int, H: int):
+    M = np.frombuffer(Mb).reshape(n, n)
+    C = np.frombuffer(Cb).reshape(n, n)
+    nh = 2 * H + 1
+    D2i = np.kron(np.eye(nh), np.linalg.inv(M))
+    B1 = (np.ascontiguousarray(D2i @ np.kron(np.eye(nh), C)),
+          np.ascontiguousarray(D2i @ (2.0 * np.kron(derivative_matrix(H), M))))
+    N = n * nh
+    A0 = np.zeros((2 * N, 2 * N))
+    A0[:N, N:] = np.eye(N)
+    return D2i, B1, A0, _parity(n, H)
 
 
 #: machine epsilon of float64
@@ -214,6 +211,61 @@ def _hill_matrix(JX, M, C, w, H):
     return A
 
 
+def _parity_blocks(A, parity):
+    """Index arrays of the even- and odd-harmonic rows of the companion matrix A, or None.
+
+    The split criterion of :func:`_hill_eigvals`: the cross-parity entries
+    have a Frobenius norm of at most ``2N eps ||A||_F``.
+    """
+    M2 = A.shape[0]
+    par2 = np.concatenate((parity, parity))
+    even = np.flatnonzero(par2 == 0)
+    odd = np.flatnonzero(par2 == 1)
+    if even.size == 0 or odd.size == 0:
+        return None
+    nrm2 = float(np.sum(A * A))
+    cross2 = float(np.sum(A[np.ix_(even, odd)] ** 2) + np.sum(A[np.ix_(odd, even)] ** 2))
+    if math.sqrt(cross2) <= M2 * _EPS * math.sqrt(nrm2):
+        return even, odd
+    return None
+
+
+def _hill_eigvals_lapack(JX, M, C, w, H, small: int = 0):
+    """All eigenvalues of the companion matrix assembled with NumPy, with the parity split of
+    :func:`_hill_eigvals`: blocks of at most ``small`` rows by the compiled EISPACK port (LAPACK
+    if its QR fails), larger ones by LAPACK ``dgeev``."""
+    A = _hill_matrix(JX, M, C, w, H)
+    blocks = _parity_blocks(A, _hill_parts(M, C, H)[3]) or (np.arange(A.shape[0]),)
+    out = []
+    for b in blocks:
+        sub = A[np.ix_(b, b)]
+        if sub.shape[0] <= small:
+            lam, ok = eigvals_inplace(sub)
+            if ok:
+                out.append(lam)
+                continue
+            sub = A[np.ix_(b, b)]
+        out.append(np.linalg.eigvals(sub))
+    return np.concatenate(out)
+
+
+def _small_eig(JX) -> bool:
+    """True when the whole companion matrix of JX (twice its rows) is small enough for the compiled path."""
+    return 2 * JX.shape[0] <= config.HB_SMALL_EIG
+
+
+def _hill_all(JX, M, C, w, H):
+    """All Hill eigenvalues: compiled for small companions (LAPACK if its QR fails), else
+    assembled with NumPy and solved by blocks (:func:`_hill_eigvals_lapack`)."""
+    JX = np.ascontiguousarray(JX, dtype=np.float64)
+    if _small_eig(JX):
+        D2iJ_pre, B1, _, parity = _hill_parts(M, C, H)
+        lam, ok = _hill_eigvals(D2iJ_pre, JX, B1[0], B1[1], float(w), parity)
+        if ok:
+            return lam
+    return _hill_eigvals_lapack(JX, M, C, w, H, config.HB_SMALL_EIG)
+
+
 def hill_exponents(JX, M, C, w, H):
     """All Hill eigenvalues and the 2n selected Floquet exponents.
 
@@ -236,18 +288,17 @@ def hill_exponents(JX, M, C, w, H):
 
     Notes
     -----
-    The eigenvalues of the 2 n (2H+1) companion matrix are computed by the
-    compiled EISPACK sequence of :mod:`jointdyn.hb._eig` (balancing,
+    The eigenvalues of the 2 n (2H+1) companion matrix (or of its parity
+    blocks) are computed by LAPACK (``numpy.linalg.eigvals``), up to
+    ``config.HB_SMALL_EIG`` rows by the compiled EISPACK sequence of
+    :mod:`jointdyn.hb._eig` (balancing,
     Hessenberg reduction, Francis double-shift QR), which agrees with
-    LAPACK to rounding at about half its cost at this size; LAPACK
-    (``numpy.linalg.eigvals``) is used if the QR iteration does not
-    converge, and for the eigenvectors of the tie-break.
+    LAPACK to rounding and is faster there (LAPACK is used if its QR
+    iteration does not converge); the eigenvectors of the tie-break come
+    from LAPACK.
     """
     n = M.shape[0]
-    D2iJ_pre, B1, _, parity = _hill_parts(M, C, H)
-    lam, ok = _hill_eigvals(D2iJ_pre, np.ascontiguousarray(JX, dtype=np.float64), B1[0], B1[1], float(w), parity)
-    if not ok:
-        lam = np.linalg.eigvals(_hill_matrix(JX, M, C, w, H))
+    lam = _hill_all(JX, M, C, w, H)
     sel, tie = _select(lam, float(w), 2 * n)
     if tie:
         # a tie at the cut: break it by the eigenvector centroid
@@ -276,19 +327,26 @@ def _hill_growth_batch(D2iJ, JXs, B1c, B1w, ws, parity, m):  # pragma: no cover 
 
 
 def hill_growth(JXs, M, C, ws, H):
-    """max Re(s) / w of the selected Floquet exponents at many points (one compiled loop).
+    """max Re(s) / w of the selected Floquet exponents at many points.
 
     ``JXs`` (points, N, N) are the HB Jacobians and ``ws`` (points,) the
     angular frequencies; the same exponents as :func:`hill_exponents`
     (points with a tie at the selection cut or a QR failure go through it).
+    Small companions (``config.HB_SMALL_EIG``) in one compiled loop.
     """
     JXs = np.ascontiguousarray(JXs, dtype=np.float64)
     ws = np.ascontiguousarray(ws, dtype=np.float64)
     n = M.shape[0]
     if JXs.shape[0] == 0:
         return np.empty(0)
-    D2iJ_pre, B1, _, parity = _hill_parts(M, C, H)
-    growth, ok = _hill_growth_batch(D2iJ_pre, JXs, B1[0], B1[1], ws, parity, 2 * n)
+    if _small_eig(JXs[0]):
+        D2iJ_pre, B1, _, parity = _hill_parts(M, C, H)
+        growth, ok = _hill_growth_batch(D2iJ_pre, JXs, B1[0], B1[1], ws, parity, 2 * n)
+    else:
+        growth, ok = np.empty(JXs.shape[0]), np.empty(JXs.shape[0], dtype=bool)
+        for k in range(JXs.shape[0]):
+            sel, tie = _select(_hill_eigvals_lapack(JXs[k], M, C, ws[k], H, config.HB_SMALL_EIG), ws[k], 2 * n)
+            growth[k], ok[k] = sel[0].real / ws[k], not tie
     for k in np.flatnonzero(~ok):
         sel, _ = hill_exponents(JXs[k], M, C, ws[k], H)
         growth[k] = float(sel[0].real) / ws[k]

@@ -2,7 +2,8 @@
 
 Importing this package imports every module of it whose name does not start
 with ``_``; each law module registers its law(s) (built in: ``iwan``,
-``iwan-paper``, ``discrete``, ``jenkins``), so a new law is one module
+the exact Iwan model and the default; ``iwan-closed`` and ``iwan-paper``,
+the closed forms; ``discrete``; ``jenkins``), so a new law is one module
 dropped here (see :mod:`jointdyn.laws._base` for the contract).
 """
 
@@ -31,7 +32,8 @@ for _module in _pkgutil.iter_modules(__path__):
 
 from ._dispatch import MAX_LAW_SLOTS, LawDispatch, law_dispatch  # noqa: E402
 from .discrete import DiscreteIwan, Jenkins  # noqa: E402
-from .iwan import Iwan, backbone  # noqa: E402
+from .exact import Iwan  # noqa: E402
+from .iwan_closed import IwanClosedForm, backbone  # noqa: E402
 
 __all__ = [
     "STICK_SLIP",
@@ -41,6 +43,7 @@ __all__ = [
     "ContactLaw",
     "LawParameter",
     "Iwan",
+    "IwanClosedForm",
     "DiscreteIwan",
     "Jenkins",
     "backbone",

@@ -520,8 +520,12 @@ def make_law(name: str, *, kt: float, mu: float, n_ref: float, **law_params) -> 
     Parameters
     ----------
     name : str
-        One of :func:`law_names` (``iwan``, ``iwan-paper``, ``discrete``,
-        ``jenkins`` and any law module added to the package).
+        One of :func:`law_names`: ``iwan`` (the exact Iwan model with
+        varying normal load, the default of every front end,
+        ``config.MODEL``), ``iwan-closed`` (the closed form with full Masing
+        memory), ``iwan-paper`` (the closed form with the paper's
+        last-reversal rule), ``discrete`` (n Jenkins elements), ``jenkins``,
+        and any law module added to the package.
     kt : float
         Total tangential stiffness, N/m (> 0).
     mu : float
@@ -529,8 +533,9 @@ def make_law(name: str, *, kt: float, mu: float, n_ref: float, **law_params) -> 
     n_ref : float
         Reference normal load N_ref, N (> 0); fy = mu * n_ref.
     **law_params
-        Law-specific parameters (:func:`law_parameters`), e.g. ``n`` of
-        ``discrete``; strings are converted (command lines).
+        Law-specific parameters (:func:`law_parameters`), e.g. ``capacity``
+        of ``iwan`` or ``n`` of ``discrete``; strings are converted
+        (command lines).
 
     Raises
     ------

@@ -127,7 +127,7 @@ class LineSpec:
     delta_deg: float
     direction: str
     gammas: tuple
-    model: str = "iwan"
+    model: str = config.MODEL
     law_params: tuple = ()
     zeta: float = 0.0
     overrides: tuple = ()
@@ -356,7 +356,7 @@ def frc_sweep(
     f1s=None,
     deltas=(0.0,),
     directions=("up", "down"),
-    model: str = "iwan",
+    model: str = config.MODEL,
     law_params: dict | None = None,
     n: int | None = None,
     zeta: float = 0.0,
@@ -394,7 +394,8 @@ def frc_sweep(
     directions : sequence of {"up", "down"}
         Sweep directions.
     model : str
-        Contact law, one of :func:`jointdyn.laws.law_names`.
+        Contact law, one of :func:`jointdyn.laws.law_names` (default
+        ``iwan``, the exact Iwan model, ``config.MODEL``).
     law_params : dict, optional
         Law-specific parameters of ``model``
         (:func:`jointdyn.laws.law_parameters`), e.g. ``{"n": 200}``.

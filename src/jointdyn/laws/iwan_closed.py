@@ -32,6 +32,13 @@ with q = kt x / fy, G = T / fy and d the direction of motion, clipped to
 
 Separation (alpha <= 0): T = 0, all memory lost; the next contact starts a
 virgin curve G = G_oa(q - q_c; alpha) from the re-contact point q_c.
+
+Registered as ``iwan-closed`` (full memory) and ``iwan-paper`` (last
+reversal). Neither rule sees the elements that slip because the normal load
+falls while a branch is followed (the branch formula scales a curve fixed
+at the reversal point): the closed forms are exact at constant load and for
+loads in phase with the motion only. The default contact law is the exact
+model, :class:`~jointdyn.Iwan` (``iwan``, :mod:`jointdyn.laws.exact`).
 """
 
 from __future__ import annotations
@@ -45,7 +52,7 @@ from .. import config
 from .._jit import jit
 from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, law_param, register
 
-__all__ = ["Iwan", "iwan_step", "iwan_step_jvp", "iwan_init", "iwan_init_jvp", "backbone"]
+__all__ = ["IwanClosedForm", "closed_step", "closed_step_jvp", "closed_init", "closed_init_jvp", "backbone"]
 
 # params: [kt, fy, n_ref, memory (0 full, 1 last), max_depth]
 # state : [q_prev, G_prev, a_prev, dir, base, base_q, base_a, m, base_G, (q_i, G_i, a_i) * max_depth]
@@ -59,7 +66,7 @@ _SAT_RTOL = 1e-12
 # reversal point has reached it: without it, rounding makes steady cycles
 # stop a hair short of their own earlier reversal points, and the stack
 # grows by one point every half cycle (memory of loops of size ~1e-16)
-_WIPE_TOL = config.IWAN_WIPE_TOL
+_WIPE_TOL = config.IWAN_CLOSED_WIPE_TOL
 
 
 @jit(inline="always")
@@ -326,7 +333,7 @@ def _propagate(ds_new, dT, fy, qs, ia, dx, dN, cq, ca, c0q, c0g, c0a, rq, rg, ra
 
 
 @jit(inline="always")
-def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
+def _closed_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
     """Trial step with optional forward-mode derivatives (see the helpers)."""
     kt = params[0]
     fy = params[1]
@@ -395,7 +402,7 @@ def _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
 # caller's compiled loop (march, integrators), where a call passing three
 # arrays field by field cost about half of the step time
 @jit(inline="always")
-def iwan_step(params, s_old, s_new, x, N):
+def closed_step(params, s_old, s_new, x, N):
     """Trial step of the closed-form Iwan law (see module docstring).
 
     Parameters
@@ -418,11 +425,11 @@ def iwan_step(params, s_old, s_new, x, N):
     code : int
         STICK_SLIP, MACROSLIP or SEPARATION.
     """
-    return _iwan_core(params, s_old, s_new, x, N, None, None, None, None, None)
+    return _closed_core(params, s_old, s_new, x, N, None, None, None, None, None)
 
 
 @jit
-def iwan_init(params, x0, n0, s):
+def closed_init(params, x0, n0, s):
     """Virgin committed state at displacement ``x0`` (m) and normal load ``n0`` (N).
 
     q = (kt / fy) x0 (the kernels' expression, bit for bit: a rounding
@@ -442,14 +449,14 @@ def iwan_init(params, x0, n0, s):
 
 
 @jit
-def iwan_init_jvp(params, x0, dx0, n0, dn0, s, ds):
-    """:func:`iwan_init` and its derivative along ``dx0.size`` directions.
+def closed_init_jvp(params, x0, dx0, n0, dn0, s, ds):
+    """:func:`closed_init` and its derivative along ``dx0.size`` directions.
 
     The virgin state is linear in x0 (rows q and the base point q_c) and in
     n0 (row alpha) on each side of n0 = 0; ``ds`` (state size, directions)
     receives d(state) = (kt/fy) dx0 on those two rows, dn0 / n_ref on alpha.
     """
-    iwan_init(params, x0, n0, s)
+    closed_init(params, x0, n0, s)
     qs = params[0] / params[1] if params[1] > 0.0 else 0.0
     ia = 1.0 / params[2]
     for r in range(ds.shape[0]):
@@ -462,14 +469,19 @@ def iwan_init_jvp(params, x0, dx0, n0, dn0, s, ds):
 
 
 @jit
-def iwan_step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT):
-    """:func:`iwan_step` with forward-mode derivatives along ``dx.size`` directions."""
-    return _iwan_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT)
+def closed_step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT):
+    """:func:`closed_step` with forward-mode derivatives along ``dx.size`` directions."""
+    return _closed_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT)
 
 
 @dataclass(frozen=True)
-class Iwan(ContactLaw):
-    """Closed-form Iwan law with slip forces scaled by N(t)/N_ref.
+class IwanClosedForm(ContactLaw):
+    """Closed-form Iwan law with slip forces scaled by N(t)/N_ref (the paper's model).
+
+    Exact at constant normal load (``memory="full"``) but not when the load
+    falls while the contact follows a branch (module docstring); the exact
+    model is :class:`~jointdyn.Iwan`. Registered as ``iwan-closed``
+    (``memory="full"``) and ``iwan-paper`` (``memory="last"``).
 
     Parameters
     ----------
@@ -492,18 +504,18 @@ class Iwan(ContactLaw):
         help="reversal memory: full (Masing's extended rules) or last (the paper's last-reversal rule)",
     )
     max_depth: int = law_param(
-        config.IWAN_MAX_DEPTH, low=2,
+        config.IWAN_CLOSED_MAX_DEPTH, low=2,
         help="capacity of the reversal-point stack (the innermost pair is forgotten when full)",
     )
-    name: ClassVar[str] = "iwan"
+    name: ClassVar[str] = "iwan-closed"
 
     @property
     def step(self):
-        return iwan_step
+        return closed_step
 
     @property
     def step_jvp(self):
-        return iwan_step_jvp
+        return closed_step_jvp
 
     @property
     def params(self) -> np.ndarray:
@@ -517,11 +529,11 @@ class Iwan(ContactLaw):
 
     @property
     def init(self):
-        return iwan_init
+        return closed_init
 
     @property
     def init_jvp(self):
-        return iwan_init_jvp
+        return closed_init_jvp
 
     @property
     def passive(self) -> bool:
@@ -555,10 +567,11 @@ class Iwan(ContactLaw):
 
 
 register(
-    "iwan", Iwan, fixed={"memory": "full"},
-    summary="closed-form Iwan with full Masing memory, exact at constant N for any history",
+    "iwan-closed", IwanClosedForm, fixed={"memory": "full"},
+    summary="closed-form Iwan with full Masing memory: exact at constant N for any history, "
+    "misses slip caused by a falling N within a branch",
 )
 register(
-    "iwan-paper", Iwan, fixed={"memory": "last"},
-    summary="closed-form Iwan with the paper's last-reversal rule",
+    "iwan-paper", IwanClosedForm, fixed={"memory": "last"},
+    summary="closed-form Iwan with the paper's last-reversal rule (Li & Xu)",
 )

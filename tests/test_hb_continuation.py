@@ -1,0 +1,107 @@
+"""The generic continuation (jointdyn.continuation): options, statuses, frozen
+results, the LAPACK path of large bordered systems, and the monitor."""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from jointdyn import config
+from jointdyn.continuation import (
+    ContinuationOptions,
+    ContinuationResult,
+    ContinuationStatus,
+    continuation,
+    newton,
+)
+from jointdyn.status import Status
+
+
+def _cubic(y, lam):
+    # y^3 - y + lam = 0: folds at lam = -+2 / (3 sqrt 3)
+    return np.array([y[0] ** 3 - y[0] + lam]), np.array([[3 * y[0] ** 2 - 1]]), np.array([1.0])
+
+
+def test_options_defaults_come_from_config():
+    opt = ContinuationOptions()
+    assert (opt.ds, opt.ds_min, opt.ds_max) == (config.CONT_DS_START, config.CONT_DS_MIN, config.CONT_DS_MAX)
+    assert (opt.tol, opt.max_iter, opt.max_points) == (config.CONT_TOL, config.CONT_MAX_ITER,
+                                                        config.CONT_MAX_POINTS)
+    assert opt.jump_fractions == config.CONT_JUMP_FRACTIONS and opt.corner_ds == config.CONT_CORNER_DS
+
+
+@pytest.mark.parametrize("field,value", [("ds", 0.0), ("ds_min", -1.0), ("max_points", 0), ("grow", -1.0),
+                                         ("shrink", 1.5), ("turn_cos", 2.0), ("predictor", "euler"),
+                                         ("jump_fractions", (1e-3, -1.0)), ("max_jumps", -1),
+                                         ("line_search_steps", 0)])
+def test_bad_options_name_the_field(field, value):
+    with pytest.raises(ValueError, match=field):
+        ContinuationOptions(**{field: value})
+    with pytest.raises(ValueError, match="ds_min"):
+        ContinuationOptions(ds_min=0.5, ds_max=0.1)
+
+
+def test_options_and_results_are_frozen():
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        ContinuationOptions().ds = 1.0
+    r = continuation(_cubic, np.array([1.5]), -1.5, 1.5, ds=0.05, ds_max=0.1)
+    assert isinstance(r, ContinuationResult)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        r.status = ContinuationStatus.FAILED
+
+
+def test_status_enumeration():
+    assert issubclass(ContinuationStatus, Status)
+    assert [s.value for s in ContinuationStatus] == ["complete", "max-points", "failed", "unbounded", "stopped"]
+    assert [s for s in ContinuationStatus if s.ok] == [ContinuationStatus.COMPLETE]
+    assert all(s.message for s in ContinuationStatus)
+    assert ContinuationStatus.COMPLETE == "complete" and f"{ContinuationStatus.FAILED}" == "failed"
+
+
+def test_cubic_folds_with_options_object():
+    opt = ContinuationOptions(ds=0.05, ds_max=0.1)
+    r = continuation(_cubic, np.array([1.5]), -1.5, 1.5, opt)
+    assert r.status is ContinuationStatus.COMPLETE and r.counters["folds"] == 2
+    assert np.allclose(np.sort(r.lam[r.fold]), [-2 / (3 * math.sqrt(3)), 2 / (3 * math.sqrt(3))], atol=0.05)
+    # keyword arguments override the options' fields
+    r2 = continuation(_cubic, np.array([1.5]), -1.5, 1.5, opt, ds_max=0.02)
+    assert r2.status is ContinuationStatus.COMPLETE and r2.lam.size > 2 * r.lam.size
+
+
+def test_max_points_and_failed_start():
+    r = continuation(_cubic, np.array([1.5]), -1.5, 1.5, ds=0.05, ds_max=0.1, max_points=5)
+    assert r.status is ContinuationStatus.MAX_POINTS and r.lam.size == 5 and not r.status.ok
+
+    def no_root(y, lam):  # y^2 + 1 = 0 has no real solution
+        return np.array([y[0] ** 2 + 1.0]), np.array([[2 * y[0]]]), np.array([0.0])
+
+    r = continuation(no_root, np.array([0.3]), 0.0, 1.0)
+    assert r.status is ContinuationStatus.FAILED and "start" in r.message and r.lam.size == 0
+
+
+def test_monitor_stops_with_its_status():
+    def monitor(y, lam):
+        if lam > 0.5:
+            return ContinuationStatus.UNBOUNDED, f"stopped at lam = {lam:.3g}"
+        return None
+
+    r = continuation(lambda y, lam: (y - lam, np.eye(1), -np.ones(1)), np.zeros(1), 0.0, 1.0, monitor=monitor)
+    assert r.status is ContinuationStatus.UNBOUNDED and 0.5 < r.lam[-1] < 0.7
+
+
+def test_large_bordered_systems_go_through_lapack():
+    # a diagonal cubic of more unknowns than config.CONT_SMALL_SOLVE: the
+    # LAPACK path; every point must solve the equations
+    n = config.CONT_SMALL_SOLVE  # n + 1 unknowns with the arc-length constraint
+    c = np.linspace(0.5, 1.5, n)
+
+    def res(y, lam):
+        return y ** 3 + y - lam * c, np.diag(3 * y ** 2 + 1), -c
+
+    r = continuation(res, np.zeros(n), 0.0, 2.0, ds=0.2, ds_max=0.5)
+    assert r.status is ContinuationStatus.COMPLETE and r.lam[-1] == 2.0
+    for y, lam in zip(r.y, r.lam):
+        assert np.max(np.abs(y ** 3 + y - lam * c)) <= 10 * config.CONT_TOL
+    y, ok, it = newton(res, r.y[-1] + 1e-3, 2.0)
+    assert ok and np.allclose(y, r.y[-1], atol=1e-9)
