@@ -100,6 +100,12 @@ SS_MAX_PERIODS = 1500
 #: periods integrated between two checks
 SS_CHUNK = 8
 
+#: rounding floor of the contact-dissipation check of a periodic state: the
+#: contact's energy per period may fall below zero by the period's
+#: energy-balance residual |W - E_contact - E_viscous| plus this fraction of
+#: |W| + |E_contact| + |E_viscous| before it is flagged as energy created
+SS_DISSIPATION_FLOOR = 1e-12
+
 # --- steady state: start and shooting ------------------------------------------------
 #: describing-function iterations of the linear start
 SS_LINEAR_ITERS = 30

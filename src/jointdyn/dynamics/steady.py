@@ -16,6 +16,7 @@ neutral (a multiplier 1).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,9 +30,9 @@ from ._model import Model, make_model, refine_if_opened
 from ._start import clean_states, linear_start
 from .integrate import Restart, Trajectory, _omega, _trajectory
 from .monodromy import fd_monodromy
-from .status import SteadyStatus
+from .status import EnergyCheck, SteadyStatus
 
-__all__ = ["SteadyState", "steady_state"]
+__all__ = ["SteadyState", "energy_check", "steady_state"]
 
 
 @dataclass(frozen=True)
@@ -78,6 +79,11 @@ class SteadyState:
         Newton iterations spent in shooting (0 if not used).
     floquet_max : float
         Largest |Floquet multiplier| from the last shooting Jacobian (NaN if none).
+    energy_check : EnergyCheck
+        ``"passive"``, ``"negative-dissipation"`` (the contact created energy
+        over the period beyond the energy-balance residual; a
+        ``RuntimeWarning`` is issued too) or ``"not-checked"`` (not
+        periodic); see :func:`energy_check`.
     last_amplitude_m : float
         Half peak-to-peak of the last integrated period, m (diagnostic; not a result).
     restart : Restart
@@ -102,6 +108,7 @@ class SteadyState:
     steps: int
     shooting_iterations: int
     floquet_max: float
+    energy_check: EnergyCheck
     last_amplitude_m: float
     restart: Restart = field(repr=False)
     loop: Trajectory | None = field(default=None, repr=False)
@@ -116,7 +123,7 @@ class SteadyState:
         keys = (
             "status", "detail", "period_multiple", "gamma", "omega", "amplitude_q", "amplitude_m",
             "offset_m", "max_abs_m", "energy_contact_J", "energy_viscous_J", "work_force_J",
-            "periods", "steps", "shooting_iterations", "floquet_max", "last_amplitude_m",
+            "periods", "steps", "shooting_iterations", "floquet_max", "energy_check", "last_amplitude_m",
         )  # fmt: skip
         return {k: getattr(self, k) for k in keys}
 
@@ -690,16 +697,40 @@ def steady_state(
     nan = math.nan
     vals = dict(amplitude_q=nan, amplitude_m=nan, offset_m=nan, max_abs_m=nan,
                 energy_contact_J=nan, energy_viscous_J=nan, work_force_J=nan)  # fmt: skip
-    loop = None
+    loop, check = None, EnergyCheck.NOT_CHECKED
     if status.ok:
         vals, loop = _periodic_values(model, st, p_found, rdof, keep_loop)
+        check = energy_check(vals["work_force_J"], vals["energy_contact_J"], vals["energy_viscous_J"])
+        if check is EnergyCheck.NEGATIVE_DISSIPATION:
+            warnings.warn(f"steady_state at gamma {gamma:g}: the contact dissipates {vals['energy_contact_J']:.3e} J "
+                          f"per period (< 0 beyond the energy-balance residual): {check.message}",
+                          RuntimeWarning, stacklevel=2)  # fmt: skip
     return SteadyState(
         status=status, detail=detail, period_multiple=int(p_found), gamma=float(gamma), omega=w,
         periods=int(math.ceil(st.counters["periods"])), steps=int(st.counters["steps"]),
-        shooting_iterations=int(st.counters["shoot"]), floquet_max=float(st.floq),
+        shooting_iterations=int(st.counters["shoot"]), floquet_max=float(st.floq), energy_check=check,
         last_amplitude_m=float(last_amp), restart=Restart(st.x.copy(), st.v.copy(), st.S.copy()), loop=loop,
         **vals,
     )  # fmt: skip
+
+
+def energy_check(work_force_J: float, energy_contact_J: float, energy_viscous_J: float) -> EnergyCheck:
+    """Passivity of the contacts over a periodic orbit, from its energies per period (J).
+
+    Flags ``energy_contact_J < -tol`` with ``tol = |W - E_contact -
+    E_viscous| + config.SS_DISSIPATION_FLOOR (|W| + |E_contact| +
+    |E_viscous|)``: the period's energy-balance residual bounds the
+    quadrature and transient error of the contact's integral, so a value
+    beyond it is energy created by the contact law.
+
+    Returns
+    -------
+    EnergyCheck
+        ``PASSIVE`` or ``NEGATIVE_DISSIPATION``.
+    """
+    W, Ec, Ev = float(work_force_J), float(energy_contact_J), float(energy_viscous_J)
+    tol = abs(W - Ec - Ev) + config.SS_DISSIPATION_FLOOR * (abs(W) + abs(Ec) + abs(Ev))
+    return EnergyCheck.NEGATIVE_DISSIPATION if Ec < -tol else EnergyCheck.PASSIVE
 
 
 def _first_state(model, start):
