@@ -96,6 +96,11 @@ TEST_SPRING_REFERENCE_RTOL = 3e-4
 #: (same step grid but for the other part's event splits; measured 3e-10)
 TEST_MIXED_DECOUPLED_RTOL = 1e-8
 
+# --- Craig-Bampton reduction -------------------------------------------------------
+#: every interior mode kept: reduced vs full model (frequencies, MAC, time
+#: response, steady state), relative (rounding; measured 3e-14)
+TEST_CB_FULL_RTOL = 1e-9
+
 # --- energy balance of steady states ------------------------------------------
 #: rounding floor of a period's contact dissipation (units of fy x_slip, the
 #: contact's energy scale): added to the point's energy-balance residual
