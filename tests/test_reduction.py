@@ -92,3 +92,18 @@ def test_bad_input_names_the_parameter(args, match):
     kw = dict(M=np.eye(8), K=np.eye(8), boundary_dofs=[0], n_modes=2) | args
     with pytest.raises(ValueError, match=match):
         craig_bampton(**kw)
+
+
+def test_contact_dofs_inside_the_interior_become_selection_vectors():
+    # the normal DOF left out of the boundary: its spring acts through
+    # direction = T^T e_n; with every mode kept the model is still exact
+    s = _chain(n=12)
+    boundary = [s.response_dof, 4]
+    red, cb = reduce_system(s, s.ndof - len(boundary), boundary_dofs=boundary)
+    assert red.contacts[0].normal.direction is not None and red.contacts[0].direction is None
+    full_tr, red_tr = jd.integrate(s, 1.0, periods=2), jd.integrate(red, 1.0, periods=2)
+    assert red_tr.t.size == full_tr.t.size
+    scale = np.max(np.abs(full_tr.x))
+    assert np.max(np.abs(cb.expand(red_tr.x) - full_tr.x)) < C.TEST_CB_FULL_RTOL * scale
+    with pytest.raises(ValueError, match="response DOF"):
+        reduce_system(s, 2, boundary_dofs=[4, 11])
