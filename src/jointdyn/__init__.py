@@ -54,11 +54,14 @@ _LAZY = {
     "ContinuationOptions": "continuation",
     "hill_stability": "hb",
     "frc_sweep": "sweeps",
+    "craig_bampton": "reduction",
+    "reduce_system": "reduction",
+    "CraigBampton": "reduction",
 }
 
 
 #: submodules reachable as attributes of the package (imported on first use)
-_SUBMODULES = ("continuation", "fourier")
+_SUBMODULES = ("continuation", "fourier", "reduction")
 
 
 def __getattr__(name):

@@ -28,10 +28,13 @@ from . import config
 from .kinematics import ConstantLoad, HarmonicLoad, NormalLoad, NormalSpring, _selection
 from .laws import ContactLaw, make_law
 
-__all__ = ["Contact", "System", "PAPER", "modal_damping"]
+__all__ = ["Contact", "System", "PAPER", "PAPER_NORMAL_DOF", "modal_damping"]
 
 #: the paper's section-3 damper (docs/model.md section 6)
 PAPER = dict(m=10.0, k=3.9e5, kt=3.0e5, kn=3.0e5, mu=0.5, n0=100.0)
+#: the normal DOF of the coupled paper damper (``System.paper_damper(normal="spring")``):
+#: mass (kg; light: sqrt(kn / mass) = 27.7 sqrt(k / m)) and damping ratio on kn
+PAPER_NORMAL_DOF = dict(mass=0.01, zeta=0.05)
 
 
 @dataclass(frozen=True)
@@ -183,8 +186,6 @@ class System:
             _check_selection(f"contact {i} tangential", c.dof, c.dof2, c.direction, n)
             if isinstance(c.normal, NormalSpring):
                 _check_selection(f"contact {i} normal", c.normal.dof, c.normal.dof2, c.normal.direction, n)
-        if len({type(c.law) for c in contacts}) > 1:
-            raise ValueError("all contacts of one System must use the same contact-law class")
         for name, value in (("M", M), ("C", C), ("K", K), ("contacts", contacts),
                             ("force", _vector("force", self.force, n, 0.0)),
                             ("force_phase_deg", _vector("force_phase_deg", self.force_phase_deg, n, 0.0))):
@@ -248,6 +249,21 @@ class System:
         if np.any(self.force_phase_deg != 0.0):
             raise ValueError(f"force_phase_deg: {solver} takes in-phase forcing only (all phases 0), "
                              f"got {self.force_phase_deg.tolist()}")
+
+    def require_prescribed_single_law(self, solver: str) -> None:
+        """ValueError naming the key if a contact has a normal spring, a
+        sampled load or a selection vector, or if the contacts use different
+        law kernels (for solvers that take one law and harmonic loads only)."""
+        for i, c in enumerate(self.contacts):
+            if not isinstance(c.normal, (ConstantLoad, HarmonicLoad)):
+                raise ValueError(f"contact {i} normal: {solver} takes constant and harmonic normal loads only, "
+                                 f"got a {type(c.normal).__name__}")
+            if c.direction is not None:
+                raise ValueError(f"contact {i} direction: {solver} takes DOF pairs only (dof, dof2), "
+                                 "not selection vectors")
+        if len({c.law.step for c in self.contacts}) > 1:
+            raise ValueError(f"contacts: {solver} takes one contact-law kernel per system, got "
+                             f"{sorted({type(c.law).__name__ for c in self.contacts})}")
 
     def forcing_coefficients(self) -> tuple[np.ndarray, np.ndarray]:
         """(cosine, sine) coefficients of the forcing, N: F = a cos(w t) + b sin(w t)."""
@@ -316,24 +332,43 @@ class System:
         f1: float | None = None,
         law_params: dict | None = None,
         n: int | None = None,
+        normal: str = "prescribed",
+        normal_mass: float | None = None,
+        normal_zeta: float | None = None,
         **overrides,
     ) -> "System":
         """The paper's friction damper (docs/model.md section 6) in its groups.
 
+        With ``normal="prescribed"`` (the paper's model) one DOF x with the
+        contact against ground and N(t) = n0 (1 + eta sin(w t + delta)).
+        With ``normal="spring"`` the paper's normal spring (``kn``) carries
+        the load from a second DOF y (the normal DOF, mass ``normal_mass``,
+        no stiffness of its own, viscous damping ratio ``normal_zeta`` on
+        kn): N = max(0, n0 + kn y), and y is driven by the normal force
+        eta n0 sin(w t + delta), so that a light normal DOF (quasi-static
+        normal response) gives N = n0 (1 + eta sin(w t + delta)) while the
+        contact stays closed (eta < 1)::
+
+            m x'' + c x' + k x + T(x, N) = f1 sin(w t)
+            m_n y'' + c_n y' + (N - n0) = eta n0 sin(w t + delta)
+
+        DOF 0 is x (the output DOF), DOF 1 is y; w0 stays sqrt(k/m).
+
         Parameters
         ----------
         eta : float
-            N1 / N0 (>= 0).
+            N1 / N0 (>= 0): the amplitude of the normal load (prescribed) or
+            of the normal force on the normal DOF (spring), over n0.
         beta : float
             mu N0 / F1 (> 0); ignored when ``f1`` is given.
         delta_deg : float
-            Normal-load phase relative to the forcing, degrees.
+            Normal-load (normal-force) phase relative to the forcing, degrees.
         model : str
             Contact-law name (:func:`jointdyn.laws.law_names`; default
             ``iwan``, the exact Iwan model; ``iwan-closed``, ``iwan-paper``,
             ``discrete``, ``jenkins``).
         zeta : float
-            Viscous damping ratio (paper: 0).
+            Viscous damping ratio of x (paper: 0).
         f1 : float, optional
             Forcing amplitude, N (instead of beta).
         law_params : dict, optional
@@ -342,14 +377,25 @@ class System:
         n : int, optional
             Shorthand for ``law_params={"n": n}`` (elements of ``discrete``);
             a model without that parameter refuses it.
+        normal : {"prescribed", "spring"}
+            Where the normal load comes from (see above).
+        normal_mass : float, optional
+            Mass of the normal DOF, kg (> 0; spring only); default
+            ``PAPER_NORMAL_DOF["mass"]`` (light: sqrt(kn / m_n) = 27.7 w0).
+        normal_zeta : float, optional
+            Damping ratio of the normal DOF on kn, c_n = 2 zeta sqrt(kn m_n)
+            (>= 0; spring only); default ``PAPER_NORMAL_DOF["zeta"]``.
         **overrides
-            Any of ``m, k, kt, mu, n0`` (paper values by default).
+            Any of ``m, k, kt, kn, mu, n0`` (paper values by default).
         """
         p = dict(PAPER)
         for key, val in overrides.items():
             if key not in p:
                 raise ValueError(f"unknown parameter {key!r}; allowed: {', '.join(p)}")
             p[key] = val
+        V.choice("normal", normal, ("prescribed", "spring"))
+        if normal == "prescribed" and (normal_mass is not None or normal_zeta is not None):
+            raise ValueError('normal_mass and normal_zeta need normal="spring"')
         law_params = dict(law_params or {})
         if n is not None:
             if "n" in law_params:
@@ -358,7 +404,24 @@ class System:
         law = make_law(model, kt=p["kt"], mu=p["mu"], n_ref=p["n0"], **law_params)
         if f1 is None:
             f1 = law.fy / V.positive("beta", beta)
-        return cls.sdof(m=p["m"], k=p["k"], law=law, f1=f1, zeta=zeta, n0=p["n0"], eta=eta, delta_deg=delta_deg)
+        if normal == "prescribed":
+            return cls.sdof(m=p["m"], k=p["k"], law=law, f1=f1, zeta=zeta, n0=p["n0"], eta=eta,
+                            delta_deg=delta_deg)  # fmt: skip
+        return _coupled_damper(cls, p, law, f1=V.finite("f1", f1), zeta=V.nonnegative("zeta", zeta),
+                               eta=V.nonnegative("eta", eta), delta_deg=V.finite("delta_deg", delta_deg),
+                               m_n=PAPER_NORMAL_DOF["mass"] if normal_mass is None else normal_mass,
+                               zeta_n=PAPER_NORMAL_DOF["zeta"] if normal_zeta is None else normal_zeta)  # fmt: skip
+
+
+def _coupled_damper(cls, p, law, *, f1, zeta, eta, delta_deg, m_n, zeta_n) -> System:
+    """The paper damper with its normal spring on a normal DOF (``System.paper_damper(normal="spring")``)."""
+    m, k, kn, n0 = V.positive("m", p["m"]), V.positive("k", p["k"]), V.positive("kn", p["kn"]), p["n0"]
+    m_n = V.positive("normal_mass", m_n)
+    c_n = 2.0 * V.nonnegative("normal_zeta", zeta_n) * math.sqrt(kn * m_n)
+    spring = NormalSpring(kn=kn, preload=n0, dof=1)
+    return cls(M=np.diag([m, m_n]), C=np.diag([2.0 * zeta * math.sqrt(k * m), c_n]), K=np.diag([k, 0.0]),
+               contacts=(Contact(law=law, dof=0, normal=spring),), force=[f1, eta * n0],
+               force_phase_deg=[0.0, delta_deg], w0_rad_s=math.sqrt(k / m), output_dof=0)  # fmt: skip
 
 
 def _dense(dof: int, dof2: int, direction, n: int) -> np.ndarray:

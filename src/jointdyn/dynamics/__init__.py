@@ -9,8 +9,8 @@ the period map (:func:`monodromy_matrix`, :func:`fd_monodromy`).
 
 from .integrate import Restart, Trajectory, integrate, integrate_sampled
 from .monodromy import fd_monodromy, monodromy_matrix
-from .status import RunStatus, SteadyStatus
-from .steady import SteadyState, steady_state
+from .status import EnergyCheck, RunStatus, SteadyStatus
+from .steady import SteadyState, energy_check, steady_state
 
 __all__ = [
     "integrate",
@@ -21,6 +21,8 @@ __all__ = [
     "SteadyState",
     "RunStatus",
     "SteadyStatus",
+    "EnergyCheck",
+    "energy_check",
     "monodromy_matrix",
     "fd_monodromy",
 ]

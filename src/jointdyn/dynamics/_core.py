@@ -9,27 +9,38 @@ stage of the next step (first-same-as-last).
 
 Events are never smeared over a step:
 
-* step boundaries are put exactly at the zero crossings of every N_c(t)
-  (the grid passed in contains them, with N snapped to exactly 0 at a
+* step boundaries are put exactly at the zero crossings of every prescribed
+  N_c(t) (the grid passed in contains them, with N snapped to exactly 0 at a
   separation and to a tiny positive value at a re-contact, so that the
   committed law state is "separated" resp. "virgin at the re-contact point");
 * when the relative velocity of any contact changes sign inside a step, the
   instant of the extremum of u is located on the cubic Hermite interpolant
   of (u, du) over the step, the step is redone up to that instant and
   committed there, so that the law's reversal point is the true extremum;
+* when P + kn g of a normal spring (g: the normal approach, from the state)
+  changes sign inside a step, the instant is located the same way on the
+  Hermite interpolant of (g, dg), the step is redone up to it and the load
+  committed there is snapped like a prescribed one (0 at the separation,
+  a tiny positive value at the re-contact), so that the law separates and
+  restarts virgin at the located instants;
 * when the motion state of a contact changes inside a step (onset or end of
   macroslip), the instant is located by bisection on the law's state code
   and the step is redone up to there.
+
+A normal spring acts on the structure with ``Bn (N - P)`` (N = max(0,
+P + kn g)), the tangential law with ``Bt T``; the contact power counted as
+dissipation is that of T alone (the spring is conservative).
 
 The runner is one loop around a single evaluation of the right-hand side
 (law trial steps included), so that the law kernel is compiled inline once;
 an *evaluation kind* (``EVAL_*``) says what the evaluation is for (the
 start, RK stages 2..4, the end of the step, a bisection probe), and small
 helpers inlined by Numba do one job each: the stage time and the probe
-state, the RK combination, the reversal split, the loads of sampled grids,
-the linear forces and the stage derivatives, the state-change test and the
-bisection, commit and record, the period summary. Two rules keep the loop
-as fast as a hand-written one (both measured):
+state, the RK combination, the reversal and spring-event split, the loads
+of sampled grids, the spring loads and reactions, the linear forces and the
+stage derivatives, the state-change test and the bisection, commit and
+record, the period summary. Two rules keep the loop as fast as a
+hand-written one (both measured):
 
 * the law kernel is called in the template's body, not inside a helper
   (inlined, the call measured 3.5x slower);
@@ -38,28 +49,39 @@ as fast as a hand-written one (both measured):
   the reference counts of its arguments, which Numba updates at every
   inlined call, are not optimised away (1.3 to 2x slower).
 
+The spring and phase work is compiled only for systems that have normal
+springs or forcing phases (global flags ``SPRINGS`` and ``PHASED`` bound
+with the kernel), so other systems run the loop they ran without it.
+
 The runner takes five grouped arguments (tuples of arrays):
 
-``system``  ``(Minv, K, C, f, kin, P)``: inverse mass matrix, stiffness and
-            damping matrices, forcing amplitudes (mode LOADS_HARMONIC), the
-            contact kinematics tuple (:mod:`jointdyn.kinematics`) and the law
-            parameter rows
-``grid``    ``(t, N, F, sin_mid, sin_end, N_mid)``: step grid (s), normal
-            loads (N) at its points, sampled forcing F (N; mode
-            LOADS_SAMPLED), forcing sines at the midpoint and end of every
-            step and normal loads at the midpoints (mode LOADS_HARMONIC)
-``control`` ``(mode, repetitions, phase0, w, rdof, max_split, record)``
+``system``  ``(Minv, K, C, (f_sin, f_cos), kin, P)``: inverse mass matrix,
+            stiffness and damping matrices, forcing amplitudes (mode
+            LOADS_HARMONIC: F = f_sin sin(w t) + f_cos cos(w t)), the contact
+            kinematics tuple (:mod:`jointdyn.kinematics`) and the law
+            parameter rows (:mod:`jointdyn.laws._dispatch`)
+``grid``    ``(t, N, F, (sin_mid, sin_end, cos_mid, cos_end), N_mid)``: step
+            grid (s), prescribed normal loads (N) at its points, sampled
+            forcing F (N; mode LOADS_SAMPLED), forcing sines and cosines at
+            the midpoint and end of every step and prescribed loads at the
+            midpoints (mode LOADS_HARMONIC)
+``control`` ``(mode, repetitions, phase0, w, rdof, max_split, record, recontact)``
+            (``recontact``: the load committed at a spring's re-contact, as
+            a fraction of its preload)
 ``io``      ``(x, v, S, cap)``: state in and out (S: committed law states,
             one row per contact) and the blow-up caps of (x, v)
 ``out``     ``(t, x, v, T, N, code, summary, z_end)``: recorded samples and
-            the per-repetition summary (columns ``S_*``) and end states
+            the per-repetition summary (columns ``S_*``; ``S_OPEN`` counts
+            the steps that end with a spring contact open) and end states
 
 It returns ``(samples recorded, run status RUN_*, repetitions done)``
 (samples: ``capacity + 1`` with RUN_OVERFLOW when the buffers were full).
-The template calls the global placeholders ``STEP`` (the law kernel) and
-``NORMAL_LOAD`` (:func:`jointdyn.kinematics.normal_load`, bound so that the
-compiled copy's cache name follows the kinematics source, whose helpers are
-compiled into it) and is compiled per law with :func:`jointdyn._jit.specialize`.
+The template calls the global placeholders ``STEP`` (the law kernel, or
+the mixed-law dispatcher), reads ``SPRINGS`` and ``PHASED`` and calls ``PRESCRIBED_LOAD``
+(:func:`jointdyn.kinematics.prescribed_load`, bound so that the compiled
+copy's cache name follows the kinematics source, whose helpers are
+compiled into it) and is compiled per kernel with
+:func:`jointdyn._jit.specialize`.
 """
 
 from __future__ import annotations
@@ -69,12 +91,19 @@ import math
 import numpy as np
 
 from .._jit import jit
-from ..kinematics import apply_tangential_force, normal_load, tangential
+from ..kinematics import (
+    NORMAL_SPRING,
+    apply_normal_force,
+    apply_tangential_force,
+    prescribed_load,
+    spring_load,
+    tangential,
+)
 from ..laws._base import SEPARATION
 
 # columns of the per-period summary
-S_XMAX, S_XMIN, S_EC, S_EV, S_W, S_XMEAN, S_STEPS = range(7)
-N_SUMMARY = 7
+S_XMAX, S_XMIN, S_EC, S_EV, S_W, S_XMEAN, S_STEPS, S_OPEN = range(8)
+N_SUMMARY = 8
 
 #: run status (compiled codes; :class:`~jointdyn.dynamics.RunStatus` names them)
 RUN_OK, RUN_BLOWUP, RUN_OVERFLOW = 0, 1, 2
@@ -185,7 +214,83 @@ def _reversal_fraction(tan_idx, tan_w, y0, y1, h, n):  # pragma: no cover - comp
     return sbest
 
 
+@jit(inline="always")
+def _spring_event(n_par, n_idx, n_w, c, y0, y1, h, n):  # pragma: no cover - compiled
+    """First sign change of P + kn g of spring contact c inside the step, on
+    the cubic Hermite interpolant of the normal approach g; returns (fraction
+    of the step, 2.0 when there is none; True at a re-contact).
+
+    A sign change between the ends is bisected; without one, an extremum of
+    g inside the step whose value has the other sign (the contact opens and
+    closes again within the step) brackets the first crossing.
+    """
+    P = n_par[c, 0]
+    kn = n_par[c, 1]
+    g0 = tangential(n_idx, n_w, c, y0, 0)
+    g1 = tangential(n_idx, n_w, c, y1, 0)
+    dg0 = tangential(n_idx, n_w, c, y0, n)
+    dg1 = tangential(n_idx, n_w, c, y1, n)
+    closed0 = P + kn * g0 > 0.0
+    lo = 0.0
+    hi = 1.0
+    if (P + kn * g1 > 0.0) == closed0:
+        if not dg0 * dg1 < 0.0:
+            return 2.0, False
+        hi = _hermite_root(g0, g1, dg0, dg1, h)
+        if (P + kn * _hermite_value(g0, g1, dg0, dg1, h, hi) > 0.0) == closed0:
+            return 2.0, False
+    for _ in range(60):
+        sm = 0.5 * (lo + hi)
+        if (P + kn * _hermite_value(g0, g1, dg0, dg1, h, sm) > 0.0) == closed0:
+            lo = sm
+        else:
+            hi = sm
+    return 0.5 * (lo + hi), not closed0
+
+
+@jit(inline="always")
+def _split_fraction(tan_idx, tan_w, n_kind, n_par, n_idx, n_w, y0, y1, h, n, springs, recontact):  # pragma: no cover
+    """Earliest event inside the step where it must be split: a velocity
+    reversal of a contact or the opening/closing of a normal spring.
+
+    Returns (fraction, 2.0 when none away from the ends; the spring contact
+    whose event it is, -1 for a reversal; the load committed there: 0 at a
+    separation, ``recontact`` times the preload at a re-contact, N).
+    """
+    sbest = _reversal_fraction(tan_idx, tan_w, y0, y1, h, n)
+    ev_c = -1
+    ev_n = 0.0
+    if springs:
+        for c in range(n_kind.shape[0]):
+            if n_kind[c] == NORMAL_SPRING:
+                sr, rising = _spring_event(n_par, n_idx, n_w, c, y0, y1, h, n)
+                if sr > _SPLIT_GUARD and sr < 1.0 - _SPLIT_GUARD and sr < sbest:
+                    sbest = sr
+                    ev_c = c
+                    ev_n = recontact * n_par[c, 0] if rising else 0.0
+    return sbest, ev_c, ev_n
+
+
 # --- loads at a time ---------------------------------------------------------------
+
+
+@jit(inline="always")
+def _add_cosines(fcos, cp, Fv):  # pragma: no cover - compiled
+    """Fv_i += fcos_i cos(w t) (``cp`` = cos(w t)): the out-of-phase part of the forcing, N."""
+    for i in range(Fv.shape[0]):
+        Fv[i] += fcos[i] * cp
+
+
+@jit(inline="always")
+def _springs(n_kind, n_par, n_idx, n_w, ys, Nv, ev_c, ev_n, work):  # pragma: no cover - compiled
+    """Loads of the spring contacts from the state ys, and their reactions:
+    work -= Bn_c (N_c - P_c) (N). Contact ``ev_c`` (>= 0 at the end of a
+    step split at its spring event) gets ``ev_n`` instead (exactly open at a
+    separation, about to load at a re-contact)."""
+    for c in range(Nv.shape[0]):
+        if n_kind[c] == NORMAL_SPRING:
+            Nv[c] = ev_n if c == ev_c else spring_load(n_par, n_idx, n_w, c, ys)
+            apply_normal_force(n_idx, n_w, c, Nv[c] - n_par[c, 0], work)
 
 
 @jit(inline="always")
@@ -304,6 +409,17 @@ def _record(out_t, out_x, out_v, out_T, out_N, out_code, i, t, y, n, Tc, Nv, cod
 
 
 @jit(inline="always")
+def _record_step(out, nrec, t, y, n, Tc, Nv, codes, status):  # pragma: no cover - compiled
+    """Record a committed step as sample ``nrec``; returns (samples, status).
+    A full buffer is overwritten in its last row and the status says
+    RUN_OVERFLOW (the caller repeats the run with a larger one)."""
+    cap = out[0].shape[0]
+    _record(out[0], out[1], out[2], out[3], out[4], out[5], min(nrec, cap - 1), t, y, n, Tc, Nv, codes)
+    nrec += 1
+    return nrec, RUN_OVERFLOW if nrec > cap and status == RUN_OK else status
+
+
+@jit(inline="always")
 def _extremum(y0, y1, h, rdof, n, xmax, xmin):  # pragma: no cover - compiled
     """(max, min) of x[rdof] so far, with the extremum inside the step (Hermite)."""
     xr0 = y0[rdof]
@@ -325,23 +441,27 @@ def _extremum(y0, y1, h, rdof, n, xmax, xmin):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _commit(y0, y1, kk, code_c, codes, xcap, n):  # pragma: no cover - compiled
+def _commit(y0, y1, kk, code_c, codes, xcap, n, n_kind, nopen):  # pragma: no cover - compiled
     """Accept the step: y0 = y1, stage 1 of the next step, committed codes;
-    returns RUN_BLOWUP if the new state is non-finite or beyond the caps, else RUN_OK."""
+    returns (RUN_BLOWUP if the new state is non-finite or beyond the caps,
+    else RUN_OK; ``nopen`` plus 1 if a spring contact is open at the end)."""
     status = RUN_OK
+    opened = 0
     for c in range(codes.shape[0]):
         code_c[c] = codes[c]
+        if n_kind[c] == NORMAL_SPRING and codes[c] == SEPARATION:
+            opened = 1
     for r in range(y0.shape[0]):
         y0[r] = y1[r]
         kk[0, r] = kk[ROW_END, r]
     for i in range(2 * n):
         if not (abs(y0[i]) <= xcap[i]):
             status = RUN_BLOWUP
-    return status
+    return status, nopen + opened
 
 
 @jit(inline="always")
-def _period_summary(summ, zend, k, y0, n, xmax, xmin, nsteps, period):  # pragma: no cover - compiled
+def _period_summary(summ, zend, k, y0, n, xmax, xmin, nsteps, nopen, period):  # pragma: no cover - compiled
     """Summary row and end state of repetition k; resets the energy integrals."""
     summ[k, S_XMAX] = xmax
     summ[k, S_XMIN] = xmin
@@ -350,6 +470,7 @@ def _period_summary(summ, zend, k, y0, n, xmax, xmin, nsteps, period):  # pragma
     summ[k, S_W] = y0[2 * n + 2]
     summ[k, S_XMEAN] = y0[2 * n + 3] / period
     summ[k, S_STEPS] = nsteps
+    summ[k, S_OPEN] = nopen
     for i in range(n):
         zend[k, i] = y0[i]
         zend[k, n + i] = y0[n + i]
@@ -402,24 +523,25 @@ def _write_back(x_io, v_io, S_io, y0, Sa):  # pragma: no cover - compiled
 
 def _run_template(system, grid, control, io, out):  # pragma: no cover - compiled
     """March ``control[1]`` repetitions of the step grid (see module docstring)."""
-    Minv, K, C, fvec, (tan_idx, tan_w, n_kind, n_par), P = system
-    tgrid, Ngrid, Fgrid, sin_mid, sin_end, N_mid = grid
-    mode, nper, phase0, w, rdof, max_split, record = control
+    Minv, K, C, (fsin, fcos), (tan_idx, tan_w, n_kind, n_par, n_idx, n_w, n_tab), P = system
+    tgrid, Ngrid, Fgrid, (sin_mid, sin_end, cos_mid, cos_end), N_mid = grid
+    mode, nper, phase0, w, rdof, max_split, record, recontact = control
     x_io, v_io, S_io, xcap = io
-    out_t, out_x, out_v, out_T, out_N, out_code, summ, zend = out
+    summ, zend = out[6], out[7]
     n, nc, J = x_io.shape[0], S_io.shape[0], tgrid.shape[0] - 1
     Sa, Sb = S_io.copy(), S_io.copy()
     y0, y1, ys, kk, work, Fv, Nv, Tc, codes, code_c = _workspace(x_io, v_io, nc)
-    blo, bhi, bit, sm, located, e = 0.0, 1.0, 0, 0.0, False, EVAL_START
-    nrec, status, done, k, j, attempt, nsplit, nsteps = 0, RUN_OK, 0, 0, 0, 0, 0, 0
+    blo, bhi, bit, sm, located, e, ev_c, ev_n = 0.0, 1.0, 0, 0.0, False, EVAL_START, -1, 0.0
+    nrec, status, done, k, j, attempt, nsplit, nsteps, nopen = 0, RUN_OK, 0, 0, 0, 0, 0, 0, 0
     tc, t_end, end_idx, h, period = tgrid[0], tgrid[1], 1, tgrid[1] - tgrid[0], tgrid[J] - tgrid[0]
     xmax = xmin = y0[rdof]
     while True:
         if e == EVAL_END:
             _rk4_combine(y0, kk, h, y1, ys)
             if attempt == 0 and nsplit < max_split:
-                sbest = _reversal_fraction(tan_idx, tan_w, y0, y1, h, n)
-                if sbest < 1.0:  # redo the step up to the velocity reversal
+                sbest, ev_c, ev_n = _split_fraction(tan_idx, tan_w, n_kind, n_par, n_idx, n_w, y0, y1, h, n,
+                                                    SPRINGS, recontact)  # noqa: F821  # fmt: skip
+                if sbest < 1.0:  # redo the step up to the velocity reversal or spring event
                     h, end_idx, attempt, e = sbest * h, -1, 1, EVAL_STAGE2
                     continue
         if e == EVAL_PROBE:
@@ -436,7 +558,10 @@ def _run_template(system, grid, control, io, out):  # pragma: no cover - compile
         if mode == LOADS_HARMONIC:
             sp = (sin_mid[j] if e < EVAL_STAGE4 else sin_end[j]) if fresh else math.sin(phase0 + w * tau)
             for i in range(n):
-                Fv[i] = fvec[i] * sp
+                Fv[i] = fsin[i] * sp
+            if PHASED:  # noqa: F821 - bound by specialize; F_i = f_i sin(w t + phi_i) = fsin_i sin(w t) + fcos_i cos(w t)
+                _add_cosines(fcos, (cos_mid[j] if e < EVAL_STAGE4 else cos_end[j]) if fresh
+                             else math.cos(phase0 + w * tau), Fv)  # fmt: skip
         else:
             _sampled_row(tgrid, Fgrid, tau, gidx, j, Fv)
         if gidx >= 0 or fresh:
@@ -446,9 +571,11 @@ def _run_template(system, grid, control, io, out):  # pragma: no cover - compile
             _sampled_row(tgrid, Ngrid, tau, gidx, j, Nv)
         else:
             for c in range(nc):
-                Nv[c] = NORMAL_LOAD(n_kind[c], n_par, c, phase0 + w * tau, ys)  # noqa: F821 - bound by specialize
+                Nv[c] = PRESCRIBED_LOAD(n_kind[c], n_par, n_tab, c, phase0 + w * tau)  # noqa: F821 - bound by specialize
         # ---- right-hand side (the law kernel here: inside an inlined helper 3.5x slower)
         _linear_forces(K, C, ys, Fv, n, work)
+        if SPRINGS:  # noqa: F821 - bound by specialize; spring loads from the state, and their reactions
+            _springs(n_kind, n_par, n_idx, n_w, ys, Nv, ev_c if e == EVAL_END else -1, ev_n, work)
         pc = 0.0
         for c in range(nc):
             u, du = tangential(tan_idx, tan_w, c, ys, 0), tangential(tan_idx, tan_w, c, ys, n)
@@ -465,7 +592,7 @@ def _run_template(system, grid, control, io, out):  # pragma: no cover - compile
             e += 1
             continue
         # change of motion state inside an unsplit step (separation and
-        # re-contact are grid points): located by bisection
+        # re-contact are grid points or spring events): located by bisection
         if e == EVAL_PROBE or (attempt == 0 and nsplit < max_split and not located
                                and _state_changed(codes, code_c, True)):  # fmt: skip
             blo, bhi, bit, e, h, end_idx, attempt, located = _bisection(e, codes, code_c, sm, blo, bhi, bit, h, end_idx,
@@ -475,55 +602,71 @@ def _run_template(system, grid, control, io, out):  # pragma: no cover - compile
         Sa, Sb = Sb, Sa
         t_new = t_end if end_idx >= 0 else tc + h
         xmax, xmin = _extremum(y0, y1, h, rdof, n, xmax, xmin)
-        status = _commit(y0, y1, kk, code_c, codes, xcap, n)
+        status, nopen = _commit(y0, y1, kk, code_c, codes, xcap, n, n_kind, nopen)
         nsteps += 1
-        if record:  # a full buffer is overwritten in its last row and the run repeated by the caller
-            _record(out_t, out_x, out_v, out_T, out_N, out_code, min(nrec, out_t.shape[0] - 1), k * period + t_new,
-                    y0, n, Tc, Nv, codes)  # fmt: skip
-            nrec += 1
-            status = RUN_OVERFLOW if nrec > out_t.shape[0] and status == RUN_OK else status
+        if record:
+            nrec, status = _record_step(out, nrec, k * period + t_new, y0, n, Tc, Nv, codes, status)
         if status != RUN_OK:
             break
         # next attempt: rest of the grid step, or the next grid step
-        e, attempt = EVAL_STAGE2, 0
+        e, attempt, ev_c = EVAL_STAGE2, 0, -1
         if end_idx < 0:
             nsplit, tc, h, end_idx = nsplit + 1, t_new, t_end - t_new, j + 1
             continue
-        j += 1
-        if j == J:
-            _period_summary(summ, zend, k, y0, n, xmax, xmin, nsteps, period)
-            done, k = done + 1, k + 1
-            if k == nper:
-                break
-            j, nsteps = 0, 0
-            xmax = xmin = y0[rdof]
+        j, k, done, nsteps, nopen, xmax, xmin = _next_grid_step(summ, zend, j, J, k, done, y0, n, xmax, xmin, nsteps,
+                                                                nopen, period, rdof)  # fmt: skip
+        if k == nper:
+            break
         nsplit, tc, t_end, end_idx, h = 0, tgrid[j], tgrid[j + 1], j + 1, tgrid[j + 1] - tgrid[j]
     _write_back(x_io, v_io, S_io, y0, Sa)
     return nrec, status, done
 
 
+@jit(inline="always")
+def _next_grid_step(summ, zend, j, J, k, done, y0, n, xmax, xmin, nsteps, nopen, period, rdof):  # pragma: no cover
+    """On to grid step j + 1; at the end of the grid, the summary of
+    repetition k and a new repetition (grid step 0, counters and extrema
+    reset). Returns (j, k, done, nsteps, nopen, xmax, xmin)."""
+    j += 1
+    if j == J:
+        _period_summary(summ, zend, k, y0, n, xmax, xmin, nsteps, nopen, period)
+        return 0, k + 1, done + 1, 0, 0, y0[rdof], y0[rdof]
+    return j, k, done, nsteps, nopen, xmax, xmin
+
+
 @jit
-def grid_sines(tgrid, w, phase0):  # pragma: no cover - compiled
-    """Forcing sines at the midpoint and end of every step of a harmonic grid
-    (the grid repeats each period, so an unsplit step reuses them)."""
+def grid_trig(tgrid, w, phase0):  # pragma: no cover - compiled
+    """Forcing sines and cosines at the midpoint and end of every step of a
+    harmonic grid (the grid repeats each period, so an unsplit step reuses
+    them): ``(sin_mid, sin_end, cos_mid, cos_end)``."""
     J = tgrid.shape[0] - 1
     sin_mid = np.empty(J)
     sin_end = np.empty(J)
+    cos_mid = np.empty(J)
+    cos_end = np.empty(J)
     for j in range(J):
-        sin_mid[j] = math.sin(phase0 + w * (tgrid[j] + 0.5 * (tgrid[j + 1] - tgrid[j])))
-        sin_end[j] = math.sin(phase0 + w * tgrid[j + 1])
-    return sin_mid, sin_end
+        am = phase0 + w * (tgrid[j] + 0.5 * (tgrid[j + 1] - tgrid[j]))
+        ae = phase0 + w * tgrid[j + 1]
+        sin_mid[j] = math.sin(am)
+        sin_end[j] = math.sin(ae)
+        cos_mid[j] = math.cos(am)
+        cos_end[j] = math.cos(ae)
+    return sin_mid, sin_end, cos_mid, cos_end
 
 
-def compiled_runner(step):
-    """The RK4 runner with ``step`` (a law kernel) bound, compiled and cached."""
+def compiled_runner(step, springs: bool = False, phased: bool = False):
+    """The RK4 runner with ``step`` (a law kernel or a mixed-law dispatcher)
+    bound, compiled and cached; ``springs`` (a contact has a normal spring)
+    and ``phased`` (a forcing phase is not 0) are compile-time constants, so
+    that systems without them compile none of that work."""
     from .._jit import specialize
 
-    return specialize(_run_template, STEP=step, NORMAL_LOAD=normal_load)
+    return specialize(_run_template, STEP=step, PRESCRIBED_LOAD=prescribed_load, SPRINGS=bool(springs),
+                      PHASED=bool(phased))  # fmt: skip
 
 
 __all__ = [
-    "S_XMAX", "S_XMIN", "S_EC", "S_EV", "S_W", "S_XMEAN", "S_STEPS", "N_SUMMARY",
+    "S_XMAX", "S_XMIN", "S_EC", "S_EV", "S_W", "S_XMEAN", "S_STEPS", "S_OPEN", "N_SUMMARY",
     "RUN_OK", "RUN_BLOWUP", "RUN_OVERFLOW", "LOADS_HARMONIC", "LOADS_SAMPLED",
-    "compiled_runner", "grid_sines",
+    "compiled_runner", "grid_trig",
 ]  # fmt: skip

@@ -17,21 +17,27 @@ from .. import config
 from .._cache import by_identity
 from ..kinematics import (
     NORMAL_HARMONIC,
+    NORMAL_SAMPLED,
+    NORMAL_SPRING,
     ContactKinematics,
     contact_kinematics,
+    load_breakpoints,
     load_events,
     load_table,
     midpoint_loads,
     no_contact_init,
     no_contact_step,
+    normal_history,
     normal_load_at,
     selection_matrix,
     tangential_history,
 )
-from ._core import LOADS_HARMONIC, N_SUMMARY, RUN_OVERFLOW, compiled_runner, grid_sines
+from ..laws import law_dispatch
+from ._core import LOADS_HARMONIC, N_SUMMARY, RUN_OVERFLOW, S_OPEN, compiled_runner, grid_trig
 from .status import RunStatus, run_status
 
-__all__ = ["PackedSystem", "pack_system", "Model", "make_model", "Grid", "RunResult", "run"]
+__all__ = ["PackedSystem", "pack_system", "Model", "make_model", "refine_if_opened", "Grid", "RunResult", "run",
+           "recontact_load"]  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -39,7 +45,9 @@ class PackedSystem:
     """The frequency-independent arrays of a System for the compiled runner.
 
     Shared by every model of the same System object and never written.
-    ``arrays`` is the runner's ``system`` argument ``(Minv, K, C, f, kin, P)``.
+    ``arrays`` is the runner's ``system`` argument
+    ``(Minv, K, C, (f_sin, f_cos), kin, P)``: the forcing
+    F_i = f_i sin(w t + phi_i) as f_sin = f cos(phi) and f_cos = f sin(phi).
     """
 
     ndof: int
@@ -49,18 +57,23 @@ class PackedSystem:
     K: np.ndarray
     C: np.ndarray
     fvec: np.ndarray
+    fsin: np.ndarray
+    fcos: np.ndarray
     kin: ContactKinematics
-    #: dense selection rows (nc, ndof) and stuck stiffnesses kt (N/m)
+    #: dense tangential and normal selection rows (nc, ndof), stuck stiffnesses kt (N/m)
     B: np.ndarray
+    Bn: np.ndarray
     kt: np.ndarray
-    #: law parameter rows (nc, longest), state length, the laws, their kernels
+    #: law parameter rows (nc, width), state length, the laws, their (dispatched) kernels
     P: np.ndarray
     slen: int
     laws: tuple
     step: object
     init: object
     runner: object
-    #: stiffness with every contact stuck, its highest and lowest natural frequencies (rad/s)
+    #: K with the normal springs closed (N/m); with every contact stuck too,
+    #: its highest and lowest natural frequencies (rad/s)
+    K_closed: np.ndarray
     K_stuck: np.ndarray
     w_max: float
     w_min_stuck: float
@@ -74,31 +87,42 @@ class PackedSystem:
     nobufs: tuple
     no_forcing_table: np.ndarray
 
+    @property
+    def springs(self) -> bool:
+        """True when some contact's normal load comes from a normal spring."""
+        return self.kin.springs.size > 0
+
 
 @by_identity
 def pack_system(system) -> PackedSystem:
-    """The :class:`PackedSystem` of ``system`` (cached per System object)."""
+    """The :class:`PackedSystem` of ``system`` (cached per System object).
+
+    The step of the period grids follows the stiffest linear mode the
+    structure can reach: every contact stuck (kt) and every normal spring
+    closed (kn), so that a light, stiff normal DOF is integrated stably.
+    """
     n = system.ndof
     cs = system.contacts
-    system.require_in_phase_forcing("the time integrator")
     kin = contact_kinematics(system)
     M = np.ascontiguousarray(system.M, dtype=np.float64)
     Minv = np.ascontiguousarray(np.linalg.inv(system.M))
     K = np.ascontiguousarray(system.K, dtype=np.float64)
     C = np.ascontiguousarray(system.C, dtype=np.float64)
     fvec = np.ascontiguousarray(system.force, dtype=np.float64)
+    phi = np.radians(system.force_phase_deg)
+    fsin = np.ascontiguousarray(fvec * np.cos(phi))
+    fcos = np.ascontiguousarray(fvec * np.sin(phi))
     if cs:
-        P = np.zeros((len(cs), max(c.law.params.size for c in cs)))
-        for i, c in enumerate(cs):
-            P[i, : c.law.params.size] = c.law.params
-        slen = max(c.law.state_size for c in cs)
-        step, init = cs[0].law.step, cs[0].law.init
+        disp = law_dispatch([c.law for c in cs])
+        P, slen, step, init = disp.P, disp.state_size, disp.step, disp.init
     else:
         P, slen, step, init = np.zeros((0, 5)), 1, no_contact_step, no_contact_init
-    B = selection_matrix(kin, n)
+    B, Bn = selection_matrix(kin, n), selection_matrix(kin, n, normal=True)
     kt = np.array([c.law.kt for c in cs], dtype=np.float64)
-    # stiffest linear mode with every contact stuck: keeps RK4 accurate/stable
-    Kst = K.copy()
+    Kcl = K.copy()
+    for i in kin.springs:
+        Kcl += kin.normal_par[i, 1] * np.outer(Bn[i], Bn[i])
+    Kst = Kcl.copy()
     for i in range(len(cs)):
         Kst += kt[i] * np.outer(B[i], B[i])
     from scipy.linalg import eigh
@@ -108,12 +132,13 @@ def pack_system(system) -> PackedSystem:
     w_min = math.sqrt(max(lam[0], 0.0))
     fmax = float(np.max(np.abs(fvec)))
     return PackedSystem(
-        ndof=n, ncontacts=len(cs), M=M, Minv=Minv, K=K, C=C, fvec=fvec, kin=kin, B=B, kt=kt, P=P,
-        slen=slen, laws=tuple(c.law for c in cs), step=step, init=init, runner=compiled_runner(step),
-        K_stuck=np.ascontiguousarray(Kst), w_max=w_max, w_min_stuck=w_min,
-        xlin=sum(c.law.fy / c.law.kt for c in cs), fmax=fmax,
+        ndof=n, ncontacts=len(cs), M=M, Minv=Minv, K=K, C=C, fvec=fvec, fsin=fsin, fcos=fcos, kin=kin, B=B,
+        Bn=Bn, kt=kt, P=P, slen=slen, laws=tuple(c.law for c in cs), step=step, init=init,
+        runner=compiled_runner(step, kin.springs.size > 0, bool(np.any(fcos != 0.0))), K_closed=np.ascontiguousarray(Kcl), K_stuck=np.ascontiguousarray(Kst),
+        w_max=w_max, w_min_stuck=w_min, xlin=sum(c.law.fy / c.law.kt for c in cs), fmax=fmax,
         kmin=max(w_min**2 * float(np.min(np.diag(system.M))), 1e-300),
-        arrays=(Minv, K, C, fvec, kin.arrays, P), nobufs=_buffers(1, n, len(cs)), no_forcing_table=np.zeros((1, n)),
+        arrays=(Minv, K, C, (fsin, fcos), kin.arrays, P), nobufs=_buffers(1, n, len(cs)),
+        no_forcing_table=np.zeros((1, n)),
     )  # fmt: skip
 
 
@@ -130,15 +155,23 @@ def _buffers(cap, n, nc):
 
 
 #: a step grid with its load tables: the runner's ``grid`` argument
-#: ``(t, N, F, sin_mid, sin_end, N_mid)`` (see ``_core.py``)
+#: ``(t, N, F, (sin_mid, sin_end, cos_mid, cos_end), N_mid)`` (see ``_core.py``)
 Grid = tuple
 
 
 def _harmonic_tables(pack: PackedSystem, tg, Ng, w) -> Grid:
     """The runner's grid tuple of a harmonic step grid tg (s) with normal loads Ng (N)."""
-    sin_mid, sin_end = grid_sines(tg, w, 0.0)
+    trig = grid_trig(tg, w, 0.0)
     N_mid = midpoint_loads(pack.kin.arrays, tg, w, 0.0)
-    return (tg, Ng, pack.no_forcing_table, sin_mid, sin_end, N_mid)
+    return (tg, Ng, pack.no_forcing_table, trig, N_mid)
+
+
+def recontact_load(kin: ContactKinematics, c: int) -> float:
+    """Load (N) a prescribed load is snapped to at a re-contact instant:
+    ``TI_RECONTACT_ALPHA`` times n0 (harmonic) or times the largest |sample| (sampled)."""
+    if kin.normal_kind[c] == NORMAL_SAMPLED:
+        return config.TI_RECONTACT_ALPHA * float(np.max(np.abs(kin.normal_table[c])))
+    return config.TI_RECONTACT_ALPHA * kin.normal_par[c, 0]
 
 
 def _period_grid(pack: PackedSystem, w: float, J: int, events: bool):
@@ -146,8 +179,9 @@ def _period_grid(pack: PackedSystem, w: float, J: int, events: bool):
 
     J uniform steps; an instant within ``TI_EVENT_MERGE`` of a step of a
     grid point moves that point, else it is inserted. The load is snapped
-    to exactly 0 at a separation and to ``TI_RECONTACT_ALPHA n0`` at a
-    re-contact.
+    to exactly 0 at a separation and to :func:`recontact_load` at a
+    re-contact. The slope changes of sampled loads (their sample phases)
+    are grid points too (inserted or merged the same way, not snapped).
     """
     Tp = 2 * math.pi / w
     t = np.arange(J + 1) * (Tp / J)  # np.linspace(0, Tp, J + 1), bit for bit, cheaper
@@ -155,7 +189,9 @@ def _period_grid(pack: PackedSystem, w: float, J: int, events: bool):
     tol = config.TI_EVENT_MERGE * Tp / J
     tg = t
     ev_at = {}
-    for te, ci, rising in load_events(pack.kin, w, Tp) if events else ():
+    instants = list(load_events(pack.kin, w, Tp)) if events else []
+    instants += [(float(tb), -1, False) for tb in load_breakpoints(pack.kin, Tp)]
+    for te, ci, rising in instants:
         k = int(np.argmin(np.abs(tg - te)))
         if abs(tg[k] - te) <= tol:
             if k == 0 or k == tg.size - 1:
@@ -163,17 +199,17 @@ def _period_grid(pack: PackedSystem, w: float, J: int, events: bool):
                 te = tg[k]
             else:
                 tg[k] = te
-            ev_at.setdefault(k, []).append((ci, rising))
         else:
             k = int(np.searchsorted(tg, te))
             tg = np.insert(tg, k, te)
             # re-key events recorded at later indices
             ev_at = {(kk + 1 if kk >= k else kk): v for kk, v in ev_at.items()}
+        if ci >= 0:
             ev_at.setdefault(k, []).append((ci, rising))
     N = load_table(pack.kin.arrays, tg, w)
     for k, lst in ev_at.items():
         for ci, rising in lst:
-            N[k, ci] = config.TI_RECONTACT_ALPHA * pack.kin.normal_par[ci, 0] if rising else 0.0
+            N[k, ci] = recontact_load(pack.kin, ci) if rising else 0.0
             if k == 0:
                 N[tg.size - 1, ci] = N[0, ci]
             if k == tg.size - 1:
@@ -187,7 +223,9 @@ class Model:
 
     Built by :func:`make_model`. ``grid`` is the period grid (None when
     ``w == 0``: sampled loads); ``xcap0`` and ``xcap`` are the blow-up caps
-    of the displacements (m) and of (x, v).
+    of the displacements (m) and of (x, v); ``steps_per_period`` is the
+    requested base and ``refined`` says whether the steps follow
+    ``TI_SPRING_OMEGA_H`` (a normal spring opened).
     """
 
     pack: PackedSystem
@@ -200,6 +238,8 @@ class Model:
     xcap: np.ndarray
     grid: Grid | None
     period: float
+    steps_per_period: int = 0
+    refined: bool = False
 
     @property
     def n(self) -> int:
@@ -242,27 +282,40 @@ class Model:
     def section_time(self) -> float:
         """Poincare-section time in [0, period) where every contact is open, else 0.
 
-        Mid-separation of the first separating contact; there the law states
-        are reset, so (x, v) is the whole state of the period map.
+        Mid-separation of the first contact whose prescribed load opens (the
+        minimum of a harmonic or sampled load), if every contact is open
+        there; there the law states are reset, so (x, v) is the whole state
+        of the period map. A spring contact's opening depends on the motion
+        (:func:`open_section`).
         """
         kin = self.pack.kin
         for c in range(self.nc):
-            n0, n1, delta = kin.normal_par[c]
-            if kin.normal_kind[c] == NORMAL_HARMONIC and n1 > n0:
+            n0, p1, delta = kin.normal_par[c]
+            ts = None
+            if kin.normal_kind[c] == NORMAL_HARMONIC and p1 > n0:
                 ts = ((1.5 * math.pi - float(delta)) / self.w) % self.period
+            elif kin.normal_kind[c] == NORMAL_SAMPLED and np.min(kin.normal_table[c]) < 0.0:
+                m = int(p1)
+                ts = int(np.argmin(kin.normal_table[c, :m])) / m * self.period
+            if ts is not None:
                 if all(normal_load_at(kin, cc, self.w, ts) < 0.0 for cc in range(self.nc)):
                     return ts
                 return 0.0
         return 0.0
 
     def initial_states(self, x: np.ndarray, loads=None) -> np.ndarray:
-        """Virgin law states at displacements x (m) and normal loads ``loads`` (N;
-        default the loads at t = 0, event-snapped: a re-contact at t = 0 starts
-        the virgin curve there)."""
+        """Virgin law states at displacements x (m) and prescribed normal loads
+        ``loads`` (N; default the loads at t = 0, event-snapped: a re-contact
+        at t = 0 starts the virgin curve there); a spring contact's load
+        comes from x."""
         S = np.zeros((self.nc, self.pack.slen))
-        u = tangential_history(self.pack.kin.arrays, np.ascontiguousarray(x, dtype=np.float64)[None, :])[0]
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        u = tangential_history(self.pack.kin.arrays, x[None, :])[0]
+        n_x = normal_history(self.pack.kin.arrays, x[None, :], np.zeros(1), self.w)[0]
         for i, law in enumerate(self.pack.laws):
-            if loads is not None:
+            if self.pack.kin.normal_kind[i] == NORMAL_SPRING:
+                n_at0 = n_x[i]
+            elif loads is not None:
                 n_at0 = loads[i]
             elif self.grid is not None:
                 n_at0 = self.grid[1][0, i]
@@ -283,10 +336,12 @@ class Model:
 
 
 def make_model(system, w: float, steps_per_period: int, *, events: bool = True,
-               force_scale: float | None = None) -> Model:  # fmt: skip
+               force_scale: float | None = None, refined: bool = False) -> Model:  # fmt: skip
     """A :class:`Model` of ``system`` at forcing frequency ``w`` (rad/s; 0: sampled loads).
 
-    ``steps_per_period`` is raised so that w_max h <= ``TI_MAX_OMEGA_H``.
+    ``steps_per_period`` is raised so that w_max h <= ``TI_MAX_OMEGA_H``
+    (w_max: every contact stuck, every normal spring closed), and with
+    ``refined`` (a normal spring opens) so that w_max h <= ``TI_SPRING_OMEGA_H``.
     ``events=False`` (for the convergence study only): no step boundaries
     at separation/re-contact and no splits at velocity reversals.
     ``force_scale`` (N, default the largest forcing amplitude) sets the
@@ -295,8 +350,10 @@ def make_model(system, w: float, steps_per_period: int, *, events: bool = True,
     pack = pack_system(system)
     w = float(w)
     J = int(steps_per_period)
+    refined = bool(refined) and pack.springs
     if w > 0:
-        J = max(J, int(math.ceil(2 * math.pi * pack.w_max / (w * config.TI_MAX_OMEGA_H))))
+        wh = config.TI_SPRING_OMEGA_H if refined else config.TI_MAX_OMEGA_H
+        J = max(J, int(math.ceil(2 * math.pi * pack.w_max / (w * wh))))
     fs = pack.fmax if force_scale is None else force_scale
     xcap0 = config.TI_BLOWUP_FACTOR * (fs / pack.kmin + pack.xlin + 1e-12)
     xcap = np.empty(2 * pack.ndof)
@@ -308,7 +365,16 @@ def make_model(system, w: float, steps_per_period: int, *, events: bool = True,
         grid, period = _harmonic_tables(pack, tg, Ng, w), 2 * math.pi / w
     return Model(pack=pack, system=system, w=w, events=bool(events),
                  max_split=config.TI_MAX_SPLITS if events else 0, J=J, xcap0=xcap0, xcap=xcap,
-                 grid=grid, period=period)  # fmt: skip
+                 grid=grid, period=period, steps_per_period=int(steps_per_period), refined=refined)  # fmt: skip
+
+
+def refine_if_opened(model: Model, summary) -> Model | None:
+    """The refined model (``TI_SPRING_OMEGA_H``) if a normal spring of
+    ``model`` opened during the repetitions of ``summary`` and the model is
+    not refined yet; else None."""
+    if model.refined or not model.pack.springs or not np.any(summary[:, S_OPEN] > 0):
+        return None
+    return make_model(model.system, model.w, model.steps_per_period, events=model.events, refined=True)
 
 
 @dataclass(frozen=True, slots=True)
@@ -339,7 +405,7 @@ def run(model: Model, grid: Grid, mode: int, x, v, S, nper: int, *, rdof: int = 
     pack = model.pack
     summ = np.zeros((nper, N_SUMMARY))
     zend = np.zeros((nper, 2 * pack.ndof))
-    control = (mode, nper, 0.0, model.w, rdof, model.max_split, record)
+    control = (mode, nper, 0.0, model.w, rdof, model.max_split, record, config.TI_RECONTACT_ALPHA)
     io = (x, v, S, model.cap(x, v))
     if record:
         x0, v0, S0 = x.copy(), v.copy(), S.copy()

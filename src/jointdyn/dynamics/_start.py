@@ -143,9 +143,11 @@ _DF_GRID = (_DF_NS, _DF_TH, np.sin(_DF_TH), np.cos(_DF_TH))
 def linear_start(model):
     """Equivalent-linearisation estimate of the periodic state at phase 0.
 
-    Solves (K - w^2 M + i w C + sum_c k_c B_c B_c^T) X = f with k_c the
+    Solves (K + Kn - w^2 M + i w C + sum_c k_c B_c B_c^T) X = f e^{i phi}
+    (Kn: the normal springs closed, phi: the forcing phases) with k_c the
     describing function (first harmonic of T over one cycle of
-    u = Im(U e^{i w t}) with the actual N_c(t), marched with the real law),
+    u = Im(U e^{i w t}) with the prescribed N_c(t), a spring contact at its
+    preload, marched with the real law),
     started from the stuck stiffness kt and iterated with relaxation 1/2
     until X changes by less than ``config.SS_LINEAR_RTOL`` (at most
     ``config.SS_LINEAR_ITERS`` solves). The iteration is one compiled call
@@ -155,8 +157,8 @@ def linear_start(model):
     """
     pk = model.pack
     w = model.w
-    Z0 = pk.K - w * w * pk.M + 1j * w * pk.C
-    f = pk.fvec.astype(np.complex128)
+    Z0 = pk.K_closed - w * w * pk.M + 1j * w * pk.C
+    f = pk.fsin + 1j * pk.fcos
     ns, th, sin_th, cos_th = _DF_GRID
     loads = load_table(pk.kin.arrays, th, 1.0).T.copy()
     S = np.zeros((pk.ncontacts, pk.slen))

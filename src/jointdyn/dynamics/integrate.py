@@ -22,7 +22,7 @@ from .. import config
 from ..kinematics import sampled_load_grid
 from ..systems import System
 from ._core import LOADS_SAMPLED
-from ._model import Model, make_model, run
+from ._model import Model, make_model, refine_if_opened, run
 from .status import RunStatus
 
 __all__ = ["Trajectory", "Restart", "integrate", "integrate_sampled"]
@@ -132,7 +132,10 @@ def integrate(
     steps_per_period : int, optional
         Base steps per forcing period (default ``config.TI_STEPS_PER_PERIOD``);
         raised automatically so that w_max h <= ``config.TI_MAX_OMEGA_H``
-        for the stiffest stuck mode; events and reversals add steps.
+        for the stiffest mode with every contact stuck and every normal
+        spring closed, and (the run repeated) so that w_max h <=
+        ``config.TI_SPRING_OMEGA_H`` when a normal spring opens; events and
+        reversals add steps.
     x0, v0 : array_like, optional
         Initial displacements (m) and velocities (m/s); default rest.
     states : array_like, optional
@@ -155,7 +158,12 @@ def integrate(
     if start is not None:
         x0, v0, states = start.x, start.v, start.states
     x, v, S = _start_vectors(model, x0, v0, states)
+    start = (x.copy(), v.copy(), S.copy())
     res = model.run_periods(x, v, S, periods, rec=True)
+    finer = refine_if_opened(model, res.summary)
+    if finer is not None:  # a normal spring opened: again with the refined steps
+        x, v, S = (a.copy() for a in start)
+        res = finer.run_periods(x, v, S, periods, rec=True)
     return _trajectory(res, x, v, S)
 
 
@@ -208,6 +216,8 @@ def integrate_sampled(
         evaluated at the samples.
     normal : array_like (nt, ncontacts) or callable
         Normal loads at the samples, N; or a callable ``N(t) -> (ncontacts,)``.
+        The column of a contact with a normal spring is not read (its load
+        comes from the state).
     x0, v0, states, start
         As in :func:`integrate`.
 
@@ -224,6 +234,9 @@ def integrate_sampled(
     F = _as_samples("force", force, t, n)
     N = _as_samples("normal", normal, t, nc) if nc else np.zeros((t.size, 0))
     model = make_model(system, 0.0, 4, force_scale=float(np.max(np.abs(F))))
+    N = N.copy()
+    for c in model.pack.kin.springs:  # a spring's load comes from the state: its column is not read
+        N[:, c] = model.pack.kin.normal_par[c, 0]
     tg, Fg, Ng = sampled_load_grid(t, F, N, config.TI_RECONTACT_ALPHA)
     if start is not None:
         x0, v0, states = start.x, start.v, start.states
@@ -231,6 +244,7 @@ def integrate_sampled(
     x, v, S = _start_vectors(model, x0, v0, states)
     if fresh:
         S = np.ascontiguousarray(model.initial_states(x, Ng[0]))
-    grid = (tg, Ng, Fg, np.zeros(0), np.zeros(0), np.zeros((0, 0)))
+    z = np.zeros(0)
+    grid = (tg, Ng, Fg, (z, z, z, z), np.zeros((0, 0)))
     res = run(model, grid, LOADS_SAMPLED, x, v, S, 1, record=True, capacity=tg.size * (1 + 2 * nc) + 8)
     return _trajectory(res, x, v, S)

@@ -10,7 +10,7 @@ from __future__ import annotations
 from ..status import Status
 from ._core import RUN_BLOWUP, RUN_OK, RUN_OVERFLOW
 
-__all__ = ["RunStatus", "SteadyStatus", "run_status"]
+__all__ = ["EnergyCheck", "RunStatus", "SteadyStatus", "run_status"]
 
 
 class RunStatus(Status):
@@ -43,3 +43,18 @@ class SteadyStatus(Status):
     PERIODIC = "periodic", "the response repeats with the forcing period or a small multiple of it", True
     NOT_SETTLED = "not-settled", "no periodic state within the period budget (see the detail)"
     UNBOUNDED = "unbounded", "the response grows without bound (or the integration blew up)"
+
+
+class EnergyCheck(Status):
+    """Passivity check of a periodic steady state (:attr:`SteadyState.energy_check`).
+
+    Over a periodic orbit a passive contact dissipates ``energy_contact_J >=
+    0``; a value below zero by more than the period's energy-balance residual
+    (plus a rounding floor, ``config.SS_DISSIPATION_FLOOR``) means that the
+    contact law created energy (e.g. the paper's closed form at some points)
+    or that the orbit is not accurate enough to tell.
+    """
+
+    PASSIVE = "passive", "the contact dissipates energy over the period (within the energy-balance residual)", True
+    NEGATIVE_DISSIPATION = "negative-dissipation", "the contact creates energy over the period, beyond the residual"
+    NOT_CHECKED = "not-checked", "no periodic state to check", True

@@ -16,6 +16,7 @@ neutral (a multiplier 1).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -25,13 +26,13 @@ from .. import config
 from .._jit import jit
 from ..systems import System
 from ._core import N_SUMMARY, S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
-from ._model import Model, make_model
+from ._model import Model, make_model, refine_if_opened
 from ._start import clean_states, linear_start
 from .integrate import Restart, Trajectory, _omega, _trajectory
 from .monodromy import fd_monodromy
-from .status import SteadyStatus
+from .status import EnergyCheck, SteadyStatus
 
-__all__ = ["SteadyState", "steady_state"]
+__all__ = ["SteadyState", "energy_check", "steady_state"]
 
 
 @dataclass(frozen=True)
@@ -78,6 +79,11 @@ class SteadyState:
         Newton iterations spent in shooting (0 if not used).
     floquet_max : float
         Largest |Floquet multiplier| from the last shooting Jacobian (NaN if none).
+    energy_check : EnergyCheck
+        ``"passive"``, ``"negative-dissipation"`` (the contact created energy
+        over the period beyond the energy-balance residual; a
+        ``RuntimeWarning`` is issued too) or ``"not-checked"`` (not
+        periodic); see :func:`energy_check`.
     last_amplitude_m : float
         Half peak-to-peak of the last integrated period, m (diagnostic; not a result).
     restart : Restart
@@ -102,6 +108,7 @@ class SteadyState:
     steps: int
     shooting_iterations: int
     floquet_max: float
+    energy_check: EnergyCheck
     last_amplitude_m: float
     restart: Restart = field(repr=False)
     loop: Trajectory | None = field(default=None, repr=False)
@@ -116,7 +123,7 @@ class SteadyState:
         keys = (
             "status", "detail", "period_multiple", "gamma", "omega", "amplitude_q", "amplitude_m",
             "offset_m", "max_abs_m", "energy_contact_J", "energy_viscous_J", "work_force_J",
-            "periods", "steps", "shooting_iterations", "floquet_max", "last_amplitude_m",
+            "periods", "steps", "shooting_iterations", "floquet_max", "energy_check", "last_amplitude_m",
         )  # fmt: skip
         return {k: getattr(self, k) for k in keys}
 
@@ -541,18 +548,25 @@ def _need_shoot(hist, model, growing, amp_rtol, chunk) -> bool:
 def _settle(model, st: _March, K, maxp, amp_rtol, energy_rtol, rdof, shooting):
     """Integrate chunks of periods (shooting over slow transients) until classified.
 
-    Returns (status or None when max_periods ran out, detail, p).
+    Once a normal spring opens, the model is replaced by its refined twin
+    (:func:`~jointdyn.dynamics._model.refine_if_opened`) and the history
+    starts again. Returns (status or None when max_periods ran out, detail,
+    p, the model in use).
     """
     chunk = max(config.SS_CHUNK, K)
     while True:
         nrun = int(min(chunk, maxp - st.counters["periods"]))
         if nrun <= 0:
-            return None, "", 0
+            return None, "", 0, model
         res = model.run_periods(st.x, st.v, st.S, nrun, rdof=rdof)
         _booker(st.counters)(res)
         st.hist.add(res.summary, res.z_end)
         if not res.status.ok:
-            return SteadyStatus.UNBOUNDED, "blow-up", 0
+            return SteadyStatus.UNBOUNDED, "blow-up", 0, model
+        finer = refine_if_opened(model, res.summary)
+        if finer is not None:
+            model, st.hist = finer, _History(np.concatenate([st.x, st.v]))
+            continue
         p_found = _period_multiple(st.hist, model, K, amp_rtol, energy_rtol)
         long_p = 0 if p_found else _long_period(st.hist, K, model, amp_rtol, energy_rtol)
         growing = False if (p_found or long_p) else _growing(st.hist, model, amp_rtol)
@@ -565,13 +579,13 @@ def _settle(model, st: _March, K, maxp, amp_rtol, energy_rtol, rdof, shooting):
             if st.shoot(model, rdof, amp_rtol):
                 continue
         if p_found:
-            return SteadyStatus.PERIODIC, "shooting" if st.counters["shoot"] else "integration", p_found
+            return SteadyStatus.PERIODIC, "shooting" if st.counters["shoot"] else "integration", p_found, model
         if long_p:
-            return SteadyStatus.NOT_SETTLED, f"period-{long_p}", 0
+            return SteadyStatus.NOT_SETTLED, f"period-{long_p}", 0, model
         if growing and not can_shoot:
-            return SteadyStatus.UNBOUNDED, "growing", 0
+            return SteadyStatus.UNBOUNDED, "growing", 0, model
         if st.counters["periods"] >= maxp or (not can_shoot and _stalled(st.hist, model)):
-            return None, "", 0
+            return None, "", 0, model
         if can_shoot and _need_shoot(st.hist, model, growing, amp_rtol, chunk):
             st.shoot(model, rdof, amp_rtol)
 
@@ -672,7 +686,7 @@ def steady_state(
     model = make_model(system, w, spp, events=_events)
     x, v, S = _first_state(model, start)
     st = _March(x, v, S, _History(np.concatenate([x, v])), {"periods": 0, "steps": 0, "shoot": 0})
-    status, detail, p_found = _settle(model, st, K, maxp, amp_rtol, energy_rtol, rdof, shooting)
+    status, detail, p_found, model = _settle(model, st, K, maxp, amp_rtol, energy_rtol, rdof, shooting)
     if status is None:
         # did not settle within max_periods: say why if we can
         status = SteadyStatus.NOT_SETTLED
@@ -683,16 +697,40 @@ def steady_state(
     nan = math.nan
     vals = dict(amplitude_q=nan, amplitude_m=nan, offset_m=nan, max_abs_m=nan,
                 energy_contact_J=nan, energy_viscous_J=nan, work_force_J=nan)  # fmt: skip
-    loop = None
+    loop, check = None, EnergyCheck.NOT_CHECKED
     if status.ok:
         vals, loop = _periodic_values(model, st, p_found, rdof, keep_loop)
+        check = energy_check(vals["work_force_J"], vals["energy_contact_J"], vals["energy_viscous_J"])
+        if check is EnergyCheck.NEGATIVE_DISSIPATION:
+            warnings.warn(f"steady_state at gamma {gamma:g}: the contact dissipates {vals['energy_contact_J']:.3e} J "
+                          f"per period (< 0 beyond the energy-balance residual): {check.message}",
+                          RuntimeWarning, stacklevel=2)  # fmt: skip
     return SteadyState(
         status=status, detail=detail, period_multiple=int(p_found), gamma=float(gamma), omega=w,
         periods=int(math.ceil(st.counters["periods"])), steps=int(st.counters["steps"]),
-        shooting_iterations=int(st.counters["shoot"]), floquet_max=float(st.floq),
+        shooting_iterations=int(st.counters["shoot"]), floquet_max=float(st.floq), energy_check=check,
         last_amplitude_m=float(last_amp), restart=Restart(st.x.copy(), st.v.copy(), st.S.copy()), loop=loop,
         **vals,
     )  # fmt: skip
+
+
+def energy_check(work_force_J: float, energy_contact_J: float, energy_viscous_J: float) -> EnergyCheck:
+    """Passivity of the contacts over a periodic orbit, from its energies per period (J).
+
+    Flags ``energy_contact_J < -tol`` with ``tol = |W - E_contact -
+    E_viscous| + config.SS_DISSIPATION_FLOOR (|W| + |E_contact| +
+    |E_viscous|)``: the period's energy-balance residual bounds the
+    quadrature and transient error of the contact's integral, so a value
+    beyond it is energy created by the contact law.
+
+    Returns
+    -------
+    EnergyCheck
+        ``PASSIVE`` or ``NEGATIVE_DISSIPATION``.
+    """
+    W, Ec, Ev = float(work_force_J), float(energy_contact_J), float(energy_viscous_J)
+    tol = abs(W - Ec - Ev) + config.SS_DISSIPATION_FLOOR * (abs(W) + abs(Ec) + abs(Ev))
+    return EnergyCheck.NEGATIVE_DISSIPATION if Ec < -tol else EnergyCheck.PASSIVE
 
 
 def _first_state(model, start):

@@ -141,6 +141,7 @@ class HBProblem:
         (system DOF numbers; None: every DOF)."""
         if not isinstance(system, System):
             raise ValueError("system must be a jointdyn.System")
+        system.require_prescribed_single_law("harmonic balance")
         if dofs is None:
             dofs = np.arange(system.ndof)
         self.H = V.positive_int("harmonics", harmonics, 1)

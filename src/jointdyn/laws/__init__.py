@@ -30,6 +30,7 @@ for _module in _pkgutil.iter_modules(__path__):
     if not _module.name.startswith("_"):
         _importlib.import_module(f"{__name__}.{_module.name}")
 
+from ._dispatch import MAX_LAW_SLOTS, LawDispatch, law_dispatch  # noqa: E402
 from .discrete import DiscreteIwan, Jenkins  # noqa: E402
 from .exact import Iwan  # noqa: E402
 from .iwan_closed import IwanClosedForm, backbone  # noqa: E402
@@ -53,4 +54,7 @@ __all__ = [
     "law_parameters",
     "law_summary",
     "canonical_law_params",
+    "MAX_LAW_SLOTS",
+    "LawDispatch",
+    "law_dispatch",
 ]

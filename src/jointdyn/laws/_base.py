@@ -13,7 +13,10 @@ Every contact law provides four compiled kernels (compiled with
     init(params, x0, n0, s)
     init_jvp(params, x0, dx0, n0, dn0, s, ds)
 
-``params``  float64[:]   the law's parameters (from ``law.params``)
+``params``  float64[:]   the law's parameters (``law.params``), possibly followed by
+                         more entries (padding to a common width, the slot of
+                         a mixed-law dispatch, laws/_dispatch.py): a kernel
+                         reads its own leading entries only
 ``s_old``   float64[:]   committed state, length ``law.state_size``
 ``s_new``   float64[:]   trial state (same length)
 ``x``       float        tangential relative displacement, m
