@@ -12,4 +12,4 @@ version are recomputed rather than reused.
 __all__ = ["SOLVER_VERSION"]
 
 #: results version of the time-domain solver (see the module docstring)
-SOLVER_VERSION = 1
+SOLVER_VERSION = 2
