@@ -363,9 +363,15 @@ def _run_time(args, gammas):
             "gamma": _jsonable(one.gamma.values),
             **{v: _jsonable(one[v].values) for v in ("amplitude_q", "amplitude_m", "offset_m", "max_abs_m")},
             "status": [status_name(c) for c in one.status.values],
+            "negative_dissipation": [bool(v) for v in one.negative_dissipation.values],
         }
         if "contact" in one.dims or "dof" in one.dims:
             result["directions"][d].update(_loop_outputs(one))
+    flagged = int(line.negative_dissipation.sum())
+    if flagged:
+        print(f"jointdyn frc: warning: {flagged} periodic points where the contact creates energy over the period "
+              "(negative dissipation beyond the energy-balance residual; negative_dissipation in the results)",
+              file=sys.stderr)
     if result["reused_points"] or ds.attrs.get("stale_points"):
         stale = int(ds.attrs.get("stale_points", 0))
         note = f"; recomputed {stale} points saved by another solver version" if stale else ""
