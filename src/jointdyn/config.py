@@ -164,6 +164,10 @@ HB_FINE_SAMPLES = 1024
 HB_MAX_PASSES = 8
 #: two consecutive marched periods agree when max|T_p - T_(p-1)| <= rtol max|T|
 HB_PERIODIC_RTOL = 1e-10
+#: load at which the AFT restarts a contact law at a re-contact phase between
+#: two samples, as a fraction of the contact's largest |N| (> 0: the law is
+#: in contact and at rest there, as the time integrator's TI_RECONTACT_ALPHA)
+HB_RECONTACT_ALPHA = 1e-12
 
 # --- continuation (jointdyn.continuation; unknowns, parameter and residual scaled) ----
 #: Newton converged when max|R| <= this (scaled residual; harmonic balance
