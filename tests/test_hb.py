@@ -153,8 +153,8 @@ def test_eta_1p5_time_domain_sweeps_jump_at_the_hb_turning_points():
 
     ds = frc_hb(System.paper_damper(eta=1.5, beta=2.0, model="iwan-paper"), 1.0, 1.3, samples=512)
     assert ds.attrs["status"] == "complete"
-    tp = np.flatnonzero(ds.turning.values)
-    assert tp.size == 2 and ds.attrs["folds"] >= 2
+    tp = np.flatnonzero(ds.fold.values)
+    assert tp.size == 2 and ds.attrs["folds"] == 2
     gB, gA = np.sort(ds.gamma.values[tp])
     assert gA - gB > 5e-3
     qA, qB = ds.amplitude_q.values[tp[0]], ds.amplitude_q.values[tp[1]]
@@ -183,7 +183,7 @@ def test_eta_1p5_discrete_ground_truth_has_no_jump(model, params):
     # from the closed form's approximation
     ds = frc_hb(System.paper_damper(eta=1.5, beta=2.0, model=model, law_params=params), 1.0, 1.3, samples=512)
     assert ds.attrs["status"] == "complete"
-    assert not ds.fold.values.any() and not ds.turning.values.any()
+    assert not ds.fold.values.any()
     assert ds.stable.values.all()
     assert np.all(np.diff(ds.gamma.values) > 0)
 
@@ -194,7 +194,11 @@ def test_hill_agrees_with_monodromy():
     br = continue_hb(System.paper_damper(eta=10.0, beta=2.0, model="iwan-closed"), 0.5, 2.0)
     f = np.flatnonzero(br.fold)
     assert f.size >= 2
-    picks = [f[0] - 3, (f[0] + f[-1]) // 2, f[-1] + 3, br.lam.size // 4]
+    # the fold pair that encloses the unstable stretch (the closed form's steep corners are folds too)
+    u = np.flatnonzero(~br.stable)
+    assert u.size
+    lo, hi = f[f <= u[0]].max(), f[f >= u[-1]].min()
+    picks = [lo - 3, (lo + hi) // 2, hi + 3, br.lam.size // 4]
     seen = set()
     for i in picks:
         ev = br.problem.evaluate(br.X[i], br.lam[i])

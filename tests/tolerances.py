@@ -79,3 +79,7 @@ TEST_EXACT_ENERGY_RTOL = 1e-5
 #: rounding floor of a period's contact dissipation (units of fy x_slip, the
 #: contact's energy scale): added to the point's energy-balance residual
 TEST_DISSIPATION_FLOOR = 1e-12
+#: harmonic-balance branches: largest distance between the straight line
+#: joining two reported points and the curve, in the plane (gamma, ln q)
+#: (0.01: 1 % of the amplitude; issue 9)
+TEST_HB_CHORD_TOL = 1e-2

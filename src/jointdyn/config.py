@@ -220,6 +220,18 @@ CONT_MAX_JUMPS = 5
 #: a jump's guess follows the tangent when its parameter component exceeds
 #: this (else the last point's unknowns)
 CONT_JUMP_TANGENT_MIN = 1e-3
+#: largest deviation between the straight line joining consecutive points of
+#: a branch and the curve, in the plane (parameter, observable) (harmonic
+#: balance: gamma and the logarithm of the amplitude, so 0.005 is half a
+#: percent of the amplitude or 0.005 in gamma)
+CONT_CHORD_TOL = 0.005
+#: refinement of a maximum along a branch (peaks): at most this many
+#: corrections, until the bracket is this fraction of its first width or the
+#: observable varies by at most CONT_REFINE_GTOL across it (harmonic
+#: balance: log q, so 1e-9 is a relative 1e-9 of the amplitude)
+CONT_REFINE_ITER = 30
+CONT_REFINE_STOL = 1e-6
+CONT_REFINE_GTOL = 1e-9
 #: bordered linear systems (Newton corrections, tangents) of at most this
 #: many unknowns are solved by the compiled elimination of
 #: jointdyn.continuation, larger ones by LAPACK (benchmarks/bench_linalg.py:
@@ -252,10 +264,24 @@ HB_SATURATION_Q = 30.0
 HB_SATURATION_SLIP_FRACTION = 0.9
 #: a Floquet exponent with Re(s) > HB_STABILITY_RTOL * w marks instability
 HB_STABILITY_RTOL = 1e-6
+#: a Hill growth Re(s)/w between HB_STABILITY_RTOL and this is decided by
+#: the monodromy matrix of the time-domain period map (Hill's method
+#: truncated to H harmonics errs by a few 1e-6 at corners of the contact
+#: force: the onset of slip of an undamped oscillator)
+HB_STABILITY_CONFIRM = 1e-4
 #: Hill companion matrices (2 n (2H+1) rows), or their parity blocks, of at
 #: most this many rows go through the compiled EISPACK eigenvalue solver,
 #: larger ones through LAPACK (benchmarks/bench_linalg.py: the compiled
 #: solver is 1.3-3.7x faster up to 150 rows, LAPACK 1.1-1.3x faster from 300)
 HB_SMALL_EIG = 200
-#: turning points of a branch (secant): dead band as a fraction of the range
+#: turning points (folds) of a branch: the parameter must come back by more
+#: than this fraction of the range, or log q move by more than
+#: HB_TURNING_BAND_LOG_Q while the parameter is short of its extreme (a fold
+#: whose branches are close in the parameter): the jitter of points at a
+#: non-smooth corner stays within both
 HB_TURNING_BAND = 5e-4
+HB_TURNING_BAND_LOG_Q = 5e-3
+#: a local maximum of the amplitude along a branch is a peak when the
+#: amplitude falls by more than this fraction of it on both sides (before
+#: rising above it again)
+HB_PEAK_PROMINENCE = 1e-3

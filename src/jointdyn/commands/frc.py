@@ -272,9 +272,19 @@ def _hb_branches(ds) -> list:
         sub = ds.isel(point=np.flatnonzero(ids == b))
         br = {v: _jsonable(sub[v].values) for v in ("gamma", "amplitude_q", "amplitude_m", "offset_m", "max_abs_m")}
         br["stable"] = [bool(s) for s in np.asarray(sub["stable"].values)]
+        br["point_status"] = [str(s) for s in np.asarray(sub["point_status"].values)]
         br["folds"] = [int(i) for i in np.flatnonzero(np.asarray(sub["fold"].values, bool))]
         out.append(br)
     return out
+
+
+def _hb_peaks(ds) -> list:
+    """The refined peaks of an hb Dataset (dim ``peak``) as JSON objects."""
+    names = {"gamma": "peak_gamma", "amplitude_q": "peak_amplitude_q", "amplitude_m": "peak_amplitude_m",
+             "branch": "peak_branch", "refined": "peak_refined"}
+    cols = {k: np.asarray(ds[v].values).tolist() for k, v in names.items()}
+    return [{k: (None if isinstance(c[i], float) and not math.isfinite(c[i]) else c[i]) for k, c in cols.items()}
+            for i in range(ds.sizes.get("peak", 0))]
 
 
 def _run_hb(args, gammas):
@@ -293,14 +303,18 @@ def _run_hb(args, gammas):
     )
     if gammas.size < 2:
         raise ValueError("--gamma must span a range (STOP > START) for --method hb")
+    # the grid's STEP is the largest gamma spacing of the branch (the step control may take smaller ones)
+    step = float(gammas[1] - gammas[0])
     ds = frc_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics, samples=args.samples,
-                progress=None if not args.json else False)
+                max_step=step, progress=None if not args.json else False)
     result = _header(args)
     result["harmonics"] = args.harmonics
     result["samples"] = args.samples
     result["branches"] = _hb_branches(ds)
+    result["peaks"] = _hb_peaks(ds)
     result["status"] = str(ds.attrs.get("status", ""))
     result["message"] = str(ds.attrs.get("message", ""))
+    result["uncovered"] = str(ds.attrs.get("uncovered", ""))
     return ds, result
 
 
@@ -324,15 +338,7 @@ def _plot(result, path: Path) -> None:
                            linestyle=style, label=f"sweep {d}", rug_y=0.03 if d == "up" else 0.07)
         mark_legend(ax, fontsize=8)
     else:
-        for i, br in enumerate(result["branches"]):
-            g = np.array(br["gamma"], float)
-            a = np.array([np.nan if v is None else v for v in br["amplitude_q"]], float)
-            st = np.array(br["stable"], bool)
-            ax.plot(g, np.where(st, a, np.nan), "-", color="C0", label="stable" if i == 0 else None)
-            ax.plot(g, np.where(~st, a, np.nan), "--", color="C1", label="unstable" if i == 0 else None)
-            if br["folds"]:
-                ax.plot(g[br["folds"]], a[br["folds"]], "ks", ms=4, label="fold" if i == 0 else None)
-        ax.legend(fontsize=8)
+        _plot_hb(ax, result)
     load = f"beta = {result['beta']:g}" if result.get("beta") is not None else ""
     ax.set_title(f"{result['method']}: eta = {result['eta']:g}, {load}, delta = {result['delta_deg']:g} deg, "
                  f"{result['model']}", fontsize=9)
@@ -343,6 +349,54 @@ def _plot(result, path: Path) -> None:
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=120)
     plt.close(fig)
+
+
+#: point statuses of an hb branch that are joined to the point before them by a line
+_JOINED = ("joined", "corner")
+
+
+def _plot_hb(ax, result) -> None:
+    """hb branches: stable (solid) and unstable (dashed) lines, broken before every point not joined to
+    the previous one; folds (squares), points where a segment stopped short (red x), refined peaks (^)."""
+    first = {}
+    for br in result["branches"]:
+        g = np.array(br["gamma"], float)
+        a = np.array([np.nan if v is None else v for v in br["amplitude_q"]], float)
+        st = np.array(br["stable"], bool)
+        cut = np.flatnonzero([s not in _JOINED for s in br["point_status"]])
+        # a NaN row between two points that are not joined breaks the line there
+        g, a, st = (np.insert(v, cut[cut > 0], f) for v, f in ((g, np.nan), (a, np.nan), (st, True)))
+        for sel, style, c, name in ((st, "-", "C0", "stable"), (~st, "--", "C1", "unstable")):
+            ax.plot(g, np.where(sel, a, np.nan), style, color=c, label=name if name not in first else None)
+            first[name] = True
+        gp = np.array(br["gamma"], float)
+        ap = np.array([np.nan if v is None else v for v in br["amplitude_q"]], float)
+        marks = ((br["folds"], "ks", "fold"),
+                 ([i for i, s in enumerate(br["point_status"]) if s == "stopped"], "rx", "stopped short"),
+                 ([i for i, s in enumerate(br["point_status"]) if s == "after-jump"], "k|", "after a jump"))
+        for idx, fmt, name in marks:
+            if len(idx):
+                ax.plot(gp[idx], ap[idx], fmt, ms=6, label=name if name not in first else None)
+                first[name] = True
+    for pk in result.get("peaks", []):
+        if pk["amplitude_q"] is not None:
+            ax.plot([pk["gamma"]], [pk["amplitude_q"]], "^", color="C2", ms=5,
+                    label="peak" if "peak" not in first else None)
+            first["peak"] = True
+    if result["status"] != "complete":
+        ax.text(0.01, 0.98, f"status: {result['status']}", transform=ax.transAxes, va="top", fontsize=8,
+                color="C3")
+    ax.legend(fontsize=8)
+
+
+def exit_status(result) -> int:
+    """0, or :data:`jointdyn.cli.EXIT_INCOMPLETE` for an hb branch that does not cover the range and is
+    not unbounded (failed, turned back, stopped at its point bound)."""
+    from ..cli import EXIT_INCOMPLETE
+
+    if result["method"] == "hb" and result["status"] not in ("complete", "unbounded"):
+        return EXIT_INCOMPLETE
+    return 0
 
 
 def run(args) -> int:
@@ -370,7 +424,12 @@ def run(args) -> int:
         print(json.dumps(result))
     else:
         _print_table(result)
-    return 0
+    rc = exit_status(result)
+    if rc:
+        import sys
+
+        print(f"jointdyn frc: incomplete: {result['status']}: {result['message']}", file=sys.stderr)
+    return rc
 
 
 def _digits(values, least: int = 4) -> int:

@@ -3,7 +3,7 @@ Jacobians, arc-length continuation (:mod:`jointdyn.continuation`) in a
 parameter object (:mod:`jointdyn.hb.parameters`), Hill stability,
 unbounded-response detection (see docs/harmonic-balance.md)."""
 
-from .frc import HBBranch, HBSolution, branch_dataset, continue_hb, frc_hb, harmonic_balance
+from .frc import HBBranch, HBPeak, HBSolution, PointStatus, branch_dataset, continue_hb, frc_hb, harmonic_balance
 from .parameters import DELTA, ETA, F1, GAMMA, N0, PARAMETERS, HBParameter, SystemParameter, parameter_named
 from .problem import HBProblem
 from .monodromy import monodromy_multipliers
@@ -16,6 +16,8 @@ __all__ = [
     "HBSolution",
     "branch_dataset",
     "HBBranch",
+    "HBPeak",
+    "PointStatus",
     "HBProblem",
     "HBParameter",
     "SystemParameter",
