@@ -130,8 +130,8 @@ def test_incomplete_branch_exits_3_and_writes_marked_files(capsys, tmp_path, mon
 
     import jointdyn.hb as hb
 
-    real = hb.frc_hb
-    monkeypatch.setattr(hb, "frc_hb", lambda *a, **k: real(*a, max_points=12, **k))
+    real = hb.continue_hb
+    monkeypatch.setattr(hb, "continue_hb", lambda *a, **k: real(*a, max_points=12, **k))
     rc, out, err = _cli_hb(capsys, "--eta", "0.5", "--beta", "2", out=tmp_path)
     assert rc == EXIT_INCOMPLETE == 3
     assert out["status"] == "max-points" and out["uncovered"]
@@ -152,3 +152,20 @@ def test_api_status_of_a_partial_branch():
     assert ds.attrs["status"] == "max-points" and not math.isnan(float(ds.gamma.values[-1]))
     assert ds.point_status.values[-1] == PointStatus.STOPPED.value
     assert "not computed" in ds.attrs["message"]
+
+
+@pytest.mark.parametrize("model,eta,beta", [("iwan", 0.01, 0.1), ("iwan", 10.0, 0.1), ("iwan", 0.5, 2.0),
+                                            ("iwan", 1.5, 5.0), ("iwan-closed", 0.01, 1000.0),
+                                            ("iwan-paper", 1.5, 10.0), ("jenkins", 1.5, 1.0)])
+def test_robustness_grid_subset(model, eta, beta):
+    # docs/hb-robustness.md: covered (or unbounded below Den Hartog's bound, beta = 0.1) and the highest
+    # peak within 1 % of the time domain started on the HB orbit
+    from jointdyn.sweeps.hb_grid import grid_case, grid_table
+
+    c = grid_case(model, eta, beta)
+    assert c.covered and c.ok, c.message
+    assert c.status == ("unbounded" if beta < math.pi / 4 else "complete")
+    if beta > math.pi / 4:
+        assert abs(c.peak_error) <= tolerances.TEST_HB_VS_TIME_RTOL
+    row = grid_table([c]).splitlines()[2]
+    assert row.startswith(f"| {model} | {eta:g} | {beta:g} | {c.status} |") and row.endswith("| yes |")

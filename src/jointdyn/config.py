@@ -179,6 +179,9 @@ CONT_MAX_ITER = 12
 CONT_DS_START = 0.05
 CONT_DS_MIN = 1e-6
 CONT_DS_MAX = 0.1
+#: ... or this fraction of the norm of the unknowns where that is larger
+#: (a flank growing without bound: as many points per decade as a small one)
+CONT_DS_MAX_REL = 0.02
 #: bound on the points of a branch
 CONT_MAX_POINTS = 2000
 #: predictor direction: "tangent" or "secant"

@@ -102,6 +102,10 @@ class ContinuationOptions:
     ds_min, ds_max : float
         Smallest and largest step; below ``ds_min`` a failed corrector ends
         the branch (after the jumps below).
+    ds_max_rel : float
+        Where the unknowns are large, the largest step is this fraction of
+        their norm instead of ``ds_max`` (a response growing without bound
+        is followed in as many steps per decade as a small one).
     max_points : int
         Bound on the points of a branch (>= 1).
     tol : float
@@ -160,6 +164,7 @@ class ContinuationOptions:
     ds: float = config.CONT_DS_START
     ds_min: float = config.CONT_DS_MIN
     ds_max: float = config.CONT_DS_MAX
+    ds_max_rel: float = config.CONT_DS_MAX_REL
     max_points: int = config.CONT_MAX_POINTS
     tol: float = config.CONT_TOL
     max_iter: int = config.CONT_MAX_ITER
@@ -183,7 +188,7 @@ class ContinuationOptions:
     chord_tol: float = config.CONT_CHORD_TOL
 
     def __post_init__(self) -> None:
-        for name in ("ds", "ds_min", "ds_max", "tol", "grow", "max_distance", "corner_ds"):
+        for name in ("ds", "ds_min", "ds_max", "ds_max_rel", "tol", "grow", "max_distance", "corner_ds"):
             V.positive(name, getattr(self, name))
         for name in ("max_dlam", "chord_tol"):
             if not getattr(self, name) > 0:  # inf allowed (no bound)
@@ -813,9 +818,9 @@ def _advance(walk: _Walk, u, t, u_prev, g_u, ds, ds_init):
             return st, ds_init
 
 
-def _next_ds(ds, turn, it, err, opt) -> float:
+def _next_ds(ds, turn, it, err, opt, size) -> float:
     """Step after an accepted point: cut where the branch bends, grown after easy corrections,
-    bounded by the chord error."""
+    bounded by the chord error and by max(ds_max, ds_max_rel size) (size: norm of the unknowns)."""
     if turn < opt.turn_cos:
         new = ds * opt.turn_shrink
     elif it <= opt.target_iter - 1:
@@ -826,7 +831,7 @@ def _next_ds(ds, turn, it, err, opt) -> float:
         new = ds
     if err > 0.0:
         new = min(new, ds * _chord_factor(err, opt))
-    return min(max(new, opt.ds_min), opt.ds_max)
+    return min(max(new, opt.ds_min), max(opt.ds_max, opt.ds_max_rel * size))
 
 
 def _bound_dlam(ds, t, n, opt) -> float:
@@ -957,7 +962,7 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
         stop = _accepted(v, n, monitor, progress)
         if stop is not None:
             return pts.finish(*stop)
-        ds = _next_ds(ds, float(t @ t_prev), st.it, st.err, opt)
+        ds = _next_ds(ds, float(t @ t_prev), st.it, st.err, opt, float(np.linalg.norm(v[:n])))
 
 
 def _accepted(v, n, monitor, progress):

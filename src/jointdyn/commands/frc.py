@@ -264,31 +264,36 @@ def _run_time(args, gammas):
     return ds, result
 
 
-def _hb_branches(ds) -> list:
-    """Split an hb Dataset (dim ``point``) into its branches (variable ``branch``: segment index)."""
-    ids = np.asarray(ds["branch"].values)
+def _hb_branches(br) -> list:
+    """The segments of an HBBranch as JSON objects (per point: gamma, amplitudes, stability, status)."""
+    from ..hb.problem import contact_of
+
+    law = contact_of(br.problem.system).law
+    amp, off, mx = br.response()
+    gam = br.gamma()
     out = []
-    for b in dict.fromkeys(ids.tolist()):
-        sub = ds.isel(point=np.flatnonzero(ids == b))
-        br = {v: _jsonable(sub[v].values) for v in ("gamma", "amplitude_q", "amplitude_m", "offset_m", "max_abs_m")}
-        br["stable"] = [bool(s) for s in np.asarray(sub["stable"].values)]
-        br["point_status"] = [str(s) for s in np.asarray(sub["point_status"].values)]
-        br["folds"] = [int(i) for i in np.flatnonzero(np.asarray(sub["fold"].values, bool))]
-        out.append(br)
+    for b in dict.fromkeys(br.segment.tolist()):
+        idx = np.flatnonzero(br.segment == b)
+        one = {"gamma": gam[idx], "amplitude_q": law.kt * amp[idx] / law.fy, "amplitude_m": amp[idx],
+               "offset_m": off[idx], "max_abs_m": mx[idx]}
+        one = {k: _jsonable(v) for k, v in one.items()}
+        one["stable"] = [bool(s) for s in br.stable[idx]]
+        one["point_status"] = [str(s) for s in br.point_status[idx]]
+        one["folds"] = [int(i) for i in np.flatnonzero(br.fold[idx])]
+        out.append(one)
     return out
 
 
-def _hb_peaks(ds) -> list:
-    """The refined peaks of an hb Dataset (dim ``peak``) as JSON objects."""
-    names = {"gamma": "peak_gamma", "amplitude_q": "peak_amplitude_q", "amplitude_m": "peak_amplitude_m",
-             "branch": "peak_branch", "refined": "peak_refined"}
-    cols = {k: np.asarray(ds[v].values).tolist() for k, v in names.items()}
-    return [{k: (None if isinstance(c[i], float) and not math.isfinite(c[i]) else c[i]) for k, c in cols.items()}
-            for i in range(ds.sizes.get("peak", 0))]
+def _hb_peaks(br) -> list:
+    """The refined peaks of an HBBranch as JSON objects."""
+    return [{"gamma": pk.gamma, "amplitude_q": _jsonable([pk.amplitude_q])[0],
+             "amplitude_m": _jsonable([pk.amplitude_m])[0], "branch": pk.segment, "refined": pk.refined}
+            for pk in br.peaks]
 
 
 def _run_hb(args, gammas):
-    from ..hb import frc_hb
+    """The hb branch: ``(branch, result)`` (the Dataset is built only for files: xarray takes time to import)."""
+    from ..hb import continue_hb
     from ..systems import System
 
     system = System.paper_damper(
@@ -305,17 +310,17 @@ def _run_hb(args, gammas):
         raise ValueError("--gamma must span a range (STOP > START) for --method hb")
     # the grid's STEP is the largest gamma spacing of the branch (the step control may take smaller ones)
     step = float(gammas[1] - gammas[0])
-    ds = frc_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics, samples=args.samples,
-                max_step=step, progress=None if not args.json else False)
+    br = continue_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics, samples=args.samples,
+                     max_step=step, progress=None if not args.json else False)
     result = _header(args)
     result["harmonics"] = args.harmonics
     result["samples"] = args.samples
-    result["branches"] = _hb_branches(ds)
-    result["peaks"] = _hb_peaks(ds)
-    result["status"] = str(ds.attrs.get("status", ""))
-    result["message"] = str(ds.attrs.get("message", ""))
-    result["uncovered"] = str(ds.attrs.get("uncovered", ""))
-    return ds, result
+    result["branches"] = _hb_branches(br)
+    result["peaks"] = _hb_peaks(br)
+    result["status"] = br.status.value
+    result["message"] = br.message
+    result["uncovered"] = ", ".join(f"{a:.6g}-{b:.6g}" for a, b in br.uncovered)
+    return br, result
 
 
 def _plot(result, path: Path) -> None:
@@ -413,7 +418,9 @@ def run(args) -> int:
             write_outputs(ds, out)
         else:
             from .._io import atomic_path
+            from ..hb import branch_dataset
 
+            ds = branch_dataset(ds)
             with atomic_path(out / "frc.nc") as tmp:
                 ds.to_netcdf(tmp, engine="scipy")
             with atomic_path(out / "frc.csv") as tmp:  # one row per point (per-harmonic data in frc.nc)

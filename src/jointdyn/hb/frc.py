@@ -391,14 +391,23 @@ class _Tracker:
 _AMPLITUDE_CACHE = 8
 
 
-def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress) -> ContinuationResult:
-    """One continued segment from lam_a to lam_b (the start from the stuck linear solution)."""
+def _bar(total: int, desc: str, progress):
+    """A tqdm bar (shown on a TTY when ``progress`` is None), or a null context without one when it is
+    False (tqdm is not even imported: it takes a noticeable part of a short command's time)."""
+    if progress is False:
+        import contextlib
+
+        return contextlib.nullcontext(None)
     from tqdm.auto import tqdm
 
+    return tqdm(total=total, desc=desc, disable=None if progress is None else not progress, leave=False)
+
+
+def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress) -> ContinuationResult:
+    """One continued segment from lam_a to lam_b (the start from the stuck linear solution)."""
     problem = tr.problem
     xs, _, ps = tr.scales
-    with tqdm(total=opt.max_points, desc=f"HB {problem.parameter.name}",
-              disable=None if progress is None else not progress, leave=False) as bar:
+    with _bar(opt.max_points, f"HB {problem.parameter.name}", progress) as bar:
         y0 = problem.linear_guess(lam_a) / xs
         if (problem.parameter is GAMMA
                 and not newton(tr.residual, y0, lam_a / ps, opt, max_iter=config.HB_START_MAX_ITER)[1]):
@@ -447,7 +456,7 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         Step control, in scaled units (unknowns in units of fy/kt of the
         first contact, parameter in its own scale, residual force /
         max(F1, fy)); keyword arguments override its fields (``ds``,
-        ``ds_max``, ``max_points``, ``chord_tol``, ...). ``chord_tol``
+        ``ds_max``, ``max_points`` (per segment), ``chord_tol``, ...). ``chord_tol``
         bounds the distance between the straight lines joining the points
         and the curve in the plane (parameter, log q): 0.005 is half a
         percent of the amplitude.
@@ -484,9 +493,10 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         opt = dataclasses.replace(opt, max_dlam=V.positive("max_step", max_step) / tr.scales[2])
     res = _segment(tr, start, stop, opt, progress)
     parts = [res]
-    left = opt.max_points - res.lam.size
-    if res.status in _GO_BACK and backward_after_unbounded and left >= 2:
-        parts.append(_segment(tr, stop, start, dataclasses.replace(opt, max_points=left), progress))
+    # the segment back from the end has a bound of its own: the first one may have spent its points
+    # on a flank that grows without bound
+    if res.status in _GO_BACK and backward_after_unbounded:
+        parts.append(_segment(tr, stop, start, opt, progress))
     return _join(tr, parts, start, stop, opt)
 
 

@@ -8,7 +8,9 @@ spacing), checked against what must hold (issue 9):
   ``unbounded`` where friction cannot bound the resonance (Den Hartog:
   beta = mu N0 / F1 < pi/4 without viscous damping);
 * its highest peak agrees with the time-domain steady state at the same
-  gamma (:func:`jointdyn.dynamics.steady_state`, where that is periodic).
+  gamma (:func:`jointdyn.dynamics.steady_state`, where that is periodic),
+  started on the harmonic-balance orbit (:func:`hb_restart`): where
+  several orbits coexist, the one harmonic balance found is checked.
 
 ``docs/scripts/hb_robustness.py`` writes the table of the whole grid into
 ``docs/hb-robustness.md``; the tests run a subset; ``benchmarks/bench_hb.py``
@@ -21,9 +23,12 @@ import math
 import time
 from dataclasses import dataclass
 
+import numpy as np
+
 from .. import config
 
-__all__ = ["GRID_MODELS", "GRID_ETAS", "GRID_BETAS", "GRID_GAMMA", "GridCase", "grid_case", "grid_table"]
+__all__ = ["GRID_MODELS", "GRID_ETAS", "GRID_BETAS", "GRID_GAMMA", "GridCase", "grid_case", "grid_table",
+           "hb_restart"]
 
 #: the grid of issue 9: models (default exact, closed form with full memory, the paper's rule, Jenkins),
 #: eta = N1 / N0, beta = mu N0 / F1, gamma START:STOP:STEP
@@ -33,6 +38,10 @@ GRID_BETAS = (0.1, 1.0, 2.0, 5.0, 10.0, 1000.0)
 GRID_GAMMA = (0.6, 1.8, 0.01)
 #: Den Hartog's bound: below this beta friction alone cannot bound the resonance
 DEN_HARTOG_BETA = math.pi / 4
+#: periods and samples per period of the HB displacement marched to set the contact states of a time-domain
+#: start on a harmonic-balance orbit (those of the monodromy check)
+WARM_PERIODS = config.MONODROMY_WARM_PERIODS
+WARM_SAMPLES = config.MONODROMY_WARM_SAMPLES
 
 
 @dataclass(frozen=True)
@@ -45,6 +54,9 @@ class GridCase:
     eta, beta : float
     status : str
         Branch status (``complete``, ``unbounded``, ``failed``, ...).
+    covered : bool
+        The branch covers the range, or is unbounded with beta below Den
+        Hartog's bound.
     ok : bool
         The branch covers the range, or is unbounded with beta below Den
         Hartog's bound, and its highest peak (if any, where the time
@@ -67,6 +79,7 @@ class GridCase:
     eta: float
     beta: float
     status: str
+    covered: bool
     ok: bool
     points: int
     folds: int
@@ -83,27 +96,59 @@ def grid_case(model: str, eta: float, beta: float, gamma=GRID_GAMMA, *, time_dom
               rtol: float = 0.01) -> GridCase:
     """Run and check one case of the grid (see the module docstring)."""
     from ..dynamics import steady_state
-    from ..hb import frc_hb
+    from ..hb import branch_dataset, continue_hb
     from ..systems import System
 
     system = System.paper_damper(eta=eta, beta=beta, model=model)
     t0 = time.process_time()
-    ds = frc_hb(system, gamma[0], gamma[1], max_step=gamma[2], progress=False)
+    br = continue_hb(system, gamma[0], gamma[1], max_step=gamma[2], progress=False)
+    ds = branch_dataset(br)
     seconds = time.process_time() - t0
     status = str(ds.attrs["status"])
     covered = status == "complete" or (status == "unbounded" and beta < DEN_HARTOG_BETA)
     g_pk, q_pk = float(ds.attrs["peak_gamma"]), float(ds.attrs["peak_amplitude_q"])
     q_td = err = math.nan
     if time_domain and math.isfinite(g_pk):
-        ss = steady_state(system, g_pk)
+        top = max(br.peaks, key=lambda pk: pk.amplitude_q)
+        ss = steady_state(system, g_pk, start=hb_restart(system, top.X, g_pk, br.problem.H))
         if ss.status == "periodic":
             law = system.contacts[0].law
             q_td = law.kt * ss.amplitude_m / law.fy
             err = (q_pk - q_td) / q_td
     ok = covered and not abs(err) > rtol  # NaN (not compared) passes
-    return GridCase(model=model, eta=eta, beta=beta, status=status, ok=bool(ok), points=int(ds.sizes["point"]),
-                    folds=int(ds.attrs["folds"]), unstable=int(ds.attrs["unstable_points"]), peak_gamma=g_pk,
-                    peak_q=q_pk, time_q=q_td, peak_error=err, seconds=seconds, message=str(ds.attrs["message"]))
+    return GridCase(model=model, eta=eta, beta=beta, status=status, covered=covered, ok=bool(ok),
+                    points=int(ds.sizes["point"]), folds=int(ds.attrs["folds"]),
+                    unstable=int(ds.attrs["unstable_points"]), peak_gamma=g_pk, peak_q=q_pk, time_q=q_td, peak_error=err, seconds=seconds, message=str(ds.attrs["message"]))
+
+
+def hb_restart(system, X, gamma: float, harmonics: int, periods: int = WARM_PERIODS,
+               samples: int = WARM_SAMPLES):
+    """Time-domain start (:class:`~jointdyn.dynamics.Restart`) on a harmonic-balance orbit at phase 0.
+
+    Displacements and velocities of the harmonics X (m, layout of
+    :class:`~jointdyn.hb.HBProblem`) at w t = 0; the contact law states
+    from marching each law over ``periods`` periods of the HB displacement
+    (``samples`` per period) ending there, so that a stable orbit is
+    continued, not another one that coexists with it at the same gamma.
+    """
+    from ..drivers import march
+    from ..dynamics import Restart
+    from ..fourier import basis, derivative_matrix
+    from ..kinematics import contact_kinematics, normal_load_samples, tangential_history
+
+    n = system.ndof
+    Xm = np.asarray(X, dtype=float).reshape(2 * harmonics + 1, n)
+    e0 = basis(harmonics, np.array([0.0]))[0]
+    w = gamma * system.w0
+    tt = np.arange(periods * samples + 1) * (2.0 * np.pi / samples)
+    kin = contact_kinematics(system)
+    U = tangential_history(kin.arrays, np.ascontiguousarray(basis(harmonics, tt) @ Xm))
+    N = normal_load_samples(kin, tt)
+    S = np.zeros((len(system.contacts), max([c.law.state_size for c in system.contacts], default=1)))
+    for i, c in enumerate(system.contacts):
+        st = march(c.law, np.ascontiguousarray(U[:, i]), N[i])[3]
+        S[i, : st.size] = st
+    return Restart(x=e0 @ Xm, v=w * (e0 @ (derivative_matrix(harmonics) @ Xm)), states=S)
 
 
 def _num(v, fmt) -> str:
