@@ -13,14 +13,13 @@ import math
 
 import numpy as np
 import pytest
-from scipy.optimize import minimize_scalar
-
 import tolerances
+from scipy.optimize import minimize_scalar
+from test_hb import _df_amplitude, _jenkins_system
+
 from jointdyn import System
 from jointdyn.cli import EXIT_INCOMPLETE, main
 from jointdyn.hb import PointStatus, frc_hb, harmonic_balance
-
-from test_hb import _df_amplitude, _jenkins_system
 
 GRID = "0.6:1.8:0.01"
 
@@ -128,7 +127,7 @@ def test_incomplete_branch_exits_3_and_writes_marked_files(capsys, tmp_path, mon
     # the uncovered part named on stderr and in the Dataset
     import xarray as xr
 
-    import jointdyn.hb as hb
+    from jointdyn import hb
 
     real = hb.continue_hb
     monkeypatch.setattr(hb, "continue_hb", lambda *a, **k: real(*a, max_points=12, **k))

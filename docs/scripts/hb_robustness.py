@@ -20,7 +20,13 @@ import sys
 from pathlib import Path
 
 from jointdyn._io import atomic_write_text
-from jointdyn.sweeps.hb_grid import GRID_BETAS, GRID_ETAS, GRID_MODELS, grid_case, grid_table
+from jointdyn.sweeps.hb_grid import (
+    GRID_BETAS,
+    GRID_ETAS,
+    GRID_MODELS,
+    grid_case,
+    grid_table,
+)
 
 PAGE = Path(__file__).resolve().parents[1] / "hb-robustness.md"
 

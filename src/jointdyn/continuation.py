@@ -632,9 +632,8 @@ def _oriented(t_new, direction, n, opt):
 
 def _fixed_lam_point(walk: _Walk, u, t, lam, guesses):
     """Newton at fixed lam from each guess in turn: ``(v, t_new, iterations)`` or None."""
-    n = walk.n
     for y0 in guesses:
-        y, ok, it, (R, Jy, Jl) = _solve_damped(walk.residual, y0.copy(), lam, None, None, walk.opt, walk.cnt)
+        y, ok, it, (_, Jy, Jl) = _solve_damped(walk.residual, y0.copy(), lam, None, None, walk.opt, walk.cnt)
         if ok:
             tn = _tangent(Jy, Jl, t)
             if tn is not None:

@@ -158,8 +158,9 @@ def _num(v, fmt) -> str:
 def grid_table(cases) -> str:
     """Markdown table of grid cases (one row each) and a summary line."""
     cases = list(cases)
-    lines = ["| model | eta | beta | status | points | folds | unstable | peak gamma | peak q | time-domain q | "
-             "error | CPU s | ok |", "|" + "---|" * 13]
+    head = ("| model | eta | beta | status | points | folds | unstable | peak gamma | peak q | time-domain q | "
+            "error | CPU s | ok |")
+    lines = [head, "|" + "---|" * 13]
     for c in cases:
         lines.append(f"| {c.model} | {c.eta:g} | {c.beta:g} | {c.status} | {c.points} | {c.folds} | {c.unstable} | "
                      f"{_num(c.peak_gamma, '.5f')} | {_num(c.peak_q, '.5g')} | {_num(c.time_q, '.5g')} | "
