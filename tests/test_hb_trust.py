@@ -168,3 +168,17 @@ def test_robustness_grid_subset(model, eta, beta):
         assert abs(c.peak_error) <= tolerances.TEST_HB_VS_TIME_RTOL
     row = grid_table([c]).splitlines()[2]
     assert row.startswith(f"| {model} | {eta:g} | {beta:g} | {c.status} |") and row.endswith("| yes |")
+
+
+def test_failed_branch_exits_3_and_names_where(capsys, tmp_path):
+    # a real failure (the paper's closed form at eta = 1.5, beta = 1: its force jumps near gamma 1.06, and
+    # Newton fails at the start): exit status 3, files written, no repeated rows, the message names where
+    rc, out, err = _cli_hb(capsys, "--model", "iwan-paper", "--eta", "1.5", "--beta", "1", out=tmp_path)
+    assert rc == EXIT_INCOMPLETE
+    assert out["status"] == "failed" and out["uncovered"]
+    assert "failed" in err and "near gamma" in err and "not computed for gamma" in out["message"]
+    for br in out["branches"]:
+        rows = list(zip(br["gamma"], br["amplitude_m"]))
+        assert all(r != s for r, s in zip(rows, rows[1:]))
+    assert any(s == "stopped" for br in out["branches"] for s in br["point_status"])
+    assert (tmp_path / "frc.png").stat().st_size > 0

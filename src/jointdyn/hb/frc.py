@@ -311,9 +311,10 @@ class _Tracker:
     """Scaled residual, observable and continuation monitor of one HB problem.
 
     The residual is that of the problem in scaled units (R / fs,
-    JX xs / fs, Jp ps / fs); the observable is log q of the response DOF
-    (the step control keeps the chords of the plotted curve within
-    ``chord_tol`` of it, relative in amplitude); the monitor computes the
+    JX xs / fs, Jp ps / fs); the step control's observable is the
+    logarithm of the norm of the response DOF's harmonics (the chords of the
+    plotted curve stay within ``chord_tol`` of it, relative in amplitude),
+    peaks and folds use log q itself; the monitor computes the
     amplitude of every accepted point, keeps its evaluation (for the
     stability and the response of the branch) and stops the branch on an
     unbounded response.
@@ -355,6 +356,19 @@ class _Tracker:
         """log q of the response DOF (NaN at zero amplitude)."""
         q = self.q(self.amplitudes(y)[0])
         return math.log(q) if q > 0 else math.nan
+
+    def observe_step(self, y, lam_s) -> float:
+        """log of the norm of the response DOF's harmonics 1..H (scaled units; NaN at zero).
+
+        The step control's observable: it follows log q within a constant
+        where the response is near-harmonic and costs a few flops, where q
+        (the half peak-to-peak of a finely sampled period) costs a
+        sampling per call.
+        """
+        p = self.problem
+        h = y.reshape(p.nh, p.n)[1:, self.dof]
+        a = math.sqrt(float(h @ h))
+        return math.log(a) if a > 0 else math.nan
 
     def monitor(self, y, lam_s):
         xs, _, ps = self.scales
@@ -417,7 +431,7 @@ def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress) -> 
             if sol.converged:
                 y0 = sol.X / xs
         return tr.relabel(continuation(tr.residual, y0, lam_a / ps, lam_b / ps, opt, monitor=tr.monitor,
-                                       progress=bar, observe=tr.observe, lam_name=problem.parameter.name))
+                                       progress=bar, observe=tr.observe_step, lam_name=problem.parameter.name))
 
 
 def continue_hb(system: System, start: float, stop: float, *, parameter="gamma", gamma: float | None = None,
@@ -536,8 +550,9 @@ def _join(tr: _Tracker, parts, start, stop, opt) -> HBBranch:
     if joined.counters.get("jumps", 0):
         message += (f"; {joined.counters['jumps']} jump(s) over discontinuities of the contact force "
                     "(points with point_status 'after-jump')")
-    peaks = [pk for i, p in enumerate(parts) for pk in _peaks(tr, p, i, opt)]
-    logq = np.array([tr.observe(y, 0.0) for p in parts for y in p.y])
+    logqs = [np.array([tr.observe(y, 0.0) for y in p.y]) for p in parts]
+    peaks = [pk for i, (p, g) in enumerate(zip(parts, logqs)) for pk in _peaks(tr, p, g, i, opt)]
+    logq = np.concatenate(logqs)
     joined = dataclasses.replace(joined, fold=_turning_mask(joined.lam, logq, joined.segment, joined.gap, start, stop))
     return _make_branch(tr, status, message, joined, peaks, uncovered)
 
@@ -591,12 +606,12 @@ def _coverage(parts, start, stop, ps, name):
     return status, message, holes
 
 
-def _peaks(tr: _Tracker, res: ContinuationResult, segment: int, opt) -> list:
-    """Maxima of the response amplitude along one segment, refined between its points (HBPeak)."""
+def _peaks(tr: _Tracker, res: ContinuationResult, g, segment: int, opt) -> list:
+    """Maxima of the response amplitude along one segment (log q at its points: g), refined between
+    its points (HBPeak)."""
     if res.lam.size < 3:
         return []
     xs, _, ps = tr.scales
-    g = np.array([tr.observe(y, 0.0) for y in res.y])
     out = []
     for i in local_maxima(g, res.gap, config.HB_PEAK_PROMINENCE):
         y, lam_s, gv, ok = refine_maximum(tr.residual, tr.observe, res.y[i - 1:i + 2], res.lam[i - 1:i + 2], opt)
