@@ -232,8 +232,8 @@ CONT_CHORD_TOL = 0.005
 #: corrections, until the bracket is this fraction of its first width or the
 #: observable varies by at most CONT_REFINE_GTOL across it (harmonic
 #: balance: log q, so 1e-7 is a relative 1e-7 of the amplitude)
-CONT_REFINE_ITER = 30
-CONT_REFINE_STOL = 1e-6
+CONT_REFINE_ITER = 20
+CONT_REFINE_STOL = 1e-4
 CONT_REFINE_GTOL = 1e-7
 #: bordered linear systems (Newton corrections, tangents) of at most this
 #: many unknowns are solved by the compiled elimination of
