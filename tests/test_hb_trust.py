@@ -182,3 +182,19 @@ def test_failed_branch_exits_3_and_names_where(capsys, tmp_path):
         assert all(r != s for r, s in zip(rows, rows[1:]))
     assert any(s == "stopped" for br in out["branches"] for s in br["point_status"])
     assert (tmp_path / "frc.png").stat().st_size > 0
+
+
+def test_table_marks_the_stopped_point_and_lists_the_peaks(capsys, monkeypatch):
+    from jointdyn import hb
+
+    real = hb.continue_hb
+    monkeypatch.setattr(hb, "continue_hb", lambda *a, **k: real(*a, max_points=40, **k))
+    rc = main(["frc", "--method", "hb", "--gamma", "1.0:1.8:0.01", "--eta", "0.5", "--beta", "2"])
+    cap = capsys.readouterr()
+    assert rc == EXIT_INCOMPLETE
+    lines = cap.out.splitlines()
+    assert lines[0].startswith("status: max-points") and lines[1].startswith("branch 0: 40 points")
+    rows = [r for r in lines if r.startswith("  ")]
+    assert rows[0].endswith("start") and rows[-1].endswith("stopped") and len(rows) == 40
+    assert all(r.split()[-1] in ("stable", "unstable") for r in rows[1:-1])
+    assert "incomplete: max-points" in cap.err

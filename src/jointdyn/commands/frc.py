@@ -280,6 +280,7 @@ def _hb_branches(br) -> list:
         one["stable"] = [bool(s) for s in br.stable[idx]]
         one["point_status"] = [str(s) for s in br.point_status[idx]]
         one["folds"] = [int(i) for i in np.flatnonzero(br.fold[idx])]
+        one["branch"] = int(b)  # the segment (0: from START, 1: continued back from STOP)
         out.append(one)
     return out
 
@@ -468,7 +469,12 @@ def _print_table(result) -> None:
         print(f"status: {result['status']} {result['message']}")
         p = _digits([g for br in result["branches"] for g in br["gamma"]])
         w = max(8, p + 6)
-        for b, br in enumerate(result["branches"]):
-            print(f"branch {b}: {len(br['gamma'])} points, folds at {br['folds']}")
-            for g, a, s in zip(br["gamma"], br["amplitude_q"], br["stable"]):
-                print(f"  {g:<{w}.{p}g} {a if a is not None else float('nan'):>12.5g} {'stable' if s else 'unstable'}")
+        for br in result["branches"]:
+            print(f"branch {br['branch']}: {len(br['gamma'])} points, folds at {br['folds']}")
+            for g, a, s, ps in zip(br["gamma"], br["amplitude_q"], br["stable"], br["point_status"]):
+                print(f"  {g:<{w}.{p}g} {a if a is not None else float('nan'):>12.5g} "
+                      f"{'stable' if s else 'unstable':<8s}{'' if ps in _JOINED else ' ' + ps}")
+        for pk in result["peaks"]:
+            q = float("nan") if pk["amplitude_q"] is None else pk["amplitude_q"]
+            print(f"peak: gamma = {pk['gamma']:.6g}, q = {q:.6g} (branch {pk['branch']}"
+                  f"{'' if pk['refined'] else ', not fully refined'})")
