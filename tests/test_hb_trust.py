@@ -93,7 +93,7 @@ def test_max_step_is_honoured_by_the_api():
 def test_eta_1p5_beta_5_covers_the_range(capsys, model):
     # reported 'complete' for a branch covering only gamma 0.600-0.616 (it turned back to the start)
     rc, out, _ = _cli_hb(capsys, "--model", model, "--eta", "1.5", "--beta", "5")
-    assert rc == 0 and out["status"] == "complete" and out["uncovered"] == ""
+    assert rc == 0 and out["status"] == "complete" and out["uncovered"] == []
     g = [x for br in out["branches"] for x in br["gamma"]]
     assert min(g) == pytest.approx(0.6) and max(g) == pytest.approx(1.8)
 
@@ -133,7 +133,7 @@ def test_incomplete_branch_exits_3_and_writes_marked_files(capsys, tmp_path, mon
     monkeypatch.setattr(hb, "continue_hb", lambda *a, **k: real(*a, max_points=12, **k))
     rc, out, err = _cli_hb(capsys, "--eta", "0.5", "--beta", "2", out=tmp_path)
     assert rc == EXIT_INCOMPLETE == 3
-    assert out["status"] == "max-points" and out["uncovered"]
+    assert out["status"] == "max-points" and out["uncovered"][-1][1] == pytest.approx(1.8)
     assert "incomplete" in err and "max-points" in err and "gamma" in err
     for name in ("frc.nc", "frc.csv", "frc.png"):
         assert (tmp_path / name).stat().st_size > 0

@@ -320,7 +320,7 @@ def _run_hb(args, gammas):
     result["peaks"] = _hb_peaks(br)
     result["status"] = br.status.value
     result["message"] = br.message
-    result["uncovered"] = ", ".join(f"{a:.6g}-{b:.6g}" for a, b in br.uncovered)
+    result["uncovered"] = [[float(a), float(b)] for a, b in br.uncovered]
     return br, result
 
 
@@ -363,7 +363,8 @@ _JOINED = ("joined", "corner")
 
 def _plot_hb(ax, result) -> None:
     """hb branches: stable (solid) and unstable (dashed) lines, broken before every point not joined to
-    the previous one; folds (squares), points where a segment stopped short (red x), refined peaks (^)."""
+    the previous one; folds (squares), points where a segment stopped short (red x), refined peaks (^),
+    parts of the range without points (hatched)."""
     first = {}
     for br in result["branches"]:
         g = np.array(br["gamma"], float)
@@ -389,6 +390,9 @@ def _plot_hb(ax, result) -> None:
             ax.plot([pk["gamma"]], [pk["amplitude_q"]], "^", color="C2", ms=5,
                     label="peak" if "peak" not in first else None)
             first["peak"] = True
+    what = "no bounded response" if result["status"] == "unbounded" else "not computed"
+    for k, (a, b) in enumerate(result["uncovered"]):
+        ax.axvspan(a, b, facecolor="0.9", edgecolor="0.6", hatch="//", lw=0, label=what if k == 0 else None)
     if result["status"] != "complete":
         ax.text(0.01, 0.98, f"status: {result['status']}", transform=ax.transAxes, va="top", fontsize=8,
                 color="C3")
