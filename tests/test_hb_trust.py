@@ -198,3 +198,20 @@ def test_table_marks_the_stopped_point_and_lists_the_peaks(capsys, monkeypatch):
     assert rows[0].endswith("start") and rows[-1].endswith("stopped") and len(rows) == 40
     assert all(r.split()[-1] in ("stable", "unstable") for r in rows[1:-1])
     assert "incomplete: max-points" in cap.err
+
+
+def test_stable_zigzags_of_a_closed_form_are_not_folds():
+    # the paper's closed form at eta = 0.5, beta = 1 turns back 16 times by 1e-5 to 1e-4 in gamma near
+    # gamma 1.031-1.035 (jumps of its force), with stable points all around: no fold, and the time domain
+    # agrees, its up and down sweeps do not jump apart there
+    from jointdyn.sweeps import frc_sweep, to_frame
+
+    system = System.paper_damper(eta=0.5, beta=1.0, model="iwan-paper")
+    ds = frc_hb(system, 0.6, 1.8, max_step=0.01)
+    assert ds.attrs["status"] == "complete" and ds.attrs["folds"] == 0 and ds.stable.values.all()
+    g = np.round(np.arange(1.028, 1.0381, 0.002), 6)
+    td = to_frame(frc_sweep(g, etas=(0.5,), betas=(1.0,), model="iwan-paper", directions=("up", "down"),
+                            progress=False, n_workers=1))
+    up = td[td.direction == "up"].sort_values("gamma").amplitude_q.to_numpy()
+    dn = td[td.direction == "down"].sort_values("gamma").amplitude_q.to_numpy()
+    assert np.all(np.abs(up - dn) <= tolerances.TEST_HB_VS_TIME_RTOL * dn)

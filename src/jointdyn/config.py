@@ -284,6 +284,10 @@ HB_SMALL_EIG = 200
 #: non-smooth corner stays within both
 HB_TURNING_BAND = 5e-4
 HB_TURNING_BAND_LOG_Q = 5e-3
+#: a turning point is a fold only with an unstable point between it and the
+#: neighbouring turning points (without one on a side: within this many
+#: points): a saddle-node changes the number of unstable multipliers
+HB_FOLD_WINDOW = 3
 #: a local maximum of the amplitude along a branch is a peak when the
 #: amplitude falls by more than this fraction of it on both sides (before
 #: rising above it again)

@@ -245,12 +245,38 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     growth = hill_growth(JXs, sysm.M, sysm.C, np.array([problem.omega(v) for v in lam]), problem.H)
     stable, checked = _confirmed_stability(problem, X, lam, growth)
     counters = {**parts.counters, "monodromy_checks": checked}
+    fold = _saddle_nodes(parts.fold, stable, parts.segment)
     return HBBranch(problem=problem, parameter=problem.parameter.name, status=status, message=message, lam=lam,
-                    X=X, segment=parts.segment, fold=parts.fold, gap=parts.gap, counters=counters,
+                    X=X, segment=parts.segment, fold=fold, gap=parts.gap, counters=counters,
                     stable=stable, growth=growth, passes=passes,
                     periodic_error=periodic_error, force_period=force_period, response0=response0,
                     point_status=parts.point_status, peaks=tuple(peaks), uncovered=tuple(uncovered),
                     response_dof=tr.dof)
+
+
+def _saddle_nodes(turning, stable, segment):
+    """The turning points that can be folds: an unstable point next to them along the branch.
+
+    At a fold of a smooth branch a real Floquet multiplier crosses +1, so
+    the number of unstable multipliers changes by one there and one side of
+    it is unstable. A turning point is kept when the stretch to the
+    neighbouring turning point on either side (or, without one, the
+    ``config.HB_FOLD_WINDOW`` points on that side) holds an unstable point;
+    on a piecewise-smooth branch the change of stability can lie a few
+    points before the extreme of the parameter. Turning points with stable
+    points all around are zigzags of the branch at corners or jumps of a
+    closed-form contact force, not folds: a sweep does not jump there.
+    """
+    out = np.zeros_like(turning)
+    k = config.HB_FOLD_WINDOW
+    for sgm in np.unique(segment):
+        idx = np.flatnonzero(segment == sgm)
+        tp = np.flatnonzero(turning[idx])
+        for j, i in enumerate(tp):
+            lo = tp[j - 1] if j > 0 else max(i - k, 0)
+            hi = tp[j + 1] if j + 1 < tp.size else min(i + k, idx.size - 1)
+            out[idx[i]] = not stable[idx[lo:hi + 1]].all()
+    return out
 
 
 def _confirmed_stability(problem: HBProblem, X, lam, growth):
