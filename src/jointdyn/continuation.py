@@ -73,6 +73,9 @@ CORNER_TRIES = 3
 #: margin (fraction of the bracket) a parabolic step keeps from the bracket's points
 GOLDEN = 0.381966
 GOLDEN_MARGIN = 0.05
+#: a step of :func:`refine_maximum` that left the bracket wider than this fraction of its width before
+#: is followed by a golden-section step (a golden step leaves 0.618 of it)
+STALL_FRACTION = 0.7
 
 
 class ContinuationStatus(Status):
@@ -1074,12 +1077,17 @@ def refine_maximum(residual: Callable, observe: Callable, y, lam, options: Conti
     s[2] = s[1] + np.linalg.norm(U[2] - U[1])
     width0 = s[2] - s[0]
     cnt = {"residual_evaluations": 0}
+    last_width = math.inf
     for _ in range(iterations):
         if _bracketed(s, g, width0):
             break
         x = _vertex(s, g)
         lo, hi = s[0] + GOLDEN_MARGIN * (s[1] - s[0]), s[2] - GOLDEN_MARGIN * (s[2] - s[1])
-        if x is None or not lo < x < hi or abs(x - s[1]) < GOLDEN_MARGIN * (s[2] - s[0]):
+        # golden section where the parabola has no maximum inside, lands next to the best point, or the
+        # last step hardly shrank the bracket (a maximum at a corner: Brent's safeguard)
+        stalled = s[2] - s[0] > STALL_FRACTION * last_width
+        last_width = s[2] - s[0]
+        if x is None or stalled or not lo < x < hi or abs(x - s[1]) < GOLDEN_MARGIN * (s[2] - s[0]):
             wide = 0 if s[1] - s[0] > s[2] - s[1] else 2
             x = s[1] + GOLDEN * (s[wide] - s[1])
         u_pred, d = _interpolate(s, U, x)
