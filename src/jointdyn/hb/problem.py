@@ -41,7 +41,7 @@ from .. import config
 from ..fourier import extrema, fourier_matrices, phases
 from ..kinematics import NORMAL_HARMONIC, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
 from ..systems import Contact, System
-from ._aft import eval_kernel
+from ._aft import eval_kernel, recontact_events
 from .parameters import SystemParameter, parameter_named
 from .stability import hill_growth, hill_stability
 
@@ -225,7 +225,8 @@ class HBProblem:
         return self.forcing(f), (np.zeros(self.size) if df is None else self.forcing(df))
 
     def _loads_at(self, p):
-        """(Nsamp, dN): normal-load samples (contacts, Ns) and their derivative along p (or None)."""
+        """(Nsamp, dN, events): normal-load samples (contacts, Ns), their derivative along p (or None),
+        and the re-contact events of the AFT (:func:`jointdyn.hb._aft.recontact_events`)."""
         co, d = self.parameter.contact_loads(self, p)
         nc = len(self.contacts)
         Nsamp = np.empty((nc, self.Ns))
@@ -234,7 +235,7 @@ class HBProblem:
             Nsamp[k], dn = _load_samples(self.tau, co[k, 0], co[k, 1], co[k, 2], None if d is None else d[k])
             if dN is not None:
                 dN[k] = dn
-        return Nsamp, dN
+        return Nsamp, dN, recontact_events(self.tau, co, d)
 
     # --- linear part --------------------------------------------------------
     def linear_matrix(self, w):
@@ -293,13 +294,14 @@ class HBProblem:
         return self._run(np.ascontiguousarray(X, dtype=np.float64), *self._inputs(p), scales)
 
     def _inputs(self, p):
-        """(w, dw/dp, Fe, Fp, Nsamp, dN) at parameter p: what the parameter fixes, as the evaluation takes it."""
+        """(w, dw/dp, Fe, Fp, Nsamp, dN, events) at parameter p: what the parameter fixes, as the evaluation
+        takes it."""
         w, dwdp = self.parameter.frequency(self, p)
         Fe, Fp = self._fixed_forcing if self._fixed_forcing is not None else self._forcing_at(p)
-        Nsamp, dN = self._fixed_loads if self._fixed_loads is not None else self._loads_at(p)
-        return w, dwdp, Fe, Fp, Nsamp, dN
+        Nsamp, dN, events = self._fixed_loads if self._fixed_loads is not None else self._loads_at(p)
+        return w, dwdp, Fe, Fp, Nsamp, dN, events
 
-    def _run(self, X, w, dwdp, Fe, Fp, Nsamp, dN, scales) -> _Eval:
+    def _run(self, X, w, dwdp, Fe, Fp, Nsamp, dN, events, scales) -> _Eval:
         """The compiled evaluation at the given frequency, forcing and loads."""
         nc = len(self.contacts)
         size = self.size
@@ -319,7 +321,7 @@ class HBProblem:
                 self._scales_seen = scales
             scaled = (self._scl, np.empty(size), np.empty((size, size)), np.empty(size))
         self._kernel((*self._linear_terms(w), float(dwdp), X, Fe, Fp), (self._Bm, self._Pm, self._ssz),
-                     (Nsamp, dN if has_p else self._dummy, has_p), (self.E, self.P),
+                     (Nsamp, dN if has_p else self._dummy, has_p, events), (self.E, self.P),
                      (int(self.max_passes), float(config.HB_PERIODIC_RTOL)), (R, JX, Jp, T, code, info), scaled)
         return _Eval(R, JX, Jp, T, code, info, None if scales is None else scaled[1:])
 
