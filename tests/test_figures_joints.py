@@ -1,6 +1,7 @@
 """The showcases of joints whose normal load comes from the structure: their data and files."""
 
 import numpy as np
+import pytest
 import pandas as pd
 
 import tolerances as C
@@ -43,3 +44,19 @@ def test_blade_damper_design_chart_has_an_interior_optimum(tmp_path):
     # points that are not periodic are labelled, never plotted as results
     assert set(curves.status) <= {"periodic", "not-settled", "unbounded"}
     assert (curves.status == "periodic").mean() > 0.9
+
+
+def test_the_blade_example_file_is_the_figures_blade():
+    from pathlib import Path
+
+    import jointdyn as jd
+    from jointdyn.figures.joints import blade_system
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "blade.toml"
+    s, ref = jd.read_system(path), blade_system(15.0)
+    for name in ("M", "K", "C", "force", "K_reference"):
+        np.testing.assert_allclose(getattr(s, name), getattr(ref, name), rtol=1e-12, atol=1e-12 * np.abs(
+            getattr(ref, name)).max())
+    assert s.response_dof == ref.response_dof == 2 and s.w0 == pytest.approx(ref.w0, rel=1e-12)
+    r, r_ref = jd.steady_state(s, 1.0), jd.steady_state(ref, 1.0)
+    assert r.status == r_ref.status == "periodic" and r.amplitude_m == pytest.approx(r_ref.amplitude_m, rel=1e-9)
