@@ -355,10 +355,13 @@ def test_builtin_parameter_objects():
     assert parameter_named(ETA) is ETA
     with pytest.raises(ValueError, match="parameter"):
         parameter_named("mu")
-    s = _damper(eta=0.2, delta=0.4, n0=90.0)
+    s = _damper(eta=0.2, delta=40.0, n0=90.0)
     p = HBProblem(s, harmonics=2, samples=16, parameter="n0", gamma=1.3)
-    co, d = N0.contact_loads(p, 120.0)
-    assert np.allclose(co, [[120.0, 0.2 * 120.0, 0.4]]) and np.allclose(d, [[1.0, 0.2, 0.0]])
+    co, d = N0.contact_loads(p, 120.0)  # the load rows hold the phase in radians
+    assert np.allclose(co, [[120.0, 0.2 * 120.0, math.radians(40.0)]]) and np.allclose(d, [[1.0, 0.2, 0.0]])
+    p = HBProblem(s, harmonics=2, samples=16, parameter="delta", gamma=1.3)
+    co, d = DELTA.contact_loads(p, 90.0)  # the parameter in degrees
+    assert np.allclose(co, [[90.0, 0.2 * 90.0, math.pi / 2]]) and np.allclose(d, [[0.0, 0.0, math.pi / 180]])
     assert GAMMA.frequency(p, 1.5) == (1.5 * p.w0, p.w0)
     with pytest.raises(ValueError, match="eta start"):
         ETA.check_range(-0.1, 1.0)
