@@ -64,7 +64,7 @@ print(time.process_time() - t)
 def _chain(n, eta):
     import numpy as np
 
-    from jointdyn import System
+    from jointdyn import HarmonicLoad, System
     from jointdyn.laws import Jenkins
     from jointdyn.systems import Contact
 
@@ -80,7 +80,7 @@ def _chain(n, eta):
     f[0] = 40.0
     law = Jenkins(kt=3e5, mu=0.5, n_ref=100.0)
     return System(M=M, C=1e-4 * K, K=K, force=f,
-                  contacts=(Contact(law=law, dof=0, n0=100.0, n1=eta * 100.0, delta=0.3),))
+                  contacts=(Contact(law, dof=0, normal=HarmonicLoad(100.0, eta * 100.0, phase_deg=np.degrees(0.3))),))
 
 
 def _jacobian(n, eta):

@@ -32,6 +32,7 @@ def main(argv=None) -> int:
         "quick": bool(args.quick),
     }
     t0 = time.perf_counter()
+    failed = []
     for path in sorted(HERE.glob("bench_*.py")):
         name = path.stem[len("bench_"):]
         if args.only and name not in args.only:
@@ -41,13 +42,19 @@ def main(argv=None) -> int:
         spec.loader.exec_module(mod)
         if not args.json:
             print(f"running {path.name} ...", file=sys.stderr)
-        out[name] = mod.run(quick=args.quick)
+        try:
+            out[name] = mod.run(quick=args.quick)
+        except Exception as exc:  # the other benchmarks still run; the exit status says one failed
+            out[name] = {"error": f"{type(exc).__name__}: {exc}"}
+            failed.append(name)
     out["total_seconds"] = time.perf_counter() - t0
     if args.json:
         print(json.dumps(out))
     else:
         print(json.dumps(out, indent=2))
-    return 0
+    if failed:
+        print(f"benchmarks failed: {', '.join(failed)}", file=sys.stderr)
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":
