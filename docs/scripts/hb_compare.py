@@ -54,9 +54,11 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import platform
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -174,7 +176,22 @@ def _commit(folder: Path) -> str:
 
 
 def run_pyharm(f1: float) -> dict:
-    """pyHarm's nonlinear FRF analysis with its default options (accepted points)."""
+    """pyHarm's nonlinear FRF analysis with its default options (accepted points).
+
+    Run in a temporary folder: pyHarm writes a ``.pyHarm/`` folder where it
+    is imported and run.
+    """
+    here = os.getcwd()
+    with tempfile.TemporaryDirectory() as cwd:
+        os.chdir(cwd)
+        try:
+            return _pyharm_branch(f1)
+        finally:
+            os.chdir(here)
+
+
+def _pyharm_branch(f1: float) -> dict:
+    """The body of :func:`run_pyharm`, in the folder it chose."""
     import logging
     from importlib.metadata import version
 
@@ -227,14 +244,13 @@ def _importable(module: str) -> bool:
 
 def _run_elsewhere(code: str, f1: float, python: str, tmdsimpy_path: str | None) -> dict:
     """Run one code in another interpreter (``--worker``); its result or ``{"error": ...}``."""
-    import os
-
     env = dict(os.environ)
     env.pop("PYTHONPATH", None)
     if tmdsimpy_path:
         env["PYTHONPATH"] = tmdsimpy_path
     cmd = [python, str(Path(__file__).resolve()), "--worker", code, "--f1", repr(f1)]
-    r = subprocess.run(cmd, check=False, capture_output=True, text=True, env=env)
+    with tempfile.TemporaryDirectory() as cwd:  # as in run_pyharm
+        r = subprocess.run(cmd, check=False, capture_output=True, text=True, env=env, cwd=cwd)
     lines = [ln for ln in r.stdout.splitlines() if ln.startswith("{")]
     if r.returncode != 0 or not lines:
         tail = (r.stderr.strip().splitlines() or ["no output"])[-1]
