@@ -52,6 +52,8 @@ jointdyn, against the same reference:
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import json
 import math
 import os
@@ -160,8 +162,11 @@ def run_tmdsimpy(f1: float) -> dict:
         ctop = hutils.harmonic_wise_conditioning(uw0, 1, h, delta=1e-3 * abs(x[1]))
         ctop[-1] = lam1
         rptoc = 1.0 / np.max(np.abs(np.diag(dfdx * ctop[:-1])))
-        cont = Continuation(solver, CtoP=ctop, RPtoC=rptoc, config={"verbose": -1})
-        return cont.continuation(lambda uw: vib.hbm_res(uw, fl, h, Nt=SAMPLES), uw0, lam0, lam1)
+        cont = Continuation(solver, CtoP=ctop, RPtoC=rptoc)
+        # default config: its progress goes to stdout (kept off the worker's JSON); with
+        # verbose < 0 ("silent") it would keep unconverged steps instead of stopping there
+        with contextlib.redirect_stdout(io.StringIO()):
+            return cont.continuation(lambda uw: vib.hbm_res(uw, fl, h, Nt=SAMPLES), uw0, lam0, lam1)
 
     xl, wall, cpu, first = _timed(branch)
     return {"gamma": (xl[:, -1] / W0).tolist(), "coefficients": xl[:, :-1].tolist(), "wall_s": wall, "cpu_s": cpu,
@@ -358,7 +363,7 @@ def measures(res: dict, ref: Reference) -> dict:
                 chord_err, at = e, gm
             normal = max(normal, abs(lq[i] + f * (lq[i + 1] - lq[i]) - math.log(qr)) / math.hypot(1.0, slope))
     top = int(np.argmax(q))
-    return {"points": int(g.size), "max_gap": float(np.max(np.abs(np.diff(g)))), "chord_err": chord_err,
+    return {"points": int(g.size), "range": (float(g.min()), float(g.max())), "max_gap": float(np.max(np.abs(np.diff(g)))), "chord_err": chord_err,
             "chord_at": at, "chord_normal": normal, "point_err": point_err, "point_at": point_at, "peak_gamma": float(g[top]),
             "peak_q": float(q[top])}
 
@@ -370,18 +375,18 @@ def table(f1: float, rows: dict, ref_peak) -> str:
     gp, qp = ref_peak
     head = (f"**F1 = {f1:g} N.** Reference peak (jointdyn's harmonic balance solved afresh, maximised over "
             f"gamma): gamma = {gp:.5f}, q = {qp:.5f}.")
-    columns = ("| code | points | largest gamma gap | largest chord error in q (at gamma) "
+    columns = ("| code | points | gamma covered | largest gamma gap | largest chord error in q (at gamma) "
                "| largest chord distance in (gamma, ln q) | largest relative point error (at gamma) | highest point: gamma, q "
                "| peak gamma error | peak q error | wall s (CPU s) |")
-    lines = [head, "", columns, "|---|---:|---:|---|---:|---:|---|---:|---:|---:|"]
+    lines = [head, "", columns, "|---|---:|---|---:|---|---:|---:|---|---:|---:|---:|"]
     for code in CODES:
         r = rows[code]
         if "error" in r:
-            lines.append(f"| {code} | not run: {r['error']} | | | | | | | | |")
+            lines.append(f"| {code} | not run: {r['error']} | | | | | | | | | |")
             continue
         m = r["measures"]
         lines.append(
-            f"| {code} | {m['points']} | {m['max_gap']:.4f} | {100 * m['chord_err']:.2f} % ({m['chord_at']:.3f}) "
+            f"| {code} | {m['points']} | {m['range'][0]:.3f}-{m['range'][1]:.3f} | {m['max_gap']:.4f} | {100 * m['chord_err']:.2f} % ({m['chord_at']:.3f}) "
             f"| {m['chord_normal']:.4f} "
             f"| {m['point_err']:.1e} ({m['point_at']:.3f}) | {m['peak_gamma']:.4f}, {m['peak_q']:.4f} "
             f"| {m['peak_gamma'] - gp:+.4f} | {100 * (m['peak_q'] / qp - 1):+.3f} % "
