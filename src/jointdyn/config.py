@@ -265,6 +265,14 @@ CONT_JUMP_TANGENT_MIN = 1e-3
 #: measured against the reported amplitude the chords stay within 1 %,
 #: tests/test_hb_trust.py)
 CONT_CHORD_TOL = 0.005
+#: harmonic balance in gamma: largest gamma spacing of a branch when the
+#: caller gives none (the command line passes the STEP of --gamma). The chord
+#: bound above is a distance in (gamma, ln amplitude); on a steep flank a
+#: chord within it can still miss the amplitude at the same gamma by more
+#: than 1 % (1.4 % at 0.1 gamma spacing on the Jenkins benchmark branch,
+#: F1 = 5 N, docs/hb-comparison.md); 0.02 keeps it below 1 % (0.9 %) for
+#: about 25 % more points
+HB_MAX_GAMMA_STEP = 0.02
 #: refinement of a maximum along a branch (peaks): at most this many
 #: corrections, until the bracket is this fraction of its first width or the
 #: observable varies by at most CONT_REFINE_GTOL across it (harmonic

@@ -488,8 +488,9 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         AFT time samples per period (>= 2H + 2).
     max_step : float, optional
         Largest change of the parameter between consecutive points (in its
-        own unit, e.g. a gamma grid spacing); default: none beyond the
-        chord bound.
+        own unit, e.g. a gamma grid spacing); default
+        ``config.HB_MAX_GAMMA_STEP`` when the parameter is gamma, none
+        beyond the chord bound otherwise.
     response_dof : int, optional
         DOF whose amplitude the step control follows and the peaks report
         (default ``system.response_dof``).
@@ -535,6 +536,8 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
     problem = make_problem(system, condense=condense, response_dofs=(dof,), harmonics=harmonics, samples=samples,
                            parameter=par, gamma=gamma)
     tr = _Tracker(problem, _scales(problem, start), dof)
+    if max_step is None and par is GAMMA:
+        max_step = config.HB_MAX_GAMMA_STEP
     if max_step is not None:
         opt = dataclasses.replace(opt, max_dlam=V.positive("max_step", max_step) / tr.scales[2])
     res = _segment(tr, start, stop, opt, progress)
@@ -823,7 +826,8 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
         >= 2H + 2.
     max_step : float, optional
         Largest gamma spacing between consecutive points (e.g. the STEP of
-        a gamma grid); the chord bound (``chord_tol``) applies in any case.
+        a gamma grid; default ``config.HB_MAX_GAMMA_STEP``); the chord
+        bound (``chord_tol``) applies in any case.
     response_dof : int, optional
         DOF whose response is reported (default ``system.response_dof``).
     options : ContinuationOptions, optional
