@@ -63,8 +63,8 @@ from .condense import make_problem
 from .parameters import GAMMA, parameter_named
 from .problem import HBProblem, contact_of
 
-__all__ = ["AUTO", "DiscretisationCheck", "HBBranch", "HBPeak", "HBSolution", "PointStatus", "continue_hb", "frc_hb", "branch_dataset",
-           "harmonic_balance"]
+__all__ = ["AUTO", "DiscretisationCheck", "HBBranch", "HBPeak", "HBSolution", "PointStatus", "continue_hb",
+           "frc_hb", "branch_dataset", "discretisation_attrs", "harmonic_balance"]
 
 
 class PointStatus(Status):
@@ -101,9 +101,10 @@ class DiscretisationCheck:
     check_harmonics, check_samples : int
         H and Ns of the check solves at the last level.
     harmonics_change, samples_change : float
-        Largest |relative change| of a peak amplitude with ``check_harmonics``
-        harmonics and with ``check_samples`` samples (NaN without a peak;
-        inf where a check solve did not converge).
+        Largest change of a peak amplitude with ``check_harmonics``
+        harmonics and with ``check_samples`` samples, relative to the
+        highest peak of the branch (NaN without a peak; inf where a check
+        solve did not converge).
     peaks : int
         Peaks checked.
     rtol : float
@@ -654,14 +655,18 @@ def _check_levels(level, auto):
 
 
 def _next_level(level, auto, bad_h: bool, bad_s: bool):
-    """The level the checks ask for, within ``config.HB_AUTO_MAX_*`` (equal to ``level``: no refinement)."""
+    """The level the checks ask for, within ``config.HB_AUTO_MAX_*`` (equal to ``level``: no refinement).
+
+    The samples first: with too few, the sampling error of the contact
+    force also moves the solution with more harmonics, so H is raised
+    only once the samples pass their check.
+    """
     by_h, by_s = _check_levels(level, auto)
-    H, Ns = level
+    if bad_s and by_s is not None:
+        return by_s if by_s[1] <= config.HB_AUTO_MAX_SAMPLES else level
     if bad_h and by_h is not None and by_h[0] <= config.HB_AUTO_MAX_HARMONICS:
-        H, Ns = by_h
-    if bad_s and by_s is not None and 2 * Ns <= config.HB_AUTO_MAX_SAMPLES:
-        Ns = 2 * Ns
-    return H, Ns
+        return by_h
+    return level
 
 
 def _solve_at(req: _Request, condensed: bool, lam: float, X, level):
@@ -678,27 +683,30 @@ def _solve_at(req: _Request, condensed: bool, lam: float, X, level):
     return (tr.amplitudes(y)[0] if ok else math.nan), y * xs
 
 
-def _change(amp: float, ref: float) -> float:
-    """|amp - ref| / ref (inf where the check solve failed)."""
-    return abs(amp - ref) / ref if math.isfinite(amp) and ref > 0 else math.inf
+def _change(amp: float, ref: float, scale: float) -> float:
+    """|amp - ref| / scale (inf where the check solve failed)."""
+    return abs(amp - ref) / scale if math.isfinite(amp) and scale > 0 else math.inf
 
 
-def _peak_level(req: _Request, condensed: bool, pk: HBPeak, level, auto):
+def _peak_level(req: _Request, condensed: bool, pk: HBPeak, scale: float, level, auto):
     """(level at which the peak converges (or the bound), (harmonics change, samples change) at ``level``).
 
     The peak is solved with more harmonics and with more samples
-    (:func:`_check_levels`); where a change exceeds ``config.HB_AUTO_RTOL``
-    it is solved at the refined level and checked there again.
+    (:func:`_check_levels`); the changes are relative to ``scale`` (the
+    highest peak of the branch, so that a small secondary peak asks for no
+    more than its share of the curve). Where a change exceeds
+    ``config.HB_AUTO_RTOL`` the peak is solved at the refined level and
+    checked there again.
     """
     at, X, amp, first = level, pk.X, pk.amplitude_m, None
     while True:
-        ch = tuple(_change(_solve_at(req, condensed, pk.lam, X, lv)[0], amp) if lv else math.nan
-                   for lv in _check_levels(at, auto))
+        solved = {lv: _solve_at(req, condensed, pk.lam, X, lv) for lv in _check_levels(at, auto) if lv}
+        ch = tuple(_change(solved[lv][0], amp, scale) if lv else math.nan for lv in _check_levels(at, auto))
         first = ch if first is None else first
         nxt = _next_level(at, auto, ch[0] > config.HB_AUTO_RTOL, ch[1] > config.HB_AUTO_RTOL)
         if nxt == at:
             return at, first
-        amp, X = _solve_at(req, condensed, pk.lam, X, nxt)
+        amp, X = solved[nxt] if nxt in solved else _solve_at(req, condensed, pk.lam, X, nxt)
         at = nxt
         if not math.isfinite(amp):
             return at, first
@@ -718,7 +726,8 @@ def _adaptive_branch(req: _Request, level, auto) -> HBBranch:
     if not any(auto):
         return br
     while True:
-        checks = [_peak_level(req, br.problem.condensed, pk, level, auto) for pk in br.peaks]
+        scale = max([pk.amplitude_m for pk in br.peaks], default=0.0)
+        checks = [_peak_level(req, br.problem.condensed, pk, scale, level, auto) for pk in br.peaks]
         target = (max([level[0]] + [c[0][0] for c in checks]), max([level[1]] + [c[0][1] for c in checks]))
         if target == level:
             break
