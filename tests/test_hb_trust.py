@@ -172,8 +172,10 @@ def test_robustness_grid_subset(model, eta, beta):
 
 def test_failed_branch_exits_3_and_names_where(capsys, tmp_path):
     # a real failure (the paper's closed form at eta = 1.5, beta = 1: its force jumps near gamma 1.06, and
-    # Newton fails at the start): exit status 3, files written, no repeated rows, the message names where
-    rc, out, err = _cli_hb(capsys, "--model", "iwan-paper", "--eta", "1.5", "--beta", "1", out=tmp_path)
+    # Newton fails at the start, with 7 harmonics and 128 samples; the automatic choice takes more samples and
+    # completes): exit status 3, files written, no repeated rows, the message names where
+    rc, out, err = _cli_hb(capsys, "--model", "iwan-paper", "--eta", "1.5", "--beta", "1", "--harmonics", "7",
+                           "--samples", "128", out=tmp_path)
     assert rc == EXIT_INCOMPLETE
     assert out["status"] == "failed" and out["uncovered"]
     assert "failed" in err and "near gamma" in err and "not computed for gamma" in out["message"]
