@@ -17,7 +17,7 @@ import tolerances
 from scipy.optimize import minimize_scalar
 from test_hb import _df_amplitude, _jenkins_system
 
-from jointdyn import System
+from jointdyn import System, config
 from jointdyn.cli import EXIT_INCOMPLETE, main
 from jointdyn.hb import PointStatus, frc_hb, harmonic_balance
 
@@ -172,8 +172,10 @@ def test_robustness_grid_subset(model, eta, beta):
 
 def test_failed_branch_exits_3_and_names_where(capsys, tmp_path):
     # a real failure (the paper's closed form at eta = 1.5, beta = 1: its force jumps near gamma 1.06, and
-    # Newton fails at the start): exit status 3, files written, no repeated rows, the message names where
-    rc, out, err = _cli_hb(capsys, "--model", "iwan-paper", "--eta", "1.5", "--beta", "1", out=tmp_path)
+    # Newton fails at the start, with 7 harmonics and 128 samples; the automatic choice takes more samples and
+    # completes): exit status 3, files written, no repeated rows, the message names where
+    rc, out, err = _cli_hb(capsys, "--model", "iwan-paper", "--eta", "1.5", "--beta", "1", "--harmonics", "7",
+                           "--samples", "128", out=tmp_path)
     assert rc == EXIT_INCOMPLETE
     assert out["status"] == "failed" and out["uncovered"]
     assert "failed" in err and "near gamma" in err and "not computed for gamma" in out["message"]
@@ -215,3 +217,81 @@ def test_stable_zigzags_of_a_closed_form_are_not_folds():
     up = td[td.direction == "up"].sort_values("gamma").amplitude_q.to_numpy()
     dn = td[td.direction == "down"].sort_values("gamma").amplitude_q.to_numpy()
     assert np.all(np.abs(up - dn) <= tolerances.TEST_HB_VS_TIME_RTOL * dn)
+
+
+# --- automatic choice of harmonics and samples (the default: harmonics="auto", samples="auto")
+
+
+@pytest.mark.parametrize("eta,beta", [(10.0, 5.0), (10.0, 10.0)])
+def test_default_model_with_separation_matches_the_time_domain(eta, beta):
+    # failed the grid with 7 harmonics and 128 samples (peak q 2.16 and 1.34, 2.6 % and 5.8 % above the time
+    # domain): the check of the peak asks for more samples, and the branch computed with them agrees
+    from jointdyn.sweeps.hb_grid import grid_case
+
+    c = grid_case(config.MODEL, eta, beta)
+    assert c.status == "complete" and c.ok, c.message
+    assert abs(c.peak_error) <= tolerances.TEST_HB_VS_TIME_RTOL
+    assert c.samples > config.HB_SAMPLES
+
+
+def test_auto_peak_is_converged_in_harmonics_and_samples():
+    # oracle: harmonic balance solved afresh at the peak with twice the harmonics and twice the samples
+    system = System.paper_damper(eta=10.0, beta=5.0)
+    ds = frc_hb(system, 0.6, 1.8, max_step=0.01)
+    a = ds.attrs
+    assert a["harmonics_choice"] == a["samples_choice"] == "auto" and a["check_converged"] == 1
+    assert a["check_peaks"] == ds.sizes["peak"] >= 1
+    assert a["discretisation_levels"].startswith(f"{config.HB_HARMONICS}x{config.HB_SAMPLES}, ")
+    assert a["discretisation_levels"].endswith(f"{a['harmonics']}x{a['samples']}")
+    assert max(a["check_harmonics_change"], a["check_samples_change"]) <= config.HB_AUTO_RTOL
+    H, Ns = 2 * a["harmonics"] + 1, 2 * a["samples"]
+    top = ds.peak_amplitude_m.values.max()  # the changes are measured against the highest peak
+    for g, amp in zip(ds.peak_gamma.values, ds.peak_amplitude_m.values):
+        sol = harmonic_balance(system, float(g), harmonics=H, samples=Ns, response_dof=system.response_dof)
+        assert sol.converged
+        assert abs(amp - sol.amplitude_m) <= tolerances.TEST_HB_AUTO_CONVERGED_RTOL * top
+
+
+def test_auto_keeps_a_converged_branch_as_it_is():
+    # the paper damper's benchmark case: 7 harmonics and 128 samples pass the check, so the branch is the
+    # one computed with them, bit for bit, and only the check solves are added
+    system = System.paper_damper(eta=0.5, beta=2.0)
+    auto = frc_hb(system, 0.6, 1.8)
+    fixed = frc_hb(system, 0.6, 1.8, harmonics=config.HB_HARMONICS, samples=config.HB_SAMPLES)
+    assert auto.attrs["discretisation_levels"] == f"{config.HB_HARMONICS}x{config.HB_SAMPLES}"
+    assert auto.attrs["check_converged"] == 1 and auto.attrs["check_peaks"] >= 1
+    assert auto.attrs["check_harmonics"] == 2 * config.HB_HARMONICS + 1
+    assert auto.attrs["check_samples"] == 2 * config.HB_SAMPLES
+    np.testing.assert_array_equal(auto.amplitude_q.values, fixed.amplitude_q.values)
+    np.testing.assert_array_equal(auto.peak_amplitude_q.values, fixed.peak_amplitude_q.values)
+    assert fixed.attrs["harmonics_choice"] == fixed.attrs["samples_choice"] == "fixed"
+    assert "check_converged" not in fixed.attrs
+
+
+def test_auto_at_its_bound_says_it_is_not_converged(monkeypatch):
+    # with the samples bounded at their start, the check of eta = 10, beta = 5 fails and the branch says so
+    monkeypatch.setattr(config, "HB_AUTO_MAX_SAMPLES", config.HB_SAMPLES)
+    ds = frc_hb(System.paper_damper(eta=10.0, beta=5.0), 0.6, 1.8, max_step=0.01)
+    assert ds.attrs["check_converged"] == 0 and ds.attrs["samples"] == config.HB_SAMPLES
+    assert ds.attrs["check_samples_change"] > config.HB_AUTO_RTOL
+    assert "not converged in the discretisation" in ds.attrs["message"]
+
+
+def test_harmonics_and_samples_refuse_other_words(capsys):
+    with pytest.raises(ValueError, match="harmonics"):
+        frc_hb(System.paper_damper(), 0.6, 1.8, harmonics="many")
+    with pytest.raises(ValueError, match="samples"):
+        frc_hb(System.paper_damper(), 0.6, 1.8, harmonics=7, samples=10)
+    assert main(["frc", "--method", "hb", "--gamma", GRID, "--samples", "3"]) == 2
+    assert "--samples must be an integer >= 4 or 'auto'" in capsys.readouterr().err
+
+
+def test_cli_reports_the_discretisation(capsys):
+    rc, out, _ = _cli_hb(capsys, "--eta", "0.5", "--beta", "2", "--harmonics", "auto")
+    assert rc == 0 and out["harmonics"] == config.HB_HARMONICS and out["samples"] == config.HB_SAMPLES
+    d = out["discretisation"]
+    assert d["harmonics_choice"] == "auto" and d["check_converged"] == 1
+    assert d["check_harmonics_change"] <= config.HB_AUTO_RTOL
+    rc, out, _ = _cli_hb(capsys, "--eta", "0.5", "--beta", "2", "--harmonics", "5", "--samples", "64")
+    assert rc == 0 and (out["harmonics"], out["samples"]) == (5, 64)
+    assert out["discretisation"]["harmonics_choice"] == "fixed"

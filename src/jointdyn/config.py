@@ -191,6 +191,17 @@ FILES_MAX_DOF = 10_000
 HB_HARMONICS = 7
 #: AFT time samples per period
 HB_SAMPLES = 128
+#: the value of ``harmonics`` / ``samples`` (and of --harmonics / --samples) that asks for the automatic choice
+HB_AUTO = "auto"
+#: ``harmonics="auto"`` / ``samples="auto"`` (the defaults of HB branches): start at HB_HARMONICS and
+#: HB_SAMPLES; every refined peak is solved again with 2H + 1 harmonics and with 2 Ns samples, and the
+#: discretisation is refined (and the branch computed again) while a peak amplitude changes by more
+#: than this fraction of the highest peak's
+HB_AUTO_RTOL = 1e-3
+#: the largest H and Ns an automatic choice takes (the check solves go one level beyond); with separation
+#: the samples decide, H = 7 already within 2e-4 of H = 15 on the paper's grid
+HB_AUTO_MAX_HARMONICS = 15
+HB_AUTO_MAX_SAMPLES = 2048
 #: uniform samples per period of the fine grid on which amplitudes and
 #: extrema of a harmonic-balance response are located
 HB_FINE_SAMPLES = 1024

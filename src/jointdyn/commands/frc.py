@@ -37,6 +37,9 @@ from ._law_args import add_law_arguments, law_params, model_help
 from ._system_args import add_system_argument, load_system_file, refuse_paper_options
 from ..systems import PAPER
 
+#: the value of --harmonics / --samples asking for the automatic choice
+AUTO = config.HB_AUTO
+
 NAME = "frc"
 HELP = ("frequency-response curve (steady amplitude vs gamma) of the paper's friction damper or of a structure "
         "of your own (--system FILE.toml)")
@@ -80,10 +83,12 @@ def add_arguments(p) -> None:
                         f"connection timeout {config.SWEEP_SCHEDULER_TIMEOUT_S:g} s)")
     p.add_argument("--workers", type=int, default=None,
                    help="time: local parallel workers (default: all cores; not with --scheduler)")
-    p.add_argument("--harmonics", type=int, default=None,
-                   help=f"hb: number of harmonics (default {config.HB_HARMONICS})")
-    p.add_argument("--samples", type=int, default=None,
-                   help=f"hb: time samples per period (default {config.HB_SAMPLES})")
+    p.add_argument("--harmonics", default=None, metavar="H|auto",
+                   help=f"hb: number of harmonics, or auto (default: from {config.HB_HARMONICS}, raised while a "
+                        f"peak changes by more than {100 * config.HB_AUTO_RTOL:g} % with 2H+1)")
+    p.add_argument("--samples", default=None, metavar="NS|auto",
+                   help=f"hb: time samples per period, or auto (default: from {config.HB_SAMPLES}, doubled while a "
+                        f"peak changes by more than {100 * config.HB_AUTO_RTOL:g} % with twice as many)")
     p.add_argument("--out", default=None, metavar="DIR",
                    help="write frc.nc, frc.csv, frc.png here (time: resume checkpoints under DIR/lines; a rerun "
                         "reuses them and says how many points it reused)")
@@ -109,6 +114,19 @@ def parse_gamma(text: str) -> np.ndarray:
                     config.SWEEP_MAX_GAMMA_POINTS, "points")
     count = int(math.floor((stop - start) / step + 1e-9)) + 1
     return np.round(start + step * np.arange(count), 12)
+
+
+def _count_or_auto(name: str, value, minimum: int):
+    """``"auto"`` or an integer >= minimum (the value of --harmonics or --samples)."""
+    if value == AUTO:
+        return AUTO
+    try:
+        count = int(value)
+    except (TypeError, ValueError):
+        count = None
+    if count is None or count < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum} or {AUTO!r}, got {value!r}")
+    return count
 
 
 def _jsonable(values):
@@ -143,8 +161,8 @@ def _check_method_options(args) -> None:
         for dest, why in _TIME_ONLY.items():
             if getattr(args, dest) is not None:
                 raise ValueError(f"{_option(dest)} applies to --method time only: {why}")
-        args.harmonics = config.HB_HARMONICS if args.harmonics is None else args.harmonics
-        args.samples = config.HB_SAMPLES if args.samples is None else args.samples
+        args.harmonics = AUTO if args.harmonics is None else args.harmonics
+        args.samples = AUTO if args.samples is None else args.samples
         return
     for dest in _HB_ONLY:
         if getattr(args, dest) is not None:
@@ -208,8 +226,8 @@ def _validate(args):
     if args.workers is not None:
         V.positive_int("--workers", args.workers)
     if args.method == "hb":
-        V.positive_int("--harmonics", args.harmonics)
-        V.positive_int("--samples", args.samples, 4)
+        args.harmonics = _count_or_auto("--harmonics", args.harmonics, 1)
+        args.samples = _count_or_auto("--samples", args.samples, 4)
     args.system_file = None
     if args.system is not None:
         refuse_paper_options(args, PAPER_OPTIONS)
@@ -411,6 +429,7 @@ def _hb_peaks(br) -> list:
 def _run_hb(args, gammas):
     """The hb branch: ``(branch, result)`` (the Dataset is built only for files: xarray takes time to import)."""
     from ..hb import continue_hb
+    from ..hb.frc import discretisation_attrs
 
     system = _system(args)
     if gammas.size < 2:
@@ -424,8 +443,10 @@ def _run_hb(args, gammas):
         # what the harmonic-balance solver refuses (a kind of normal load, mixed laws) is said as its own
         raise ValueError(f"--method hb: {exc}") from None
     result = _header(args)
-    result["harmonics"] = args.harmonics
-    result["samples"] = args.samples
+    result["harmonics"] = br.problem.H
+    result["samples"] = br.problem.Ns
+    result["discretisation"] = {k: (_jsonable([v])[0] if isinstance(v, float) else v)
+                                for k, v in discretisation_attrs(br).items()}
     result["branches"] = _hb_branches(br)
     result["peaks"] = _hb_peaks(br)
     result["status"] = br.status.value

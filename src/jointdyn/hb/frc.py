@@ -63,8 +63,8 @@ from .condense import make_problem
 from .parameters import GAMMA, parameter_named
 from .problem import HBProblem, contact_of
 
-__all__ = ["HBBranch", "HBPeak", "HBSolution", "PointStatus", "continue_hb", "frc_hb", "branch_dataset",
-           "harmonic_balance"]
+__all__ = ["AUTO", "DiscretisationCheck", "HBBranch", "HBPeak", "HBSolution", "PointStatus", "continue_hb",
+           "frc_hb", "branch_dataset", "discretisation_attrs", "harmonic_balance"]
 
 
 class PointStatus(Status):
@@ -77,6 +77,52 @@ class PointStatus(Status):
     AFTER_JUMP = "after-jump", ("reached by a jump over a discontinuity of the contact force: not joined to the "
                                 "previous point")
     STOPPED = "stopped", "last point of a segment that stopped short (the branch message says where and why)"
+
+
+#: ``harmonics`` / ``samples`` value asking for the automatic choice (:func:`continue_hb`)
+AUTO = config.HB_AUTO
+
+
+@dataclass(frozen=True)
+class DiscretisationCheck:
+    """The convergence check of a branch's peaks in the harmonics and the samples.
+
+    Every refined peak is solved again at its parameter value with 2H + 1
+    harmonics (same samples, at least 2(2H + 1) + 2) and with 2 Ns samples
+    (same harmonics), from the peak's own solution; the changes are
+    relative to the peak's amplitude of the response DOF.
+
+    Attributes
+    ----------
+    harmonics_auto, samples_auto : bool
+        Which of the two were chosen automatically.
+    levels : tuple of (int, int)
+        (H, Ns) of every branch computed, the last one reported.
+    check_harmonics, check_samples : int
+        H and Ns of the check solves at the last level.
+    harmonics_change, samples_change : float
+        Largest change of a peak amplitude with ``check_harmonics``
+        harmonics and with ``check_samples`` samples, relative to the
+        highest peak of the branch (NaN without a peak; inf where a check
+        solve did not converge).
+    peaks : int
+        Peaks checked.
+    rtol : float
+        Tolerance on the changes (``config.HB_AUTO_RTOL``).
+    converged : bool
+        Both changes within ``rtol`` (True without a peak).
+    """
+
+    harmonics_auto: bool
+    samples_auto: bool
+    levels: tuple
+    check_harmonics: int
+    check_samples: int
+    harmonics_change: float
+    samples_change: float
+    peaks: int
+    rtol: float
+    converged: bool
 
 
 @dataclass(frozen=True)
@@ -162,6 +208,9 @@ class HBBranch:
         bound).
     response_dof : int
         DOF of ``response0``, of the peaks and of the step control.
+    discretisation : DiscretisationCheck or None
+        The automatic choice of harmonics and samples and the convergence
+        check of the peaks (None when both were given).
     """
 
     problem: HBProblem
@@ -184,6 +233,7 @@ class HBBranch:
     peaks: tuple
     uncovered: tuple
     response_dof: int
+    discretisation: DiscretisationCheck | None = None
 
     def gamma(self):
         """gamma = w / w0 per point."""
@@ -462,7 +512,7 @@ def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress) -> 
 
 
 def continue_hb(system: System, start: float, stop: float, *, parameter="gamma", gamma: float | None = None,
-                harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
+                harmonics: int | str = AUTO, samples: int | str = AUTO,
                 max_step: float | None = None, response_dof: int | None = None,
                 options: ContinuationOptions | None = None, backward_after_unbounded: bool = True,
                 progress: bool | None = None, condense: bool | None = None, **overrides) -> HBBranch:
@@ -482,10 +532,18 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         value that builds the System).
     gamma : float, optional
         w / w0, required unless ``parameter == "gamma"``.
-    harmonics : int
-        Highest harmonic H (>= 1); harmonics 0..H are used.
-    samples : int
-        AFT time samples per period (>= 2H + 2).
+    harmonics : int or "auto"
+        Highest harmonic H (>= 1); harmonics 0..H are used. ``"auto"``
+        (default): start at ``config.HB_HARMONICS``; every refined peak is
+        solved again with 2H + 1 harmonics and, where its amplitude changes
+        by more than ``config.HB_AUTO_RTOL``, the branch is computed again
+        with more (up to ``config.HB_AUTO_MAX_HARMONICS``).
+    samples : int or "auto"
+        AFT time samples per period (>= 2H + 2). ``"auto"`` (default):
+        start at ``config.HB_SAMPLES`` and double the same way, checked
+        with 2 Ns samples (up to ``config.HB_AUTO_MAX_SAMPLES``). The
+        levels used and the check are in ``HBBranch.discretisation``; a
+        converged branch costs two extra solves per peak.
     max_step : float, optional
         Largest change of the parameter between consecutive points (in its
         own unit, e.g. a gamma grid spacing); default
@@ -533,20 +591,166 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {dof!r}")
     opt = make_options(options, overrides)
     V.positive_int("max_points", opt.max_points, 2)
-    problem = make_problem(system, condense=condense, response_dofs=(dof,), harmonics=harmonics, samples=samples,
-                           parameter=par, gamma=gamma)
-    tr = _Tracker(problem, _scales(problem, start), dof)
     if max_step is None and par is GAMMA:
         max_step = config.HB_MAX_GAMMA_STEP
     if max_step is not None:
-        opt = dataclasses.replace(opt, max_dlam=V.positive("max_step", max_step) / tr.scales[2])
-    res = _segment(tr, start, stop, opt, progress)
+        V.positive("max_step", max_step)
+    level, auto = _first_level(harmonics, samples)
+    req = _Request(system=system, start=start, stop=stop, parameter=par, gamma=gamma, max_step=max_step, dof=dof,
+                   options=opt, backward=backward_after_unbounded, progress=progress, condense=condense)
+    return _adaptive_branch(req, level, auto)
+
+
+@dataclass(frozen=True)
+class _Request:
+    """What a branch is asked for, apart from its discretisation (validated by :func:`continue_hb`)."""
+
+    system: System
+    start: float
+    stop: float
+    parameter: object
+    gamma: float | None
+    max_step: float | None
+    dof: int
+    options: ContinuationOptions
+    backward: bool
+    progress: bool | None
+    condense: bool | None
+
+
+def _fixed_branch(req: _Request, level) -> HBBranch:
+    """The branch with H harmonics and Ns samples, ``level = (H, Ns)``."""
+    problem = make_problem(req.system, condense=req.condense, response_dofs=(req.dof,), harmonics=level[0],
+                           samples=level[1], parameter=req.parameter, gamma=req.gamma)
+    tr = _Tracker(problem, _scales(problem, req.start), req.dof)
+    opt = req.options
+    if req.max_step is not None:
+        opt = dataclasses.replace(opt, max_dlam=req.max_step / tr.scales[2])
+    res = _segment(tr, req.start, req.stop, opt, req.progress)
     parts = [res]
     # the segment back from the end has a bound of its own: the first one may have spent its points
     # on a flank that grows without bound
-    if res.status in _GO_BACK and backward_after_unbounded:
-        parts.append(_segment(tr, stop, start, opt, progress))
-    return _join(tr, parts, start, stop, opt)
+    if res.status in _GO_BACK and req.backward:
+        parts.append(_segment(tr, req.stop, req.start, opt, req.progress))
+    return _join(tr, parts, req.start, req.stop, opt)
+
+
+def _first_level(harmonics, samples):
+    """((H, Ns) of the first branch, (harmonics auto, samples auto)); validates both."""
+    auto_h, auto_s = harmonics == AUTO, samples == AUTO
+    for name, v, auto in (("harmonics", harmonics, auto_h), ("samples", samples, auto_s)):
+        if isinstance(v, str) and not auto:
+            raise ValueError(f"{name} must be an integer or {AUTO!r}, got {v!r}")
+    H = config.HB_HARMONICS if auto_h else V.positive_int("harmonics", harmonics, 1)
+    if auto_s:
+        return (H, max(config.HB_SAMPLES, 2 * H + 2)), (auto_h, auto_s)
+    return (H, V.positive_int("samples", samples, 2 * H + 2)), (auto_h, auto_s)
+
+
+def _check_levels(level, auto):
+    """(H, Ns) of the harmonics check and of the samples check one level above ``level`` (None: not made)."""
+    H, Ns = level
+    h2 = 2 * H + 1
+    by_h = (h2, max(Ns, 2 * h2 + 2) if auto[1] else Ns) if auto[0] else None
+    if by_h is not None and by_h[1] < 2 * h2 + 2:
+        by_h = None  # the samples fixed by the caller cannot carry more harmonics
+    return by_h, ((H, 2 * Ns) if auto[1] else None)
+
+
+def _next_level(level, auto, bad_h: bool, bad_s: bool):
+    """The level the checks ask for, within ``config.HB_AUTO_MAX_*`` (equal to ``level``: no refinement).
+
+    The samples first: with too few, the sampling error of the contact
+    force also moves the solution with more harmonics, so H is raised
+    only once the samples pass their check.
+    """
+    by_h, by_s = _check_levels(level, auto)
+    if bad_s and by_s is not None:
+        return by_s if by_s[1] <= config.HB_AUTO_MAX_SAMPLES else level
+    if bad_h and by_h is not None and by_h[0] <= config.HB_AUTO_MAX_HARMONICS:
+        return by_h
+    return level
+
+
+def _solve_at(req: _Request, condensed: bool, lam: float, X, level):
+    """(amplitude of the response DOF (m; NaN where Newton failed), X) at parameter ``lam`` with
+    ``level = (H, Ns)``, by Newton from the harmonics X (zero above their H)."""
+    problem = make_problem(req.system, condense=condensed, response_dofs=(req.dof,), harmonics=level[0],
+                           samples=level[1], parameter=req.parameter, gamma=req.gamma)
+    tr = _Tracker(problem, _scales(problem, req.start), req.dof)
+    xs, _, ps = tr.scales
+    Xm = np.asarray(X).reshape(-1, problem.n)
+    X0 = np.zeros((problem.nh, problem.n))
+    X0[: min(Xm.shape[0], problem.nh)] = Xm[: problem.nh]
+    y, ok, _ = newton(tr.residual, X0.ravel() / xs, lam / ps, req.options)
+    return (tr.amplitudes(y)[0] if ok else math.nan), y * xs
+
+
+def _change(amp: float, ref: float, scale: float) -> float:
+    """|amp - ref| / scale (inf where the check solve failed)."""
+    return abs(amp - ref) / scale if math.isfinite(amp) and scale > 0 else math.inf
+
+
+def _peak_level(req: _Request, condensed: bool, pk: HBPeak, scale: float, level, auto):
+    """(level at which the peak converges (or the bound), (harmonics change, samples change) at ``level``).
+
+    The peak is solved with more harmonics and with more samples
+    (:func:`_check_levels`); the changes are relative to ``scale`` (the
+    highest peak of the branch, so that a small secondary peak asks for no
+    more than its share of the curve). Where a change exceeds
+    ``config.HB_AUTO_RTOL`` the peak is solved at the refined level and
+    checked there again.
+    """
+    at, X, amp, first = level, pk.X, pk.amplitude_m, None
+    while True:
+        solved = {lv: _solve_at(req, condensed, pk.lam, X, lv) for lv in _check_levels(at, auto) if lv}
+        ch = tuple(_change(solved[lv][0], amp, scale) if lv else math.nan for lv in _check_levels(at, auto))
+        first = ch if first is None else first
+        nxt = _next_level(at, auto, ch[0] > config.HB_AUTO_RTOL, ch[1] > config.HB_AUTO_RTOL)
+        if nxt == at:
+            return at, first
+        amp, X = solved[nxt] if nxt in solved else _solve_at(req, condensed, pk.lam, X, nxt)
+        at = nxt
+        if not math.isfinite(amp):
+            return at, first
+
+
+def _worst(values) -> float:
+    """Largest of the values that are not NaN (NaN when there is none)."""
+    v = [x for x in values if not math.isnan(x)]
+    return max(v) if v else math.nan
+
+
+def _adaptive_branch(req: _Request, level, auto) -> HBBranch:
+    """The branch at ``level``, computed again at a finer level while its peaks ask for one (``auto``:
+    which of (harmonics, samples) may change); with its :class:`DiscretisationCheck`."""
+    levels = [level]
+    br = _fixed_branch(req, level)
+    if not any(auto):
+        return br
+    while True:
+        scale = max([pk.amplitude_m for pk in br.peaks], default=0.0)
+        checks = [_peak_level(req, br.problem.condensed, pk, scale, level, auto) for pk in br.peaks]
+        target = (max([level[0]] + [c[0][0] for c in checks]), max([level[1]] + [c[0][1] for c in checks]))
+        if target == level:
+            break
+        level = target
+        levels.append(level)
+        br = _fixed_branch(req, level)
+    by_h, by_s = _check_levels(level, auto)
+    ch_h, ch_s = _worst(c[1][0] for c in checks), _worst(c[1][1] for c in checks)
+    converged = not (ch_h > config.HB_AUTO_RTOL or ch_s > config.HB_AUTO_RTOL)
+    check = DiscretisationCheck(harmonics_auto=auto[0], samples_auto=auto[1], levels=tuple(levels),
+                                check_harmonics=by_h[0] if by_h else 0, check_samples=by_s[1] if by_s else 0,
+                                harmonics_change=ch_h, samples_change=ch_s, peaks=len(checks),
+                                rtol=config.HB_AUTO_RTOL, converged=converged)
+    message = br.message
+    if not converged:
+        message += (f"; the peak amplitude is not converged in the discretisation at its bound (H = {level[0]}, "
+                    f"Ns = {level[1]}): it changes by {100 * _worst([ch_h, ch_s]):.3g} % with "
+                    f"{check.check_harmonics or level[0]} harmonics or {check.check_samples or level[1]} samples "
+                    f"(tolerance {100 * config.HB_AUTO_RTOL:g} %)")
+    return dataclasses.replace(br, discretisation=check, message=message)
 
 
 #: segment statuses after which a second segment is continued back from the end of the range
@@ -798,11 +1002,41 @@ def _branch_attrs(branch: HBBranch, dof: int, ds) -> dict:
         force_period_2_points=int((branch.force_period == 2).sum()),
         force_not_periodic_points=int((branch.force_period == 0).sum()),
         **{f"counter_{k}": int(v) for k, v in branch.counters.items()},
+        **discretisation_attrs(branch),
     )
 
 
-def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: int = config.HB_HARMONICS,
-           samples: int = config.HB_SAMPLES, max_step: float | None = None, response_dof: int | None = None,
+def discretisation_attrs(branch: HBBranch) -> dict:
+    """Attributes of the choice of harmonics and samples and of its check (see :class:`DiscretisationCheck`).
+
+    ``harmonics_choice`` and ``samples_choice`` (``auto`` or ``fixed``),
+    ``discretisation_levels`` (the (H, Ns) of every branch computed, e.g.
+    ``"7x128, 7x256"``), ``check_harmonics`` and ``check_samples`` (of the
+    check solves, 0 where none was made), ``check_harmonics_change`` and
+    ``check_samples_change`` (largest relative change of a peak amplitude;
+    NaN without a check), ``check_rtol``, ``check_converged`` (1/0) and
+    ``check_peaks``.
+    """
+    d = branch.discretisation
+    if d is None:
+        p = branch.problem
+        return dict(harmonics_choice="fixed", samples_choice="fixed", discretisation_levels=f"{p.H}x{p.Ns}")
+    return dict(
+        harmonics_choice="auto" if d.harmonics_auto else "fixed",
+        samples_choice="auto" if d.samples_auto else "fixed",
+        discretisation_levels=", ".join(f"{h}x{n}" for h, n in d.levels),
+        check_harmonics=d.check_harmonics,
+        check_samples=d.check_samples,
+        check_harmonics_change=float(d.harmonics_change),
+        check_samples_change=float(d.samples_change),
+        check_rtol=float(d.rtol),
+        check_converged=int(d.converged),
+        check_peaks=d.peaks,
+    )
+
+
+def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: int | str = AUTO,
+           samples: int | str = AUTO, max_step: float | None = None, response_dof: int | None = None,
            options: ContinuationOptions | None = None, progress: bool | None = None, condense: bool | None = None,
            **overrides):
     """Frequency-response curve by harmonic balance and arc-length continuation.
@@ -820,10 +1054,11 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
     gamma_start, gamma_stop : float
         Range of gamma = w / w0 (> 0, distinct); the branch starts at
         ``gamma_start`` from the stuck-contact linear solution.
-    harmonics : int
-        H >= 1.
-    samples : int
-        >= 2H + 2.
+    harmonics : int or "auto"
+        H >= 1, or chosen from the convergence of the peaks (default; see
+        :func:`continue_hb`).
+    samples : int or "auto"
+        >= 2H + 2, or chosen likewise (default).
     max_step : float, optional
         Largest gamma spacing between consecutive points (e.g. the STEP of
         a gamma grid; default ``config.HB_MAX_GAMMA_STEP``); the chord

@@ -70,7 +70,10 @@ class GridCase:
     peak_error : float
         (peak_q - time_q) / time_q (NaN where not compared).
     seconds : float
-        CPU seconds of the branch (process time).
+        CPU seconds of the branch (process time), the automatic choice of
+        harmonics and samples included.
+    harmonics, samples : int
+        H and Ns of the reported branch (chosen automatically).
     message : str
         The branch's message.
     """
@@ -89,6 +92,8 @@ class GridCase:
     time_q: float
     peak_error: float
     seconds: float
+    harmonics: int
+    samples: int
     message: str
 
 
@@ -118,7 +123,10 @@ def grid_case(model: str, eta: float, beta: float, gamma=GRID_GAMMA, *, time_dom
     ok = covered and not abs(err) > rtol  # NaN (not compared) passes
     return GridCase(model=model, eta=eta, beta=beta, status=status, covered=covered, ok=bool(ok),
                     points=int(ds.sizes["point"]), folds=int(ds.attrs["folds"]),
-                    unstable=int(ds.attrs["unstable_points"]), peak_gamma=g_pk, peak_q=q_pk, time_q=q_td, peak_error=err, seconds=seconds, message=str(ds.attrs["message"]))
+                    unstable=int(ds.attrs["unstable_points"]), peak_gamma=g_pk, peak_q=q_pk, time_q=q_td,
+                    peak_error=err, seconds=seconds,
+                    harmonics=int(ds.attrs["harmonics"]), samples=int(ds.attrs["samples"]),
+                    message=str(ds.attrs["message"]))
 
 
 def hb_restart(system, X, gamma: float, harmonics: int, periods: int = WARM_PERIODS,
@@ -159,13 +167,13 @@ def grid_table(cases) -> str:
     """Markdown table of grid cases (one row each) and a summary line."""
     cases = list(cases)
     head = ("| model | eta | beta | status | points | folds | unstable | peak gamma | peak q | time-domain q | "
-            "error | CPU s | ok |")
-    lines = [head, "|" + "---|" * 13]
+            "error | H x Ns | CPU s | ok |")
+    lines = [head, "|" + "---|" * 14]
     for c in cases:
         lines.append(f"| {c.model} | {c.eta:g} | {c.beta:g} | {c.status} | {c.points} | {c.folds} | {c.unstable} | "
                      f"{_num(c.peak_gamma, '.5f')} | {_num(c.peak_q, '.5g')} | {_num(c.time_q, '.5g')} | "
                      f"{_num(100 * c.peak_error, '+.2f')}{'' if not math.isfinite(c.peak_error) else ' %'} | "
-                     f"{c.seconds:.2f} | {'yes' if c.ok else '**no**'} |")
+                     f"{c.harmonics} x {c.samples} | {c.seconds:.2f} | {'yes' if c.ok else '**no**'} |")
     good = sum(c.ok for c in cases)
     lines.append("")
     lines.append(f"{good} of {len(cases)} cases pass; {sum(c.status == 'complete' for c in cases)} branches "
