@@ -37,3 +37,22 @@ def test_the_closed_form_is_flagged_and_the_default_law_is_not():
 def test_not_periodic_is_not_checked():
     r = jd.steady_state(jd.System.paper_damper(eta=0.5, beta=1.0), 1.0, max_periods=2, shooting=False)
     assert r.status != "periodic" and r.energy_check == "not-checked"
+
+
+def test_sweeps_and_the_cli_flag_negative_dissipation(tmp_path):
+    # the closed form at issue 9's point creates energy; the exact default does not
+    import json
+    import subprocess
+    import sys
+
+    flagged = jd.frc_sweep([0.6], etas=[1.5], betas=[2.0], model="iwan-closed", directions=("up",), n_workers=1,
+                           progress=False)
+    assert int(flagged.negative_dissipation.sum()) == 1
+    exact = jd.frc_sweep([0.6], etas=[1.5], betas=[2.0], directions=("up",), n_workers=1, progress=False)
+    assert int(exact.negative_dissipation.sum()) == 0
+    proc = subprocess.run([sys.executable, "-m", "jointdyn", "frc", "--model", "iwan-closed", "--eta", "1.5",
+                           "--beta", "2", "--gamma", "0.6:0.6:0.01", "--sweep", "up", "--json"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0
+    assert json.loads(proc.stdout)["directions"]["up"]["negative_dissipation"] == [True]
+    assert "1 periodic points where the contact creates energy" in proc.stderr

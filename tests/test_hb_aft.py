@@ -14,12 +14,13 @@ import numpy as np
 import pytest
 
 from jointdyn import System, config
+from jointdyn.fourier import basis, derivative_matrix
 from jointdyn.hb import HBProblem
 
 
 def _reference(p, X, lam):
     """R, JX, Jp, T, code, info of HBProblem.evaluate, marched in Python."""
-    w, dwdp, Fe, Fp, Nsamp, dN = p._inputs(lam)
+    w, dwdp, Fe, Fp, Nsamp, dN, (ev_tau, ev_dtau, ev_load) = p._inputs(lam)
     AK, AC, AM = p._lin
     A = AK + w * AC + w * w * AM
     R = A @ X - Fe
@@ -55,6 +56,14 @@ def _reference(p, X, lam):
         while passes < p.max_passes:
             T, dT, code = np.empty(ns), np.empty((ns, nd)), np.empty(ns, dtype=np.int64)
             for i in range(ns):
+                if ev_tau[c, i] >= 0.0:  # virgin restart at the re-contact phase inside the interval
+                    tr = ev_tau[c, i]
+                    Er = basis(p.H, [tr])[0]
+                    dxr = np.zeros(nd)
+                    dxr[:nh] = Er
+                    if has_p:
+                        dxr[nh] = (Er @ (derivative_matrix(p.H) @ U)) * ev_dtau[c, i]
+                    law.init_jvp(law.params, float(Er @ U), dxr, float(ev_load[c]), np.zeros(nd), a, da)
                 dx = np.zeros(nd)
                 dx[:nh] = p.E[i]
                 dn = np.zeros(nd)

@@ -53,7 +53,8 @@ def test_options_and_results_are_frozen():
 
 def test_status_enumeration():
     assert issubclass(ContinuationStatus, Status)
-    assert [s.value for s in ContinuationStatus] == ["complete", "max-points", "failed", "unbounded", "stopped"]
+    assert [s.value for s in ContinuationStatus] == ["complete", "max-points", "failed", "unbounded", "stopped",
+                                                     "turned-back"]
     assert [s for s in ContinuationStatus if s.ok] == [ContinuationStatus.COMPLETE]
     assert all(s.message for s in ContinuationStatus)
     assert ContinuationStatus.COMPLETE == "complete" and f"{ContinuationStatus.FAILED}" == "failed"

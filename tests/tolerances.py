@@ -163,3 +163,7 @@ TEST_MODES_TMDSIMPY_SAME_RTOL = 1e-9
 #: QSMA of the uniform Iwan contact vs the closed-form Masing secant and loop
 #: area (the Hermite-corrected work integral is exact for the quadratic backbone)
 TEST_QSMA_MASING_RTOL = 1e-9
+#: harmonic-balance branches: largest distance between the straight line
+#: joining two reported points and the curve, in the plane (gamma, ln q)
+#: (0.01: 1 % of the amplitude; issue 9)
+TEST_HB_CHORD_TOL = 1e-2

@@ -13,6 +13,11 @@ Exit status
   error): one line on stderr naming the parameter, no file written.
 - 1: an operating-system error during the run, after validation (e.g. a
   full disk while writing the results): one line on stderr.
+- 3: incomplete result: the computation ran, but its answer does not
+  cover what was asked (``jointdyn frc --method hb``: a branch that failed,
+  turned back or stopped at its point bound short of the gamma range).
+  The output and the files are still written, with a per-point status;
+  one line on stderr names where and why it stopped.
 - 130: interrupted (Ctrl-C).
 - 141 (128 + SIGPIPE): the reader of stdout went away (``jointdyn ... |
   head``); the command stops quietly, as Unix tools do, and the shell's
@@ -33,6 +38,8 @@ __all__ = ["main"]
 EXIT_BROKEN_PIPE = 141
 EXIT_BAD_INPUT = 2
 EXIT_OS_ERROR = 1
+#: the run finished but its result does not cover the request (see the module docstring)
+EXIT_INCOMPLETE = 3
 EXIT_INTERRUPTED = 130
 
 

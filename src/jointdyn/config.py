@@ -199,6 +199,10 @@ HB_FINE_SAMPLES = 1024
 HB_MAX_PASSES = 8
 #: two consecutive marched periods agree when max|T_p - T_(p-1)| <= rtol max|T|
 HB_PERIODIC_RTOL = 1e-10
+#: load at which the AFT restarts a contact law at a re-contact phase between
+#: two samples, as a fraction of the contact's largest |N| (> 0: the law is
+#: in contact and at rest there, as the time integrator's TI_RECONTACT_ALPHA)
+HB_RECONTACT_ALPHA = 1e-12
 
 # --- continuation (jointdyn.continuation; unknowns, parameter and residual scaled) ----
 #: Newton converged when max|R| <= this (scaled residual; harmonic balance
@@ -210,6 +214,9 @@ CONT_MAX_ITER = 12
 CONT_DS_START = 0.05
 CONT_DS_MIN = 1e-6
 CONT_DS_MAX = 0.1
+#: ... or this fraction of the norm of the unknowns where that is larger
+#: (a flank growing without bound: as many points per decade as a small one)
+CONT_DS_MAX_REL = 0.02
 #: bound on the points of a branch
 CONT_MAX_POINTS = 2000
 #: predictor direction: "tangent" or "secant"
@@ -251,6 +258,20 @@ CONT_MAX_JUMPS = 5
 #: a jump's guess follows the tangent when its parameter component exceeds
 #: this (else the last point's unknowns)
 CONT_JUMP_TANGENT_MIN = 1e-3
+#: largest deviation between the straight line joining consecutive points of
+#: a branch and the curve, in the plane (parameter, observable) (harmonic
+#: balance: gamma and the logarithm of the norm of the response DOF's
+#: harmonics, so 0.005 is half a percent of the amplitude or 0.005 in gamma;
+#: measured against the reported amplitude the chords stay within 1 %,
+#: tests/test_hb_trust.py)
+CONT_CHORD_TOL = 0.005
+#: refinement of a maximum along a branch (peaks): at most this many
+#: corrections, until the bracket is this fraction of its first width or the
+#: observable varies by at most CONT_REFINE_GTOL across it (harmonic
+#: balance: log q, so 1e-7 is a relative 1e-7 of the amplitude)
+CONT_REFINE_ITER = 20
+CONT_REFINE_STOL = 1e-4
+CONT_REFINE_GTOL = 1e-7
 #: bordered linear systems (Newton corrections, tangents) of at most this
 #: many unknowns are solved by the compiled elimination of
 #: jointdyn.continuation, larger ones by LAPACK (benchmarks/bench_linalg.py:
@@ -283,12 +304,21 @@ HB_SATURATION_Q = 30.0
 HB_SATURATION_SLIP_FRACTION = 0.9
 #: a Floquet exponent with Re(s) > HB_STABILITY_RTOL * w marks instability
 HB_STABILITY_RTOL = 1e-6
+#: a Hill growth Re(s)/w between HB_STABILITY_RTOL and this is decided by
+#: the monodromy matrix of the time-domain period map (Hill's method
+#: truncated to H harmonics errs by a few 1e-6 at corners of the contact
+#: force: the onset of slip of an undamped oscillator)
+HB_STABILITY_CONFIRM = 1e-4
 #: Hill companion matrices (2 n (2H+1) rows), or their parity blocks, of at
 #: most this many rows go through the compiled EISPACK eigenvalue solver,
 #: larger ones through LAPACK (benchmarks/bench_linalg.py: the compiled
 #: solver is 1.3-3.7x faster up to 150 rows, LAPACK 1.1-1.3x faster from 300)
 HB_SMALL_EIG = 200
-#: turning points of a branch (secant): dead band as a fraction of the range
+#: turning points (folds) of a branch: the parameter must come back by more
+#: than this fraction of the range, or log q move by more than
+#: HB_TURNING_BAND_LOG_Q while the parameter is short of its extreme (a fold
+#: whose branches are close in the parameter): the jitter of points at a
+#: non-smooth corner stays within both
 HB_TURNING_BAND = 5e-4
 
 # --- nonlinear modes (jointdyn.modes) ------------------------------------------------
@@ -352,3 +382,12 @@ HB_CONDENSE_CHECK_RTOL = 1e-9
 #: a condensed problem computes Hill stability (on the full Jacobian it
 #: assembles) when the full companion matrix has at most this many rows
 HB_CONDENSED_HILL_ROWS = 200
+HB_TURNING_BAND_LOG_Q = 5e-3
+#: a turning point is a fold only with an unstable point between it and the
+#: neighbouring turning points (without one on a side: within this many
+#: points): a saddle-node changes the number of unstable multipliers
+HB_FOLD_WINDOW = 3
+#: a local maximum of the amplitude along a branch is a peak when the
+#: amplitude falls by more than this fraction of it on both sides (before
+#: rising above it again)
+HB_PEAK_PROMINENCE = 1e-3

@@ -14,19 +14,31 @@ Bifurcation and Stability Analysis*, Springer 2010, sec. 4.4):
 * corrector: damped Newton on ``R(u) = 0, d^T (u - u_pred) = 0``;
 * step length: grown after easy corrections, shrunk after hard ones and
   where the tangent turned (folds are resolved), cut and retried after a
-  failure, down to ``ds_min``;
+  failure, down to ``ds_min``; bounded so that lam moves by at most
+  ``max_dlam`` per step (a user's grid spacing) and, given an
+  ``observe`` function (e.g. the logarithm of an amplitude), so that the
+  straight line between consecutive points stays within ``chord_tol`` of
+  the curve in the plane (lam, observe): a resonance peak cannot be
+  stepped over;
 * a fold (turning point in lam) is where the lam component of the tangent
   changes sign; it is flagged at the first point past it;
+* a sharp corner of a piecewise-smooth branch (turning by more than a
+  right angle while lam keeps its direction) is passed by Newton at fixed
+  lam just beyond it (points marked ``corner``);
 * a residual that jumps (a contact law with a discontinuous force, e.g.
   the closed-form Iwan rules under a varying load) can leave no solution
   on the arc: when the corrector fails at ``ds_min``, Newton at fixed lam
-  is tried a little further on (``jump_fractions`` of the range); if it
-  converges the branch goes on from there and the point is marked as a
-  ``gap``;
+  is tried a little further on (``jump_fractions`` of the range, at most
+  ``max_dlam``); if it converges the branch goes on from there and the
+  point is marked as a ``gap``;
 * the branch stops when lam leaves ``[min(lam0, lam_stop), max(..)]``
-  (the end point is corrected onto the bound exactly), after
-  ``max_points``, when a ``monitor`` says so, or when the corrector fails
-  at ``ds_min``.
+  (the end point is corrected onto the bound exactly; ``complete`` only at
+  ``lam_stop``, ``turned-back`` at ``lam0``), after ``max_points``, when a
+  ``monitor`` says so, or when the corrector fails at ``ds_min``.
+
+:func:`refine_maximum` locates the maximum of an observable along a
+computed branch between three points (peaks of response curves), and
+:func:`local_maxima` finds the points to start from.
 
 Every number of the step control is a field of :class:`ContinuationOptions`
 (defaults in :mod:`jointdyn.config`, group "continuation"). Bordered linear
@@ -50,7 +62,20 @@ from ._jit import jit
 from .status import Status
 
 __all__ = ["ContinuationOptions", "ContinuationStatus", "ContinuationResult", "continuation", "newton",
-           "turning_points", "make_options"]
+           "turning_points", "make_options", "local_maxima", "refine_maximum"]
+
+#: a step is sized to move lam by at most this fraction of ``max_dlam`` (the
+#: corrector moves lam a little more or less than the prediction)
+DLAM_SAFETY = 0.95
+#: attempts of a corner pass, each a quarter of the distance in lam of the one before
+CORNER_TRIES = 3
+#: golden-section fraction of :func:`refine_maximum`'s fallback step, and the
+#: margin (fraction of the bracket) a parabolic step keeps from the bracket's points
+GOLDEN = 0.381966
+GOLDEN_MARGIN = 0.05
+#: a step of :func:`refine_maximum` that left the bracket wider than this fraction of its width before
+#: is followed by a golden-section step (a golden step leaves 0.618 of it)
+STALL_FRACTION = 0.7
 
 
 class ContinuationStatus(Status):
@@ -61,6 +86,7 @@ class ContinuationStatus(Status):
     FAILED = "failed", "Newton failed (at the start, or at the smallest step): the branch stops short"
     UNBOUNDED = "unbounded", "the solution grows without bound (stopped by the problem's monitor)"
     STOPPED = "stopped", "the problem's monitor stopped the branch"
+    TURNED_BACK = "turned-back", "the branch turned back to the start of the range: the end was not reached"
 
 
 @dataclass(frozen=True)
@@ -79,6 +105,10 @@ class ContinuationOptions:
     ds_min, ds_max : float
         Smallest and largest step; below ``ds_min`` a failed corrector ends
         the branch (after the jumps below).
+    ds_max_rel : float
+        Where the unknowns are large, the largest step is this fraction of
+        their norm instead of ``ds_max`` (a response growing without bound
+        is followed in as many steps per decade as a small one).
     max_points : int
         Bound on the points of a branch (>= 1).
     tol : float
@@ -126,11 +156,18 @@ class ContinuationOptions:
         Bound on those jumps per branch.
     jump_tangent_min : float
         A jump's guess follows the tangent when |t_lam| exceeds this.
+    max_dlam : float
+        Largest change of lam between consecutive points (inf: none).
+    chord_tol : float
+        Largest deviation between the straight line joining consecutive
+        points and the curve, in the plane (lam, observable), when
+        :func:`continuation` is given an ``observe`` function (inf: none).
     """
 
     ds: float = config.CONT_DS_START
     ds_min: float = config.CONT_DS_MIN
     ds_max: float = config.CONT_DS_MAX
+    ds_max_rel: float = config.CONT_DS_MAX_REL
     max_points: int = config.CONT_MAX_POINTS
     tol: float = config.CONT_TOL
     max_iter: int = config.CONT_MAX_ITER
@@ -150,10 +187,15 @@ class ContinuationOptions:
     jump_fractions: tuple = config.CONT_JUMP_FRACTIONS
     max_jumps: int = config.CONT_MAX_JUMPS
     jump_tangent_min: float = config.CONT_JUMP_TANGENT_MIN
+    max_dlam: float = math.inf
+    chord_tol: float = config.CONT_CHORD_TOL
 
     def __post_init__(self) -> None:
-        for name in ("ds", "ds_min", "ds_max", "tol", "grow", "max_distance", "corner_ds"):
+        for name in ("ds", "ds_min", "ds_max", "ds_max_rel", "tol", "grow", "max_distance", "corner_ds"):
             V.positive(name, getattr(self, name))
+        for name in ("max_dlam", "chord_tol"):
+            if not getattr(self, name) > 0:  # inf allowed (no bound)
+                raise ValueError(f"{name} must be > 0 (inf: no bound), got {getattr(self, name)!r}")
         for name in ("max_points", "max_iter", "target_iter", "line_search_steps", "max_evals_factor"):
             V.positive_int(name, getattr(self, name))
         V.positive_int("max_jumps", self.max_jumps, 0)
@@ -194,7 +236,10 @@ class ContinuationResult:
         True where the point was reached by a jump over a discontinuity of
         the residual (see :func:`continuation`), not along the curve.
     counters : dict
-        ``points, residual_evaluations, steps_rejected, folds, jumps``.
+        ``points, residual_evaluations, steps_rejected, folds, jumps, corners``.
+    corner : ndarray of bool (points,)
+        True where the point was reached past a sharp corner by Newton at
+        fixed lam (see :func:`continuation`); the curve is continuous there.
     """
 
     status: Status
@@ -206,6 +251,7 @@ class ContinuationResult:
     iterations: np.ndarray
     gap: np.ndarray
     counters: dict = field(default_factory=dict)
+    corner: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
 
 
 # --- linear algebra -------------------------------------------------------------------
@@ -471,16 +517,20 @@ def make_options(options: ContinuationOptions | None = None, overrides: dict | N
     return dataclasses.replace(opt, **overrides) if overrides else opt
 
 
-def turning_points(lam, gap=None, band: float = 0.0):
+def turning_points(lam, gap=None, band: float = 0.0, observed=None, observed_band: float = math.inf):
     """Indices where lam is extremal along a branch (secant turning points).
 
     A reversal counts only once lam has come back from the running extreme
-    by more than ``band`` (dead band: jitter of the points of a
-    piecewise-smooth branch is ignored). Points reached by a jump
-    (``gap``) restart the search.
+    by more than ``band``, or, given ``observed`` values along the branch
+    (what a plot shows against lam), once they have moved by more than
+    ``observed_band`` from their value at the extreme while lam is still
+    short of it (a fold whose branches are close in lam but far apart in
+    the observable): jitter of the points of a piecewise-smooth branch is
+    ignored. Points reached by a jump (``gap``) restart the search.
     """
     lam = np.asarray(lam, dtype=float)
     gap = np.zeros(lam.size, dtype=bool) if gap is None else np.asarray(gap, dtype=bool)
+    obs = np.zeros(lam.size) if observed is None else np.asarray(observed, dtype=float)
     out = []
     i_ext = 0
     direction = 0
@@ -489,13 +539,14 @@ def turning_points(lam, gap=None, band: float = 0.0):
             i_ext, direction = i, 0
             continue
         if direction == 0:
-            if abs(lam[i] - lam[i_ext]) > band:
+            if lam[i] != lam[i_ext] and (abs(lam[i] - lam[i_ext]) > band
+                                         or abs(obs[i] - obs[i_ext]) > observed_band):
                 direction = 1 if lam[i] > lam[i_ext] else -1
                 i_ext = i
             continue
         if direction * (lam[i] - lam[i_ext]) >= 0:
             i_ext = i
-        elif abs(lam[i] - lam[i_ext]) > band:
+        elif abs(lam[i] - lam[i_ext]) > band or abs(obs[i] - obs[i_ext]) > observed_band:
             out.append(i_ext)
             direction = -direction
             i_ext = i
@@ -510,16 +561,18 @@ class _Points:
 
     def __init__(self, n: int):
         self.n = n
-        self.Y, self.L, self.TL, self.FOLD, self.IT, self.GAP = [], [], [], [], [], []
-        self.cnt = {"points": 0, "residual_evaluations": 0, "steps_rejected": 0, "folds": 0, "jumps": 0}
+        self.Y, self.L, self.TL, self.FOLD, self.IT, self.GAP, self.CORNER = [], [], [], [], [], [], []
+        self.cnt = {"points": 0, "residual_evaluations": 0, "steps_rejected": 0, "folds": 0, "jumps": 0,
+                    "corners": 0}
 
-    def add(self, y, lam, t_lam, fold, it, gap) -> None:
+    def add(self, y, lam, t_lam, fold, it, gap, corner=False) -> None:
         self.Y.append(y)
         self.L.append(lam)
         self.TL.append(t_lam)
         self.FOLD.append(fold)
         self.IT.append(it)
         self.GAP.append(gap)
+        self.CORNER.append(corner)
 
     def finish(self, status: Status, message: str) -> ContinuationResult:
         self.cnt["points"] = len(self.L)
@@ -533,16 +586,57 @@ class _Points:
             iterations=np.array(self.IT, dtype=int),
             gap=np.array(self.GAP, dtype=bool),
             counters=dict(self.cnt),
+            corner=np.array(self.CORNER, dtype=bool),
         )
 
 
-def _jump(residual, u, t, span, sgn, opt, cnt):
-    """Newton at fixed lam a little beyond u (over a discontinuity): ``(v, t, iterations)`` or None."""
-    n = u.size - 1
-    for frac in opt.jump_fractions:
-        lam = u[n] + sgn * frac * span  # forward in the range: never bounce back over the same discontinuity
-        y0 = u[:n] + (t[:n] * ((lam - u[n]) / t[n]) if abs(t[n]) > opt.jump_tangent_min else 0.0)
-        y, ok, it, (R, Jy, Jl) = _solve_damped(residual, y0, lam, None, None, opt, cnt)
+@dataclass(slots=True)
+class _Walk:
+    """What every step of one branch needs: residual, options, counters, observable, direction."""
+
+    residual: Callable
+    opt: ContinuationOptions
+    cnt: dict
+    observe: Callable | None
+    sgn: float
+    span: float
+    n: int
+
+    def observed(self, u) -> float:
+        """The observable at u (NaN without one, or where it is not finite)."""
+        if self.observe is None:
+            return math.nan
+        g = float(self.observe(u[:self.n], u[self.n]))
+        return g if math.isfinite(g) else math.nan
+
+
+@dataclass(slots=True)
+class _Step:
+    """Outcome of one predicted and corrected step (see :func:`_try_step`)."""
+
+    v: np.ndarray
+    t: np.ndarray | None
+    it: int
+    ok: bool
+    factor: float  # step factor after a rejection
+    corner_like: bool = False
+    err: float = 0.0  # chord error estimate (0 without an observable)
+    g: float = math.nan  # observable at v
+    gap: bool = False
+    corner: bool = False
+
+
+def _oriented(t_new, direction, n, opt):
+    """t_new, reversed if its lam component opposes ``direction`` (when that component is not negligible)."""
+    if t_new[n] * direction < 0.0 and abs(t_new[n]) > opt.jump_tangent_min:
+        return -t_new
+    return t_new
+
+
+def _fixed_lam_point(walk: _Walk, u, t, lam, guesses):
+    """Newton at fixed lam from each guess in turn: ``(v, t_new, iterations)`` or None."""
+    for y0 in guesses:
+        y, ok, it, (_, Jy, Jl) = _solve_damped(walk.residual, y0.copy(), lam, None, None, walk.opt, walk.cnt)
         if ok:
             tn = _tangent(Jy, Jl, t)
             if tn is not None:
@@ -550,15 +644,123 @@ def _jump(residual, u, t, span, sgn, opt, cnt):
     return None
 
 
-def _try_step(residual, u, t, u_prev, ds, opt, cnt):
-    """Predict and correct one step of length ds: ``(v, t_new, iterations, ok, corner_like)``.
+def _guesses(u, t, lam, n, opt):
+    """Starting guesses at parameter lam near u: along the tangent (if it has a lam component), then u."""
+    out = [u[:n]]
+    if abs(t[n]) > opt.jump_tangent_min:
+        out.insert(0, u[:n] + t[:n] * ((lam - u[n]) / t[n]))
+    return out
 
-    A corrected point is rejected, above ``opt.corner_ds``, when the
-    corrector went farther than ``opt.max_distance * ds`` from the
-    prediction or the tangent turned sharply (maybe onto another part of
-    the branch; ``corner_like``); at smaller steps those are corners of a
-    non-smooth branch (e.g. onset of slip) and are accepted.
+
+def _jump(walk: _Walk, u, t) -> _Step | None:
+    """Newton at fixed lam a little beyond u (over a discontinuity of the residual), oriented forward.
+
+    The point found is a ``gap`` unless the straight line to it stays
+    within ``chord_tol`` of the curve (:func:`_joined`): then the step
+    passed a corner, not a discontinuity.
     """
+    opt, n = walk.opt, walk.n
+    for frac in opt.jump_fractions:
+        # forward in the range, never farther than the largest lam step: never bounce back over the same
+        # discontinuity, never skip more than a step
+        lam = u[n] + walk.sgn * min(frac * walk.span, opt.max_dlam)
+        hit = _fixed_lam_point(walk, u, t, lam, _guesses(u, t, lam, n, opt))
+        if hit is not None:
+            v, tn, it = hit
+            corner = _joined(walk, u, v, t)
+            return _Step(v, _oriented(tn, walk.sgn, n, opt), it, True, 1.0, g=walk.observed(v), gap=not corner,
+                         corner=corner)
+    return None
+
+
+def _corner_pass(walk: _Walk, u, t) -> _Step | None:
+    """Past a sharp corner of a piecewise-smooth branch by Newton at fixed lam.
+
+    Where the branch turns by more than a right angle at a corner (the
+    onset of slip at one more sample, say) while lam keeps its direction,
+    no hyperplane ahead of u meets it and the arc-length corrector fails
+    at every step. Newton at ``lam + sign(t_lam) |t_lam| corner_ds``
+    finds the point past the corner; it is accepted when the straight line
+    to it stays within ``chord_tol`` of the curve (:func:`_joined`), else
+    tried closer (:data:`CORNER_TRIES` times, a quarter of the distance
+    each time). Its tangent keeps the direction of travel in lam.
+    """
+    opt, n = walk.opt, walk.n
+    if abs(t[n]) <= opt.jump_tangent_min:
+        return None  # a vertical tangent (a fold): no direction of travel in lam
+    direction = math.copysign(1.0, t[n])
+    dlam = min(abs(t[n]) * opt.corner_ds, opt.max_dlam)
+    for _ in range(CORNER_TRIES):
+        lam = u[n] + direction * dlam
+        hit = _fixed_lam_point(walk, u, t, lam, _guesses(u, t, lam, n, opt))
+        if hit is not None and _joined(walk, u, hit[0], t):
+            v, tn, it = hit
+            return _Step(v, _oriented(tn, direction, n, opt), it, True, 1.0, g=walk.observed(v), corner=True)
+        dlam *= 0.25
+    return None
+
+
+def _joined(walk: _Walk, u, v, t) -> bool:
+    """True if the straight line u-v stays within ``chord_tol`` of the curve at its middle.
+
+    The curve's middle is found by Newton at the middle value of lam from
+    the middle of the chord; the deviation is measured in the plane
+    (lam, observable), or in (y, lam) without an observable. A
+    discontinuity of the residual between u and v leaves the middle point
+    on one side, far from the chord.
+    """
+    n = walk.n
+    mid = 0.5 * (u + v)
+    hit = _fixed_lam_point(walk, u, t, mid[n], [mid[:n]])
+    if hit is None:
+        return False
+    w = hit[0]
+    if walk.observe is None:
+        return bool(np.linalg.norm(w - mid) <= walk.opt.chord_tol)
+    g = (walk.observed(u), walk.observed(v), walk.observed(w))
+    if not all(math.isfinite(x) for x in g):
+        return False
+    return abs(g[2] - 0.5 * (g[0] + g[1])) <= walk.opt.chord_tol
+
+
+def _chord_error(walk: _Walk, u, g_u, v, g_v, t, t_new) -> float:
+    """Deviation of the curve from the chord u-v at its middle, in the plane (lam, observable).
+
+    The curve's middle is the cubic Hermite interpolant of the two points
+    and their unit tangents at half the chord length L:
+    ``(u + v) / 2 + L (t - t_new) / 8``; its observable against the
+    chord's middle gives the deviation (error O(L^4)).
+    """
+    if walk.observe is None or not (math.isfinite(g_u) and math.isfinite(g_v)):
+        return 0.0
+    L = float(np.linalg.norm(v - u))
+    mid = 0.5 * (u + v) + (0.125 * L) * (t - t_new)
+    g_mid = walk.observed(mid)
+    if not math.isfinite(g_mid):
+        return 0.0
+    n = walk.n
+    return math.hypot(mid[n] - 0.5 * (u[n] + v[n]), g_mid - 0.5 * (g_u + g_v))
+
+
+def _chord_factor(err, opt) -> float:
+    """Step factor that brings a chord error ``err`` (O(ds^2)) to ``0.9 chord_tol``, within [1/8, grow]."""
+    if err <= 0.0:
+        return opt.grow
+    return min(max(0.9 * math.sqrt(opt.chord_tol / err), 0.125), opt.grow)
+
+
+def _try_step(walk: _Walk, u, t, u_prev, g_u, ds) -> _Step:
+    """Predict and correct one step of length ds, then check it.
+
+    Rejected (with the factor for the next try) when the corrector failed;
+    above ``opt.corner_ds`` when it went farther than ``opt.max_distance * ds``
+    from the prediction or the tangent turned sharply (maybe onto another
+    part of the branch; ``corner_like``), or the chord to the new point
+    strays more than ``opt.chord_tol`` from the curve; and when lam moved by
+    more than ``opt.max_dlam``. At smaller steps sharp turns are corners of
+    a non-smooth branch (e.g. onset of slip) and are accepted.
+    """
+    opt, n = walk.opt, walk.n
     if opt.predictor == "secant" and u_prev is not None:
         d = u - u_prev
         d /= np.linalg.norm(d)
@@ -568,50 +770,77 @@ def _try_step(residual, u, t, u_prev, ds, opt, cnt):
     # away from the smallest steps, a corrector that needs many iterations is
     # stopped: retrying at a smaller step is cheaper (a corner of a non-smooth branch)
     big = ds > opt.corner_ds
-    v, ok, it, (R, Jy, Jl) = _solve_damped(residual, u_pred.copy(), None, d, u_pred, opt, cnt,
+    v, ok, it, (R, Jy, Jl) = _solve_damped(walk.residual, u_pred.copy(), None, d, u_pred, opt, walk.cnt,
                                            max_evals=opt.max_evals_factor * opt.target_iter if big else None)
     if ok and big and np.linalg.norm(v - u_pred) > opt.max_distance * ds:
-        return v, None, it, False, True
-    if not ok:
-        return v, None, it, False, False
-    t_new = _tangent(Jy, Jl, t)
+        return _Step(v, None, it, False, opt.corner_shrink, corner_like=True)
+    t_new = _tangent(Jy, Jl, t) if ok else None
     if t_new is None:
-        return v, None, it, False, False
+        return _Step(v, None, it, False, opt.reject_shrink)
     if t_new @ t < opt.min_tangent_dot and big:
-        return v, t_new, it, False, True
-    return v, t_new, it, True, False
+        return _Step(v, t_new, it, False, opt.corner_shrink, corner_like=True)
+    dlam = abs(v[n] - u[n])
+    if dlam > opt.max_dlam:
+        return _Step(v, t_new, it, False, min(DLAM_SAFETY * opt.max_dlam / dlam, opt.reject_shrink))
+    g_v = walk.observed(v)
+    err = _chord_error(walk, u, g_u, v, g_v, t, t_new)
+    if err > opt.chord_tol and big:
+        return _Step(v, t_new, it, False, min(_chord_factor(err, opt), opt.reject_shrink))
+    return _Step(v, t_new, it, True, 1.0, err=err, g=g_v)
 
 
-def _advance(residual, u, t, u_prev, ds, ds_init, span, sgn, opt, cnt):
-    """The next point: steps tried (and cut) until one is accepted, else a jump.
+def _advance(walk: _Walk, u, t, u_prev, g_u, ds, ds_init):
+    """The next point: steps tried (and cut) until one is accepted, else a corner pass or a jump.
 
-    Returns ``(v, t_new, iterations, gap, ds)``, or ``None`` when the
-    corrector failed at the smallest step and no jump succeeded.
+    Returns ``(step, ds)`` with the accepted :class:`_Step` and the step
+    length it was taken with, or ``None`` when the corrector failed at the
+    smallest step and neither a corner pass nor a jump succeeded.
     """
+    opt = walk.opt
+    corner_tried = False
     while True:
-        v, t_new, it, ok, corner_like = _try_step(residual, u, t, u_prev, ds, opt, cnt)
-        if ok:
-            return v, t_new, it, False, ds
-        cnt["steps_rejected"] += 1
-        ds *= opt.corner_shrink if corner_like else opt.reject_shrink
-        if corner_like and ds < opt.corner_ds:
+        st = _try_step(walk, u, t, u_prev, g_u, ds)
+        if st.ok:
+            return st, ds
+        walk.cnt["steps_rejected"] += 1
+        ds *= st.factor
+        if st.corner_like and ds < opt.corner_ds:
             ds = opt.corner_ds
+        if ds < opt.corner_ds and not corner_tried:
+            corner_tried = True
+            st = _corner_pass(walk, u, t)
+            if st is not None:
+                walk.cnt["corners"] += 1
+                return st, opt.corner_ds
         if ds < opt.ds_min:
-            jump = _jump(residual, u, t, span, sgn, opt, cnt) if cnt["jumps"] < opt.max_jumps else None
-            if jump is None:
+            st = _jump(walk, u, t) if walk.cnt["jumps"] < opt.max_jumps else None
+            if st is None:
                 return None
-            cnt["jumps"] += 1
-            return (*jump, True, ds_init)
+            walk.cnt["corners" if st.corner else "jumps"] += 1
+            return st, ds_init
 
 
-def _next_ds(ds, turn, it, opt) -> float:
-    """Step after an accepted point: cut where the branch bends, grown after easy corrections."""
+def _next_ds(ds, turn, it, err, opt, size) -> float:
+    """Step after an accepted point: cut where the branch bends, grown after easy corrections,
+    bounded by the chord error and by max(ds_max, ds_max_rel size) (size: norm of the unknowns)."""
     if turn < opt.turn_cos:
-        return max(ds * opt.turn_shrink, opt.ds_min)
-    if it <= opt.target_iter - 1:
-        return min(ds * opt.grow, opt.ds_max)
-    if it > opt.target_iter:
-        return max(ds * opt.shrink, opt.ds_min)
+        new = ds * opt.turn_shrink
+    elif it <= opt.target_iter - 1:
+        new = ds * opt.grow
+    elif it > opt.target_iter:
+        new = ds * opt.shrink
+    else:
+        new = ds
+    if err > 0.0:
+        new = min(new, ds * _chord_factor(err, opt))
+    return min(max(new, opt.ds_min), max(opt.ds_max, opt.ds_max_rel * size))
+
+
+def _bound_dlam(ds, t, n, opt) -> float:
+    """ds such that the predicted change of lam, ds |t_lam|, stays below the largest lam step."""
+    tl = abs(t[n])
+    if tl * ds > DLAM_SAFETY * opt.max_dlam:
+        return max(DLAM_SAFETY * opt.max_dlam / tl, opt.ds_min)
     return ds
 
 
@@ -629,11 +858,11 @@ def _land(residual, u, v, t, lam_end, fold, pts, opt):
     return ok
 
 
-def _start(residual, y0, lam0, sgn, opt, pts):
+def _start(residual, y0, lam0, sgn, opt, pts, lam_name):
     """First point at lam0: ``(u, t)`` or ``(None, message)``."""
     y, ok, it = newton(residual, np.array(y0, dtype=float), lam0, opt, counter=pts.cnt)
     if not ok:
-        return None, f"Newton did not converge at the start lam = {lam0:.6g}"
+        return None, f"Newton did not converge at the start {lam_name} = {lam0:.6g}"
     R, Jy, Jl = residual(y, lam0)
     pts.cnt["residual_evaluations"] += 1
     n = y.size
@@ -641,13 +870,27 @@ def _start(residual, y0, lam0, sgn, opt, pts):
     t_seed[n] = sgn
     t = _tangent(Jy, Jl, t_seed)
     if t is None:
-        return None, f"singular Jacobian at the start lam = {lam0:.6g}"
+        return None, f"singular Jacobian at the start {lam_name} = {lam0:.6g}"
     pts.add(y.copy(), lam0, t[n], False, it, False)
     return np.concatenate((y, [lam0])), t
 
 
+def _range_end(walk, u, v, t, fold, pts, lam_stop, lam_name):
+    """(status, message) after the step to v left the range: the end point landed on the bound it crossed."""
+    n = walk.n
+    lam_end = lam_stop if (v[n] - lam_stop) * walk.sgn > 0 else lam_stop - walk.sgn * walk.span
+    ok_end = _land(walk.residual, u, v, t, lam_end, fold, pts, walk.opt)
+    note = "" if ok_end else f" (Newton at {lam_name} = {lam_end:.6g} itself failed; last point {lam_name} = {u[n]:.6g})"
+    if lam_end == lam_stop:
+        return ContinuationStatus.COMPLETE, f"reached {lam_name} = {lam_end:.6g}{note}"
+    return ContinuationStatus.TURNED_BACK, (
+        f"the branch turned back at {lam_name} = {max(pts.L) if walk.sgn > 0 else min(pts.L):.6g} and returned "
+        f"to the start of the range {lam_name} = {lam_end:.6g}{note}")
+
+
 def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: ContinuationOptions | None = None,
-                 *, monitor: Callable | None = None, progress=None, **overrides) -> ContinuationResult:
+                 *, monitor: Callable | None = None, progress=None, observe: Callable | None = None,
+                 lam_name: str = "lam", **overrides) -> ContinuationResult:
     """Follow the solution curve of R(y, lam) = 0 from lam0 towards lam_stop.
 
     Parameters
@@ -669,10 +912,20 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
         :class:`~jointdyn.status.Status`; the point is kept).
     progress : tqdm-like, optional
         Its ``update(1)`` is called per accepted point.
+    observe : callable, optional
+        ``observe(y, lam) -> float``, the quantity a plot of the branch
+        shows against lam (e.g. the logarithm of an amplitude, so that the
+        bound is relative): the straight line between consecutive points
+        stays within ``options.chord_tol`` of the curve in the plane
+        (lam, observe) (estimated at the middle of each chord; steps above
+        ``corner_ds`` are cut until it holds).
+    lam_name : str
+        Name of the parameter in messages.
 
     Returns
     -------
     ContinuationResult
+        ``status`` COMPLETE only when the branch reached ``lam_stop``.
     """
     opt = make_options(options, overrides)
     lam0 = V.finite("lam0", lam0)
@@ -681,39 +934,37 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
         raise ValueError("lam_stop must differ from lam0")
     ds = ds_init = min(max(opt.ds, opt.ds_min), opt.ds_max)
     sgn = 1.0 if lam_stop > lam0 else -1.0
-    lo, hi = min(lam0, lam_stop), max(lam0, lam_stop)
     n = len(np.asarray(y0).ravel())
     pts = _Points(n)
-    u, t = _start(residual, y0, lam0, sgn, opt, pts)
+    walk = _Walk(residual, opt, pts.cnt, observe, sgn, abs(lam_stop - lam0), n)
+    u, t = _start(residual, y0, lam0, sgn, opt, pts, lam_name)
     if u is None:
         return pts.finish(ContinuationStatus.FAILED, t)
     stop = _accepted(u, n, monitor, progress)
     if stop is not None:
         return pts.finish(*stop)
-    u_prev = None
+    u_prev, g_u = None, walk.observed(u)
     while True:
         if len(pts.L) >= opt.max_points:
-            return pts.finish(ContinuationStatus.MAX_POINTS, f"stopped after {len(pts.L)} points at lam = {u[n]:.6g}")
-        step = _advance(residual, u, t, u_prev, ds, ds_init, hi - lo, sgn, opt, pts.cnt)
-        if step is None:
+            return pts.finish(ContinuationStatus.MAX_POINTS,
+                              f"stopped after {len(pts.L)} points at {lam_name} = {u[n]:.6g}")
+        adv = _advance(walk, u, t, u_prev, g_u, _bound_dlam(ds, t, n, opt), ds_init)
+        if adv is None:
             why = "" if pts.cnt["jumps"] < opt.max_jumps else f" after {opt.max_jumps} jumps over discontinuities"
             return pts.finish(ContinuationStatus.FAILED,
-                              f"corrector failed at the smallest step near lam = {u[n]:.6g}{why}")
-        v, t_new, it, gap, ds = step
-        fold = bool(np.sign(t_new[n]) != np.sign(t[n]) and t[n] != 0.0) and not gap
+                              f"corrector failed at the smallest step near {lam_name} = {u[n]:.6g}{why}")
+        st, ds = adv
+        v, t_new = st.v, st.t
+        fold = bool(np.sign(t_new[n]) != np.sign(t[n]) and t[n] != 0.0) and not (st.gap or st.corner)
         pts.cnt["folds"] += fold
-        if v[n] > hi or v[n] < lo:
-            lam_end = hi if v[n] > hi else lo
-            ok_end = _land(residual, u, v, t, lam_end, fold, pts, opt)
-            where = "lam_stop" if lam_end == lam_stop else "the start of the range (the branch turned back)"
-            note = "" if ok_end else f" (Newton at lam = {lam_end:.6g} itself failed; last point lam = {u[n]:.6g})"
-            return pts.finish(ContinuationStatus.COMPLETE, f"reached {where} lam = {lam_end:.6g}{note}")
-        u_prev, t_prev, u, t = u, t, v, t_new
-        pts.add(v[:n].copy(), v[n], t[n], fold, it, gap)
+        if (v[n] - lam_stop) * sgn > 0 or (v[n] - lam0) * sgn < 0:
+            return pts.finish(*_range_end(walk, u, v, t, fold, pts, lam_stop, lam_name))
+        u_prev, t_prev, u, t, g_u = u, t, v, t_new, st.g
+        pts.add(v[:n].copy(), v[n], t[n], fold, st.it, st.gap, st.corner)
         stop = _accepted(v, n, monitor, progress)
         if stop is not None:
             return pts.finish(*stop)
-        ds = _next_ds(ds, float(t @ t_prev), it, opt)
+        ds = _next_ds(ds, float(t @ t_prev), st.it, st.err, opt, float(np.linalg.norm(v[:n])))
 
 
 def _accepted(v, n, monitor, progress):
@@ -723,3 +974,135 @@ def _accepted(v, n, monitor, progress):
     if monitor is not None:
         return monitor(v[:n], v[n])
     return None
+
+
+# --- extrema along a branch --------------------------------------------------------------
+
+
+def local_maxima(values, gap=None, prominence: float = 0.0) -> np.ndarray:
+    """Indices of the interior local maxima of ``values`` along a branch.
+
+    A maximum counts when, on each side, the values fall below it by more
+    than ``prominence`` times |value| before they rise above it (or the
+    piece ends). Points reached by a jump (``gap``) start a new piece: a
+    maximum needs a neighbour on each side within its piece; NaN values
+    end a piece too.
+    """
+    g = np.asarray(values, dtype=float)
+    gap = np.zeros(g.size, dtype=bool) if gap is None else np.asarray(gap, dtype=bool)
+    piece = np.cumsum(gap | ~np.isfinite(g))
+    out = []
+    for i in range(1, g.size - 1):
+        if not (np.isfinite(g[i]) and piece[i - 1] == piece[i] == piece[i + 1]):
+            continue
+        if not (g[i] >= g[i - 1] and g[i] > g[i + 1]):
+            continue
+        drop = prominence * abs(g[i])
+        if _falls(g, piece, i, -1, drop) and _falls(g, piece, i, 1, drop):
+            out.append(i)
+    return np.array(out, dtype=int)
+
+
+def _falls(g, piece, i, step, drop) -> bool:
+    """True if, walking from i by ``step`` within its piece, g falls below g[i] - drop before exceeding g[i]."""
+    j = i + step
+    while 0 <= j < g.size and piece[j] == piece[i]:
+        if g[j] > g[i]:
+            return False
+        if g[j] < g[i] - drop:
+            return True
+        j += step
+    return True
+
+
+def _vertex(s, g):
+    """Abscissa of the vertex of the parabola through three points, or None if it is not a maximum."""
+    d1 = (g[1] - g[0]) / (s[1] - s[0])
+    d2 = (g[2] - g[1]) / (s[2] - s[1])
+    a = (d2 - d1) / (s[2] - s[0])
+    if not a < 0.0:
+        return None
+    return 0.5 * (s[0] + s[1]) - d1 / (2.0 * a)
+
+
+def _interpolate(s, U, x):
+    """Value and unit derivative at x of the quadratic through (s_k, U_k), k = 0, 1, 2."""
+    w = np.empty(3)
+    dw = np.empty(3)
+    for k in range(3):
+        o = [j for j in range(3) if j != k]
+        den = (s[k] - s[o[0]]) * (s[k] - s[o[1]])
+        w[k] = (x - s[o[0]]) * (x - s[o[1]]) / den
+        dw[k] = ((x - s[o[0]]) + (x - s[o[1]])) / den
+    d = dw @ U
+    return w @ U, d / np.linalg.norm(d)
+
+
+def _bracketed(s, g, width0) -> bool:
+    """True when the bracket of :func:`refine_maximum` is narrow enough or flat enough (value converged)."""
+    return bool(s[2] - s[0] <= config.CONT_REFINE_STOL * width0
+                or g[1] - min(g[0], g[2]) <= config.CONT_REFINE_GTOL)
+
+
+def refine_maximum(residual: Callable, observe: Callable, y, lam, options: ContinuationOptions | None = None,
+                   *, iterations: int = config.CONT_REFINE_ITER, **overrides):
+    """Maximum of an observable along the solution curve, refined between three branch points.
+
+    ``y`` (3, n) and ``lam`` (3,) are consecutive points of a branch whose
+    middle one has the largest ``observe(y, lam)``. Successive parabolic
+    interpolation in the chord length s: the vertex of the parabola
+    through the three values (a golden-section point of the larger half
+    when the parabola has no maximum inside), the point of the curve there
+    by the arc-length corrector (predicted by the quadratic through the
+    three points, constrained to the hyperplane orthogonal to its
+    derivative), and the bracket shrunk around the best point; until the
+    bracket is ``config.CONT_REFINE_STOL`` of its first width, or the
+    observable varies by at most ``config.CONT_REFINE_GTOL`` across it
+    (the value has converged; a flat maximum's location is then known to
+    the square root of that), or
+    ``iterations`` corrections were made (a maximum at a corner of a
+    piecewise-smooth branch converges linearly).
+
+    Returns
+    -------
+    (y, lam, value, converged) : the best point found (one of the three
+    given points if no correction succeeded), its observable, and whether
+    the bracket shrank to the tolerance.
+    """
+    opt = make_options(options, overrides)
+    U = np.column_stack((np.asarray(y, dtype=float), np.asarray(lam, dtype=float)))
+    n = U.shape[1] - 1
+    g = np.array([float(observe(U[k, :n], U[k, n])) for k in range(3)])
+    s = np.array([0.0, np.linalg.norm(U[1] - U[0]), 0.0])
+    s[2] = s[1] + np.linalg.norm(U[2] - U[1])
+    width0 = s[2] - s[0]
+    cnt = {"residual_evaluations": 0}
+    last_width = math.inf
+    for _ in range(iterations):
+        if _bracketed(s, g, width0):
+            break
+        x = _vertex(s, g)
+        lo, hi = s[0] + GOLDEN_MARGIN * (s[1] - s[0]), s[2] - GOLDEN_MARGIN * (s[2] - s[1])
+        # golden section where the parabola has no maximum inside, lands next to the best point, or the
+        # last step hardly shrank the bracket (a maximum at a corner: Brent's safeguard)
+        stalled = s[2] - s[0] > STALL_FRACTION * last_width
+        last_width = s[2] - s[0]
+        if x is None or stalled or not lo < x < hi or abs(x - s[1]) < GOLDEN_MARGIN * (s[2] - s[0]):
+            wide = 0 if s[1] - s[0] > s[2] - s[1] else 2
+            x = s[1] + GOLDEN * (s[wide] - s[1])
+        u_pred, d = _interpolate(s, U, x)
+        v, ok, _, _ = _solve_damped(residual, u_pred.copy(), None, d, u_pred, opt, cnt)
+        if not ok:
+            break
+        gv = float(observe(v[:n], v[n]))
+        if not math.isfinite(gv):
+            break
+        # the bracket keeps the best point in the middle
+        k = 0 if x < s[1] else 2
+        if gv > g[1]:
+            U[2 - k], g[2 - k], s[2 - k] = U[1], g[1], s[1]
+            U[1], g[1], s[1] = v, gv, x
+        else:
+            U[k], g[k], s[k] = v, gv, x
+    converged = _bracketed(s, g, width0)
+    return U[1, :n].copy(), float(U[1, n]), float(g[1]), bool(converged)

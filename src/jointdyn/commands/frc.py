@@ -363,9 +363,15 @@ def _run_time(args, gammas):
             "gamma": _jsonable(one.gamma.values),
             **{v: _jsonable(one[v].values) for v in ("amplitude_q", "amplitude_m", "offset_m", "max_abs_m")},
             "status": [status_name(c) for c in one.status.values],
+            "negative_dissipation": [bool(v) for v in one.negative_dissipation.values],
         }
         if "contact" in one.dims or "dof" in one.dims:
             result["directions"][d].update(_loop_outputs(one))
+    flagged = int(line.negative_dissipation.sum())
+    if flagged:
+        print(f"jointdyn frc: warning: {flagged} periodic points where the contact creates energy over the period "
+              "(negative dissipation beyond the energy-balance residual; negative_dissipation in the results)",
+              file=sys.stderr)
     if result["reused_points"] or ds.attrs.get("stale_points"):
         stale = int(ds.attrs.get("stale_points", 0))
         note = f"; recomputed {stale} points saved by another solver version" if stale else ""
@@ -374,38 +380,58 @@ def _run_time(args, gammas):
     return ds, result
 
 
-def _hb_branches(ds) -> list:
-    """Split an hb Dataset (dim ``point``) into its branches (variable ``branch``: segment index)."""
-    ids = np.asarray(ds["branch"].values)
+def _hb_branches(br) -> list:
+    """The segments of an HBBranch as JSON objects (per point: gamma, amplitudes, stability, status)."""
+    from ..hb.problem import contact_of
+
+    law = contact_of(br.problem.system).law
+    amp, off, mx = br.response()
+    gam = br.gamma()
     out = []
-    for b in dict.fromkeys(ids.tolist()):
-        sub = ds.isel(point=np.flatnonzero(ids == b))
-        br = {v: _jsonable(sub[v].values) for v in ("gamma", "amplitude_q", "amplitude_m", "offset_m", "max_abs_m")}
-        br["stable"] = [bool(s) for s in np.asarray(sub["stable"].values)]
-        br["folds"] = [int(i) for i in np.flatnonzero(np.asarray(sub["fold"].values, bool))]
-        out.append(br)
+    for b in dict.fromkeys(br.segment.tolist()):
+        idx = np.flatnonzero(br.segment == b)
+        one = {"gamma": gam[idx], "amplitude_q": law.kt * amp[idx] / law.fy, "amplitude_m": amp[idx],
+               "offset_m": off[idx], "max_abs_m": mx[idx]}
+        one = {k: _jsonable(v) for k, v in one.items()}
+        one["stable"] = [bool(s) for s in br.stable[idx]]
+        one["point_status"] = [str(s) for s in br.point_status[idx]]
+        one["folds"] = [int(i) for i in np.flatnonzero(br.fold[idx])]
+        one["branch"] = int(b)  # the segment (0: from START, 1: continued back from STOP)
+        out.append(one)
     return out
 
 
+def _hb_peaks(br) -> list:
+    """The refined peaks of an HBBranch as JSON objects."""
+    return [{"gamma": pk.gamma, "amplitude_q": _jsonable([pk.amplitude_q])[0],
+             "amplitude_m": _jsonable([pk.amplitude_m])[0], "branch": pk.segment, "refined": pk.refined}
+            for pk in br.peaks]
+
+
 def _run_hb(args, gammas):
-    from ..hb import frc_hb
+    """The hb branch: ``(branch, result)`` (the Dataset is built only for files: xarray takes time to import)."""
+    from ..hb import continue_hb
 
     system = _system(args)
     if gammas.size < 2:
         raise ValueError("--gamma must span a range (STOP > START) for --method hb")
+    # the grid's STEP is the largest gamma spacing of the branch (the step control may take smaller ones)
+    step = float(gammas[1] - gammas[0])
     try:
-        ds = frc_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics, samples=args.samples,
-                    response_dof=system.response_dof, progress=None if not args.json else False)
+        br = continue_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics,
+                         samples=args.samples, max_step=step, progress=None if not args.json else False)
     except ValueError as exc:
-        # what the harmonic-balance solver refuses (a kind of normal load, forcing phases) is said as its own
+        # what the harmonic-balance solver refuses (a kind of normal load, mixed laws) is said as its own
         raise ValueError(f"--method hb: {exc}") from None
     result = _header(args)
     result["harmonics"] = args.harmonics
     result["samples"] = args.samples
-    result["branches"] = _hb_branches(ds)
-    result["status"] = str(ds.attrs.get("status", ""))
-    result["message"] = str(ds.attrs.get("message", ""))
-    return ds, result
+    result["branches"] = _hb_branches(br)
+    result["peaks"] = _hb_peaks(br)
+    result["status"] = br.status.value
+    result["message"] = br.message
+    result["uncovered"] = [[float(a), float(b)] for a, b in br.uncovered]
+    return br, result
 
 
 def _plot_title(result) -> str:
@@ -438,15 +464,7 @@ def _plot(result, path: Path) -> None:
                            linestyle=style, label=f"sweep {d}", rug_y=0.03 if d == "up" else 0.07)
         mark_legend(ax, fontsize=8)
     else:
-        for i, br in enumerate(result["branches"]):
-            g = np.array(br["gamma"], float)
-            a = np.array([np.nan if v is None else v for v in br["amplitude_q"]], float)
-            st = np.array(br["stable"], bool)
-            ax.plot(g, np.where(st, a, np.nan), "-", color="C0", label="stable" if i == 0 else None)
-            ax.plot(g, np.where(~st, a, np.nan), "--", color="C1", label="unstable" if i == 0 else None)
-            if br["folds"]:
-                ax.plot(g[br["folds"]], a[br["folds"]], "ks", ms=4, label="fold" if i == 0 else None)
-        ax.legend(fontsize=8)
+        _plot_hb(ax, result)
     ax.set_title(_plot_title(result), fontsize=9)
     ax.set_xlabel("gamma = w / w0")
     ax.set_ylabel("amplitude of q = kt x / fy (half peak-to-peak)")
@@ -455,6 +473,58 @@ def _plot(result, path: Path) -> None:
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=120)
     plt.close(fig)
+
+
+#: point statuses of an hb branch that are joined to the point before them by a line
+_JOINED = ("joined", "corner")
+
+
+def _plot_hb(ax, result) -> None:
+    """hb branches: stable (solid) and unstable (dashed) lines, broken before every point not joined to
+    the previous one; folds (squares), points where a segment stopped short (red x), refined peaks (^),
+    parts of the range without points (hatched)."""
+    first = {}
+    for br in result["branches"]:
+        g = np.array(br["gamma"], float)
+        a = np.array([np.nan if v is None else v for v in br["amplitude_q"]], float)
+        st = np.array(br["stable"], bool)
+        cut = np.flatnonzero([s not in _JOINED for s in br["point_status"]])
+        # a NaN row between two points that are not joined breaks the line there
+        g, a, st = (np.insert(v, cut[cut > 0], f) for v, f in ((g, np.nan), (a, np.nan), (st, True)))
+        for sel, style, c, name in ((st, "-", "C0", "stable"), (~st, "--", "C1", "unstable")):
+            ax.plot(g, np.where(sel, a, np.nan), style, color=c, label=name if name not in first else None)
+            first[name] = True
+        gp = np.array(br["gamma"], float)
+        ap = np.array([np.nan if v is None else v for v in br["amplitude_q"]], float)
+        marks = ((br["folds"], "ks", "fold"),
+                 ([i for i, s in enumerate(br["point_status"]) if s == "stopped"], "rx", "stopped short"),
+                 ([i for i, s in enumerate(br["point_status"]) if s == "after-jump"], "k|", "after a jump"))
+        for idx, fmt, name in marks:
+            if len(idx):
+                ax.plot(gp[idx], ap[idx], fmt, ms=6, label=name if name not in first else None)
+                first[name] = True
+    for pk in result.get("peaks", []):
+        if pk["amplitude_q"] is not None:
+            ax.plot([pk["gamma"]], [pk["amplitude_q"]], "^", color="C2", ms=5,
+                    label="peak" if "peak" not in first else None)
+            first["peak"] = True
+    what = "no bounded response" if result["status"] == "unbounded" else "not computed"
+    for k, (a, b) in enumerate(result["uncovered"]):
+        ax.axvspan(a, b, facecolor="0.9", edgecolor="0.6", hatch="//", lw=0, label=what if k == 0 else None)
+    if result["status"] != "complete":
+        ax.text(0.01, 0.98, f"status: {result['status']}", transform=ax.transAxes, va="top", fontsize=8,
+                color="C3")
+    ax.legend(fontsize=8)
+
+
+def exit_status(result) -> int:
+    """0, or :data:`jointdyn.cli.EXIT_INCOMPLETE` for an hb branch that does not cover the range and is
+    not unbounded (failed, turned back, stopped at its point bound)."""
+    from ..cli import EXIT_INCOMPLETE
+
+    if result["method"] == "hb" and result["status"] not in ("complete", "unbounded"):
+        return EXIT_INCOMPLETE
+    return 0
 
 
 def run(args) -> int:
@@ -471,7 +541,9 @@ def run(args) -> int:
             write_outputs(ds, out)
         else:
             from .._io import atomic_path
+            from ..hb import branch_dataset
 
+            ds = branch_dataset(ds)
             with atomic_path(out / "frc.nc") as tmp:
                 ds.to_netcdf(tmp, engine="scipy")
             with atomic_path(out / "frc.csv") as tmp:  # one row per point (per-harmonic data in frc.nc)
@@ -482,7 +554,12 @@ def run(args) -> int:
         print(json.dumps(result))
     else:
         _print_table(result)
-    return 0
+    rc = exit_status(result)
+    if rc:
+        import sys
+
+        print(f"jointdyn frc: incomplete: {result['status']}: {result['message']}", file=sys.stderr)
+    return rc
 
 
 def _digits(values, least: int = 4) -> int:
@@ -514,7 +591,12 @@ def _print_table(result) -> None:
         print(f"status: {result['status']} {result['message']}")
         p = _digits([g for br in result["branches"] for g in br["gamma"]])
         w = max(8, p + 6)
-        for b, br in enumerate(result["branches"]):
-            print(f"branch {b}: {len(br['gamma'])} points, folds at {br['folds']}")
-            for g, a, s in zip(br["gamma"], br["amplitude_q"], br["stable"]):
-                print(f"  {g:<{w}.{p}g} {a if a is not None else float('nan'):>12.5g} {'stable' if s else 'unstable'}")
+        for br in result["branches"]:
+            print(f"branch {br['branch']}: {len(br['gamma'])} points, folds at {br['folds']}")
+            for g, a, s, ps in zip(br["gamma"], br["amplitude_q"], br["stable"], br["point_status"]):
+                print(f"  {g:<{w}.{p}g} {a if a is not None else float('nan'):>12.5g} "
+                      f"{'stable' if s else 'unstable':<8s}{'' if ps in _JOINED else ' ' + ps}")
+        for pk in result["peaks"]:
+            q = float("nan") if pk["amplitude_q"] is None else pk["amplitude_q"]
+            print(f"peak: gamma = {pk['gamma']:.6g}, q = {q:.6g} (branch {pk['branch']}"
+                  f"{'' if pk['refined'] else ', not fully refined'})")

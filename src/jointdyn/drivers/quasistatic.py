@@ -18,9 +18,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 from .. import _validate as V
 from .. import config
@@ -528,6 +531,8 @@ def quasistatic(law, t, x, N, *, period=None, state=None) -> LoopResult:
         m = _window_metrics(tr, xr, Tr, sep, contact, i0, i1)
         m["cycle"] = k
         rows.append(m)
+    import pandas as pd  # here: the package's other commands start faster without it
+
     cycles = pd.DataFrame(rows, columns=list(CYCLE_COLUMNS))
     return LoopResult(
         t=t,

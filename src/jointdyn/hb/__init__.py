@@ -6,7 +6,7 @@ condensation onto the contact DOFs for large structures
 (:mod:`jointdyn.hb.condense`; see docs/harmonic-balance.md)."""
 
 from .condense import CondensedHBProblem, Receptance, make_problem, receptance
-from .frc import HBBranch, HBSolution, branch_dataset, continue_hb, frc_hb, harmonic_balance
+from .frc import HBBranch, HBPeak, HBSolution, PointStatus, branch_dataset, continue_hb, frc_hb, harmonic_balance
 from .parameters import DELTA, ETA, F1, GAMMA, N0, PARAMETERS, HBParameter, SystemParameter, parameter_named
 from .problem import HBProblem
 from .monodromy import monodromy_multipliers
@@ -19,6 +19,8 @@ __all__ = [
     "HBSolution",
     "branch_dataset",
     "HBBranch",
+    "HBPeak",
+    "PointStatus",
     "HBProblem",
     "CondensedHBProblem",
     "make_problem",

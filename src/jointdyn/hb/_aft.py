@@ -5,7 +5,11 @@ Harmonic coefficients of a periodic signal in normalised time tau = w t
 (``E @ U``), the contact law is marched over the samples (over whole
 periods, repeatedly, until the force repeats: a hysteretic law needs its
 periodic internal state), and the force samples are projected back
-(``P @ T``). Derivatives are carried forward through the same march with
+(``P @ T``). Where a contact re-closes between two samples (its normal
+load crosses zero upwards), the law is restarted virgin at the exact
+re-contact phase, at the displacement there (:func:`recontact_events`),
+before it steps to the next sample: the re-contact instant is not
+quantised to the sampling grid. Derivatives are carried forward through the same march with
 the law's ``step_jvp`` kernel, starting from the exact derivative of the
 virgin state (the law's ``init_jvp``), so the Jacobian of the force
 coefficients with respect to the displacement coefficients (and to a
@@ -31,7 +35,7 @@ import numpy as np
 
 from .._jit import jit, specialize
 
-__all__ = ["eval_kernel"]
+__all__ = ["eval_kernel", "recontact_events", "NO_EVENT"]
 
 #: the march keeps the first pass's states (and derivatives) at every
 #: sample, to stop marching once they repeat, for laws with states of at
@@ -42,6 +46,8 @@ _HIST_MAX_STATE = 16
 #: largest change of the force between the last two periods (N), and the
 #: worst period of the marched force over the contacts (1, 2 or 0)
 INFO_PASSES, INFO_ERROR, INFO_PERIOD = 0, 1, 2
+#: phase of an event table entry without a re-contact in the interval before the sample
+NO_EVENT = -1.0
 #: force periods in forcing periods: repeated every period, every second
 #: period (the mean of both is used), or not repeated within the bound
 PERIOD_ONE, PERIOD_TWO, PERIOD_NONE = 1.0, 2.0, 0.0
@@ -60,9 +66,14 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
       normal row ``Bnm[c]`` (g = Bnm[c] . x) and ``Sp[c] = (P, kn)`` of a
       spring contact (kn = 0: prescribed load), ``spr`` True when some
       contact has a spring;
-    * ``load = (Nsamp, dN, has_p)``: prescribed normal-load samples
+    * ``load = (Nsamp, dN, has_p, events)``: prescribed normal-load samples
       (contacts, Ns) and, when ``has_p``, their derivative along the
       continuation parameter (rows of spring contacts unused);
+      ``events = (ev_tau, ev_dtau, ev_load)`` from :func:`recontact_events`:
+      per contact and sample, the phase of a re-contact of a prescribed
+      load inside the interval before the sample (:data:`NO_EVENT` if none)
+      and its derivative along the parameter, and per contact the load at
+      which the law restarts there;
     * ``four = (E, P)``: synthesis and analysis matrices;
     * ``ctl = (max_passes, rtol)``: bound on the marched periods and the
       periodicity tolerance;
@@ -122,7 +133,7 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
     if nc == 0:
         _scale_outputs(R, JX, Jp, scaled)
         return
-    Nsamp, dN, has_p = load
+    Nsamp, dN, has_p, events = load
     E, P = four
     max_passes, rtol = ctl
     sig, dirs, st, pw, hist, proj, nrm = _workspace(con, four, has_p, code)
@@ -144,8 +155,9 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
         err = np.inf
         period = PERIOD_NONE
         while passes < max_passes:
-            err, err2, tmax, cur = _pass(STEP_JVP, prm, u, (Nc, km), dN, c, has_p, E, dirs,  # noqa: F821
-                                         (a, bb, da, dbb), (Tc, dT, T1, T2, dT1, cprev), hist, code, passes, rtol)
+            err, err2, tmax, cur = _pass(STEP_JVP, INIT_JVP, prm, (u, U), (Nc, km), dN, c, has_p, events,  # noqa: F821
+                                         E, dirs, (a, bb, da, dbb), (Tc, dT, T1, T2, dT1, cprev), hist, code,
+                                         passes, rtol)
             if cur == 1:  # committed state back in (a, da), once per pass
                 a, bb = bb, a
                 da, dbb = dbb, da
@@ -274,13 +286,17 @@ def _project(c, P, Tc, dT, T, proj):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _pass(step_jvp, prm, u, nk, dN, c, has_p, E, dirs, st, pw, hist, code, passes, rtol):  # pragma: no cover
+def _pass(step_jvp, init_jvp, prm, sig, nk, dN, c, has_p, events, E, dirs, st, pw, hist, code, passes,
+          rtol):  # pragma: no cover - compiled
     """One marched period: force samples ``Tc``, derivatives ``dT`` and codes of contact c.
 
-    ``nk = (Nc, km)``: the contact's normal-load samples and their slope
-    dN/dg (kn while a spring is closed, 0 when open or prescribed).
-
-    The committed state is in ``(a, da)`` when ``cur == 0``, in
+    ``sig = (u, U)``: displacement samples and coefficients; ``nk = (Nc,
+    km)``: the contact's normal-load samples and their slope dN/dg (kn
+    while a spring is closed, 0 when open or prescribed). Where the
+    event table has a re-contact in the interval before sample i, the
+    committed state is first replaced by the virgin state at the
+    re-contact phase (:func:`_event_point`, ``init_jvp``). The committed
+    state is in ``(a, da)`` when ``cur == 0``, in
     ``(bb, dbb)`` when ``cur == 1``: the kernel writes the other pair, so
     no array variable is reassigned per sample (that costs reference
     counting). For laws with small states the first pass stores its
@@ -296,6 +312,8 @@ def _pass(step_jvp, prm, u, nk, dN, c, has_p, E, dirs, st, pw, hist, code, passe
     Tc, dT, T1, T2, dT1, cprev = pw
     Sh, dSh = hist
     Nc, km = nk
+    u, U = sig
+    ev_tau, ev_dtau, ev_load = events
     dxj, dNj, dTj = dirs[0], dirs[1], dirs[2]
     ns = u.shape[0]
     nh = E.shape[1]
@@ -308,6 +326,18 @@ def _pass(step_jvp, prm, u, nk, dN, c, has_p, E, dirs, st, pw, hist, code, passe
     for i in range(ns):
         for d in range(nh):
             dxj[d] = E[i, d]
+        if ev_tau[c, i] != NO_EVENT:
+            # virgin restart at the re-contact phase (load derivative zero: N = 0 there)
+            xr = _event_point(U, ev_tau[c, i], ev_dtau[c, i], has_p, dxj)
+            dNj[:] = 0.0
+            if cur == 0:
+                init_jvp(prm, xr, dxj, ev_load[c], dNj, a, da)
+            else:
+                init_jvp(prm, xr, dxj, ev_load[c], dNj, bb, dbb)
+            for d in range(nh):
+                dxj[d] = E[i, d]
+            if has_p:
+                dxj[nd - 1] = 0.0
         if spr:
             for d in range(nh):
                 dNj[nh + d] = km[i] * E[i, d]
@@ -339,6 +369,102 @@ def _pass(step_jvp, prm, u, nk, dN, c, has_p, E, dirs, st, pw, hist, code, passe
                     _load_state(bb, dbb, Sh, dSh, ns - 1)
                 break
     return err, err2, tmax, cur
+
+
+@jit
+def _event_point(U, tau, dtau, has_p, dx):  # pragma: no cover - compiled
+    """Displacement at phase ``tau`` of the signal with coefficients ``U``; its derivative into ``dx``.
+
+    ``dx[h]`` (h < 2H+1) is the basis function h at ``tau`` (the derivative
+    along coefficient h; the entries of the normal approach's coefficients,
+    if any, are left as they are: zero); with ``has_p`` the last entry is
+    ``u'(tau) dtau``,
+    the derivative along the parameter through the phase (``dtau`` its
+    derivative). A plain compiled function, called once per event.
+    """
+    nh = U.shape[0]
+    x = U[0]
+    du = 0.0
+    dx[0] = 1.0
+    for k in range(1, (nh - 1) // 2 + 1):
+        ck = np.cos(k * tau)
+        sk = np.sin(k * tau)
+        dx[2 * k - 1] = ck
+        dx[2 * k] = sk
+        x += U[2 * k - 1] * ck + U[2 * k] * sk
+        du += k * (U[2 * k] * ck - U[2 * k - 1] * sk)
+    if has_p:
+        dx[dx.shape[0] - 1] = du * dtau
+    return x
+
+
+def recontact_events(tau, coefficients, derivatives=None):
+    """Re-contact phases of harmonic normal loads inside the sampling intervals.
+
+    For N = n0 + n1 sin(tau + delta) the contact re-closes where N crosses
+    zero upwards, at ``tau_r = -delta - asin(n0 / |n1|)`` (mod 2 pi, with
+    ``delta`` shifted by pi for n1 < 0) when |n0| < |n1|. The event is
+    attached to the first sample after it, ``tau_i > tau_r``, if the load
+    there is positive (a re-contact exactly on a sample, or a contact
+    shorter than the interval, needs none: the step at that sample
+    handles it).
+
+    Parameters
+    ----------
+    tau : ndarray (Ns,)
+        Uniform sample phases 2 pi j / Ns, rad.
+    coefficients : ndarray (contacts, 3)
+        (n0, n1, delta) per contact (N, N, rad).
+    derivatives : ndarray (contacts, 3), optional
+        Their derivatives along the continuation parameter.
+
+    Returns
+    -------
+    ev_tau, ev_dtau : ndarray (contacts, Ns)
+        Re-contact phase in the interval before each sample (rad;
+        :data:`NO_EVENT` where none) and its derivative along the
+        parameter.
+    ev_load : ndarray (contacts,)
+        Load at which the law restarts there (N): ``config.HB_RECONTACT_ALPHA``
+        times the largest |N| of the contact (> 0, so that the law is in
+        contact, at rest).
+
+    Notes
+    -----
+    A normal load produced by the structure (a normal spring) crosses
+    zero at phases that depend on the unknowns: the same table applies,
+    with the root of the spring's load polynomial in each interval and
+    its derivative along every unknown.
+    """
+    from .. import config
+
+    co = np.atleast_2d(np.asarray(coefficients, dtype=np.float64))
+    nc, ns = co.shape[0], tau.size
+    ev_tau = np.full((nc, ns), NO_EVENT)
+    ev_dtau = np.zeros((nc, ns))
+    ev_load = np.zeros(nc)
+    h = 2.0 * np.pi / ns
+    for c in range(nc):
+        n0, n1, delta = co[c]
+        ev_load[c] = config.HB_RECONTACT_ALPHA * (abs(n0) + abs(n1))
+        a1 = abs(n1)
+        if not abs(n0) < a1:
+            continue
+        dl = delta + (np.pi if n1 < 0.0 else 0.0)
+        r = n0 / a1
+        tr = (-dl - np.arcsin(r)) % (2.0 * np.pi)
+        i = int(np.ceil(tr / h))
+        if i * h <= tr:  # rounding: the sample must lie after the crossing
+            i += 1
+        i %= ns
+        if n0 + n1 * np.sin(tau[i] + delta) <= 0.0:
+            continue
+        ev_tau[c, i] = tr
+        if derivatives is not None:
+            dn0, dn1, ddelta = np.asarray(derivatives, dtype=np.float64)[c]
+            dr = dn0 / a1 - n0 * np.sign(n1) * dn1 / (a1 * a1)
+            ev_dtau[c, i] = -ddelta - dr / np.sqrt(1.0 - r * r)
+    return ev_tau, ev_dtau, ev_load
 
 
 @jit(inline="always")

@@ -48,19 +48,66 @@ from ..continuation import (
     ContinuationResult,
     ContinuationStatus,
     continuation,
+    local_maxima,
     make_options,
     newton,
+    refine_maximum,
     turning_points,
 )
 from ..fourier import derivative_matrix
 from ..laws import MACROSLIP, SEPARATION
+from ..status import Status
 from ..systems import System
 from ._aft import INFO_ERROR, INFO_PASSES, INFO_PERIOD
 from .condense import make_problem
 from .parameters import GAMMA, parameter_named
 from .problem import HBProblem, contact_of
 
-__all__ = ["HBBranch", "HBSolution", "continue_hb", "frc_hb", "branch_dataset", "harmonic_balance"]
+__all__ = ["HBBranch", "HBPeak", "HBSolution", "PointStatus", "continue_hb", "frc_hb", "branch_dataset",
+           "harmonic_balance"]
+
+
+class PointStatus(Status):
+    """How a point of a harmonic-balance branch joins the point before it (Dataset ``point_status``)."""
+
+    START = "start", "first point of a segment: not joined to the point before it", True
+    JOINED = "joined", "joined to the previous point along the branch", True
+    CORNER = "corner", ("joined to the previous point past a sharp corner of the branch (found at fixed "
+                        "parameter; the curve is continuous)"), True
+    AFTER_JUMP = "after-jump", ("reached by a jump over a discontinuity of the contact force: not joined to the "
+                                "previous point")
+    STOPPED = "stopped", "last point of a segment that stopped short (the branch message says where and why)"
+
+
+@dataclass(frozen=True)
+class HBPeak:
+    """A maximum of the response amplitude along a branch, refined between its points.
+
+    Attributes
+    ----------
+    lam : float
+        Parameter value at the peak.
+    gamma : float
+        w / w0 at the peak.
+    X : ndarray
+        Harmonic coefficients there, m.
+    amplitude_m : float
+        Half peak-to-peak amplitude of the response DOF, m.
+    amplitude_q : float
+        kt X / fy of the first contact.
+    segment : int
+        Segment of the branch it lies on.
+    refined : bool
+        True when the refinement converged (else the best point found).
+    """
+
+    lam: float
+    gamma: float
+    X: np.ndarray
+    amplitude_m: float
+    amplitude_q: float
+    segment: int
+    refined: bool
 
 
 @dataclass(frozen=True)
@@ -73,16 +120,22 @@ class HBBranch:
     parameter : str
         Name of the continuation parameter.
     status : ContinuationStatus
-        ``status.ok`` only for a complete branch.
+        ``complete`` only when the computed points cover the requested
+        range; ``unbounded`` when the response grows without bound inside
+        it (both flanks computed); otherwise what stopped it (``failed``,
+        ``turned-back``, ``max-points``, ``stopped``).
     message : str
+        Where and why each segment stopped, and the parts of the range
+        not computed.
     lam : ndarray (points,)
         Parameter values.
     X : ndarray (points, n(2H+1))
         Harmonic coefficients, m.
     segment : ndarray of int (points,)
         0 for the branch from the start, 1 for the one continued back from
-        the end after an unbounded stop.
+        the end after a stop short of it.
     fold : ndarray of bool
+        Turning points in the parameter (see :func:`branch_dataset`).
     gap : ndarray of bool
         Point reached by a jump over a discontinuity of the contact force
         (do not join it to the previous point).
@@ -97,8 +150,18 @@ class HBBranch:
         alternates between two cycles, the mean of both is then used; 0 if
         it did not repeat within ``config.HB_MAX_PASSES``).
     response0 : ndarray (points, 3)
-        (half peak-to-peak, mean, max |x|) of DOF 0 where the continuation
-        monitor computed them (NaN elsewhere; see :meth:`response`).
+        (half peak-to-peak, mean, max |x|) of the response DOF where the
+        continuation monitor computed them (NaN elsewhere; see :meth:`response`).
+    point_status : ndarray of PointStatus (points,)
+        How each point joins the one before it.
+    peaks : tuple of HBPeak
+        Maxima of the response amplitude, refined between the points.
+    uncovered : tuple of (float, float)
+        Parts of the requested range without a computed point (empty for a
+        complete branch; for an unbounded one, where the response has no
+        bound).
+    response_dof : int
+        DOF of ``response0``, of the peaks and of the step control.
     """
 
     problem: HBProblem
@@ -117,6 +180,10 @@ class HBBranch:
     periodic_error: np.ndarray
     force_period: np.ndarray
     response0: np.ndarray
+    point_status: np.ndarray
+    peaks: tuple
+    uncovered: tuple
+    response_dof: int
 
     def gamma(self):
         """gamma = w / w0 per point."""
@@ -124,22 +191,38 @@ class HBBranch:
             return self.lam.copy()
         return np.full(self.lam.size, self.problem.gamma_fixed)
 
-    def response(self, dof: int = 0):
-        """(amplitude_m, offset_m, max_abs_m) per point for DOF ``dof``."""
-        out = self.response0.copy() if dof == 0 else np.full((self.lam.size, 3), np.nan)
+    def response(self, dof: int | None = None):
+        """(amplitude_m, offset_m, max_abs_m) per point for DOF ``dof`` (default: the response DOF)."""
+        dof = self.response_dof if dof is None else dof
+        out = self.response0.copy() if dof == self.response_dof else np.full((self.lam.size, 3), np.nan)
         # rows computed by the monitor for the same X are kept; the others computed here
         for i in np.flatnonzero(np.isnan(out[:, 0])):
             out[i] = self.problem.amplitudes(self.X[i], dof, self.lam[i])
         return out[:, 0], out[:, 1], out[:, 2]
 
 
-def _make_branch(problem, status, message, lam, X, segment, fold, gap, counters, evaluations) -> HBBranch:
+@dataclass(frozen=True)
+class _Parts:
+    """The continued segments of a branch with what the HBBranch takes from them (unscaled)."""
+
+    lam: np.ndarray
+    X: np.ndarray
+    segment: np.ndarray
+    fold: np.ndarray
+    gap: np.ndarray
+    point_status: np.ndarray
+    counters: dict
+
+
+def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBranch:
     """HBBranch of the continued points: AFT diagnostics and Hill stability of every point.
 
-    ``evaluations`` maps a parameter value to ``(X, evaluation, amplitudes)``
-    kept by the continuation monitor; they are reused where X is the very
-    same, else the point is evaluated again.
+    The evaluations kept by the continuation monitor (``tr.evaluations``:
+    parameter value -> (X, evaluation, amplitudes)) are reused where X is
+    the very same, else the point is evaluated again.
     """
+    problem = tr.problem
+    lam, X = parts.lam, parts.X
     n = lam.size
     passes = np.zeros(n, dtype=int)
     periodic_error = np.zeros(n)
@@ -147,7 +230,7 @@ def _make_branch(problem, status, message, lam, X, segment, fold, gap, counters,
     response0 = np.full((n, 3), np.nan)
     JXs = np.empty((n, problem.size, problem.size))
     for i in range(n):
-        ev = evaluations.get(float(lam[i]))
+        ev = tr.evaluations.get(float(lam[i]))
         if ev is None or ev[0].tobytes() != X[i].tobytes():  # not kept for this very X
             ev = (X[i], problem.evaluate(X[i], lam[i]))
         elif len(ev) > 2:
@@ -159,10 +242,64 @@ def _make_branch(problem, status, message, lam, X, segment, fold, gap, counters,
         force_period[i] = int(ev.info[INFO_PERIOD])
     # Hill stability of every point (hill_stability's criterion; NaN where a condensed problem does not compute it)
     growth = problem.hill_growth(JXs, np.array([problem.omega(v) for v in lam]))
+    stable, checked = _confirmed_stability(problem, X, lam, growth)
+    counters = {**parts.counters, "monodromy_checks": checked}
+    # folds need the stability on both sides; without it (a large condensed problem) the turning points stand
+    fold = _saddle_nodes(parts.fold, stable, parts.segment) if np.all(np.isfinite(growth)) else parts.fold
     return HBBranch(problem=problem, parameter=problem.parameter.name, status=status, message=message, lam=lam,
-                    X=X, segment=segment, fold=fold, gap=gap, counters=counters,
-                    stable=growth <= config.HB_STABILITY_RTOL, growth=growth, passes=passes,
-                    periodic_error=periodic_error, force_period=force_period, response0=response0)
+                    X=X, segment=parts.segment, fold=fold, gap=parts.gap, counters=counters,
+                    stable=stable, growth=growth, passes=passes,
+                    periodic_error=periodic_error, force_period=force_period, response0=response0,
+                    point_status=parts.point_status, peaks=tuple(peaks), uncovered=tuple(uncovered),
+                    response_dof=tr.dof)
+
+
+def _saddle_nodes(turning, stable, segment):
+    """The turning points that can be folds: an unstable point next to them along the branch.
+
+    At a fold of a smooth branch a real Floquet multiplier crosses +1, so
+    the number of unstable multipliers changes by one there and one side of
+    it is unstable. A turning point is kept when the stretch to the
+    neighbouring turning point on either side (or, without one, the
+    ``config.HB_FOLD_WINDOW`` points on that side) holds an unstable point;
+    on a piecewise-smooth branch the change of stability can lie a few
+    points before the extreme of the parameter. Turning points with stable
+    points all around are zigzags of the branch at corners or jumps of a
+    closed-form contact force, not folds: a sweep does not jump there.
+    """
+    out = np.zeros_like(turning)
+    k = config.HB_FOLD_WINDOW
+    for sgm in np.unique(segment):
+        idx = np.flatnonzero(segment == sgm)
+        tp = np.flatnonzero(turning[idx])
+        for j, i in enumerate(tp):
+            lo = tp[j - 1] if j > 0 else max(i - k, 0)
+            hi = tp[j + 1] if j + 1 < tp.size else min(i + k, idx.size - 1)
+            out[idx[i]] = not stable[idx[lo:hi + 1]].all()
+    return out
+
+
+def _confirmed_stability(problem: HBProblem, X, lam, growth):
+    """(stable, number of monodromy checks): Hill's criterion, with marginal growth decided by the monodromy.
+
+    Hill's method truncated to H harmonics is only approximate where the
+    contact force has a corner (the onset of slip of a Jenkins element on
+    an otherwise undamped oscillator gives Re(s)/w of a few 1e-6 at
+    points whose period map is contracting). A growth between
+    ``config.HB_STABILITY_RTOL`` and ``config.HB_STABILITY_CONFIRM`` is
+    therefore decided by the Floquet multipliers of the time-domain period
+    map (:func:`~jointdyn.hb.monodromy.monodromy_multipliers`): unstable
+    when one lies outside the unit circle by more than
+    ``2 pi config.HB_STABILITY_RTOL``.
+    """
+    from .monodromy import monodromy_multipliers
+
+    stable = growth <= config.HB_STABILITY_RTOL
+    marginal = np.flatnonzero(~stable & (growth < config.HB_STABILITY_CONFIRM))
+    for i in marginal:
+        mu = np.max(np.abs(monodromy_multipliers(problem, X[i], lam[i])))
+        stable[i] = mu <= 1.0 + 2.0 * math.pi * config.HB_STABILITY_RTOL
+    return stable, int(marginal.size)
 
 
 def _scales(problem: HBProblem, start: float):
@@ -197,22 +334,29 @@ def _saturation_test(problem: HBProblem, ev, X, q, lam):
 
 
 class _Tracker:
-    """Scaled residual and continuation monitor of one HB problem.
+    """Scaled residual, observable and continuation monitor of one HB problem.
 
     The residual is that of the problem in scaled units (R / fs,
-    JX xs / fs, Jp ps / fs); the monitor computes the amplitude of every
-    accepted point, keeps its evaluation (for the stability and the
-    response of the branch) and stops the branch on an unbounded response.
+    JX xs / fs, Jp ps / fs); the step control's observable is the
+    logarithm of the norm of the response DOF's harmonics (the chords of the
+    plotted curve stay within ``chord_tol`` of it, relative in amplitude),
+    peaks and folds use log q itself; the monitor computes the
+    amplitude of every accepted point, keeps its evaluation (for the
+    stability and the response of the branch) and stops the branch on an
+    unbounded response.
     """
 
-    def __init__(self, problem: HBProblem, scales):
+    def __init__(self, problem: HBProblem, scales, dof: int):
         self.problem = problem
         self.scales = scales
+        self.dof = dof
         law = contact_of(problem.system).law
         self.kt, self.fy = law.kt, law.fy
         self.last = None
-        #: parameter value -> (X, evaluation, amplitudes of DOF 0) at accepted points
+        #: parameter value -> (X, evaluation, amplitudes of the response DOF) at accepted points
         self.evaluations = {}
+        #: the amplitudes of the last few unknowns asked for (observable and monitor share them)
+        self._amps = {}
 
     def residual(self, y, lam_s):
         xs, _, ps = self.scales
@@ -220,18 +364,44 @@ class _Tracker:
         self.last = ev
         return ev.scaled
 
-    def q(self, X, amps=None) -> float:
-        """kt X / fy of DOF 0 (X the half peak-to-peak amplitude)."""
-        if amps is None:
-            amps = self.problem.amplitudes(X, 0)
-        return self.kt * amps[0] / self.fy if self.fy > 0 else 0.0
+    def amplitudes(self, y):
+        """(half peak-to-peak, mean, max |x|) of the response DOF at scaled unknowns y, m."""
+        key = y.tobytes()
+        hit = self._amps.get(key)
+        if hit is None:
+            if len(self._amps) >= _AMPLITUDE_CACHE:
+                self._amps.clear()
+            hit = self._amps[key] = self.problem.amplitudes(y * self.scales[0], self.dof)
+        return hit
+
+    def q(self, amp) -> float:
+        """kt X / fy (X the half peak-to-peak amplitude, m)."""
+        return self.kt * amp / self.fy if self.fy > 0 else amp / self.scales[0]
+
+    def observe(self, y, lam_s) -> float:
+        """log q of the response DOF (NaN at zero amplitude)."""
+        q = self.q(self.amplitudes(y)[0])
+        return math.log(q) if q > 0 else math.nan
+
+    def observe_step(self, y, lam_s) -> float:
+        """log of the norm of the response DOF's harmonics 1..H (scaled units; NaN at zero).
+
+        The step control's observable: it follows log q within a constant
+        where the response is near-harmonic and costs a few flops, where q
+        (the half peak-to-peak of a finely sampled period) costs a
+        sampling per call.
+        """
+        p = self.problem
+        h = y.reshape(p.nh, p.n)[1:, p.dof_index(self.dof)]
+        a = math.sqrt(float(h @ h))
+        return math.log(a) if a > 0 else math.nan
 
     def monitor(self, y, lam_s):
         xs, _, ps = self.scales
         name = self.problem.parameter.name
         X = y * xs
-        amps = self.problem.amplitudes(X, 0)
-        q = self.q(X, amps)
+        amps = self.amplitudes(y)
+        q = self.q(amps[0])
         lam = lam_s * ps
         if self.last is not None:
             self.evaluations[float(lam)] = (X, self.last, amps)
@@ -249,7 +419,7 @@ class _Tracker:
     def relabel(self, res: ContinuationResult) -> ContinuationResult:
         """A corrector failure at a very large amplitude is an unbounded response."""
         if res.status is ContinuationStatus.FAILED and res.y.shape[0] > 0:
-            q = self.q(res.y[-1] * self.scales[0])
+            q = self.q(self.amplitudes(res.y[-1])[0])
             if q > config.HB_UNBOUNDED_FAIL_FRACTION * config.HB_UNBOUNDED_Q:
                 return dataclasses.replace(
                     res, status=ContinuationStatus.UNBOUNDED,
@@ -257,14 +427,27 @@ class _Tracker:
         return res
 
 
-def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress) -> ContinuationResult:
-    """One continued segment from lam_a to lam_b (the start from the stuck linear solution)."""
+#: amplitudes kept by a tracker before its cache is cleared (a step asks for a few)
+_AMPLITUDE_CACHE = 8
+
+
+def _bar(total: int, desc: str, progress):
+    """A tqdm bar (shown on a TTY when ``progress`` is None), or a null context without one when it is
+    False (tqdm is not even imported: it takes a noticeable part of a short command's time)."""
+    if progress is False:
+        import contextlib
+
+        return contextlib.nullcontext(None)
     from tqdm.auto import tqdm
 
+    return tqdm(total=total, desc=desc, disable=None if progress is None else not progress, leave=False)
+
+
+def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress) -> ContinuationResult:
+    """One continued segment from lam_a to lam_b (the start from the stuck linear solution)."""
     problem = tr.problem
     xs, _, ps = tr.scales
-    with tqdm(total=opt.max_points, desc=f"HB {problem.parameter.name}",
-              disable=None if progress is None else not progress, leave=False) as bar:
+    with _bar(opt.max_points, f"HB {problem.parameter.name}", progress) as bar:
         y0 = problem.linear_guess(lam_a) / xs
         if (problem.parameter is GAMMA
                 and not newton(tr.residual, y0, lam_a / ps, opt, max_iter=config.HB_START_MAX_ITER)[1]):
@@ -275,11 +458,12 @@ def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress) -> 
             if sol.converged:
                 y0 = sol.X / xs
         return tr.relabel(continuation(tr.residual, y0, lam_a / ps, lam_b / ps, opt, monitor=tr.monitor,
-                                       progress=bar))
+                                       progress=bar, observe=tr.observe_step, lam_name=problem.parameter.name))
 
 
 def continue_hb(system: System, start: float, stop: float, *, parameter="gamma", gamma: float | None = None,
                 harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
+                max_step: float | None = None, response_dof: int | None = None,
                 options: ContinuationOptions | None = None, backward_after_unbounded: bool = True,
                 progress: bool | None = None, condense: bool | None = None, **overrides) -> HBBranch:
     """Continue harmonic-balance solutions in a scalar parameter.
@@ -302,14 +486,25 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         Highest harmonic H (>= 1); harmonics 0..H are used.
     samples : int
         AFT time samples per period (>= 2H + 2).
+    max_step : float, optional
+        Largest change of the parameter between consecutive points (in its
+        own unit, e.g. a gamma grid spacing); default: none beyond the
+        chord bound.
+    response_dof : int, optional
+        DOF whose amplitude the step control follows and the peaks report
+        (default ``system.response_dof``).
     options : ContinuationOptions, optional
         Step control, in scaled units (unknowns in units of fy/kt of the
         first contact, parameter in its own scale, residual force /
         max(F1, fy)); keyword arguments override its fields (``ds``,
-        ``ds_max``, ``max_points``, ``predictor``, ``tol``, ...).
+        ``ds_max``, ``max_points`` (per segment), ``chord_tol``, ...). ``chord_tol``
+        bounds the distance between the straight lines joining the points
+        and the curve in the plane (parameter, log q): 0.005 is half a
+        percent of the amplitude.
     backward_after_unbounded : bool
-        After an unbounded (or failed) stop, continue a second segment from
-        ``stop`` backwards, so that both ends of the range are covered.
+        After a stop short of ``stop`` (unbounded, failed, turned back),
+        continue a second segment from ``stop`` backwards, so that both
+        ends of the range are covered.
     progress : bool, optional
         Show a tqdm bar (None: only on a TTY).
     condense : bool, optional
@@ -320,6 +515,8 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
     Returns
     -------
     HBBranch
+        With its status (``complete`` only when the range is covered),
+        per-point status, refined peaks and uncovered parts of the range.
     """
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
@@ -330,121 +527,267 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
     if start == stop:
         raise ValueError(f"{par.name} range must not be empty (start == stop == {start!r})")
     par.check_range(start, stop)
+    dof = system.response_dof if response_dof is None else V.positive_int("response_dof", response_dof, 0)
+    if dof >= system.ndof:
+        raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {dof!r}")
     opt = make_options(options, overrides)
     V.positive_int("max_points", opt.max_points, 2)
-    problem = make_problem(system, condense=condense, harmonics=harmonics, samples=samples, parameter=par,
-                           gamma=gamma)
-    tr = _Tracker(problem, _scales(problem, start))
+    problem = make_problem(system, condense=condense, response_dofs=(dof,), harmonics=harmonics, samples=samples,
+                           parameter=par, gamma=gamma)
+    tr = _Tracker(problem, _scales(problem, start), dof)
+    if max_step is not None:
+        opt = dataclasses.replace(opt, max_dlam=V.positive("max_step", max_step) / tr.scales[2])
     res = _segment(tr, start, stop, opt, progress)
     parts = [res]
-    status, message = res.status, res.message
-    left = opt.max_points - res.lam.size
-    if res.status in (ContinuationStatus.UNBOUNDED, ContinuationStatus.FAILED) and backward_after_unbounded \
-            and left >= 2:
-        back = _segment(tr, stop, start, dataclasses.replace(opt, max_points=left), progress)
-        parts.append(back)
-        message += f"; continued back from {par.name} = {stop:.6g}: {back.status} ({back.message})"
-        if res.lam.size == 0 and back.status is ContinuationStatus.COMPLETE:
-            # no start at `start`, but the branch from `stop` covers the range
-            status = ContinuationStatus.COMPLETE
-            message = f"computed from {par.name} = {stop:.6g} back to {start:.6g} ({message})"
-    return _join(tr, parts, status, message)
+    # the segment back from the end has a bound of its own: the first one may have spent its points
+    # on a flank that grows without bound
+    if res.status in _GO_BACK and backward_after_unbounded:
+        parts.append(_segment(tr, stop, start, opt, progress))
+    return _join(tr, parts, start, stop, opt)
 
 
-def _join(tr: _Tracker, parts, status, message) -> HBBranch:
-    """The HBBranch of the continued segments (unscaled)."""
+#: segment statuses after which a second segment is continued back from the end of the range
+_GO_BACK = (ContinuationStatus.UNBOUNDED, ContinuationStatus.FAILED, ContinuationStatus.TURNED_BACK)
+
+
+def _point_status(res: ContinuationResult) -> np.ndarray:
+    """PointStatus of every point of one segment."""
+    out = np.full(res.lam.size, PointStatus.JOINED, dtype=object)
+    if res.lam.size:
+        out[res.gap] = PointStatus.AFTER_JUMP
+        out[res.corner] = PointStatus.CORNER
+        out[0] = PointStatus.START
+        # a segment that turned back ends on the start of the range (landed there): not short of anything
+        if not res.status.ok and res.status is not ContinuationStatus.TURNED_BACK:
+            out[-1] = PointStatus.STOPPED
+    return out
+
+
+def _join(tr: _Tracker, parts, start, stop, opt) -> HBBranch:
+    """The HBBranch of the continued segments (unscaled), with its status, peaks and coverage."""
     problem = tr.problem
     xs, _, ps = tr.scales
     lam = np.concatenate([p.lam * ps for p in parts])
-    X = np.concatenate([p.y * xs for p in parts]) if lam.size else np.empty((0, problem.size))
-    seg = np.concatenate([np.full(p.lam.size, i) for i, p in enumerate(parts)]).astype(int)
-    fold = np.concatenate([p.fold for p in parts]).astype(bool)
-    gap = np.concatenate([p.gap for p in parts]).astype(bool)
-    counters = {k: sum(p.counters.get(k, 0) for p in parts) for k in parts[0].counters}
-    counters["segments"] = len(parts)
-    if counters.get("jumps", 0):
-        message += (f"; {counters['jumps']} jump(s) over discontinuities of the contact force "
-                    "(points flagged 'gap')")
-    return _make_branch(problem, status, message, lam, X, seg, fold, gap, counters, tr.evaluations)
+    joined = _Parts(
+        lam=lam,
+        X=np.concatenate([p.y * xs for p in parts]) if lam.size else np.empty((0, problem.size)),
+        segment=np.concatenate([np.full(p.lam.size, i) for i, p in enumerate(parts)]).astype(int),
+        fold=np.zeros(lam.size, dtype=bool),
+        gap=np.concatenate([p.gap for p in parts]).astype(bool),
+        point_status=np.concatenate([_point_status(p) for p in parts]),
+        counters={**{k: sum(p.counters.get(k, 0) for p in parts) for k in parts[0].counters},
+                  "segments": len(parts)},
+    )
+    status, message, uncovered = _coverage(parts, start, stop, ps, problem.parameter.name)
+    if joined.counters.get("jumps", 0):
+        message += (f"; {joined.counters['jumps']} jump(s) over discontinuities of the contact force "
+                    "(points with point_status 'after-jump')")
+    logqs = [np.array([tr.observe(y, 0.0) for y in p.y]) for p in parts]
+    peaks = [pk for i, (p, g) in enumerate(zip(parts, logqs)) for pk in _peaks(tr, p, g, i, opt)]
+    logq = np.concatenate(logqs)
+    joined = dataclasses.replace(joined, fold=_turning_mask(joined.lam, logq, joined.segment, joined.gap, start, stop))
+    return _make_branch(tr, status, message, joined, peaks, uncovered)
 
 
-def _turning_mask(branch):
-    m = np.zeros(branch.lam.size, dtype=bool)
-    span = float(np.ptp(branch.lam)) if branch.lam.size else 0.0
-    for sgm in np.unique(branch.segment):
-        idx = np.flatnonzero(branch.segment == sgm)
-        tp = turning_points(branch.lam[idx], branch.gap[idx], band=config.HB_TURNING_BAND * span)
+def _span(p: ContinuationResult, ps):
+    """(lo, hi) of a segment's parameter values (unscaled), or None for an empty one."""
+    return (float(p.lam.min() * ps), float(p.lam.max() * ps)) if p.lam.size else None
+
+
+def _holes(spans, lo, hi):
+    """Parts of [lo, hi] outside the union of the intervals ``spans``."""
+    out, at = [], lo
+    for a, b in sorted(s for s in spans if s is not None):
+        if a > at:
+            out.append((at, min(a, hi)))
+        at = max(at, b)
+    if at < hi:
+        out.append((at, hi))
+    return [(a, b) for a, b in out if b > a]
+
+
+def _coverage(parts, start, stop, ps, name):
+    """(status, message, uncovered intervals) of a branch made of its segments.
+
+    ``complete`` when the segments cover [start, stop]: the first one
+    reached ``stop``, or the one continued back from ``stop`` reached
+    ``start`` or the parameter where the first one stopped; ``unbounded``
+    when both ended unbounded (the response has no bound between them);
+    otherwise the status of the first segment that neither completed nor
+    ended unbounded (a failure of the segment continued back is not hidden
+    behind an unbounded first one), with the parts of the range not
+    computed named in the message.
+    """
+    lo, hi = min(start, stop), max(start, stop)
+    first = parts[0]
+    message = first.message
+    if len(parts) > 1:
+        message += f"; continued back from {name} = {stop:.6g}: {parts[1].status} ({parts[1].message})"
+    holes = _holes([_span(p, ps) for p in parts], lo, hi)
+    if first.status is ContinuationStatus.COMPLETE or (len(parts) > 1 and not holes):
+        status = ContinuationStatus.COMPLETE
+    elif len(parts) > 1 and all(p.status is ContinuationStatus.UNBOUNDED for p in parts):
+        status = ContinuationStatus.UNBOUNDED
+    else:
+        status = next((p.status for p in parts if not p.status.ok and p.status is not ContinuationStatus.UNBOUNDED),
+                      first.status)
+    if holes:
+        where = ", ".join(f"{a:.6g} to {b:.6g}" for a, b in holes)
+        what = "no bounded response" if status is ContinuationStatus.UNBOUNDED else "not computed"
+        message += f"; {what} for {name} from {where}"
+    return status, message, holes
+
+
+def _peaks(tr: _Tracker, res: ContinuationResult, g, segment: int, opt) -> list:
+    """Maxima of the response amplitude along one segment (log q at its points: g), refined between
+    its points (HBPeak)."""
+    if res.lam.size < 3:
+        return []
+    xs, _, ps = tr.scales
+    out = []
+    for i in local_maxima(g, res.gap, config.HB_PEAK_PROMINENCE):
+        y, lam_s, gv, ok = refine_maximum(tr.residual, tr.observe, res.y[i - 1:i + 2], res.lam[i - 1:i + 2], opt)
+        if not gv >= g[i]:  # the refinement found nothing higher: keep the branch point
+            y, lam_s, gv, ok = res.y[i], res.lam[i], g[i], False
+        lam = float(lam_s * ps)
+        amp = tr.amplitudes(y)[0]
+        gam = lam if tr.problem.parameter is GAMMA else float(tr.problem.gamma_fixed)
+        out.append(HBPeak(lam=lam, gamma=gam, X=y * xs, amplitude_m=float(amp), amplitude_q=float(tr.q(amp)),
+                          segment=segment, refined=ok))
+    return out
+
+
+def _turning_mask(lam, observed, segment, gap, start, stop):
+    """Folds: points where the parameter is extremal along a segment, beyond a dead band.
+
+    A reversal of the parameter counts once it exceeds
+    ``config.HB_TURNING_BAND`` of the range, or once log q has moved by
+    more than ``config.HB_TURNING_BAND_LOG_Q`` while the parameter is still
+    short of the extreme (a fold whose two branches are close in the
+    parameter but far apart in amplitude). The jitter of points at a
+    non-smooth corner (onset of slip or separation, where the branch keeps
+    going) is within both bands and does not count.
+    """
+    m = np.zeros(lam.size, dtype=bool)
+    band = config.HB_TURNING_BAND * abs(stop - start)
+    for sgm in np.unique(segment):
+        idx = np.flatnonzero(segment == sgm)
+        tp = turning_points(lam[idx], gap[idx], band=band, observed=observed[idx],
+                            observed_band=config.HB_TURNING_BAND_LOG_Q)
         m[idx[tp]] = True
     return m
 
 
-def branch_dataset(branch: HBBranch, response_dof: int = 0):
-    """xarray Dataset of a branch (dim ``point``).
+def branch_dataset(branch: HBBranch, response_dof: int | None = None):
+    """xarray Dataset of a branch (dims ``point``, ``harmonic``, ``peak``).
 
-    Variables: ``gamma``, the parameter (if not gamma), ``amplitude_q``
-    (kt X / fy of the first contact, X = half peak-to-peak of x(t) of
-    ``response_dof``), ``amplitude_m`` (X, m), ``offset_m`` (mean, m),
-    ``max_abs_m`` (m), ``stable``, ``fold`` (sign change of the parameter
-    component of the Jacobian tangent: consistent with Hill's method, where
-    a real Floquet multiplier crosses 1), ``turning`` (points where the
-    parameter is extremal along the computed branch, the secant turning
-    points, with a dead band of ``config.HB_TURNING_BAND`` of the range;
-    on a piecewise-smooth branch they can differ from ``fold``),
-    ``branch`` (segment index), ``gap``, ``growth``
-    (max Re(s)/w of the Floquet exponents), ``aft_passes`` (periods
-    marched), ``force_period`` (1; 2 when the law alternated between two
-    cycles and their mean was used; 0 if the force did not repeat),
-    ``harmonic_amplitude_m`` (dims point, harmonic: sqrt(a_k^2 + b_k^2),
-    |a_0| for k = 0).
+    Variables per point: ``gamma``, the parameter (if not gamma),
+    ``amplitude_q`` (kt X / fy of the first contact, X = half
+    peak-to-peak of x(t) of ``response_dof``), ``amplitude_m`` (X, m),
+    ``offset_m`` (mean, m), ``max_abs_m`` (m), ``stable``, ``fold``
+    (turning points: the parameter is extremal along the computed branch,
+    beyond a dead band of ``config.HB_TURNING_BAND`` of the range, so that
+    the corners of a piecewise-smooth branch, where it keeps its
+    direction, are not folds), ``point_status`` (:class:`PointStatus`:
+    how the point joins the one before it; a line is drawn only to
+    ``joined`` and ``corner`` points), ``branch`` (segment index), ``gap``
+    (reached by a jump), ``growth`` (max Re(s)/w of the Floquet
+    exponents), ``aft_passes`` (periods marched), ``force_period`` (1; 2
+    when the law alternated between two cycles and their mean was used; 0
+    if the force did not repeat), ``harmonic_amplitude_m`` (dims point,
+    harmonic: sqrt(a_k^2 + b_k^2), |a_0| for k = 0). Per peak (dim
+    ``peak``): ``peak_gamma``, ``peak_<parameter>`` (if not gamma),
+    ``peak_amplitude_q``, ``peak_amplitude_m``, ``peak_branch``,
+    ``peak_refined``.
+
+    Attributes: ``status`` (:class:`~jointdyn.continuation.ContinuationStatus`;
+    ``complete`` only when the range is covered), ``message`` (where and
+    why segments stopped), ``uncovered`` (parts of the range without
+    points, e.g. ``"1.164-1.185"``; empty when none), ``peaks``,
+    ``peak_gamma`` and ``peak_amplitude_q`` (the highest peak, NaN
+    without one), ``folds``, ``unstable_points`` and the counters.
     """
     import xarray as xr
 
     p = branch.problem
-    if not 0 <= response_dof < p.system.ndof:
-        raise ValueError(f"response_dof must be in [0, {p.system.ndof - 1}], got {response_dof!r}")
+    dof = branch.response_dof if response_dof is None else response_dof
+    if not 0 <= dof < p.system.ndof:
+        raise ValueError(f"response_dof must be in [0, {p.system.ndof - 1}], got {dof!r}")
     law = contact_of(p.system).law
-    amp, off, mx = branch.response(response_dof)
-    Xd = p.dof_coefficients(branch.X, response_dof, branch.lam) if branch.X.size else np.empty((0, p.nh))
+    amp, off, mx = branch.response(dof)
+    Xd = p.dof_coefficients(branch.X, dof, branch.lam) if branch.X.size else np.empty((0, p.nh))
     harm = np.empty((Xd.shape[0], p.H + 1))
     harm[:, 0] = np.abs(Xd[:, 0])
     for k in range(1, p.H + 1):
         harm[:, k] = np.hypot(Xd[:, 2 * k - 1], Xd[:, 2 * k])
-    turning = _turning_mask(branch)
+    qs = law.kt / law.fy if law.fy > 0 else np.nan
     data = {
         "gamma": ("point", branch.gamma()),
-        "amplitude_q": ("point", law.kt * amp / law.fy if law.fy > 0 else amp * np.nan),
+        "amplitude_q": ("point", qs * amp),
         "amplitude_m": ("point", amp),
         "offset_m": ("point", off),
         "max_abs_m": ("point", mx),
         "stable": ("point", branch.stable),
         "fold": ("point", branch.fold),
-        "turning": ("point", turning),
+        "point_status": ("point", np.array([str(s) for s in branch.point_status], dtype=str)),
         "branch": ("point", branch.segment),
         "gap": ("point", branch.gap),
         "growth": ("point", branch.growth),
         "aft_passes": ("point", branch.passes),
         "force_period": ("point", branch.force_period),
         "harmonic_amplitude_m": (("point", "harmonic"), harm),
+        **_peak_variables(branch, dof, qs),
     }
     if branch.parameter != "gamma":
         data[branch.parameter] = ("point", branch.lam)
     attrs = {"gamma": {"long_name": "w / w0"}, "amplitude_q": {"long_name": "kt X / fy", "units": "1"},
-             **{v: {"units": "m"} for v in ("amplitude_m", "offset_m", "max_abs_m", "harmonic_amplitude_m")}}
+             **{v: {"units": "m"} for v in ("amplitude_m", "offset_m", "max_abs_m", "harmonic_amplitude_m",
+                                            "peak_amplitude_m")},
+             "point_status": {"flag_meanings": " ".join(s.value for s in PointStatus)}}
     # variables built with their attributes (no DataArray round trips afterwards)
     data = {k: xr.Variable(dims, np.asarray(v), attrs=attrs.get(k)) for k, (dims, v) in data.items()}
-    ds = xr.Dataset(data, coords={"point": np.arange(branch.lam.size), "harmonic": np.arange(p.H + 1)})
-    ds.attrs.update(
+    ds = xr.Dataset(data, coords={"point": np.arange(branch.lam.size), "harmonic": np.arange(p.H + 1),
+                                  "peak": np.arange(len(branch.peaks))})
+    ds.attrs.update(_branch_attrs(branch, dof, ds))
+    return ds
+
+
+def _peak_variables(branch: HBBranch, dof: int, qs: float) -> dict:
+    """Dataset variables on dim ``peak`` (see :func:`branch_dataset`)."""
+    pk = branch.peaks
+    p = branch.problem
+    amp = [k.amplitude_m if dof == branch.response_dof else p.amplitudes(k.X, dof)[0] for k in pk]
+    out = {
+        "peak_gamma": ("peak", np.array([k.gamma for k in pk], dtype=float)),
+        "peak_amplitude_q": ("peak", qs * np.array(amp, dtype=float)),
+        "peak_amplitude_m": ("peak", np.array(amp, dtype=float)),
+        "peak_branch": ("peak", np.array([k.segment for k in pk], dtype=int)),
+        "peak_refined": ("peak", np.array([k.refined for k in pk], dtype=bool)),
+    }
+    if branch.parameter != "gamma":
+        out["peak_" + branch.parameter] = ("peak", np.array([k.lam for k in pk], dtype=float))
+    return out
+
+
+def _branch_attrs(branch: HBBranch, dof: int, ds) -> dict:
+    """Dataset attributes of a branch (see :func:`branch_dataset`)."""
+    p = branch.problem
+    top = int(np.argmax(ds.peak_amplitude_q.values)) if len(branch.peaks) else None
+    return dict(
         status=branch.status.value,
         message=branch.message,
+        uncovered=", ".join(f"{a:.6g}-{b:.6g}" for a, b in branch.uncovered),
         method="hb",
         parameter=branch.parameter,
         harmonics=p.H,
         samples=p.Ns,
-        response_dof=response_dof,
+        response_dof=dof,
         points=int(branch.lam.size),
+        peaks=len(branch.peaks),
+        peak_gamma=float(ds.peak_gamma.values[top]) if top is not None else math.nan,
+        peak_amplitude_q=float(ds.peak_amplitude_q.values[top]) if top is not None else math.nan,
         folds=int(branch.fold.sum()),
-        turning_points=int(turning.sum()),
-        unstable_points=int(np.sum(branch.growth > config.HB_STABILITY_RTOL)),
+        unstable_points=int((~branch.stable).sum()),
         stability="hill" if np.all(np.isfinite(branch.growth)) else "not-computed",
         condensed=int(p.condensed),
         unknown_dofs=int(p.n),
@@ -453,18 +796,19 @@ def branch_dataset(branch: HBBranch, response_dof: int = 0):
         force_not_periodic_points=int((branch.force_period == 0).sum()),
         **{f"counter_{k}": int(v) for k, v in branch.counters.items()},
     )
-    return ds
 
 
 def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: int = config.HB_HARMONICS,
-           samples: int = config.HB_SAMPLES, response_dof: int = 0, options: ContinuationOptions | None = None,
-           progress: bool | None = None, condense: bool | None = None, **overrides):
+           samples: int = config.HB_SAMPLES, max_step: float | None = None, response_dof: int | None = None,
+           options: ContinuationOptions | None = None, progress: bool | None = None, condense: bool | None = None,
+           **overrides):
     """Frequency-response curve by harmonic balance and arc-length continuation.
 
     Harmonics 0..H of every DOF (normalised time tau = w t), contact forces
-    by alternating frequency-time with ``samples`` per period, exact
-    Jacobians by forward mode through the march of the contact laws,
-    stability by Hill's method, folds from the tangent. See
+    by alternating frequency-time with ``samples`` per period (re-contact
+    instants located exactly between samples), exact Jacobians by forward
+    mode through the march of the contact laws, stability by Hill's method,
+    folds as turning points, peaks refined between the points. See
     :func:`continue_hb` for the parameters.
 
     Parameters
@@ -477,11 +821,14 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
         H >= 1.
     samples : int
         >= 2H + 2.
-    response_dof : int
-        DOF whose response is reported.
+    max_step : float, optional
+        Largest gamma spacing between consecutive points (e.g. the STEP of
+        a gamma grid); the chord bound (``chord_tol``) applies in any case.
+    response_dof : int, optional
+        DOF whose response is reported (default ``system.response_dof``).
     options : ContinuationOptions, optional
         Step control; keyword arguments override its fields (``ds``,
-        ``ds_max``, ``max_points``, ``predictor``, ...).
+        ``ds_max``, ``max_points``, ``chord_tol``, ``predictor``, ...).
     condense : bool, optional
         Condense exactly onto the contact DOFs (None: by size; see
         :func:`continue_hb`).
@@ -489,23 +836,22 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
     Returns
     -------
     xarray.Dataset
-        Dim ``point``; variables ``gamma``, ``amplitude_q``,
-        ``amplitude_m``, ``offset_m``, ``max_abs_m``, ``stable``, ``fold``
-        (and ``turning``, ``branch``, ``gap``, ``growth``, ``aft_passes``,
-        ``force_period``, ``harmonic_amplitude_m``; see
-        :func:`branch_dataset`); attrs ``status`` (``complete`` |
-        ``unbounded`` | ``failed`` | ``max-points``), ``message``,
-        ``harmonics``, ``samples`` and the counters (``counter_*``).
+        Dims ``point`` and ``peak``; variables ``gamma``, ``amplitude_q``,
+        ``amplitude_m``, ``offset_m``, ``max_abs_m``, ``stable``, ``fold``,
+        ``point_status``, the refined peaks (``peak_gamma``,
+        ``peak_amplitude_q``, ...) and more (see :func:`branch_dataset`);
+        attrs ``status`` (``complete`` only when the range is covered;
+        ``unbounded``, ``failed``, ``turned-back``, ``max-points``),
+        ``message``, ``uncovered``, ``harmonics``, ``samples`` and the
+        counters (``counter_*``). A branch that is not complete is never
+        silent: its status, message and the ``stopped`` point say where.
     """
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
-    V.positive_int("response_dof", response_dof, 0)
-    if response_dof >= system.ndof:
-        raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {response_dof!r}")
     br = continue_hb(system, V.positive("gamma_start", gamma_start), V.positive("gamma_stop", gamma_stop),
-                     parameter=GAMMA, harmonics=harmonics, samples=samples, options=options, progress=progress,
-                     condense=condense, **overrides)
-    return branch_dataset(br, response_dof)
+                     parameter=GAMMA, harmonics=harmonics, samples=samples, max_step=max_step,
+                     response_dof=response_dof, options=options, progress=progress, condense=condense, **overrides)
+    return branch_dataset(br)
 
 
 @dataclass(frozen=True)

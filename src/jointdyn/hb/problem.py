@@ -42,7 +42,7 @@ from ..fourier import extrema, fourier_matrices, phases
 from ..kinematics import NORMAL_SPRING, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
 from ..laws import law_dispatch
 from ..systems import Contact, System
-from ._aft import eval_kernel
+from ._aft import NO_EVENT, eval_kernel, recontact_events
 from .parameters import SystemParameter, parameter_named
 from .stability import hill_growth, hill_stability
 
@@ -246,7 +246,8 @@ class HBProblem:
         return self.forcing(f), (np.zeros(self.size) if df is None else self.forcing(df))
 
     def _loads_at(self, p):
-        """(Nsamp, dN): normal-load samples (contacts, Ns) and their derivative along p (or None)."""
+        """(Nsamp, dN, events): normal-load samples (contacts, Ns), their derivative along p (or None),
+        and the re-contact events of the AFT (:func:`jointdyn.hb._aft.recontact_events`)."""
         co, d = self.parameter.contact_loads(self, p)
         nc = len(self.contacts)
         Nsamp = np.empty((nc, self.Ns))
@@ -255,7 +256,10 @@ class HBProblem:
             Nsamp[k], dn = _load_samples(self.tau, co[k, 0], co[k, 1], co[k, 2], None if d is None else d[k])
             if dN is not None:
                 dN[k] = dn
-        return Nsamp, dN
+        events = recontact_events(self.tau, co, d)
+        # a spring's re-contact phases depend on the unknowns: located in the AFT itself
+        events[0][self._Sp[:, 1] > 0.0] = NO_EVENT
+        return Nsamp, dN, events
 
     # --- linear part --------------------------------------------------------
     def linear_matrix(self, w):
@@ -315,13 +319,14 @@ class HBProblem:
         return self._run(np.ascontiguousarray(X, dtype=np.float64), *self._inputs(p), scales)
 
     def _inputs(self, p):
-        """(w, dw/dp, Fe, Fp, Nsamp, dN) at parameter p: what the parameter fixes, as the evaluation takes it."""
+        """(w, dw/dp, Fe, Fp, Nsamp, dN, events) at parameter p: what the parameter fixes, as the evaluation
+        takes it."""
         w, dwdp = self.parameter.frequency(self, p)
         Fe, Fp = self._fixed_forcing if self._fixed_forcing is not None else self._forcing_at(p)
-        Nsamp, dN = self._fixed_loads if self._fixed_loads is not None else self._loads_at(p)
-        return w, dwdp, Fe, Fp, Nsamp, dN
+        Nsamp, dN, events = self._fixed_loads if self._fixed_loads is not None else self._loads_at(p)
+        return w, dwdp, Fe, Fp, Nsamp, dN, events
 
-    def _run(self, X, w, dwdp, Fe, Fp, Nsamp, dN, scales) -> _Eval:
+    def _run(self, X, w, dwdp, Fe, Fp, Nsamp, dN, events, scales) -> _Eval:
         """The compiled evaluation at the given frequency, forcing and loads."""
         nc = len(self.contacts)
         size = self.size
@@ -343,7 +348,7 @@ class HBProblem:
             scaled = (self._scl, np.empty(size), np.empty((size, size)), np.empty(size))
         self._kernel((*self._linear_terms(w), float(dwdp), X, Fe, Fp),
                      (self._Bm, self._Pm, self._ssz, self._Bnm, self._Sp, self.has_springs),
-                     (Nsamp, dN if has_p else self._dummy, has_p), (self.E, self.P),
+                     (Nsamp, dN if has_p else self._dummy, has_p, events), (self.E, self.P),
                      (int(self.max_passes), float(config.HB_PERIODIC_RTOL)), (R, JX, Jp, T, Nout, code, info), scaled)
         return _Eval(R, JX, Jp, T, code, info, None if scales is None else scaled[1:], Nout)
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import config
+from ..dynamics.status import EnergyCheck
 from ..laws import STATE_NAMES
 
 __all__ = [
@@ -57,6 +58,8 @@ VARIABLES = {
 INT_VARIABLES = {
     "periods": ("1", "forcing periods integrated for this point"),
     "period_multiple": ("1", "the steady response repeats after this many forcing periods (0 if none)"),
+    "negative_dissipation": ("1", "1 where the periodic state's contact dissipation is negative beyond its "
+                                  "energy-balance residual (a contact created energy: SteadyState.energy_check)"),
 }
 #: per requested DOF (dimension ``dof``), from the recorded steady period
 DOF_VARIABLES = {
@@ -319,6 +322,7 @@ def _store(out: dict, k: int, res, system, task: ChunkTask) -> None:
         out[name][k] = float(getattr(res, name, math.nan))
     out["periods"][k] = int(res.periods)
     out["period_multiple"][k] = int(getattr(res, "period_multiple", 0) or 0)
+    out["negative_dissipation"][k] = int(getattr(res, "energy_check", None) == EnergyCheck.NEGATIVE_DISSIPATION)
     loop = getattr(res, "loop", None)
     if task.loop_outputs and loop is not None:
         st = loop_statistics(loop, system, task.dofs, out["period_multiple"][k])

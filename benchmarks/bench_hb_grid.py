@@ -1,0 +1,87 @@
+"""Benchmark of harmonic balance on the robustness grid (issue 9).
+
+Reported:
+
+* ``grid_*``: the whole grid of :mod:`jointdyn.sweeps.hb_grid` (4 models x
+  4 eta x 6 beta, default CLI settings, gamma 0.6:1.8:0.01, each highest
+  peak checked against the time domain): wall seconds, CPU seconds of the
+  branches, the fraction of branches that cover the range (or are
+  unbounded where Den Hartog's bound says so) and the fraction of cases
+  that pass every check;
+* ``fig6_hb_default_*``: the Fig 6 harmonic-balance data set with the
+  default (exact) model, 4 eta x 6 beta, default settings: wall seconds,
+  without the time-domain checks (target <= 5 s on 2 cores).
+
+* ``cli_hb_process_*``: time to first answer, ``jointdyn frc --method hb
+  --model jenkins --gamma 0.6:1.8:0.01 --json`` as a whole process with a
+  warm compile cache: best of ``CLI_ROUNDS`` runs, wall and CPU seconds
+  (the process and its children).
+
+``--quick``: the default model's row only (the Fig 6 data set), no time domain.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+SRC = Path(__file__).resolve().parents[1] / "src"
+CLI_ROUNDS = 3
+CLI_ARGS = ("-m", "jointdyn", "frc", "--method", "hb", "--model", "jenkins", "--gamma", "0.6:1.8:0.01", "--json")
+
+
+def cli_process_seconds(rounds: int = CLI_ROUNDS) -> tuple:
+    """(wall, cpu) seconds of the CLI's hb command as a whole process, best of ``rounds`` (after one warm-up)."""
+    import os
+    import resource
+    import subprocess
+
+    env = {**os.environ, "PYTHONPATH": str(SRC) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    wall = cpu = float("inf")
+    for k in range(rounds + 1):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        t = time.perf_counter()
+        subprocess.run([sys.executable, *CLI_ARGS], env=env, stdout=subprocess.DEVNULL, check=True)
+        w = time.perf_counter() - t
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        if k:  # the first run warms the compile cache
+            wall = min(wall, w)
+            cpu = min(cpu, after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+    return wall, cpu
+
+
+def run(quick: bool = False) -> dict:
+    sys.path.insert(0, str(SRC))
+    from jointdyn import config
+    from jointdyn.sweeps.hb_grid import GRID_BETAS, GRID_ETAS, GRID_MODELS, grid_case
+
+    grid_case(config.MODEL, 0.5, 2.0, time_domain=False)  # warm-up (compiles or loads the cache)
+    t = time.perf_counter()
+    fig6 = [grid_case(config.MODEL, e, b, time_domain=False) for e in GRID_ETAS for b in GRID_BETAS]
+    out = {
+        "fig6_hb_default_model": config.MODEL,
+        "fig6_hb_default_seconds": time.perf_counter() - t,
+        "fig6_hb_default_branch_cpu_seconds": sum(c.seconds for c in fig6),
+        "fig6_hb_default_covered_rate": sum(c.covered for c in fig6) / len(fig6),
+    }
+    out["cli_hb_process_wall_seconds"], out["cli_hb_process_cpu_seconds"] = cli_process_seconds(
+        1 if quick else CLI_ROUNDS)
+    if quick:
+        return out
+    t = time.perf_counter()
+    cases = [grid_case(m, e, b) for m in GRID_MODELS for e in GRID_ETAS for b in GRID_BETAS]
+    out.update({
+        "grid_cases": len(cases),
+        "grid_seconds": time.perf_counter() - t,
+        "grid_branch_cpu_seconds": sum(c.seconds for c in cases),
+        "grid_covered_rate": sum(c.covered for c in cases) / len(cases),
+        "grid_pass_rate": sum(c.ok for c in cases) / len(cases),
+    })
+    return out
+
+
+if __name__ == "__main__":
+    import json
+
+    print(json.dumps(run(quick="--quick" in sys.argv), indent=2))
