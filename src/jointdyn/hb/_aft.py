@@ -48,6 +48,8 @@ _HIST_MAX_STATE = 16
 INFO_PASSES, INFO_ERROR, INFO_PERIOD = 0, 1, 2
 #: phase of an event table entry without a re-contact in the interval before the sample
 NO_EVENT = -1.0
+#: Newton iterations and relative step (of the sampling interval) of a spring's re-contact root
+_ROOT_MAX_ITER, _ROOT_TOL = 50, 1e-14
 #: force periods in forcing periods: repeated every period, every second
 #: period (the mean of both is used), or not repeated within the bound
 PERIOD_ONE, PERIOD_TWO, PERIOD_NONE = 1.0, 2.0, 0.0
@@ -63,7 +65,7 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
       (see ``problem.py``);
     * ``con = (Bm, Pm, ssz, Bnm, Sp, spr)``: selection row ``Bm[c]`` and
       kernel parameters ``Pm[c]`` of each contact, state length ``ssz``,
-      normal row ``Bnm[c]`` (g = Bnm[c] . x) and ``Sp[c] = (P, kn)`` of a
+      normal row ``Bnm[c]`` (g = Bnm[c] . x) and ``Sp[c] = (P, kn, restart load)`` of a
       spring contact (kn = 0: prescribed load), ``spr`` True when some
       contact has a spring;
     * ``load = (Nsamp, dN, has_p, events)``: prescribed normal-load samples
@@ -155,7 +157,7 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
         err = np.inf
         period = PERIOD_NONE
         while passes < max_passes:
-            err, err2, tmax, cur = _pass(STEP_JVP, INIT_JVP, prm, (u, U), (Nc, km), dN, c, has_p, events,  # noqa: F821
+            err, err2, tmax, cur = _pass(STEP_JVP, INIT_JVP, prm, (u, U), (Nc, km, nrm[0], nrm[1], con[4][c]), dN, c, has_p, events,  # noqa: F821
                                          E, dirs, (a, bb, da, dbb), (Tc, dT, T1, T2, dT1, cprev), hist, code,
                                          passes, rtol)
             if cur == 1:  # committed state back in (a, da), once per pass
@@ -291,9 +293,12 @@ def _pass(step_jvp, init_jvp, prm, sig, nk, dN, c, has_p, events, E, dirs, st, p
     """One marched period: force samples ``Tc``, derivatives ``dT`` and codes of contact c.
 
     ``sig = (u, U)``: displacement samples and coefficients; ``nk = (Nc,
-    km)``: the contact's normal-load samples and their slope dN/dg (kn
-    while a spring is closed, 0 when open or prescribed). Where the
-    event table has a re-contact in the interval before sample i, the
+    km, G, g, sp)``: the contact's normal-load samples and their slope
+    dN/dg (kn while a spring is closed, 0 when open or prescribed), the
+    normal approach's coefficients and samples and the spring row
+    ``sp = (P, kn, restart load)``. Where the event table has a re-contact
+    of a prescribed load in the interval before sample i, or a spring
+    closes between samples i-1 and i (:func:`_spring_event`), the
     committed state is first replaced by the virgin state at the
     re-contact phase (:func:`_event_point`, ``init_jvp``). The committed
     state is in ``(a, da)`` when ``cur == 0``, in
@@ -311,7 +316,7 @@ def _pass(step_jvp, init_jvp, prm, sig, nk, dN, c, has_p, events, E, dirs, st, p
     a, bb, da, dbb = st
     Tc, dT, T1, T2, dT1, cprev = pw
     Sh, dSh = hist
-    Nc, km = nk
+    Nc, km, Gc, gs, sp = nk
     u, U = sig
     ev_tau, ev_dtau, ev_load = events
     dxj, dNj, dTj = dirs[0], dirs[1], dirs[2]
@@ -336,6 +341,20 @@ def _pass(step_jvp, init_jvp, prm, sig, nk, dN, c, has_p, events, E, dirs, st, p
                 init_jvp(prm, xr, dxj, ev_load[c], dNj, bb, dbb)
             for d in range(nh):
                 dxj[d] = E[i, d]
+            if has_p:
+                dxj[nd - 1] = 0.0
+        if km[i] > 0.0 and km[i - 1 if i > 0 else ns - 1] == 0.0:
+            # a spring closing between samples: virgin restart at the root of P + kn g
+            xr = _spring_event(U, Gc, sp, 2.0 * np.pi * i / ns, 2.0 * np.pi / ns, gs[i - 1 if i > 0 else ns - 1],
+                               gs[i], dxj)
+            dNj[:] = 0.0
+            if cur == 0:
+                init_jvp(prm, xr, dxj, sp[2], dNj, a, da)
+            else:
+                init_jvp(prm, xr, dxj, sp[2], dNj, bb, dbb)
+            for d in range(nh):
+                dxj[d] = E[i, d]
+                dxj[nh + d] = 0.0
             if has_p:
                 dxj[nd - 1] = 0.0
         if spr:
@@ -395,6 +414,58 @@ def _event_point(U, tau, dtau, has_p, dx):  # pragma: no cover - compiled
         du += k * (U[2 * k] * ck - U[2 * k - 1] * sk)
     if has_p:
         dx[dx.shape[0] - 1] = du * dtau
+    return x
+
+
+@jit
+def _trig(C, tau):  # pragma: no cover - compiled
+    """(f, f') at phase ``tau`` of the signal with coefficients ``C`` (constant, cos, sin, ...)."""
+    f = C[0]
+    df = 0.0
+    for k in range(1, (C.shape[0] - 1) // 2 + 1):
+        ck = np.cos(k * tau)
+        sk = np.sin(k * tau)
+        f += C[2 * k - 1] * ck + C[2 * k] * sk
+        df += k * (C[2 * k] * ck - C[2 * k - 1] * sk)
+    return f, df
+
+
+@jit
+def _spring_event(U, G, sp, tau1, h, g0, g1, dx):  # pragma: no cover - compiled
+    """Re-contact of a spring between the phases ``tau1 - h`` and ``tau1``: displacement there, derivative into ``dx``.
+
+    The root tau_r of v(tau) = P + kn g(tau) (v <= 0 at ``tau1 - h`` where
+    g = ``g0``, v > 0 at ``tau1`` where g = ``g1``) by Newton's method kept
+    inside the bracket (regula falsi where a step leaves it), to rounding.
+    Returns u(tau_r); ``dx`` gets its derivative along the coefficients of
+    u (the basis at tau_r, entries 0..nh-1) and of g (entries nh..2nh-1:
+    u'(tau_r) dtau_r/dG_h with dtau_r/dG_h = -Q_h(tau_r) / g'(tau_r)). A
+    plain compiled function, called once per event.
+    """
+    P0, kn = sp[0], sp[1]
+    a, b = tau1 - h, tau1
+    va, vb = P0 + kn * g0, P0 + kn * g1
+    t = a - va * (b - a) / (vb - va)
+    for _ in range(_ROOT_MAX_ITER):
+        g, dg = _trig(G, t)
+        v = P0 + kn * g
+        if v > 0.0:
+            b, vb = t, v
+        else:
+            a, va = t, v
+        tn = t - v / (kn * dg) if dg != 0.0 else a - 1.0
+        if not a < tn < b:
+            tn = a - va * (b - a) / (vb - va)
+        if abs(tn - t) <= _ROOT_TOL * h:
+            t = tn
+            break
+        t = tn
+    x = _event_point(U, t, 0.0, False, dx)
+    du = _trig(U, t)[1]
+    dg = _trig(G, t)[1]
+    nh = U.shape[0]
+    for d in range(nh):
+        dx[nh + d] = -du * dx[d] / dg if dg != 0.0 else 0.0
     return x
 
 

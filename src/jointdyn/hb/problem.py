@@ -203,9 +203,10 @@ class HBProblem:
         self.Bn = list(selection_matrix(kin, self.system.ndof, normal=True)[:, self.dofs])
         self._Bm = np.array(self.B, dtype=np.float64).reshape(nc, self.n)
         self._Bnm = np.array(self.Bn, dtype=np.float64).reshape(nc, self.n)
-        #: (P, kn) per contact, kn = 0 for a prescribed load
-        self._Sp = np.zeros((nc, 2))
-        self._Sp[springs] = kin.normal_par[springs, :2]
+        #: (P, kn, restart load at a re-contact between samples) per contact, kn = 0 for a prescribed load
+        self._Sp = np.zeros((nc, 3))
+        self._Sp[springs, :2] = kin.normal_par[springs, :2]
+        self._Sp[:, 2] = config.HB_RECONTACT_ALPHA * self._Sp[:, 0]
         if nc:
             disp = law_dispatch([c.law for c in self.contacts])
             self._Pm, self._ssz = disp.P, disp.state_size
@@ -296,7 +297,7 @@ class HBProblem:
         w = self.omega(p)
         A = q.linear_matrix(w)
         if stuck:
-            for c, b, bn, (_, kn) in zip(q.contacts, q.B, q.Bn, q._Sp):
+            for c, b, bn, kn in zip(q.contacts, q.B, q.Bn, q._Sp[:, 1]):
                 Kc = c.law.kt * np.outer(b, b) + kn * np.outer(bn, bn)
                 for h in range(q.nh):
                     A[h * q.n:(h + 1) * q.n, h * q.n:(h + 1) * q.n] += Kc
