@@ -250,20 +250,13 @@ class System:
             raise ValueError(f"force_phase_deg: {solver} takes in-phase forcing only (all phases 0), "
                              f"got {self.force_phase_deg.tolist()}")
 
-    def require_prescribed_single_law(self, solver: str) -> None:
-        """ValueError naming the key if a contact has a normal spring, a
-        sampled load or a selection vector, or if the contacts use different
-        law kernels (for solvers that take one law and harmonic loads only)."""
+    def require_phase_loads(self, solver: str) -> None:
+        """ValueError naming the key if a contact has a sampled normal load
+        (for solvers that take constant and harmonic loads and normal springs)."""
         for i, c in enumerate(self.contacts):
-            if not isinstance(c.normal, (ConstantLoad, HarmonicLoad)):
-                raise ValueError(f"contact {i} normal: {solver} takes constant and harmonic normal loads only, "
-                                 f"got a {type(c.normal).__name__}")
-            if c.direction is not None:
-                raise ValueError(f"contact {i} direction: {solver} takes DOF pairs only (dof, dof2), "
-                                 "not selection vectors")
-        if len({c.law.step for c in self.contacts}) > 1:
-            raise ValueError(f"contacts: {solver} takes one contact-law kernel per system, got "
-                             f"{sorted({type(c.law).__name__ for c in self.contacts})}")
+            if not isinstance(c.normal, (ConstantLoad, HarmonicLoad, NormalSpring)):
+                raise ValueError(f"contact {i} normal: {solver} takes constant and harmonic normal loads and "
+                                 f"normal springs, got a {type(c.normal).__name__}")
 
     def forcing_coefficients(self) -> tuple[np.ndarray, np.ndarray]:
         """(cosine, sine) coefficients of the forcing, N: F = a cos(w t) + b sin(w t)."""

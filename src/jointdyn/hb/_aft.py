@@ -48,6 +48,8 @@ _HIST_MAX_STATE = 16
 INFO_PASSES, INFO_ERROR, INFO_PERIOD = 0, 1, 2
 #: phase of an event table entry without a re-contact in the interval before the sample
 NO_EVENT = -1.0
+#: Newton iterations and relative step (of the sampling interval) of a spring's re-contact root
+_ROOT_MAX_ITER, _ROOT_TOL = 50, 1e-14
 #: force periods in forcing periods: repeated every period, every second
 #: period (the mean of both is used), or not repeated within the bound
 PERIOD_ONE, PERIOD_TWO, PERIOD_NONE = 1.0, 2.0, 0.0
@@ -61,32 +63,44 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
     * ``lin = (AK, AC, AM, w, dwdp, X, Fe, Fp)``: ``A = AK + w AC + w^2 AM``,
       ``R = A X - Fe``, ``JX = A``, ``Jp = dwdp (AC + 2 w AM) X - Fp``
       (see ``problem.py``);
-    * ``con = (Bm, Pm, ssz)``: selection row ``Bm[c]`` and kernel
-      parameters ``Pm[c]`` of each contact, state length ``ssz``;
-    * ``load = (Nsamp, dN, has_p, events)``: normal-load samples (contacts,
-      Ns) and, when ``has_p``, their derivative along the continuation
-      parameter; ``events = (ev_tau, ev_dtau, ev_load)`` from
-      :func:`recontact_events`: per contact and sample, the phase of a
-      re-contact inside the interval before the sample (:data:`NO_EVENT`
-      if none) and its derivative along the parameter, and per contact the
-      load at which the law restarts there;
+    * ``con = (Bm, Pm, ssz, Bnm, Sp, spr)``: selection row ``Bm[c]`` and
+      kernel parameters ``Pm[c]`` of each contact, state length ``ssz``,
+      normal row ``Bnm[c]`` (g = Bnm[c] . x) and ``Sp[c] = (P, kn, restart load)`` of a
+      spring contact (kn = 0: prescribed load), ``spr`` True when some
+      contact has a spring;
+    * ``load = (Nsamp, dN, has_p, events)``: prescribed normal-load samples
+      (contacts, Ns) and, when ``has_p``, their derivative along the
+      continuation parameter (rows of spring contacts unused);
+      ``events = (ev_tau, ev_dtau, ev_load)`` from :func:`recontact_events`:
+      per contact and sample, the phase of a re-contact of a prescribed
+      load inside the interval before the sample (:data:`NO_EVENT` if none)
+      and its derivative along the parameter, and per contact the load at
+      which the law restarts there;
     * ``four = (E, P)``: synthesis and analysis matrices;
     * ``ctl = (max_passes, rtol)``: bound on the marched periods and the
       periodicity tolerance;
-    * ``out = (R, JX, Jp, T, code, info)``: outputs, ``T[c]`` and
-      ``code[c]`` the force samples and motion codes of the last pass,
+    * ``out = (R, JX, Jp, T, Nout, code, info)``: outputs, ``T[c]``,
+      ``Nout[c]`` and ``code[c]`` the force samples, normal-load samples
+      and motion codes of the last pass,
       ``info`` as described by ``INFO_*``;
     * ``scaled = (scl, Rs, JXs, Jps)``: when ``scl[0] > 0`` also
       ``Rs = R / scl[0]``, ``JXs = JX * scl[1]``, ``Jps = Jp * scl[2]``
       (the continuation's unknowns and residual in units of order one).
 
-    Per contact c: ``U = Xm Bm[c]``, restart of the law at the mean
-    displacement ``U[0]`` and the first load sample (``INIT_JVP``), AFT
-    passes of ``STEP_JVP`` (:func:`_pass`) until the force repeats,
-    projection, and scatter ``R += b F``, ``JX += b b^T dF/dU``,
-    ``Jp += b dF/dp``. AFT directions: the 2H+1 coefficients of u
-    (du_i = E[i, d]) and, when ``has_p``, the parameter entering the
-    normal load (dN_i = dN[c, i]).
+    Per contact c: ``U = Xm Bm[c]``, its normal-load samples (prescribed,
+    or ``max(0, P + kn g)`` from ``G = Xm Bnm[c]`` for a spring,
+    :func:`_contact_loads`), restart of the law at the mean displacement
+    ``U[0]`` and the first load sample (``INIT_JVP``), AFT passes of
+    ``STEP_JVP`` (:func:`_pass`) until the force repeats, projection, and
+    scatter ``R += b F``, ``JX += b (b^T dF/dU + bn^T dF/dG)``,
+    ``Jp += b dF/dp``; a spring also adds its reaction ``bn P (N - P0)``
+    and ``bn bn^T P diag(dN/dg) E`` (:func:`_normal_reaction`). AFT
+    directions: the 2H+1 coefficients of u (du_i = E[i, d]); with springs,
+    the 2H+1 coefficients of g (dN_i = kn E[i, d] where closed, 0 where
+    open: the law's dT/dN carried by ``STEP_JVP``); when ``has_p``, the
+    parameter entering the prescribed loads (dN_i = dN[c, i]). Separation
+    (N <= 0 at a sample) and re-contact are the law's (contract item 2:
+    T = 0 while open, virgin again on re-contact), resolved to the samples.
 
     The march stops when two consecutive passes agree to ``rtol * max|T|``,
     or when the committed state at the end of a pass equals (to ``rtol``,
@@ -110,12 +124,13 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
     structure agrees with the plain-Python reference of
     ``tests/test_hb_aft.py`` for every law, also with bounds checking.
     """
-    R, JX, Jp, T, code, info = out
+    R, JX, Jp, T, Nout, code, info = out
     _linear_part(lin, R, JX, Jp)
     info[INFO_PASSES] = 0.0
     info[INFO_ERROR] = 0.0
     info[INFO_PERIOD] = PERIOD_ONE
-    Bm, Pm, _ = con
+    Bm = con[0]
+    Pm = con[1]
     nc = Bm.shape[0]
     if nc == 0:
         _scale_outputs(R, JX, Jp, scaled)
@@ -123,14 +138,16 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
     Nsamp, dN, has_p, events = load
     E, P = four
     max_passes, rtol = ctl
-    sig, dirs, st, pw, hist, proj = _workspace(con, four, has_p, code)
+    sig, dirs, st, pw, hist, proj, nrm = _workspace(con, four, has_p, code)
     U, u = sig
     a, bb, da, dbb, s_end = st
+    Nc, km = nrm[2], nrm[3]
     for c in range(nc):
         # the law restarted at the mean displacement, marched until its force repeats
         _contact_samples(lin[5], Bm, c, E, U, u)
+        _contact_loads(lin[5], con, Nsamp, c, E, nrm)
         prm = Pm[c]
-        _restart(INIT_JVP, prm, U[0], Nsamp[c, 0], dN[c, 0] if has_p else 0.0, has_p, E.shape[1], dirs,  # noqa: F821
+        _restart(INIT_JVP, prm, U[0], Nc[0], km[0], dN[c, 0] if has_p else 0.0, has_p, E, dirs,  # noqa: F821
                  (a, bb, da, dbb))
         Tc, dT, T1, T2, dT1, cprev = pw
         for i in range(u.shape[0]):
@@ -140,7 +157,7 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
         err = np.inf
         period = PERIOD_NONE
         while passes < max_passes:
-            err, err2, tmax, cur = _pass(STEP_JVP, INIT_JVP, prm, (u, U), Nsamp[c], dN, c, has_p, events,  # noqa: F821
+            err, err2, tmax, cur = _pass(STEP_JVP, INIT_JVP, prm, (u, U), (Nc, km, nrm[0], nrm[1], con[4][c]), dN, c, has_p, events,  # noqa: F821
                                          E, dirs, (a, bb, da, dbb), (Tc, dT, T1, T2, dT1, cprev), hist, code,
                                          passes, rtol)
             if cur == 1:  # committed state back in (a, da), once per pass
@@ -157,7 +174,11 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
                 cprev[i] = code[c, i]
             dT, dT1 = dT1, dT
         _project(c, P, Tc, dT, T, proj)
-        _scatter(c, Bm, proj, has_p, R, JX, Jp)
+        for i in range(Nc.shape[0]):
+            Nout[c, i] = Nc[i]
+        _scatter(c, con, proj, has_p, R, JX, Jp)
+        if con[4][c, 1] > 0.0:
+            _normal_reaction(c, con, four, nrm, R, JX)
         _update_info(info, passes, err, period)
     _scale_outputs(R, JX, Jp, scaled)
 
@@ -185,20 +206,23 @@ def _linear_part(lin, R, JX, Jp):  # pragma: no cover - compiled
 def _workspace(con, four, has_p, code):  # pragma: no cover - compiled
     """Buffers of the AFT, allocated once per evaluation and grouped by use.
 
-    ``(sig, dirs, st, pw, hist, proj)``: displacement coefficients and
+    ``(sig, dirs, st, pw, hist, proj, nrm)``: displacement coefficients and
     samples of a contact; sample and restart directions; committed and
     trial states (and derivatives) and the state at the end of the last
     pass; force samples of the current and the last two passes; first-pass
     states at every sample (small states only); projected force and
-    derivatives.
+    derivatives; normal approach (coefficients, samples), normal-load
+    samples, their slope dN/dg (kn closed, 0 open) and the projected
+    reaction with its derivative (:func:`_contact_loads`).
     """
     E = four[0]
     ssz = con[2]
     ns = E.shape[0]
     nh = E.shape[1]
-    nd = nh + (1 if has_p else 0)
+    nd = nh + (nh if con[5] else 0) + (1 if has_p else 0)
     sig = (np.empty(nh), np.empty(ns))
-    # directions of a sample: dx = E[i] (0 on the parameter), dN = dN[c, i] on the parameter
+    # directions of a sample: dx = E[i] on the coefficients of u (0 elsewhere);
+    # dN = kn E[i] on the coefficients of g (closed spring) and dN[c, i] on the parameter
     dirs = (np.zeros(nd), np.zeros(nd), np.empty(nd), np.zeros(nd), np.zeros(nd))
     # zeros, not garbage: entries of a state that a law leaves unwritten in a step
     # keep a defined value, so the end-of-pass comparison of states is deterministic
@@ -208,7 +232,8 @@ def _workspace(con, four, has_p, code):  # pragma: no cover - compiled
     nhist = ns if ssz <= _HIST_MAX_STATE else 0
     hist = (np.empty((nhist, ssz)), np.empty((nhist, ssz, nd)))
     proj = (np.empty(nh), np.empty((nh, nd)))
-    return sig, dirs, st, pw, hist, proj
+    nrm = (np.empty(nh), np.empty(ns), np.empty(ns), np.empty(ns), np.empty(nh), np.empty((nh, nh)))
+    return sig, dirs, st, pw, hist, proj, nrm
 
 
 @jit(inline="always")
@@ -229,18 +254,26 @@ def _contact_samples(X, Bm, c, E, U, u):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _restart(init_jvp, prm, U0, N0, dN0, has_p, nh, dirs, st):  # pragma: no cover - compiled
+def _restart(init_jvp, prm, U0, N0, k0, dN0, has_p, E, dirs, st):  # pragma: no cover - compiled
     """Virgin state of the law at the mean displacement ``U0`` and load ``N0``, with its exact derivative.
 
     Direction 0 (the constant coefficient of u) moves the mean
-    displacement; the parameter direction (index ``nh``) moves the load by
-    ``dN0``. The state goes to ``st[0]``, its derivative to ``st[2]``.
+    displacement; the directions of the normal approach's coefficients
+    (indices nh..2nh-1, when the system has springs) move the load by
+    ``k0 E[0, d]`` (``k0`` = dN/dg at the first sample); the parameter
+    direction (the last) moves it by ``dN0``. The state goes to ``st[0]``,
+    its derivative to ``st[2]``.
     """
     dx0 = dirs[3]
     dn0 = dirs[4]
+    nh = E.shape[1]
+    nd = dx0.shape[0]
     dx0[0] = 1.0
+    if nd - (1 if has_p else 0) > nh:
+        for d in range(nh):
+            dn0[nh + d] = k0 * E[0, d]
     if has_p:
-        dn0[nh] = dN0
+        dn0[nd - 1] = dN0
     init_jvp(prm, U0, dx0, N0, dn0, st[0], st[2])
 
 
@@ -255,12 +288,17 @@ def _project(c, P, Tc, dT, T, proj):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _pass(step_jvp, init_jvp, prm, sig, Nc, dN, c, has_p, events, E, dirs, st, pw, hist, code, passes,
+def _pass(step_jvp, init_jvp, prm, sig, nk, dN, c, has_p, events, E, dirs, st, pw, hist, code, passes,
           rtol):  # pragma: no cover - compiled
     """One marched period: force samples ``Tc``, derivatives ``dT`` and codes of contact c.
 
-    ``sig = (u, U)``: displacement samples and coefficients. Where the
-    event table has a re-contact in the interval before sample i, the
+    ``sig = (u, U)``: displacement samples and coefficients; ``nk = (Nc,
+    km, G, g, sp)``: the contact's normal-load samples and their slope
+    dN/dg (kn while a spring is closed, 0 when open or prescribed), the
+    normal approach's coefficients and samples and the spring row
+    ``sp = (P, kn, restart load)``. Where the event table has a re-contact
+    of a prescribed load in the interval before sample i, or a spring
+    closes between samples i-1 and i (:func:`_spring_event`), the
     committed state is first replaced by the virgin state at the
     re-contact phase (:func:`_event_point`, ``init_jvp``). The committed
     state is in ``(a, da)`` when ``cur == 0``, in
@@ -278,12 +316,14 @@ def _pass(step_jvp, init_jvp, prm, sig, Nc, dN, c, has_p, events, E, dirs, st, p
     a, bb, da, dbb = st
     Tc, dT, T1, T2, dT1, cprev = pw
     Sh, dSh = hist
+    Nc, km, Gc, gs, sp = nk
     u, U = sig
     ev_tau, ev_dtau, ev_load = events
     dxj, dNj, dTj = dirs[0], dirs[1], dirs[2]
     ns = u.shape[0]
     nh = E.shape[1]
     nd = dxj.shape[0]
+    spr = nd - (1 if has_p else 0) > nh
     err = 0.0
     err2 = 0.0
     tmax = 0.0
@@ -302,9 +342,26 @@ def _pass(step_jvp, init_jvp, prm, sig, Nc, dN, c, has_p, events, E, dirs, st, p
             for d in range(nh):
                 dxj[d] = E[i, d]
             if has_p:
-                dxj[nh] = 0.0
+                dxj[nd - 1] = 0.0
+        if km[i] > 0.0 and km[i - 1 if i > 0 else ns - 1] == 0.0:
+            # a spring closing between samples: virgin restart at the root of P + kn g
+            xr = _spring_event(U, Gc, sp, 2.0 * np.pi * i / ns, 2.0 * np.pi / ns, gs[i - 1 if i > 0 else ns - 1],
+                               gs[i], dxj)
+            dNj[:] = 0.0
+            if cur == 0:
+                init_jvp(prm, xr, dxj, sp[2], dNj, a, da)
+            else:
+                init_jvp(prm, xr, dxj, sp[2], dNj, bb, dbb)
+            for d in range(nh):
+                dxj[d] = E[i, d]
+                dxj[nh + d] = 0.0
+            if has_p:
+                dxj[nd - 1] = 0.0
+        if spr:
+            for d in range(nh):
+                dNj[nh + d] = km[i] * E[i, d]
         if has_p:
-            dNj[nh] = dN[c, i]
+            dNj[nd - 1] = dN[c, i]
         if cur == 0:
             t_, k_, c_ = step_jvp(prm, a, da, bb, dbb, u[i], dxj, Nc[i], dNj, dTj)
         else:
@@ -338,7 +395,9 @@ def _event_point(U, tau, dtau, has_p, dx):  # pragma: no cover - compiled
     """Displacement at phase ``tau`` of the signal with coefficients ``U``; its derivative into ``dx``.
 
     ``dx[h]`` (h < 2H+1) is the basis function h at ``tau`` (the derivative
-    along coefficient h); with ``has_p`` the last entry is ``u'(tau) dtau``,
+    along coefficient h; the entries of the normal approach's coefficients,
+    if any, are left as they are: zero); with ``has_p`` the last entry is
+    ``u'(tau) dtau``,
     the derivative along the parameter through the phase (``dtau`` its
     derivative). A plain compiled function, called once per event.
     """
@@ -354,7 +413,59 @@ def _event_point(U, tau, dtau, has_p, dx):  # pragma: no cover - compiled
         x += U[2 * k - 1] * ck + U[2 * k] * sk
         du += k * (U[2 * k] * ck - U[2 * k - 1] * sk)
     if has_p:
-        dx[nh] = du * dtau
+        dx[dx.shape[0] - 1] = du * dtau
+    return x
+
+
+@jit
+def _trig(C, tau):  # pragma: no cover - compiled
+    """(f, f') at phase ``tau`` of the signal with coefficients ``C`` (constant, cos, sin, ...)."""
+    f = C[0]
+    df = 0.0
+    for k in range(1, (C.shape[0] - 1) // 2 + 1):
+        ck = np.cos(k * tau)
+        sk = np.sin(k * tau)
+        f += C[2 * k - 1] * ck + C[2 * k] * sk
+        df += k * (C[2 * k] * ck - C[2 * k - 1] * sk)
+    return f, df
+
+
+@jit
+def _spring_event(U, G, sp, tau1, h, g0, g1, dx):  # pragma: no cover - compiled
+    """Re-contact of a spring between the phases ``tau1 - h`` and ``tau1``: displacement there, derivative into ``dx``.
+
+    The root tau_r of v(tau) = P + kn g(tau) (v <= 0 at ``tau1 - h`` where
+    g = ``g0``, v > 0 at ``tau1`` where g = ``g1``) by Newton's method kept
+    inside the bracket (regula falsi where a step leaves it), to rounding.
+    Returns u(tau_r); ``dx`` gets its derivative along the coefficients of
+    u (the basis at tau_r, entries 0..nh-1) and of g (entries nh..2nh-1:
+    u'(tau_r) dtau_r/dG_h with dtau_r/dG_h = -Q_h(tau_r) / g'(tau_r)). A
+    plain compiled function, called once per event.
+    """
+    P0, kn = sp[0], sp[1]
+    a, b = tau1 - h, tau1
+    va, vb = P0 + kn * g0, P0 + kn * g1
+    t = a - va * (b - a) / (vb - va)
+    for _ in range(_ROOT_MAX_ITER):
+        g, dg = _trig(G, t)
+        v = P0 + kn * g
+        if v > 0.0:
+            b, vb = t, v
+        else:
+            a, va = t, v
+        tn = t - v / (kn * dg) if dg != 0.0 else a - 1.0
+        if not a < tn < b:
+            tn = a - va * (b - a) / (vb - va)
+        if abs(tn - t) <= _ROOT_TOL * h:
+            t = tn
+            break
+        t = tn
+    x = _event_point(U, t, 0.0, False, dx)
+    du = _trig(U, t)[1]
+    dg = _trig(G, t)[1]
+    nh = U.shape[0]
+    for d in range(nh):
+        dx[nh + d] = -du * dx[d] / dg if dg != 0.0 else 0.0
     return x
 
 
@@ -523,11 +634,19 @@ def _load_state(s, ds, Sh, dSh, i):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _scatter(c, Bm, proj, has_p, R, JX, Jp):  # pragma: no cover - compiled
-    """R[h n + i] += b_i F_h; JX[(h, i), (g, j)] += b_i b_j G_hg; Jp[h n + i] += b_i G_h,p."""
+def _scatter(c, con, proj, has_p, R, JX, Jp):  # pragma: no cover - compiled
+    """R[h n + i] += b_i F_h; JX[(h, i), (g, j)] += b_i (b_j G_hg + bn_j G_h,nh+g); Jp[h n + i] += b_i G_h,p.
+
+    ``b = Bm[c]`` the tangential row, ``bn = Bnm[c]`` the normal row (the
+    force's dependence on the normal approach, systems with springs only).
+    """
+    Bm = con[0]
+    Bnm = con[3]
     F, G = proj
     n = Bm.shape[1]
     nh = F.shape[0]
+    ip = G.shape[1] - 1
+    spr = con[5]
     for h in range(nh):
         for i in range(n):
             bi = Bm[c, i]
@@ -535,12 +654,84 @@ def _scatter(c, Bm, proj, has_p, R, JX, Jp):  # pragma: no cover - compiled
                 continue
             R[h * n + i] += F[h] * bi
             if has_p:
-                Jp[h * n + i] += G[h, nh] * bi
+                Jp[h * n + i] += G[h, ip] * bi
             for g in range(nh):
                 for j in range(n):
                     bj = Bm[c, j]
                     if bj != 0.0:
                         JX[h * n + i, g * n + j] += G[h, g] * (bi * bj)
+            if spr:
+                for g in range(nh):
+                    for j in range(n):
+                        bj = Bnm[c, j]
+                        if bj != 0.0:
+                            JX[h * n + i, g * n + j] += G[h, nh + g] * (bi * bj)
+
+
+@jit(inline="always")
+def _contact_loads(X, con, Nsamp, c, E, nrm):  # pragma: no cover - compiled
+    """Normal-load samples ``Nc`` of contact c and their slope ``km`` = dN/dg.
+
+    Prescribed load: ``Nc = Nsamp[c]``, ``km = 0``. Spring (``Sp[c] = (P,
+    kn)``, kn > 0): the approach g = Bnm[c] . x sampled from the
+    coefficients, ``Nc = max(0, P + kn g)`` and ``km = kn`` where closed
+    (``P + kn g > 0``), 0 where open (the law separates at N <= 0).
+    """
+    Gc, gs, Nc, km = nrm[0], nrm[1], nrm[2], nrm[3]
+    Sp = con[4]
+    P0 = Sp[c, 0]
+    kn = Sp[c, 1]
+    if kn > 0.0:
+        _contact_samples(X, con[3], c, E, Gc, gs)
+        for i in range(Nc.shape[0]):
+            v = P0 + kn * gs[i]
+            if v > 0.0:
+                Nc[i] = v
+                km[i] = kn
+            else:
+                Nc[i] = 0.0
+                km[i] = 0.0
+    else:
+        for i in range(Nc.shape[0]):
+            Nc[i] = Nsamp[c, i]
+            km[i] = 0.0
+
+
+@jit(inline="always")
+def _normal_reaction(c, con, four, nrm, R, JX):  # pragma: no cover - compiled
+    """Reaction of spring contact c: R[h n + i] += bn_i Fn_h, JX[(h, i), (g, j)] += bn_i bn_j dFn_hg.
+
+    ``Fn = P (Nc - P0)`` (the load less the preload, projected) and
+    ``dFn = P diag(km) E`` (its exact derivative along g's coefficients).
+    """
+    Bnm = con[3]
+    P0 = con[4][c, 0]
+    E, P = four
+    Nc, km, Fn, dFn = nrm[2], nrm[3], nrm[4], nrm[5]
+    n = Bnm.shape[1]
+    nh = E.shape[1]
+    ns = E.shape[0]
+    for h in range(nh):
+        acc = 0.0
+        for i in range(ns):
+            acc += P[h, i] * (Nc[i] - P0)
+        Fn[h] = acc
+        for g in range(nh):
+            acc = 0.0
+            for i in range(ns):
+                acc += P[h, i] * km[i] * E[i, g]
+            dFn[h, g] = acc
+    for h in range(nh):
+        for i in range(n):
+            bi = Bnm[c, i]
+            if bi == 0.0:
+                continue
+            R[h * n + i] += Fn[h] * bi
+            for g in range(nh):
+                for j in range(n):
+                    bj = Bnm[c, j]
+                    if bj != 0.0:
+                        JX[h * n + i, g * n + j] += dFn[h, g] * (bi * bj)
 
 
 @jit(inline="always")

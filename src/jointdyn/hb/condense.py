@@ -455,9 +455,10 @@ def _check(system: System, rec: Receptance, w2) -> None:
 
 
 def retained_dofs(system: System, response_dofs=()) -> np.ndarray:
-    """Sorted DOFs kept by a condensed problem: contact selections, DOF 0 and ``response_dofs``."""
+    """Sorted DOFs kept by a condensed problem: contact selections (tangential
+    and, for normal springs, normal), DOF 0 and ``response_dofs``."""
     kin = contact_kinematics(system)
-    B = selection_matrix(kin, system.ndof)
+    B = np.vstack([selection_matrix(kin, system.ndof), selection_matrix(kin, system.ndof, normal=True)])
     keep = set(np.flatnonzero(np.any(B != 0.0, axis=0)).tolist()) | {0}
     for d in response_dofs:
         d = int(d)

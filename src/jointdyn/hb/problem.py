@@ -39,9 +39,10 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ..fourier import extrema, fourier_matrices, phases
-from ..kinematics import NORMAL_HARMONIC, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
+from ..kinematics import NORMAL_SPRING, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
+from ..laws import law_dispatch
 from ..systems import Contact, System
-from ._aft import eval_kernel, recontact_events
+from ._aft import NO_EVENT, eval_kernel, recontact_events
 from .parameters import SystemParameter, parameter_named
 from .stability import hill_growth, hill_stability
 
@@ -59,6 +60,8 @@ class _Eval:
     info: np.ndarray
     #: (R, JX, Jp) scaled as asked by ``HBProblem.evaluate(..., scales=)`` (else None)
     scaled: tuple | None = None
+    #: (contacts, Ns): normal-load samples of each contact, N (prescribed, or max(0, P + kn g))
+    N: np.ndarray | None = None
 
 
 def _pad_rows(rows, width=None):
@@ -141,7 +144,7 @@ class HBProblem:
         (system DOF numbers; None: every DOF)."""
         if not isinstance(system, System):
             raise ValueError("system must be a jointdyn.System")
-        system.require_prescribed_single_law("harmonic balance")
+        system.require_phase_loads("harmonic balance")
         if dofs is None:
             dofs = np.arange(system.ndof)
         self.H = V.positive_int("harmonics", harmonics, 1)
@@ -172,26 +175,45 @@ class HBProblem:
         #: per system DOF, sin and cos of the forcing phase: f sin(w t + phi) has the
         #: coefficients f sin(phi) of cos(w t) and f cos(phi) of sin(w t)
         self.phase_sin, self.phase_cos = np.sin(phi), np.cos(phi)
-        kin = contact_kinematics(system)
-        if np.any(kin.normal_kind != NORMAL_HARMONIC):
-            raise ValueError("contacts: harmonic balance takes constant and harmonic normal loads")
-        #: per contact (n0, n1, delta) of its normal load as given in the system (N, N, rad)
-        self.load_coefficients = kin.normal_par.copy()
-        self.B = list(selection_matrix(kin, system.ndof)[:, self.dofs])
-        # inputs of the compiled evaluation, built once: selection rows and
-        # kernel parameters padded to a common length
-        nc = len(self.contacts)
-        self._Bm = np.array(self.B, dtype=np.float64).reshape(nc, self.n)
-        self._Pm = _pad_rows([c.law.params for c in self.contacts])
-        self._ssz = max([c.law.state_size for c in self.contacts], default=1)
-        # one law class per System (checked there): one kernel for every contact
-        law = self.contacts[0].law if nc else None
-        self._kernel = (eval_kernel(law.step_jvp, law.init_jvp) if nc
-                        else eval_kernel(no_contact_step_jvp, no_contact_init_jvp))
+        self._contact_inputs(contact_kinematics(system))
         self._dummy = np.zeros((1, 1))
         self._zero1 = np.zeros(1)
         self._noscale = np.zeros(3)
         self._scales_seen = None
+
+    def _contact_inputs(self, kin) -> None:
+        """Selection rows, spring rows, kernel parameters and the compiled kernel (built once).
+
+        Contacts with different law kernels go through one dispatching
+        kernel (:func:`jointdyn.laws.law_dispatch`); its parameter rows are
+        the laws' own (zero padded) when every contact has the same kernels.
+        """
+        nc = len(self.contacts)
+        springs = kin.normal_kind == NORMAL_SPRING
+        #: True when some contact's normal load comes from a normal spring
+        self.has_springs = bool(np.any(springs))
+        if self.has_springs and self.parameter.enters_loads:
+            raise ValueError(f"parameter: {self.parameter.name!r} moves prescribed normal loads; a system with "
+                             "normal springs takes its loads from the structure (use gamma, f1 or a SystemParameter)")
+        #: per contact (n0, n1, delta) of its normal load as given in the system (N, N, rad);
+        #: (P, kn, 0) for a spring contact (kinematics.ContactKinematics.normal_par)
+        self.load_coefficients = kin.normal_par.copy()
+        self.B = list(selection_matrix(kin, self.system.ndof)[:, self.dofs])
+        #: normal rows (g_c = Bn[c] . x over the unknown DOFs), zero for a prescribed load
+        self.Bn = list(selection_matrix(kin, self.system.ndof, normal=True)[:, self.dofs])
+        self._Bm = np.array(self.B, dtype=np.float64).reshape(nc, self.n)
+        self._Bnm = np.array(self.Bn, dtype=np.float64).reshape(nc, self.n)
+        #: (P, kn, restart load at a re-contact between samples) per contact, kn = 0 for a prescribed load
+        self._Sp = np.zeros((nc, 3))
+        self._Sp[springs, :2] = kin.normal_par[springs, :2]
+        self._Sp[:, 2] = config.HB_RECONTACT_ALPHA * self._Sp[:, 0]
+        if nc:
+            disp = law_dispatch([c.law for c in self.contacts])
+            self._Pm, self._ssz = disp.P, disp.state_size
+            self._kernel = eval_kernel(disp.step_jvp, disp.init_jvp)
+        else:
+            self._Pm, self._ssz = _pad_rows([]), 1
+            self._kernel = eval_kernel(no_contact_step_jvp, no_contact_init_jvp)
 
     @property
     def condensed(self) -> bool:
@@ -235,7 +257,10 @@ class HBProblem:
             Nsamp[k], dn = _load_samples(self.tau, co[k, 0], co[k, 1], co[k, 2], None if d is None else d[k])
             if dN is not None:
                 dN[k] = dn
-        return Nsamp, dN, recontact_events(self.tau, co, d)
+        events = recontact_events(self.tau, co, d)
+        # a spring's re-contact phases depend on the unknowns: located in the AFT itself
+        events[0][self._Sp[:, 1] > 0.0] = NO_EVENT
+        return Nsamp, dN, events
 
     # --- linear part --------------------------------------------------------
     def linear_matrix(self, w):
@@ -262,7 +287,8 @@ class HBProblem:
         return Fe
 
     def linear_guess(self, p, stuck: bool = True):
-        """Linear response with every contact stuck (stiffness kt) or absent.
+        """Linear response with every contact stuck (stiffness kt) or absent
+        (normal springs closed, stiffness kn, in both cases).
 
         Used to start Newton and continuation (docs/model.md section 6: all
         stuck -> linear system with K + kt).
@@ -271,8 +297,8 @@ class HBProblem:
         w = self.omega(p)
         A = q.linear_matrix(w)
         if stuck:
-            for c, b in zip(q.contacts, q.B):
-                Kc = c.law.kt * np.outer(b, b)
+            for c, b, bn, kn in zip(q.contacts, q.B, q.Bn, q._Sp[:, 1]):
+                Kc = c.law.kt * np.outer(b, b) + kn * np.outer(bn, bn)
                 for h in range(q.nh):
                     A[h * q.n:(h + 1) * q.n, h * q.n:(h + 1) * q.n] += Kc
         return np.linalg.solve(A, q.forcing(q.parameter.forcing(q, p)[0], w))
@@ -309,6 +335,7 @@ class HBProblem:
         JX = np.empty((size, size))
         Jp = np.empty(size)
         T = np.empty((nc, self.Ns))
+        Nout = np.empty((nc, self.Ns))
         code = np.empty((nc, self.Ns), dtype=np.int64)
         info = np.empty(3)
         has_p = dN is not None
@@ -320,10 +347,11 @@ class HBProblem:
                 self._scl = np.array([fs, xs / fs, ps / fs])
                 self._scales_seen = scales
             scaled = (self._scl, np.empty(size), np.empty((size, size)), np.empty(size))
-        self._kernel((*self._linear_terms(w), float(dwdp), X, Fe, Fp), (self._Bm, self._Pm, self._ssz),
+        self._kernel((*self._linear_terms(w), float(dwdp), X, Fe, Fp),
+                     (self._Bm, self._Pm, self._ssz, self._Bnm, self._Sp, self.has_springs),
                      (Nsamp, dN if has_p else self._dummy, has_p, events), (self.E, self.P),
-                     (int(self.max_passes), float(config.HB_PERIODIC_RTOL)), (R, JX, Jp, T, code, info), scaled)
-        return _Eval(R, JX, Jp, T, code, info, None if scales is None else scaled[1:])
+                     (int(self.max_passes), float(config.HB_PERIODIC_RTOL)), (R, JX, Jp, T, Nout, code, info), scaled)
+        return _Eval(R, JX, Jp, T, code, info, None if scales is None else scaled[1:], Nout)
 
     def _evaluate_central(self, X, p, scales) -> _Eval:
         """Residual of the System built at p; dR/dp by a central difference (SystemParameter)."""
