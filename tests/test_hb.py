@@ -191,7 +191,8 @@ def test_eta_1p5_discrete_ground_truth_has_no_jump(model, params):
 def test_hill_agrees_with_monodromy():
     # the closed form's fold pair near gamma 1.183 gives an unstable stretch
     # to compare the two stability methods on (the exact law has no fold here)
-    br = continue_hb(System.paper_damper(eta=10.0, beta=2.0, model="iwan-closed"), 0.5, 2.0)
+    br = continue_hb(System.paper_damper(eta=10.0, beta=2.0, model="iwan-closed"), 0.5, 2.0, harmonics=7,
+                     samples=128)
     f = np.flatnonzero(br.fold)
     assert f.size >= 2
     # the fold pair that encloses the unstable stretch (the closed form's steep corners are folds too)
