@@ -91,6 +91,14 @@ class Backbone:
     problem : object, optional
         The EPMC residual (:class:`~jointdyn.modes.EPMCProblem`) for EPMC
         backbones, used to solve further points on the same mode.
+    reduction : CraigBampton, optional
+        The Craig-Bampton reduction the backbone was computed on
+        (``epmc(..., reduce=n_modes)``); then ``system``, ``linear``,
+        ``output_dof``, ``X`` and ``problem`` are the reduced model's, the
+        amplitudes, frequencies, damping ratios and energies those of the
+        full model (the output DOF and the contact DOFs are kept as they
+        are), and ``reduction.error`` compares the linear modes with the
+        full model's. None: computed on the full model.
     """
 
     method: str
@@ -113,11 +121,29 @@ class Backbone:
     energy_viscous_j: np.ndarray
     counters: dict = field(default_factory=dict)
     problem: object = None
+    reduction: object = None
 
     @property
     def points(self) -> int:
         """Number of points."""
         return int(self.amplitude_m.size)
+
+    @property
+    def full_output_dof(self) -> int:
+        """The output DOF in the full model's numbering."""
+        return self.output_dof if self.reduction is None else int(self.reduction.boundary[self.output_dof])
+
+    def full_shape(self) -> np.ndarray:
+        """Harmonic coefficients of the mode shape on the full model's DOFs, (points, N (2H + 1)), m.
+
+        ``X`` itself without a reduction; otherwise each harmonic expanded
+        by x = T q (harmonic-major, as ``X``).
+        """
+        if self.reduction is None:
+            return self.X
+        r = self.reduction.size
+        q = self.X.reshape(-1, r)  # rows: (point, coefficient)
+        return (q @ self.reduction.T.T).reshape(self.points, -1)
 
 
 def _harmonic_amplitudes(X: np.ndarray, H: int, n: int) -> np.ndarray:
