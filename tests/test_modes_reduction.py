@@ -91,12 +91,15 @@ def test_fewer_modes_converge_to_the_full_backbone(system, exact):
     assert np.all(errors[-1] < tol.TEST_MODES_CB_20_MODES_RTOL), errors
 
 
-def test_full_shape_and_dataset_of_a_reduced_backbone(system, exact):
+def test_full_shape_and_dataset_of_a_reduced_backbone(system, exact, tmp_path):
     X = exact.full_shape()
     assert X.shape == (exact.points, N * (2 * H + 1))
     assert np.allclose(X.reshape(exact.points, 2 * H + 1, N)[:, 1, N - 1], exact.amplitude_m, rtol=1e-12)
     ds = jd.modes.backbone_dataset(exact)
     assert ds.sizes["dof"] == exact.reduction.size
+    assert ds.attrs["full_output_dof"] == N - 1 and ds.attrs["reduction_modes"] == N - 3
+    assert list(ds.attrs["reduction_boundary_dofs"]) == [N // 3, (2 * N) // 3, N - 1]
+    ds.to_netcdf(tmp_path / "modes.nc", engine="scipy")  # the attributes fit a netCDF3 file
 
 
 def test_unreduced_backbone_reports_itself(system):

@@ -173,6 +173,9 @@ def backbone_dataset(backbone: Backbone):
     ``mode`` is taken by netCDF files), ``output_dof``, ``harmonics``, ``samples``,
     ``omega_linear_rad_s``, ``w0_rad_s``, ``model`` and ``law`` (class
     name and parameters of the first contact's law), ``points`` and the solver counters (``counter_*``).
+    A backbone on a reduction (``epmc(..., reduce=n)``) has ``dof`` over the
+    reduced coordinates and the attributes ``full_output_dof``,
+    ``reduction_modes`` and ``reduction_boundary_dofs`` (full-model DOFs).
     """
     import xarray as xr
 
@@ -211,4 +214,7 @@ def backbone_dataset(backbone: Backbone):
                     omega_linear_rad_s=b.linear.omega_rad_s, w0_rad_s=s.w0, model=law.name, law=repr(law),
                     points=b.points,
                     **{f"counter_{k}": int(v) for k, v in b.counters.items()})
+    if b.reduction is not None:  # dof: the reduced coordinates (boundary DOFs first)
+        ds.attrs.update(full_output_dof=b.full_output_dof, reduction_modes=int(b.reduction.interior_w_rad_s.size),
+                        reduction_boundary_dofs=np.asarray(b.reduction.boundary, dtype=np.int32))  # netCDF3: int32
     return ds
