@@ -122,19 +122,29 @@ def _boundary(boundary_dofs, n: int) -> np.ndarray:
     return b
 
 
-def _modes(K, M):
-    """(w rad/s, mass-normalised shapes) of (K, M), increasing."""
+def _modes(K, M, count: int | None = None):
+    """(w rad/s, mass-normalised shapes) of (K, M), increasing: all, or the lowest ``count``."""
     from scipy.linalg import eigh
 
-    lam, phi = eigh(K, M)
+    subset = None if count is None or count >= K.shape[0] else [0, count - 1]
+    lam, phi = eigh(K, M, subset_by_index=subset)
     return np.sqrt(np.maximum(lam, 0.0)), phi
+
+
+def _positive_definite(A) -> bool:
+    """Whether the symmetric A is positive definite (its Cholesky factorisation exists)."""
+    try:
+        np.linalg.cholesky(A)
+    except np.linalg.LinAlgError:
+        return False
+    return True
 
 
 def _mode_error(M, K, T, Mr, Kr) -> ModeError:
     """Reduced (Mr, Kr) modes against the full (M, K) modes, matched by order."""
-    w_full, phi_full = _modes(K, M)
     w_red, phi_red = _modes(Kr, Mr)
     m = w_red.size
+    w_full, phi_full = _modes(K, M, m)
     w_full, phi_full = w_full[:m], phi_full[:, :m]
     expanded = T @ phi_red
     num = np.einsum("ij,ik,kj->j", phi_full, M, expanded) ** 2
@@ -176,7 +186,7 @@ def craig_bampton(M, K, boundary_dofs, n_modes: int, *, C=None, K_modes=None) ->
     if n_modes > interior.size:
         raise ValueError(f"n_modes must be in [0, {interior.size}] (interior DOFs), got {n_modes}")
     Kii, Mii = K[np.ix_(interior, interior)], M[np.ix_(interior, interior)]
-    if interior.size and np.min(np.linalg.eigvalsh(Kii)) <= 0.0:
+    if interior.size and not _positive_definite(Kii):
         raise ValueError("K: the interior block (boundary DOFs fixed) must be positive definite")
     nb = b.size
     T = np.zeros((n, nb + n_modes))
@@ -184,9 +194,9 @@ def craig_bampton(M, K, boundary_dofs, n_modes: int, *, C=None, K_modes=None) ->
     w_int = np.zeros(0)
     if interior.size:
         T[np.ix_(interior, np.arange(nb))] = -np.linalg.solve(Kii, K[np.ix_(interior, b)])
-        w_all, phi = _modes(Kii, Mii)
-        w_int = w_all[:n_modes]
-        T[np.ix_(interior, nb + np.arange(n_modes))] = phi[:, :n_modes]
+        if n_modes:
+            w_int, phi = _modes(Kii, Mii, n_modes)
+            T[np.ix_(interior, nb + np.arange(n_modes))] = phi[:, :n_modes]
     Mr, Kr = T.T @ M @ T, T.T @ K @ T
     Mr, Kr = 0.5 * (Mr + Mr.T), 0.5 * (Kr + Kr.T)
     Cr = None

@@ -91,6 +91,14 @@ class Backbone:
     problem : object, optional
         The EPMC residual (:class:`~jointdyn.modes.EPMCProblem`) for EPMC
         backbones, used to solve further points on the same mode.
+    reduction : CraigBampton, optional
+        The Craig-Bampton reduction the backbone was computed on
+        (``epmc(..., reduce=n_modes)``); then ``system``, ``linear``,
+        ``output_dof``, ``X`` and ``problem`` are the reduced model's, the
+        amplitudes, frequencies, damping ratios and energies those of the
+        full model (the output DOF and the contact DOFs are kept as they
+        are), and ``reduction.error`` compares the linear modes with the
+        full model's. None: computed on the full model.
     """
 
     method: str
@@ -113,11 +121,29 @@ class Backbone:
     energy_viscous_j: np.ndarray
     counters: dict = field(default_factory=dict)
     problem: object = None
+    reduction: object = None
 
     @property
     def points(self) -> int:
         """Number of points."""
         return int(self.amplitude_m.size)
+
+    @property
+    def full_output_dof(self) -> int:
+        """The output DOF in the full model's numbering."""
+        return self.output_dof if self.reduction is None else int(self.reduction.boundary[self.output_dof])
+
+    def full_shape(self) -> np.ndarray:
+        """Harmonic coefficients of the mode shape on the full model's DOFs, (points, N (2H + 1)), m.
+
+        ``X`` itself without a reduction; otherwise each harmonic expanded
+        by x = T q (harmonic-major, as ``X``).
+        """
+        if self.reduction is None:
+            return self.X
+        r = self.reduction.size
+        q = self.X.reshape(-1, r)  # rows: (point, coefficient)
+        return (q @ self.reduction.T.T).reshape(self.points, -1)
 
 
 def _harmonic_amplitudes(X: np.ndarray, H: int, n: int) -> np.ndarray:
@@ -147,6 +173,9 @@ def backbone_dataset(backbone: Backbone):
     ``mode`` is taken by netCDF files), ``output_dof``, ``harmonics``, ``samples``,
     ``omega_linear_rad_s``, ``w0_rad_s``, ``model`` and ``law`` (class
     name and parameters of the first contact's law), ``points`` and the solver counters (``counter_*``).
+    A backbone on a reduction (``epmc(..., reduce=n)``) has ``dof`` over the
+    reduced coordinates and the attributes ``full_output_dof``,
+    ``reduction_modes`` and ``reduction_boundary_dofs`` (full-model DOFs).
     """
     import xarray as xr
 
@@ -185,4 +214,7 @@ def backbone_dataset(backbone: Backbone):
                     omega_linear_rad_s=b.linear.omega_rad_s, w0_rad_s=s.w0, model=law.name, law=repr(law),
                     points=b.points,
                     **{f"counter_{k}": int(v) for k, v in b.counters.items()})
+    if b.reduction is not None:  # dof: the reduced coordinates (boundary DOFs first)
+        ds.attrs.update(full_output_dof=b.full_output_dof, reduction_modes=int(b.reduction.interior_w_rad_s.size),
+                        reduction_boundary_dofs=np.asarray(b.reduction.boundary, dtype=np.int32))  # netCDF3: int32
     return ds

@@ -39,6 +39,14 @@ The branch starts at the smallest amplitude from the linear stuck mode
 (:func:`jointdyn.modes._free.linear_stuck_mode`) and is followed by the
 generic pseudo-arc-length continuation (:mod:`jointdyn.continuation`).
 
+Large structures: ``epmc(system, ..., reduce=n_modes)`` computes the
+backbone on a Craig-Bampton reduction (:func:`jointdyn.reduction.reduce_system`)
+whose boundary DOFs are the contact DOFs, the forced DOFs and the output
+DOF, plus ``n_modes`` fixed-interface modes. The output DOF is a boundary
+DOF, kept as it is, so the backbone's amplitude is that of the full
+model's output DOF; the backbone holds the reduction (its linear-mode
+error report and the expansion of the mode shape to the full model).
+
 Normal loads: every autonomous load that harmonic balance evaluates
 (constant loads; a normal spring as soon as the harmonic-balance contact
 evaluation takes it) is taken as it is; loads prescribed at a forcing
@@ -258,16 +266,26 @@ def _points(problem: EPMCProblem, lam, V, stash):
     return out
 
 
-def _backbone(problem: EPMCProblem, status, message, lam, V, stash, counters) -> Backbone:
+def _backbone(problem: EPMCProblem, status, message, lam, V, stash, counters, reduction=None) -> Backbone:
     pts = _points(problem, np.asarray(lam, dtype=np.float64), V, stash)
     return Backbone(method="epmc", status=status, message=message, system=problem.system, linear=problem.linear,
                     output_dof=problem.output_dof, harmonics=problem.H, samples=problem.hb.Ns,
-                    counters=dict(counters), problem=problem, **pts)
+                    counters=dict(counters), problem=problem, reduction=reduction, **pts)
+
+
+def _reduce(system, n_modes: int, output_dof):
+    """(reduced System, CraigBampton): boundary = contact, forced and output DOFs, plus ``n_modes`` modes."""
+    from ..reduction import default_boundary, reduce_system
+
+    out = output_dof_of(system, output_dof)
+    target = system if out == system.response_dof else dataclasses.replace(system, output_dof=out)
+    return reduce_system(target, n_modes, sorted(set(default_boundary(target)) | {out}))
 
 
 def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None,
          harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
-         options: ContinuationOptions | None = None, progress: bool | None = None, **overrides) -> Backbone:
+         options: ContinuationOptions | None = None, progress: bool | None = None, reduce: int | None = None,
+         **overrides) -> Backbone:
     """Backbone of a nonlinear mode by the extended periodic motion concept.
 
     Parameters
@@ -296,17 +314,33 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         ``tol``, ...).
     progress : bool, optional
         Show a tqdm bar (None: only on a TTY).
+    reduce : int, optional
+        Compute the backbone on a Craig-Bampton reduction keeping the
+        contact DOFs, the forced DOFs and the output DOF plus this many
+        fixed-interface modes (0 .. interior DOFs; all of them: exact up to
+        rounding). ``mode`` then counts the linear modes of the reduced
+        model, the same as the full model's while the reduction resolves
+        them (``Backbone.reduction.error``). Default: the full model.
 
     Returns
     -------
     Backbone
         ``status`` complete, max-points, failed (the points computed are
-        kept) or no-start (empty).
+        kept) or no-start (empty). With ``reduce``, its ``system``,
+        ``X``, ``linear``, ``output_dof`` and ``problem`` are those of the
+        reduced model and ``reduction`` is the
+        :class:`~jointdyn.reduction.CraigBampton` (``error``: linear
+        modes against the full model's; :meth:`Backbone.full_shape`: the
+        harmonics of the mode shape on the full model's DOFs).
     """
     from tqdm.auto import tqdm
 
     check_free_vibration(system, "EPMC")
     lo, hi = amplitude_range(system, amplitude)
+    reduction = None
+    if reduce is not None:
+        system, reduction = _reduce(system, reduce, output_dof)
+        output_dof = None
     problem = EPMCProblem(system, mode=mode, output_dof=output_dof, harmonics=harmonics, samples=samples)
     opt = _options(options, overrides)
     lam0, lam1 = math.log10(lo), math.log10(hi)
@@ -314,7 +348,7 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     if not ok:
         return _backbone(problem, ModeStatus.NO_START, f"Newton did not converge at the smallest amplitude "
                          f"{lo:.6g} m from linear stuck mode {problem.linear.index}", np.empty(0),
-                         np.empty((0, problem.size)), {}, {"points": 0})
+                         np.empty((0, problem.size)), {}, {"points": 0}, reduction)
     stash = {}
 
     def keep(v, lam):
@@ -328,4 +362,4 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         res = continuation(problem.residual, v0, lam0, lam1, opt, monitor=keep, progress=bar)
     status = _STATUS.get(res.status, ModeStatus.FAILED if res.lam.size else ModeStatus.NO_START)
     message = res.message.replace("lam = ", "log10(amplitude / m) = ")
-    return _backbone(problem, status, message, res.lam, res.y, stash, res.counters)
+    return _backbone(problem, status, message, res.lam, res.y, stash, res.counters, reduction)
