@@ -228,15 +228,23 @@ def test_bad_systems_are_refused_with_the_reason(make, word):
 
 
 def test_normal_spring_goes_to_harmonic_balance_and_qsma_refuses_it():
-    from jointdyn.modes import qsma
+    # the normal DOF does not move in the tangential mode: the spring keeps N at its
+    # preload, and the backbone is that of the same system at constant load
+    from jointdyn.modes import backbone_dataset, qsma
 
     law = jd.make_law("iwan", kt=KT, mu=0.5, n_ref=100.0)
-    s = jd.System(np.diag([10.0, 1.0]), None, np.diag([3.9e5, 1e5]),
-                  contacts=(jd.Contact(law, dof=0, normal=jd.NormalSpring(kn=3e5, preload=100.0, dof=1)),))
-    with pytest.raises(ValueError, match="harmonic balance"):
-        epmc(s, progress=False)
+    M, K = np.diag([10.0, 1.0]), np.diag([3.9e5, 1e5])
+    spring = jd.System(M, None, K, contacts=(jd.Contact(law, dof=0,
+                                                        normal=jd.NormalSpring(kn=3e5, preload=100.0, dof=1)),))
+    const = jd.System(M, None, K + np.diag([0.0, 3e5]),
+                      contacts=(jd.Contact(law, dof=0, normal=jd.ConstantLoad(100.0)),))
+    amps = (1e-2 * 50.0 / KT, 1e2 * 50.0 / KT)
+    a, b = (backbone_dataset(epmc(s, amps, progress=False)) for s in (spring, const))
+    assert a.attrs["status"] == b.attrs["status"] == "complete"
+    for name in ("amplitude_m", "omega_rad_s", "damping_ratio"):  # the same continuation, to rounding
+        np.testing.assert_allclose(a[name].values, b[name].values, rtol=1e-9)
     with pytest.raises(ValueError, match="contact 0: QSMA takes constant normal loads only"):
-        qsma(s)
+        qsma(spring)
 
 
 @pytest.mark.parametrize("kwargs, word", [
