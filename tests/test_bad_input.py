@@ -561,3 +561,15 @@ def test_version(capsys):
         main(["--version"])
     assert exc.value.code == 0
     assert capsys.readouterr().out.strip() == f"jointdyn {jointdyn.__version__}"
+
+
+@pytest.mark.parametrize("command", [None, "loop", "frc", "modes", "figures"])
+def test_every_help_text_prints(command, capsys):
+    # argparse expands % in help texts: a literal percent sign must be written %%
+    from jointdyn.cli import main
+
+    argv = ["--help"] if command is None else [command, "--help"]
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 0
+    assert "usage: jointdyn" in capsys.readouterr().out

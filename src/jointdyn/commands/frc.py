@@ -85,10 +85,10 @@ def add_arguments(p) -> None:
                    help="time: local parallel workers (default: all cores; not with --scheduler)")
     p.add_argument("--harmonics", default=None, metavar="H|auto",
                    help=f"hb: number of harmonics, or auto (default: from {config.HB_HARMONICS}, raised while a "
-                        f"peak changes by more than {100 * config.HB_AUTO_RTOL:g} % with 2H+1)")
+                        f"peak changes by more than {100 * config.HB_AUTO_RTOL:g} %% with 2H+1)")
     p.add_argument("--samples", default=None, metavar="NS|auto",
                    help=f"hb: time samples per period, or auto (default: from {config.HB_SAMPLES}, doubled while a "
-                        f"peak changes by more than {100 * config.HB_AUTO_RTOL:g} % with twice as many)")
+                        f"peak changes by more than {100 * config.HB_AUTO_RTOL:g} %% with twice as many)")
     p.add_argument("--out", default=None, metavar="DIR",
                    help="write frc.nc, frc.csv, frc.png here (time: resume checkpoints under DIR/lines; a rerun "
                         "reuses them and says how many points it reused)")
