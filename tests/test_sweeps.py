@@ -654,26 +654,3 @@ def test_interrupt_on_dask_keeps_every_finished_point(tmp_path, monkeypatch):
     ds = frc_sweep(GAMMAS, **kw, n_workers=1, out=tmp_path)
     assert ds.attrs["reused_points"] == finished and len(again.calls) == 4 * len(GAMMAS) - finished
     xr.testing.assert_identical(_results(ds), _results(full))
-
-
-def _report_points(points, n):
-    for _ in range(n):
-        points.add(1)
-    return n
-
-
-def test_dask_chunks_report_every_point_to_the_progress_bar():
-    # the chunks on the workers report each finished point; the client counts them
-    # before the chunk returns (the bar moves per point, not per chunk)
-    from distributed import Client, LocalCluster
-
-    from jointdyn.sweeps._pool import _DaskPoints
-
-    with LocalCluster(n_workers=1, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
-        with Client(lc) as client:
-            points = _DaskPoints("jointdyn-test-points", client)
-            assert points.drain() == 0
-            assert client.submit(_report_points, points, 3).result() == 3
-            assert points.drain() == 3
-            assert client.submit(_report_points, points, 2).result() == 2
-            assert points.drain() == 5

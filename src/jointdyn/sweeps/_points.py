@@ -285,15 +285,10 @@ class Context:
         return self.stop.is_set()
 
     def point_done(self) -> None:
-        """Count one finished point (a counter with ``add`` reports it, e.g. to a
-        Dask client; otherwise a shared value is incremented under its lock)."""
+        """Count one finished point."""
         if self.counter is not None:
-            add = getattr(self.counter, "add", None)
-            if add is not None:
-                add(1)
-            else:
-                with self.counter.get_lock():
-                    self.counter.value += 1
+            with self.counter.get_lock():
+                self.counter.value += 1
         if self.on_point is not None:
             self.on_point()
 

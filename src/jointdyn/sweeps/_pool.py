@@ -22,8 +22,8 @@ and hands every finished chunk to a callback (which saves it). On
 KeyboardInterrupt it sets the stop flag, so that each running chunk returns
 after its current point, hands those partial chunks to the callback too,
 and re-raises: an interrupt loses at most the points in progress (on a Dask
-cluster too: the stop flag is a ``distributed.Event``, and the finished
-points reach the progress bar one by one through a ``distributed.Queue``).
+cluster too: the stop flag is a ``distributed.Event``; there the progress
+bar moves per chunk).
 """
 
 from __future__ import annotations
@@ -203,29 +203,6 @@ class LocalExecutor:
         self.pool.shutdown(wait=True, cancel_futures=True)
 
 
-class _DaskPoints:
-    """Finished points reported by chunks on Dask workers: one item per point
-    in a ``distributed.Queue`` on the scheduler, drained by the client."""
-
-    def __init__(self, name: str, client):
-        from distributed import Queue
-
-        self.queue = Queue(name, client=client)
-        self.seen = 0
-
-    def add(self, n: int) -> None:
-        """On a worker: report ``n`` finished points."""
-        self.queue.put(n)
-
-    def drain(self) -> int:
-        """On the client: the points reported so far."""
-        with contextlib.suppress(Exception):  # a scheduler going away leaves the count where it was
-            size = self.queue.qsize()
-            if size:
-                self.seen += sum(self.queue.get(batch=size))
-        return self.seen
-
-
 class DaskExecutor:
     """Chunks on a Dask cluster through a connected ``distributed.Client``."""
 
@@ -236,11 +213,8 @@ class DaskExecutor:
 
         self.client = client
         self.systems = client.scatter(list(systems), broadcast=True)
-        # the stop request reaches the running chunks through the scheduler, checked between
-        # points; so do the finished points, one by one, for the progress bar
-        key = uuid.uuid4().hex
-        self.points = _DaskPoints(f"jointdyn-sweep-points-{key}", client)
-        self.ctx = Context(stop=Event(f"jointdyn-sweep-stop-{key}", client=client), counter=self.points)
+        # the stop request reaches the running chunks through the scheduler, checked between points
+        self.ctx = Context(stop=Event(f"jointdyn-sweep-stop-{uuid.uuid4().hex}", client=client))
         self.results = queue.Queue()
         self.futures = set()
         self.done_points = 0
@@ -268,9 +242,8 @@ class DaskExecutor:
         return res
 
     def progress(self) -> int:
-        """Points finished so far: reported one by one by the running chunks,
-        and never fewer than those of the chunks returned."""
-        return max(self.points.drain(), self.done_points)
+        """Points of the chunks returned so far."""
+        return self.done_points
 
     def request_stop(self) -> None:
         """Ask every running chunk to return after its current point (queued
@@ -284,8 +257,6 @@ class DaskExecutor:
         self.futures.clear()
         with contextlib.suppress(Exception):  # a client already closing has nothing left to clear
             self.ctx.stop.clear()
-        with contextlib.suppress(Exception):
-            self.points.queue.close()
 
 
 def _drain(executor, lines, on_chunk) -> None:
