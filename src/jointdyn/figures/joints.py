@@ -57,7 +57,7 @@ def _curve_rows(ds, labels: dict) -> pd.DataFrame:
         for direction in ds.direction.values:
             one = ds.sel(system=name, direction=direction)
             rows.append(pd.DataFrame({
-                **{k: v for k, v in extra.items()},
+                **extra,
                 "direction": str(direction),
                 "gamma": one.gamma.values,
                 "amplitude_m": one.amplitude_m.values,
