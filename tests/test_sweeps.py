@@ -257,6 +257,62 @@ def test_progress_moves_per_point_and_shows_the_reused(fake, tmp_path, monkeypat
     assert "reused 6" in bars[1].postfix
 
 
+def test_dask_progress_moves_per_point(monkeypatch):
+    """On a Dask cluster each finished point reaches the client while its
+    chunk still runs: before solving a point, the (in-process) worker waits
+    until the client has counted every earlier point of the chunk; the bar
+    then ends at the total."""
+    import time
+
+    import tqdm
+    from distributed import Client, LocalCluster
+
+    from jointdyn.sweeps import _pool
+
+    executors, seen, bars = [], [], []
+    init = _pool.DaskExecutor.__init__
+
+    def keep(self, *a, **kw):
+        init(self, *a, **kw)
+        executors.append(self)
+
+    monkeypatch.setattr(_pool.DaskExecutor, "__init__", keep)
+    inner = _Fake()
+
+    def solver(system, gamma, **kw):
+        done = len(inner.calls)
+        for _ in range(3000):  # the client hears of each point before the next one starts
+            if executors[0].progress() >= done:
+                break
+            time.sleep(0.01)
+        seen.append((done, executors[0].progress()))
+        return inner(system, gamma, **kw)
+
+    class Bar:
+        def __init__(self, total, initial=0, **kw):
+            self.total, self.n = total, initial
+            bars.append(self)
+
+        def update(self, k):
+            self.n += k
+
+        def set_postfix_str(self, text):
+            pass
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(tqdm, "tqdm", Bar)
+    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: solver)
+    gammas = [0.7, 0.75, 0.8, 0.85, 0.9, 0.95]  # one chunk of six points
+    with LocalCluster(n_workers=1, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
+        with Client(lc) as client:
+            frc_sweep(gammas, directions=("up",), client=client)
+    assert len(gammas) <= _frc.config.SWEEP_CHUNK_POINTS
+    assert seen == [(k, k) for k in range(len(gammas))]
+    assert bars[0].n == bars[0].total == len(gammas)
+
+
 def test_threads_and_dask_equal_serial(fake, monkeypatch):
     from distributed import Client, LocalCluster
 

@@ -272,8 +272,9 @@ class ChunkResult:
 
 class Context:
     """What a running chunk shares with its sweep: a stop request and a
-    count of finished points (process- or thread-shared objects, or plain
-    ones in the calling process)."""
+    count of finished points (process- or thread-shared objects, plain ones
+    in the calling process, or on Dask a counter whose ``add(k)`` reports
+    the points to the client)."""
 
     def __init__(self, stop=None, counter=None, on_point=None):
         self.stop = stop if stop is not None else threading.Event()
@@ -286,7 +287,10 @@ class Context:
 
     def point_done(self) -> None:
         """Count one finished point."""
-        if self.counter is not None:
+        add = getattr(self.counter, "add", None)  # a counter that reports elsewhere (Dask events)
+        if add is not None:
+            add(1)
+        elif self.counter is not None:
             with self.counter.get_lock():
                 self.counter.value += 1
         if self.on_point is not None:

@@ -22,8 +22,9 @@ and hands every finished chunk to a callback (which saves it). On
 KeyboardInterrupt it sets the stop flag, so that each running chunk returns
 after its current point, hands those partial chunks to the callback too,
 and re-raises: an interrupt loses at most the points in progress (on a Dask
-cluster too: the stop flag is a ``distributed.Event``; there the progress
-bar moves per chunk).
+cluster too: the stop flag is a ``distributed.Event``, and each finished
+point is logged as an event on the sweep's topic, which the client
+subscribes to, so that the progress bar moves per point there as well).
 """
 
 from __future__ import annotations
@@ -102,6 +103,24 @@ class _Counter:
     def get_lock(self):
         """The lock guarding ``value``."""
         return self._lock
+
+
+class _EventCounter:
+    """Counts finished points on a Dask worker: each is logged as an event on
+    the sweep's topic (the client's subscription adds them up)."""
+
+    def __init__(self, topic: str):
+        self.topic = topic
+
+    def add(self, k: int) -> None:
+        """Log ``k`` finished points (nothing outside a Dask worker)."""
+        from distributed import get_worker
+
+        try:
+            worker = get_worker()
+        except ValueError:  # not running on a worker: nobody to tell
+            return
+        worker.log_event(self.topic, int(k))
 
 
 class SerialExecutor:
@@ -214,10 +233,13 @@ class DaskExecutor:
         self.client = client
         self.systems = client.scatter(list(systems), broadcast=True)
         # the stop request reaches the running chunks through the scheduler, checked between points
-        self.ctx = Context(stop=Event(f"jointdyn-sweep-stop-{uuid.uuid4().hex}", client=client))
+        name = f"jointdyn-sweep-{uuid.uuid4().hex}"
+        self.ctx = Context(stop=Event(f"{name}-stop", client=client), counter=_EventCounter(f"{name}-points"))
         self.results = queue.Queue()
         self.futures = set()
-        self.done_points = 0
+        self.done_points = 0  # points of the chunks returned
+        self.logged_points = 0  # points the workers reported one by one
+        client.subscribe_topic(self.ctx.counter.topic, self._on_points)
         self.capacity = config.SWEEP_TASKS_PER_WORKER * max(1, sum(client.nthreads().values()))
 
     def submit(self, task) -> None:
@@ -241,9 +263,14 @@ class DaskExecutor:
         self.done_points += res.done
         return res
 
+    def _on_points(self, event) -> None:
+        """The client's handler of the points topic: ``event`` is ``(time, k)``."""
+        self.logged_points += event[1]
+
     def progress(self) -> int:
-        """Points of the chunks returned so far."""
-        return self.done_points
+        """Points finished so far: those the workers reported one by one, or
+        those of the chunks returned when that is more (an event still on its way)."""
+        return max(self.done_points, self.logged_points)
 
     def request_stop(self) -> None:
         """Ask every running chunk to return after its current point (queued
@@ -257,6 +284,8 @@ class DaskExecutor:
         self.futures.clear()
         with contextlib.suppress(Exception):  # a client already closing has nothing left to clear
             self.ctx.stop.clear()
+        with contextlib.suppress(Exception):
+            self.client.unsubscribe_topic(self.ctx.counter.topic)
 
 
 def _drain(executor, lines, on_chunk) -> None:
