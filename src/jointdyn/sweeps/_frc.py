@@ -40,7 +40,6 @@ Dataset goes to ``DIR/frc.nc`` and a tidy CSV ``DIR/frc.csv``.
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Mapping
 from pathlib import Path
