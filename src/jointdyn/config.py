@@ -202,6 +202,13 @@ HB_AUTO_RTOL = 1e-3
 #: the samples decide, H = 7 already within 2e-4 of H = 15 on the paper's grid
 HB_AUTO_MAX_HARMONICS = 15
 HB_AUTO_MAX_SAMPLES = 2048
+#: a contact force is zero while the contact is open and continuous at separation and re-contact: where a
+#: prescribed normal load changes sign, the AFT projects the force with the corners there taken into
+#: account (jointdyn.fourier.event_projection): one-sided polynomials of this degree through the corner
+#: and the nearest samples (error O(h^4) for a force smooth on either side, against O(h^2) uniform) ...
+HB_EVENT_ORDER = 3
+#: ... skipping samples nearer to the corner than this fraction of the sampling interval (nearly zero)
+HB_EVENT_MIN_OFFSET = 0.25
 #: uniform samples per period of the fine grid on which amplitudes and
 #: extrema of a harmonic-balance response are located
 HB_FINE_SAMPLES = 1024
