@@ -273,6 +273,13 @@ CONT_MAX_DISTANCE = 2.0
 #: point (fractions of the parameter range), at most CONT_MAX_JUMPS times
 CONT_JUMP_FRACTIONS = (1e-4, 1e-3, 1e-2)
 CONT_MAX_JUMPS = 5
+#: a branch that goes back and forth without getting anywhere (a zigzag at a jump of a
+#: piecewise-smooth residual that the corrector keeps accepting): over the last
+#: CONT_STALL_POINTS points, the distance from the first to the last (scaled unknowns and
+#: parameter) is below CONT_STALL_RATIO times the path through them; the branch stops there
+#: as failed, without those points
+CONT_STALL_POINTS = 100
+CONT_STALL_RATIO = 0.01
 #: a jump's guess follows the tangent when its parameter component exceeds
 #: this (else the last point's unknowns)
 CONT_JUMP_TANGENT_MIN = 1e-3
