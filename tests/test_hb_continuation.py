@@ -125,7 +125,7 @@ def test_a_zigzag_in_place_is_a_stall_and_a_branch_is_not():
 
 def test_jenkins_zigzag_at_a_jump_stops_and_the_branch_is_continued_back():
     # Jenkins at eta = 10, beta = 1000 with 7 harmonics and 128 samples: near gamma 1.2047 the corrector kept
-    # accepting points that went back and forth between two states (2000 points, the bound, 18 s); the stall
+    # accepting points that went back and forth between the same two states (2000 points, the bound, 18 s); the stall
     # stops that segment as failed, the branch is continued back from the end and covers the range
     from jointdyn import System
     from jointdyn.hb import continue_hb
