@@ -106,3 +106,31 @@ def test_large_bordered_systems_go_through_lapack():
         assert np.max(np.abs(y ** 3 + y - lam * c)) <= 10 * config.CONT_TOL
     y, ok, it = newton(res, r.y[-1] + 1e-3, 2.0)
     assert ok and np.allclose(y, r.y[-1], atol=1e-9)
+
+
+def test_a_zigzag_in_place_is_a_stall_and_a_branch_is_not():
+    from jointdyn.continuation import ContinuationOptions, _Points, _stalled
+
+    opt = ContinuationOptions()
+    k = opt.stall_points
+    zig, line = _Points(2), _Points(2)
+    for i in range(k + 1):
+        zig.add(np.array([1.0, 0.5 + 0.01 * (i % 2)]), 1.2 + 1e-4 * (i % 2), 1.0, False, 2, False)
+        line.add(np.array([1.0 + 0.01 * i, 0.5]), 1.2 + 1e-4 * i, 1.0, False, 2, False)
+        assert not _stalled(line, opt)
+    assert _stalled(zig, opt)
+    zig.drop(k)
+    assert len(zig.L) == 1 and len(zig.Y) == 1
+
+
+def test_jenkins_zigzag_at_a_jump_stops_and_the_branch_is_continued_back():
+    # Jenkins at eta = 10, beta = 1000 with 7 harmonics and 128 samples: near gamma 1.2047 the corrector kept
+    # accepting points that went back and forth between the same two states (2000 points, the bound, 18 s); the stall
+    # stops that segment as failed, the branch is continued back from the end and covers the range
+    from jointdyn import System
+    from jointdyn.hb import continue_hb
+
+    system = System.paper_damper(eta=10.0, beta=1000.0, model="jenkins")
+    br = continue_hb(system, 0.6, 1.8, max_step=0.01, harmonics=7, samples=128)
+    assert br.status == "complete" and "stalled near gamma = 1.204" in br.message
+    assert br.lam.size < 1000 and br.lam.min() == pytest.approx(0.6) and br.lam.max() == pytest.approx(1.8)

@@ -75,3 +75,68 @@ def test_refined_extrema_are_closer_to_the_true_extrema(seed):
     assert abs(hi - true_hi) <= 1e-5 * scale and abs(lo - true_lo) <= 1e-5 * scale
     assert abs(hi - true_hi) <= abs(grid.max() - true_hi) and abs(lo - true_lo) <= abs(grid.min() - true_lo)
     assert hi >= grid.max() and lo <= grid.min()
+
+
+def _clipped(n0, n1, delta):
+    """A contact-force-like signal: max(0, N) times a smooth factor, N = n0 + n1 sin(tau + delta), and the
+    corners where N changes sign, as event_projection takes them."""
+    def f(tau):
+        N = n0 + n1 * np.sin(tau + delta)
+        return np.where(N > 0.0, N * (np.cos(2.0 * tau) + 0.5 * np.sin(tau) + 0.3), 0.0)
+
+    a = np.arcsin(-n0 / n1)
+    events = tuple(sorted(((ph - delta) % (2.0 * np.pi), fourier.STARTS if n1 * np.cos(ph) > 0 else fourier.STOPS)
+                          for ph in (a, np.pi - a)))
+    return f, events
+
+
+def _exact_coefficients(f, H, events):
+    # oracle: adaptive quadrature of f b_k over the stretch where f is not zero (scipy.integrate.quad)
+    from scipy.integrate import quad
+
+    start = next(t for t, side in events if side == fourier.STARTS)
+    stop = next(t for t, side in events if side == fourier.STOPS)
+    stop = stop if stop > start else stop + 2.0 * np.pi
+    out = np.empty(2 * H + 1)
+    for k in range(2 * H + 1):
+        b = (lambda t: 1.0) if k == 0 else (lambda t, k=k: fourier.basis(H, [t])[0, k])
+        out[k] = quad(lambda t: float(f(np.array(t))) * b(t), start, stop, epsabs=1e-13, epsrel=1e-12,
+                      limit=400)[0] / (2.0 * np.pi if k == 0 else np.pi)
+    return out
+
+
+@pytest.mark.parametrize("n0,n1,delta", [(1.0, 1.5, 0.3), (1.0, -4.0, 2.0), (0.2, 1.0, -1.0)])
+def test_event_projection_integrates_a_clipped_signal_to_fourth_order(n0, n1, delta):
+    H = 7
+    f, events = _clipped(n0, n1, delta)
+    exact = _exact_coefficients(f, H, events)
+    errs = []
+    for Ns in (128, 256, 512):
+        T = f(fourier.phases(Ns))
+        uniform = np.abs(fourier.fourier_matrices(H, Ns)[1] @ T - exact).max()
+        errs.append(np.abs(fourier.event_projection(H, Ns, events) @ T - exact).max())
+        assert errs[-1] <= 1e-2 * uniform  # the trapezoidal rule is O(h^2) at the corners
+    assert errs[1] <= errs[0] / 8.0 and errs[2] <= errs[1] / 8.0
+
+
+def test_event_projection_without_events_is_the_uniform_one():
+    P = fourier.fourier_matrices(5, 64)[1]
+    assert np.array_equal(fourier.event_projection(5, 64, ()), P)
+    assert fourier.event_projection(5, 64, ()) is fourier.event_projection(5, 64, ())
+
+
+def test_event_projection_with_corners_on_samples():
+    # corners exactly on samples 16 and 48 of 64 (tau = pi / 2, 3 pi / 2): those samples are zero (open); the
+    # formula takes a start there as the end of the interval before it, a stop as the start of the one after
+    H, Ns, fine = 3, 64, 2 ** 18
+    for first in (fourier.STARTS, fourier.STOPS):
+        def f(tau, first=first):
+            on = (tau > 0.5 * np.pi) & (tau < 1.5 * np.pi)
+            return np.where(on if first == fourier.STARTS else ~on & (np.abs(np.cos(tau)) > 0), 1.0, 0.0) * (
+                np.cos(tau) * (1.0 + 0.3 * np.sin(tau)))
+
+        events = ((0.5 * np.pi, first), (1.5 * np.pi, -first))
+        exact = fourier.fourier_matrices(H, fine)[1] @ f(fourier.phases(fine))  # O(h^2): 1e-9 at the corners
+        got = fourier.event_projection(H, Ns, events) @ f(fourier.phases(Ns))
+        uniform = fourier.fourier_matrices(H, Ns)[1] @ f(fourier.phases(Ns))
+        assert np.abs(got - exact).max() <= 1e-7 < np.abs(uniform - exact).max()

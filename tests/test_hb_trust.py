@@ -19,6 +19,7 @@ from test_hb import _df_amplitude, _jenkins_system
 
 from jointdyn import System, config
 from jointdyn.cli import EXIT_INCOMPLETE, main
+from jointdyn.fourier import fourier_matrices
 from jointdyn.hb import PointStatus, frc_hb, harmonic_balance
 
 GRID = "0.6:1.8:0.01"
@@ -170,6 +171,25 @@ def test_robustness_grid_subset(model, eta, beta):
     assert row.startswith(f"| {model} | {eta:g} | {beta:g} | {c.status} |") and row.endswith("| yes |")
 
 
+
+def test_grid_does_not_compare_a_subharmonic_time_domain_orbit():
+    # the full-memory closed form at eta = 0.5, beta = 5: the time-domain steady state at the HB peak repeats
+    # every 4 forcing periods, so the period-one HB peak (q 1.436 against 1.371) is marked not compared, not passed
+    from jointdyn.sweeps.hb_grid import Verdict, grid_case, grid_table
+
+    c = grid_case("iwan-closed", 0.5, 5.0)
+    assert c.covered and c.verdict is Verdict.SUBHARMONIC and c.time_period > 1 and not c.ok
+    assert math.isnan(c.peak_error) and grid_table([c]).splitlines()[2].endswith("| n/c |")
+
+
+def test_a_finer_sampling_whose_branch_fails_is_followed_by_the_next():
+    # the full-memory closed form at eta = 0.5, beta = 2: its force jumps with the normal load, the peak check
+    # asks for 512 samples, where the corrector fails near the resonance (it completes with 128, 256 and 1024)
+    ds = frc_hb(System.paper_damper(eta=0.5, beta=2.0, model="iwan-closed"), 0.6, 1.8, max_step=0.01)
+    levels = ds.attrs["discretisation_levels"].split(", ")
+    assert ds.attrs["status"] == "complete" and ds.sizes["peak"] >= 1
+    assert f"{config.HB_HARMONICS}x512" in levels and levels[-1] != f"{config.HB_HARMONICS}x512"
+
 def test_failed_branch_exits_3_and_names_where(capsys, tmp_path):
     # a real failure (the paper's closed form at eta = 1.5, beta = 1: its force jumps near gamma 1.06, and
     # Newton fails at the start, with 7 harmonics and 128 samples; the automatic choice takes more samples and
@@ -295,3 +315,18 @@ def test_cli_reports_the_discretisation(capsys):
     rc, out, _ = _cli_hb(capsys, "--eta", "0.5", "--beta", "2", "--harmonics", "5", "--samples", "64")
     assert rc == 0 and (out["harmonics"], out["samples"]) == (5, 64)
     assert out["discretisation"]["harmonics_choice"] == "fixed"
+
+
+def test_separation_corners_make_few_samples_accurate():
+    # Jenkins at eta = 1.5, beta = 1000 (open about a quarter of the period): the force's corners at
+    # separation and re-contact, projected with jointdyn.fourier.event_projection, leave 128 samples within
+    # 1e-6 of 4096 (the uniform projection: 1.7e-3); oracle: the same problem with 32 times the samples
+    from jointdyn.hb.problem import HBProblem
+
+    system = System.paper_damper(eta=1.5, beta=1000.0, model="jenkins")
+    q = {Ns: harmonic_balance(system, 1.3034, samples=Ns).amplitude_m for Ns in (128, 4096)}
+    assert abs(q[128] - q[4096]) <= 1e-6 * q[4096]
+    p = HBProblem(system, samples=128)
+    assert not np.array_equal(p.P, fourier_matrices(p.H, 128)[1])
+    assert np.array_equal(HBProblem(System.paper_damper(eta=0.5, beta=2.0), samples=128).P,
+                          fourier_matrices(p.H, 128)[1])  # no separation: the uniform projection

@@ -40,7 +40,7 @@ def main(argv=None) -> int:
         for eta in GRID_ETAS:
             for beta in GRID_BETAS:
                 c = grid_case(model, eta, beta)
-                print(f"{model} eta={eta:g} beta={beta:g}: {c.status} ok={c.ok} err={c.peak_error:+.3g} "
+                print(f"{model} eta={eta:g} beta={beta:g}: {c.status} ok={c.ok} {c.verdict} err={c.peak_error:+.3g} "
                       f"{c.seconds:.2f} s", file=sys.stderr, flush=True)
                 cases.append(c)
     table = grid_table(cases)

@@ -202,6 +202,13 @@ HB_AUTO_RTOL = 1e-3
 #: the samples decide, H = 7 already within 2e-4 of H = 15 on the paper's grid
 HB_AUTO_MAX_HARMONICS = 15
 HB_AUTO_MAX_SAMPLES = 2048
+#: a contact force is zero while the contact is open and continuous at separation and re-contact: where a
+#: prescribed normal load changes sign, the AFT projects the force with the corners there taken into
+#: account (jointdyn.fourier.event_projection): one-sided polynomials of this degree through the corner
+#: and the nearest samples (error O(h^4) for a force smooth on either side, against O(h^2) uniform) ...
+HB_EVENT_ORDER = 3
+#: ... skipping samples nearer to the corner than this fraction of the sampling interval (nearly zero)
+HB_EVENT_MIN_OFFSET = 0.25
 #: uniform samples per period of the fine grid on which amplitudes and
 #: extrema of a harmonic-balance response are located
 HB_FINE_SAMPLES = 1024
@@ -266,6 +273,15 @@ CONT_MAX_DISTANCE = 2.0
 #: point (fractions of the parameter range), at most CONT_MAX_JUMPS times
 CONT_JUMP_FRACTIONS = (1e-4, 1e-3, 1e-2)
 CONT_MAX_JUMPS = 5
+#: a branch that goes back and forth without getting anywhere (the corrector keeps accepting
+#: points that alternate between the same states at a jump of a piecewise-smooth residual):
+#: over the last CONT_STALL_POINTS points, the distance from the first to the last (scaled
+#: unknowns and parameter) is below CONT_STALL_RATIO times the path through them; the branch
+#: stops there as failed, without those points. Such a stall measures about 1e-14 (Jenkins at
+#: eta 10, beta 1000, 7 x 128 samples); the zigzags at the non-smooth corners of branches that
+#: do get through stay above 6e-4 (Jenkins with separation on the grid of docs/hb-robustness.md)
+CONT_STALL_POINTS = 100
+CONT_STALL_RATIO = 1e-6
 #: a jump's guess follows the tangent when its parameter component exceeds
 #: this (else the last point's unknowns)
 CONT_JUMP_TANGENT_MIN = 1e-3

@@ -162,6 +162,11 @@ class ContinuationOptions:
         Largest deviation between the straight line joining consecutive
         points and the curve, in the plane (lam, observable), when
         :func:`continuation` is given an ``observe`` function (inf: none).
+    stall_points, stall_ratio : int, float
+        The branch stops as failed where, over the last ``stall_points``
+        points, the distance from the first to the last is below
+        ``stall_ratio`` times the path through them (it goes back and
+        forth); those points are dropped.
     """
 
     ds: float = config.CONT_DS_START
@@ -189,6 +194,8 @@ class ContinuationOptions:
     jump_tangent_min: float = config.CONT_JUMP_TANGENT_MIN
     max_dlam: float = math.inf
     chord_tol: float = config.CONT_CHORD_TOL
+    stall_points: int = config.CONT_STALL_POINTS
+    stall_ratio: float = config.CONT_STALL_RATIO
 
     def __post_init__(self) -> None:
         for name in ("ds", "ds_min", "ds_max", "ds_max_rel", "tol", "grow", "max_distance", "corner_ds"):
@@ -196,7 +203,8 @@ class ContinuationOptions:
         for name in ("max_dlam", "chord_tol"):
             if not getattr(self, name) > 0:  # inf allowed (no bound)
                 raise ValueError(f"{name} must be > 0 (inf: no bound), got {getattr(self, name)!r}")
-        for name in ("max_points", "max_iter", "target_iter", "line_search_steps", "max_evals_factor"):
+        for name in ("max_points", "max_iter", "target_iter", "line_search_steps", "max_evals_factor",
+                     "stall_points"):
             V.positive_int(name, getattr(self, name))
         V.positive_int("max_jumps", self.max_jumps, 0)
         for name in ("shrink", "turn_shrink", "reject_shrink", "corner_shrink"):
@@ -573,6 +581,11 @@ class _Points:
         self.IT.append(it)
         self.GAP.append(gap)
         self.CORNER.append(corner)
+
+    def drop(self, k: int) -> None:
+        """Forget the last ``k`` points."""
+        for col in (self.Y, self.L, self.TL, self.FOLD, self.IT, self.GAP, self.CORNER):
+            del col[-k:]
 
     def finish(self, status: Status, message: str) -> ContinuationResult:
         self.cnt["points"] = len(self.L)
@@ -961,10 +974,26 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
             return pts.finish(*_range_end(walk, u, v, t, fold, pts, lam_stop, lam_name))
         u_prev, t_prev, u, t, g_u = u, t, v, t_new, st.g
         pts.add(v[:n].copy(), v[n], t[n], fold, st.it, st.gap, st.corner)
+        if _stalled(pts, opt):
+            pts.drop(opt.stall_points)
+            return pts.finish(ContinuationStatus.FAILED,
+                              f"stalled near {lam_name} = {v[n]:.6g}: {opt.stall_points} points went back and "
+                              f"forth there (the corrector accepts a zigzag at a jump of the residual)")
         stop = _accepted(v, n, monitor, progress)
         if stop is not None:
             return pts.finish(*stop)
         ds = _next_ds(ds, float(t @ t_prev), st.it, st.err, opt, float(np.linalg.norm(v[:n])))
+
+
+def _stalled(pts, opt) -> bool:
+    """True when the last ``opt.stall_points`` points got nowhere: the first-to-last distance is below
+    ``opt.stall_ratio`` times the path through them (scaled unknowns and parameter)."""
+    k = opt.stall_points
+    if len(pts.L) <= k:
+        return False
+    U = np.column_stack([np.array(pts.Y[-k - 1:]), np.array(pts.L[-k - 1:])])
+    path = float(np.linalg.norm(np.diff(U, axis=0), axis=1).sum())
+    return path > 0.0 and float(np.linalg.norm(U[-1] - U[0])) < opt.stall_ratio * path
 
 
 def _accepted(v, n, monitor, progress):

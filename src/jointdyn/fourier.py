@@ -24,7 +24,11 @@ from . import config
 from ._cache import by_value
 from ._jit import jit
 
-__all__ = ["phases", "basis", "fourier_matrices", "derivative_matrix", "reconstruct", "extrema"]
+__all__ = ["phases", "basis", "fourier_matrices", "event_projection", "derivative_matrix", "reconstruct", "extrema"]
+
+#: one side of a zero stretch of a signal (:func:`event_projection`): the signal is zero before the phase
+#: (it starts there) or after it (it stops there)
+STARTS, STOPS = 1, -1
 
 
 def phases(samples: int) -> np.ndarray:
@@ -60,6 +64,107 @@ def fourier_matrices(harmonics: int, samples: int):
     P = np.ascontiguousarray(E.T * (2.0 / samples))
     P[0] *= 0.5
     return E, P
+
+
+def _bernoulli(m: int, x: float) -> float:
+    """Bernoulli polynomial B_m(x), m = 1..4."""
+    return (x - 0.5, x * x - x + 1.0 / 6.0, x ** 3 - 1.5 * x * x + 0.5 * x,
+            x ** 4 - 2.0 * x ** 3 + x * x - 1.0 / 30.0)[m - 1]
+
+
+def _basis_derivatives(harmonics: int, tau: float) -> np.ndarray:
+    """The basis functions and their first two derivatives at ``tau``: (3, 2H+1)."""
+    out = np.zeros((3, 2 * harmonics + 1))
+    out[0, 0] = 1.0
+    for k in range(1, harmonics + 1):
+        c, s = np.cos(k * tau), np.sin(k * tau)
+        out[:, 2 * k - 1] = (c, -k * s, -k * k * c)
+        out[:, 2 * k] = (s, k * c, -k * k * s)
+    return out
+
+
+def _one_sided_derivatives(tau_e: float, side: int, samples: int, order: int, min_offset: float):
+    """(sample indices, D): D[m - 1] @ u[indices] is d^m u / dtau^m (m = 1..p) at ``tau_e`` from the side
+    where u is not zero, by the polynomial of degree p <= ``order`` through u(tau_e) = 0 and the p nearest
+    samples on that side at least ``min_offset`` sampling intervals away (None where fewer than 1)."""
+    h = 2.0 * np.pi / samples
+    x = (tau_e % (2.0 * np.pi)) / h
+    j0 = int(np.floor(x))
+    first = j0 + 1 if side == STARTS else (j0 if x > j0 else j0 - 1)
+    js = [first + side * i for i in range(order + 1)]
+    s = [(j * h - tau_e) / h for j in js]
+    keep = [i for i in range(len(js)) if abs(s[i]) >= min_offset][:order]
+    if not keep:
+        return None
+    sl = np.array([s[i] for i in keep])
+    p = sl.size
+    C = np.linalg.inv(sl[:, None] ** np.arange(1, p + 1)[None, :])  # u(s) = sum_q a_q s^q, a = C u
+    fact = np.cumprod(np.arange(1, p + 1, dtype=float))
+    return [js[i] % samples for i in keep], (fact / h ** np.arange(1, p + 1))[:, None] * C
+
+
+@by_value()
+def event_projection(harmonics: int, samples: int, events: tuple, order: int = config.HB_EVENT_ORDER,
+                     min_offset: float = config.HB_EVENT_MIN_OFFSET) -> np.ndarray:
+    """Analysis matrix (2H+1, Ns) for a signal that is zero on stretches of the period, given their ends.
+
+    The uniform projection (:func:`fourier_matrices`) is the trapezoidal
+    rule: spectrally accurate for a smooth periodic signal, but only
+    O(h^2), with an error that jumps with the position of a corner inside
+    its sampling interval, for a signal with corners. A contact force
+    that is zero while the contact is open and continuous at separation
+    and re-contact (|T| <= mu N -> 0) has corners there, at phases known
+    before the force is. Each such corner at ``tau_e = (j + theta) h`` adds
+    to the trapezoidal sum of ``g = u b_k`` the terms
+    ``(-1)^m [g^(m)] h^(m+1) B_(m+1)(theta) / (m+1)!`` (generalised
+    Euler-Maclaurin; ``[g^(m)]`` the jump of the m-th derivative, B the
+    Bernoulli polynomials), m = 1..p; they are subtracted with the
+    one-sided derivatives of u at the corner from the polynomial through
+    u(tau_e) = 0 and the p nearest samples on the side where u is not zero
+    (``order`` p = 3: error O(h^4) for a signal smooth on either side).
+    The result is linear in the samples, so an AFT Jacobian through it is
+    exact. Built once per arguments and shared: do not write into it.
+
+    Parameters
+    ----------
+    harmonics, samples : int
+        H and Ns.
+    events : tuple of (float, int)
+        ``(tau_e, side)``: a phase (rad) where the signal leaves zero
+        (``side`` = :data:`STARTS`) or comes to zero (:data:`STOPS`).
+    order : int
+        Degree p of the one-sided polynomials.
+    min_offset : float
+        Samples nearer than this many sampling intervals to a corner are
+        not nodes of its polynomial (their value is nearly zero).
+    """
+    E, P = fourier_matrices(harmonics, samples)
+    out = P.copy()
+    h = 2.0 * np.pi / samples
+    weight = np.full(2 * harmonics + 1, 2.0 / samples)  # coefficient per unit of the trapezoidal sum / h
+    weight[0] = 1.0 / samples
+    for tau_e, side in events:
+        x = (tau_e % (2.0 * np.pi)) / h
+        j0 = np.floor(x)
+        theta = x - j0
+        if side == STARTS and theta == 0.0:
+            theta = 1.0  # the sample on the corner is open: the corner ends the interval before it
+        nodes = _one_sided_derivatives(tau_e, side, samples, order, min_offset)
+        if nodes is None:
+            continue
+        idx, D = nodes
+        b = _basis_derivatives(harmonics, tau_e)
+        jumps = [np.outer(b[0], D[0])]  # [g'] = u' b (u = 0 at the corner)
+        if len(D) > 1:
+            jumps.append(np.outer(b[0], D[1]) + 2.0 * np.outer(b[1], D[0]))
+        if len(D) > 2:
+            jumps.append(np.outer(b[0], D[2]) + 3.0 * np.outer(b[1], D[1]) + 3.0 * np.outer(b[2], D[0]))
+        corr = np.zeros((2 * harmonics + 1, len(idx)))
+        for m, J in enumerate(jumps, start=1):
+            corr += ((-1.0) ** m * side * h ** (m + 1) * _bernoulli(m + 1, theta) / np.prod(np.arange(1, m + 2))) * J
+        # the trapezoidal sum h sum_j g_j exceeds the integral by corr; the coefficient is weight / h times it
+        out[:, idx] -= (weight / h)[:, None] * corr
+    return np.ascontiguousarray(out)
 
 
 @by_value()

@@ -3,8 +3,8 @@
 ``fig6_hb``
     The Fig 6 cases (eta = 0.01, 0.5, 1.5, 10; a few beta) by harmonic
     balance and arc-length continuation (:func:`jointdyn.hb.frc_hb`, the
-    default model ``iwan``, the exact Iwan model; 7 harmonics, 128 samples;
-    512 with separation, eta > 1),
+    default model ``iwan``, the exact Iwan model; harmonics and samples
+    chosen automatically),
     stable parts solid, unstable parts
     dashed, folds marked, overlaid on the time-domain steady states of
     up and down sweeps (:func:`jointdyn.sweeps.frc_sweep`) on a coarse grid.
@@ -37,8 +37,8 @@ def fig6_hb_data(etas=HB_ETAS, betas=HB_BETAS, gamma=HB_GAMMA, time_step=HB_TIME
     rows = []
     for eta in etas:
         for beta in betas:
-            # default settings: the AFT locates re-contact between samples, so 128 samples hold with
-            # separation too (docs/hb-robustness.md)
+            # default settings: harmonics and samples chosen per branch by the check of its peaks
+            # (docs/hb-robustness.md)
             ds = frc_hb(System.paper_damper(eta=eta, beta=beta, model=model), gamma[0], gamma[1], progress=False)
             df = pd.DataFrame({v: ds[v].values for v in ("gamma", "amplitude_q", "offset_m", "stable", "fold",
                                                           "gap", "branch")})

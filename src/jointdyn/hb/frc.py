@@ -715,6 +715,30 @@ def _peak_level(req: _Request, condensed: bool, pk: HBPeak, scale: float, level,
             return at, first
 
 
+def _combined_target(req: _Request, br: HBBranch, scale: float, level, auto, wanted):
+    """The level of the next branch: the most harmonics and the most samples that the peaks ask for
+    (``wanted``: their levels from :func:`_peak_level`).
+
+    Where the peaks ask for both more harmonics and more samples, the
+    harmonics are checked again at the higher samples first (the peaks
+    solved there): a harmonics check made with too few samples also
+    measures the sampling error of the contact force, and more harmonics
+    cost as much as more samples in every AFT evaluation of the branch.
+    """
+    target = (max([level[0]] + [w[0] for w in wanted]), max([level[1]] + [w[1] for w in wanted]))
+    if not (target[0] > level[0] and target[1] > level[1]):
+        return target
+    at = (level[0], target[1])
+    again = []
+    for pk in br.peaks:
+        amp, X = _solve_at(req, br.problem.condensed, pk.lam, pk.X, at)
+        if not math.isfinite(amp):
+            return target
+        again.append(_peak_level(req, br.problem.condensed, dataclasses.replace(pk, X=X, amplitude_m=amp),
+                                 scale, at, auto)[0])
+    return (max([at[0]] + [w[0] for w in again]), max([at[1]] + [w[1] for w in again]))
+
+
 def _worst(values) -> float:
     """Largest of the values that are not NaN (NaN when there is none)."""
     v = [x for x in values if not math.isnan(x)]
@@ -731,12 +755,20 @@ def _adaptive_branch(req: _Request, level, auto) -> HBBranch:
     while True:
         scale = max([pk.amplitude_m for pk in br.peaks], default=0.0)
         checks = [_peak_level(req, br.problem.condensed, pk, scale, level, auto) for pk in br.peaks]
-        target = (max([level[0]] + [c[0][0] for c in checks]), max([level[1]] + [c[0][1] for c in checks]))
+        target = _combined_target(req, br, scale, level, auto, [c[0] for c in checks])
         if target == level:
             break
         level = target
         levels.append(level)
-        br = _fixed_branch(req, level)
+        finer = _fixed_branch(req, level)
+        # a finer level may fail where the coarser covered the range (a closed form's force jumps with the
+        # normal load: Newton fails at one sampling and not at the next): the next samples are tried
+        while (finer.status is ContinuationStatus.FAILED and br.status is not ContinuationStatus.FAILED
+               and auto[1] and 2 * level[1] <= config.HB_AUTO_MAX_SAMPLES):
+            level = (level[0], 2 * level[1])
+            levels.append(level)
+            finer = _fixed_branch(req, level)
+        br = finer
     by_h, by_s = _check_levels(level, auto)
     ch_h, ch_s = _worst(c[1][0] for c in checks), _worst(c[1][1] for c in checks)
     converged = not (ch_h > config.HB_AUTO_RTOL or ch_s > config.HB_AUTO_RTOL)

@@ -38,7 +38,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ..fourier import extrema, fourier_matrices, phases
+from ..fourier import STARTS, STOPS, event_projection, extrema, fourier_matrices, phases
 from ..kinematics import NORMAL_SPRING, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
 from ..laws import law_dispatch
 from ..systems import Contact, System
@@ -90,6 +90,17 @@ def _load_samples(tau, n0, n1, delta, d=None):
     if ddelta != 0.0:
         dN = dN + (n1 * ddelta) * np.cos(ph)
     return N, dN
+
+
+def _load_events(n0: float, n1: float, delta: float) -> tuple:
+    """Phases where N = n0 + n1 sin(tau + delta) crosses zero, as ``(tau, side)`` of
+    :func:`~jointdyn.fourier.event_projection`: re-contact (N rises through zero: the force starts) and
+    separation (it stops); empty when N keeps its sign."""
+    if not abs(n1) > abs(n0):
+        return ()
+    a = math.asin(-n0 / n1)
+    return tuple(sorted(((ph - delta) % (2.0 * math.pi), STARTS if n1 * math.cos(ph) > 0.0 else STOPS)
+                        for ph in (a, math.pi - a)))
 
 
 def _linear_blocks(system: System, H: int):
@@ -176,6 +187,7 @@ class HBProblem:
         #: coefficients f sin(phi) of cos(w t) and f cos(phi) of sin(w t)
         self.phase_sin, self.phase_cos = np.sin(phi), np.cos(phi)
         self._contact_inputs(contact_kinematics(system))
+        self.P = self._projection()
         self._dummy = np.zeros((1, 1))
         self._zero1 = np.zeros(1)
         self._noscale = np.zeros(3)
@@ -214,6 +226,18 @@ class HBProblem:
         else:
             self._Pm, self._ssz = _pad_rows([]), 1
             self._kernel = eval_kernel(no_contact_step_jvp, no_contact_init_jvp)
+
+    def _projection(self) -> np.ndarray:
+        """The AFT's analysis matrix: :func:`~jointdyn.fourier.event_projection` with the separations and
+        re-contacts of the prescribed normal loads, where the kernel's one matrix serves every contact (the
+        same phases for all) and the parameter does not move them; the uniform projection otherwise."""
+        if not self.contacts or self.has_springs or self.parameter.enters_loads:
+            return self.P
+        events = {_load_events(*co) for co in self.load_coefficients}
+        if len(events) != 1:
+            return self.P
+        ev = events.pop()
+        return event_projection(self.H, self.Ns, ev) if ev else self.P
 
     @property
     def condensed(self) -> bool:
