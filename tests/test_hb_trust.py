@@ -330,3 +330,19 @@ def test_separation_corners_make_few_samples_accurate():
     assert not np.array_equal(p.P, fourier_matrices(p.H, 128)[1])
     assert np.array_equal(HBProblem(System.paper_damper(eta=0.5, beta=2.0), samples=128).P,
                           fourier_matrices(p.H, 128)[1])  # no separation: the uniform projection
+
+
+def test_grid_folds_are_jumps_of_time_domain_sweeps():
+    """The closed form's folds at eta 1.5, beta 2 (grid case): time-domain
+    sweeps up and down settle on different periodic orbits between them;
+    a branch without folds has nothing to check."""
+    from jointdyn.sweeps.hb_folds import FoldVerdict, fold_check
+
+    c = fold_check("iwan-closed", 1.5, 2.0)
+    assert c is not None and len(c.folds) >= 2
+    assert c.verdict is FoldVerdict.CONFIRMED
+    assert all(c.folds[0] < g < c.folds[-1] for g in c.inside_apart) and len(c.inside_apart) >= 3
+    outside = [i for i, g in enumerate(c.gammas) if g < c.folds[0] - 1e-4 or g > c.folds[-1] + 1e-4]
+    for i in outside:  # one orbit away from the folds: the sweeps agree there
+        assert abs(c.q_up[i] - c.q_down[i]) <= 0.02 * abs(c.q_down[i])
+    assert fold_check("iwan", 0.5, 2.0) is None
