@@ -32,7 +32,7 @@ from .integrate import Restart, Trajectory, _omega, _trajectory
 from .monodromy import fd_monodromy
 from .status import EnergyCheck, SteadyStatus
 
-__all__ = ["SteadyState", "energy_check", "steady_state"]
+__all__ = ["SteadyState", "energy_check", "prepare_kernels", "steady_state"]
 
 
 @dataclass(frozen=True)
@@ -731,6 +731,28 @@ def energy_check(work_force_J: float, energy_contact_J: float, energy_viscous_J:
     W, Ec, Ev = float(work_force_J), float(energy_contact_J), float(energy_viscous_J)
     tol = abs(W - Ec - Ev) + config.SS_DISSIPATION_FLOOR * (abs(W) + abs(Ec) + abs(Ev))
     return EnergyCheck.NEGATIVE_DISSIPATION if Ec < -tol else EnergyCheck.PASSIVE
+
+
+def prepare_kernels(system: System) -> None:
+    """Compile, or load from the disk cache, the kernels :func:`steady_state` runs for ``system``.
+
+    Process pools call this before they fork, so that their workers inherit
+    the compiled code: each would otherwise compile the same kernels at the
+    same time (on a cold cache, k workers compile everything k times). It
+    runs, at gamma = 1, the equivalent-linearisation start, one period of
+    the step grid and the periodicity test on a history too short to pass:
+    milliseconds once compiled. A system that steady_state refuses
+    (ValueError) is left to the solve that reports it.
+    """
+    try:
+        model = make_model(system, _omega(system, 1.0), config.TI_STEPS_PER_PERIOD)
+    except ValueError:
+        return
+    x, v, S = _first_state(model, None)
+    model.run_periods(x, v, S, 1)
+    _periodic_arrays(np.empty((0, N_SUMMARY)), np.zeros((1, 2 * model.n)), 1, config.SS_CHECK_PERIODS, model.n,
+                     model.w, model.pack.K_stuck, model.pack.M, _amplitude_scale(model, 0.0), config.SS_AMP_RTOL,
+                     config.SS_ENERGY_RTOL, config.SS_BALANCE_RTOL)  # fmt: skip
 
 
 def _first_state(model, start):
