@@ -121,7 +121,8 @@ def _df_template(contacts, cycle, X, kc, final, S_out):  # pragma: no cover - co
             continue
         ca, cb = _df_march(INIT, MARCH, P[i], U, cycle, loads[i], u, T, kT, code, s0, sf)  # noqa: F821
         if final:
-            S_out[i, :] = sf
+            for r in range(sf.shape[0]):  # not a slice assignment: see drivers._march
+                S_out[i, r] = sf[r]
         else:
             kc[i] = 0.5 * kc[i] + 0.5 * (2.0 / cycle[2]) * (ca + 1j * cb) / U
 

@@ -740,8 +740,9 @@ def prepare_kernels(system: System) -> None:
     the compiled code: each would otherwise compile the same kernels at the
     same time (on a cold cache, k workers compile everything k times). It
     runs, at gamma = 1, the equivalent-linearisation start, one period of
-    the step grid and the periodicity test on a history too short to pass:
-    milliseconds once compiled. A system that steady_state refuses
+    the step grid, the rebuilding of the law states from it and the
+    periodicity test on a history too short to pass: milliseconds once
+    compiled. A system that steady_state refuses
     (ValueError) is left to the solve that reports it.
     """
     try:
@@ -749,7 +750,7 @@ def prepare_kernels(system: System) -> None:
     except ValueError:
         return
     x, v, S = _first_state(model, None)
-    model.run_periods(x, v, S, 1)
+    clean_states(model, x, v, S, 0, lambda res: None)
     _periodic_arrays(np.empty((0, N_SUMMARY)), np.zeros((1, 2 * model.n)), 1, config.SS_CHECK_PERIODS, model.n,
                      model.w, model.pack.K_stuck, model.pack.M, _amplitude_scale(model, 0.0), config.SS_AMP_RTOL,
                      config.SS_ENERGY_RTOL, config.SS_BALANCE_RTOL)  # fmt: skip

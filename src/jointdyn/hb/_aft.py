@@ -286,8 +286,11 @@ def _project(c, P, Tc, dT, T, proj):  # pragma: no cover - compiled
     for i in range(Tc.shape[0]):
         T[c, i] = Tc[i]
     F, G = proj
-    F[:] = np.dot(P, Tc)
-    G[:, :] = np.dot(P, dT)
+    # into the outputs (the same BLAS product): an assignment of np.dot's
+    # result compiles numba's shape-mismatch error message (string
+    # formatting, about 3 s of cold compile)
+    np.dot(P, Tc, F)
+    np.dot(P, dT, G)
 
 
 @jit(inline="always")
