@@ -261,8 +261,7 @@ def _prepare_kernels(systems) -> None:
     from ..dynamics import prepare_kernels, steady_state
 
     if _steady_state_fn() is steady_state:
-        for system in systems:
-            prepare_kernels(system)
+        prepare_kernels(systems)
 
 
 def _line_runs(family, directions, g, spp, dofs, loop_outputs) -> list:
