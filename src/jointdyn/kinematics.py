@@ -3,9 +3,11 @@
 This module is the one home of the contact geometry and of the normal load:
 the tangential selection of each contact from the structure's degrees of
 freedom, the normal load as a function of time and state, the instants
-where a prescribed load crosses zero, the load tables of a step grid, and
-the kernels that stand in for "no contact" in compiled loops of systems
-without contacts (they are not a contact law and are registered nowhere).
+where a prescribed load crosses zero, the load tables of a step grid. It
+re-exports the kernels that stand in for "no contact" in compiled loops of
+systems without contacts (defined in :mod:`jointdyn.laws._dispatch`, where
+they also fill the unused slots of the mixed-law dispatchers; they are not
+a contact law and are registered nowhere).
 
 Data layout
 -----------
@@ -69,6 +71,7 @@ import numpy as np
 from . import _validate as V
 from ._cache import by_identity
 from ._jit import jit
+from .laws._dispatch import no_contact_init, no_contact_init_jvp, no_contact_step, no_contact_step_jvp
 
 __all__ = [
     "NormalLoad",
@@ -681,36 +684,3 @@ def sampled_load_grid(t, F, N, recontact_alpha: float):
     Fg = np.ascontiguousarray(np.array(Fl).reshape(tg.size, F.shape[1]))
     Ng = np.ascontiguousarray(np.array(Nl).reshape(tg.size, nc))
     return tg, Fg, Ng
-
-
-# --- kernels for systems without contacts --------------------------------------
-
-
-@jit
-def no_contact_step(params, s_old, s_new, x, N):  # pragma: no cover - never reached
-    """Kernel bound in compiled loops of systems without contacts (no force)."""
-    return 0.0, 0.0, 0
-
-
-@jit
-def no_contact_step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT):  # pragma: no cover
-    """Forward-mode twin of :func:`no_contact_step` (no force, no derivative)."""
-    for j in range(dT.shape[0]):
-        dT[j] = 0.0
-    return 0.0, 0.0, 0
-
-
-@jit
-def no_contact_init(params, x0, n0, s):  # pragma: no cover - never reached
-    """Virgin state of :func:`no_contact_step` (empty)."""
-    for r in range(s.shape[0]):
-        s[r] = 0.0
-
-
-@jit
-def no_contact_init_jvp(params, x0, dx0, n0, dn0, s, ds):  # pragma: no cover - never reached
-    """:func:`no_contact_init` with derivatives (all zero)."""
-    for r in range(s.shape[0]):
-        s[r] = 0.0
-        for j in range(ds.shape[1]):
-            ds[r, j] = 0.0

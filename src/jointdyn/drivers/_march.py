@@ -21,7 +21,10 @@ def _march_template(params, s0, x, N, T, kT, code, s_final):  # pragma: no cover
         kT[i] = k_
         code[i] = c_
         a, b = b, a
-    s_final[:] = a
+    # element by element: a slice assignment compiles numba's shape-mismatch
+    # error message (string formatting, about 1.5 s of cold compile)
+    for r in range(a.shape[0]):
+        s_final[r] = a[r]
 
 
 def march(law, x, N, state=None):

@@ -2,7 +2,8 @@
 
 Public API: :func:`integrate` (harmonic loads), :func:`integrate_sampled`
 (sampled loads), :class:`Trajectory`, :class:`Restart`,
-:func:`steady_state` and :class:`SteadyState`, the statuses
+:func:`steady_state` and :class:`SteadyState` (:func:`prepare_kernels`
+compiles its kernels ahead, for process pools), the statuses
 :class:`RunStatus` and :class:`SteadyStatus`, and the monodromy matrix of
 the period map (:func:`monodromy_matrix`, :func:`fd_monodromy`).
 """
@@ -10,7 +11,7 @@ the period map (:func:`monodromy_matrix`, :func:`fd_monodromy`).
 from .integrate import Restart, Trajectory, integrate, integrate_sampled
 from .monodromy import fd_monodromy, monodromy_matrix
 from .status import EnergyCheck, RunStatus, SteadyStatus
-from .steady import SteadyState, energy_check, steady_state
+from .steady import SteadyState, energy_check, prepare_kernels, steady_state
 
 __all__ = [
     "integrate",
@@ -18,6 +19,7 @@ __all__ = [
     "Trajectory",
     "Restart",
     "steady_state",
+    "prepare_kernels",
     "SteadyState",
     "RunStatus",
     "SteadyStatus",

@@ -24,15 +24,10 @@ from ..kinematics import load_table, tangential_history
 __all__ = ["linear_start", "clean_states"]
 
 
-@jit(inline="always")
-def _df_solve(Z0, f, B, kc, X, have, rtol, xmax):  # pragma: no cover - compiled
-    """One solve of (Z0 + sum_c B_c k_c B_c^T) X = f into X.
-
-    Returns (ok, converged): ok False when X is non-finite or larger than
-    ``xmax`` (m); converged when X changed by at most ``rtol`` of its size
-    since the last solve (``have``: there was one).
-    """
-    n = f.shape[0]
+@jit
+def _df_matrix(Z0, B, kc):  # pragma: no cover - compiled
+    """Z0 + sum_c B_c k_c B_c^T (N/m): the dynamic stiffness with the contacts' describing functions."""
+    n = Z0.shape[0]
     Z = np.zeros((n, n), dtype=np.complex128)
     for a in range(n):
         for b in range(n):
@@ -41,7 +36,30 @@ def _df_solve(Z0, f, B, kc, X, have, rtol, xmax):  # pragma: no cover - compiled
         for a in range(n):
             for b in range(n):
                 Z[a, b] += B[i, a] * kc[i] * B[i, b]
-    Xn = np.linalg.solve(Z, f)
+    return Z
+
+
+def _df_solve(Z, f):
+    """Z^-1 f by LAPACK ``zgesv`` (what ``np.linalg.solve`` calls); None when Z
+    is not finite or singular. Called from Python: compiled, the solve costs
+    every process seconds of compilation for a few small solves."""
+    from scipy.linalg import lapack
+
+    if not np.all(np.isfinite(Z)):
+        return None
+    _, _, Xn, info = lapack.zgesv(Z, f)
+    return None if info != 0 else Xn
+
+
+@jit
+def _df_accept(Xn, X, have, rtol, xmax):  # pragma: no cover - compiled
+    """Accept the solve Xn (m) into X.
+
+    Returns (ok, converged): ok False when Xn is non-finite or larger than
+    ``xmax`` (m); converged when X changed by at most ``rtol`` of its size
+    since the last solve (``have``: there was one).
+    """
+    n = Xn.shape[0]
     big = 0.0
     diff = 0.0
     for a in range(n):
@@ -77,60 +95,36 @@ def _df_march(init, marcher, params, U, cycle, Nrow, u, T, kT, code, s0, sf):  #
     return ca, cb
 
 
-def _df_template(lin, contacts, cycle, opts, out):  # pragma: no cover - compiled
-    """Describing-function iteration of :func:`linear_start`, compiled (``INIT``, ``MARCH`` bound).
+def _df_template(contacts, cycle, X, kc, final, S_out):  # pragma: no cover - compiled
+    """One update of the describing-function iteration of :func:`linear_start`, compiled (``INIT``, ``MARCH`` bound).
 
-    ``lin = (Z0, f)``: dynamic stiffness without contacts (N/m) and forcing
-    (N); ``contacts = (B, kt, P)``: selection rows, stuck stiffnesses (N/m),
-    law parameters; ``cycle = (sin theta, cos theta, ns, N)``: the samples
-    (two cycles of ns, then theta = 0) and the normal loads per contact;
-    ``opts = (iterations, rtol, xmax m)``; ``out = (S, X)``. Returns False
-    if the iteration diverges (non-finite or absurdly large X); else writes
-    X (complex amplitudes, m) and the law states after the two-cycle march
-    of the final estimate. ``np.linalg.solve`` raises ``LinAlgError`` for a
-    singular dynamic stiffness.
+    ``contacts = (B, P)``: selection rows and law parameters; ``cycle =
+    (sin theta, cos theta, ns, N)``: the samples (two cycles of ns, then
+    theta = 0) and the normal loads per contact; ``X``: the current
+    estimate (complex amplitudes, m). Each contact's law is marched over
+    its displacement u = Im(U e^{i theta}), U = B_c X, from its virgin
+    state: unless ``final``, its describing function ``kc[c]`` (N/m) is
+    relaxed by 1/2 towards the first harmonic of the force over the second
+    cycle (a contact at rest keeps it); when ``final``, ``S_out[c]`` gets
+    the law state at the end of the march.
     """
-    Z0, f = lin
-    B, kt, P = contacts
+    B, P = contacts
     loads = cycle[3]
-    iters, rtol, xmax = opts
-    S_out, X_out = out
-    n, nc, L = f.shape[0], B.shape[0], loads.shape[1]
-    kc = np.zeros(nc, dtype=np.complex128)
-    for i in range(nc):
-        kc[i] = kt[i]
-    X = np.zeros(n, dtype=np.complex128)
-    U = np.zeros(nc, dtype=np.complex128)
+    n, nc, L = X.shape[0], B.shape[0], loads.shape[1]
     u, T, kT, code = np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L, dtype=np.int8)
     s0, sf = np.zeros(S_out.shape[1]), np.zeros(S_out.shape[1])
-    have = False
-    final = False
-    it = 0
-    while True:
-        if not final:
-            ok, conv = _df_solve(Z0, f, B, kc, X, have, rtol, xmax)
-            if not ok:
-                return False
-            have = True
-            it += 1
-            final = conv or it >= iters
-        for i in range(nc):
-            acc = 0.0 + 0.0j
-            for a in range(n):
-                acc += B[i, a] * X[a]
-            U[i] = acc
-        for i in range(nc):
-            if U[i] == 0 and not final:
-                continue
-            ca, cb = _df_march(INIT, MARCH, P[i], U[i], cycle, loads[i], u, T, kT, code, s0, sf)  # noqa: F821
-            if final:
-                S_out[i, :] = sf
-            else:
-                kc[i] = 0.5 * kc[i] + 0.5 * (2.0 / cycle[2]) * (ca + 1j * cb) / U[i]
+    for i in range(nc):
+        U = 0.0 + 0.0j
+        for a in range(n):
+            U += B[i, a] * X[a]
+        if U == 0 and not final:
+            continue
+        ca, cb = _df_march(INIT, MARCH, P[i], U, cycle, loads[i], u, T, kT, code, s0, sf)  # noqa: F821
         if final:
-            break
-    X_out[:] = X
-    return True
+            for r in range(sf.shape[0]):  # not a slice assignment: see drivers._march
+                S_out[i, r] = sf[r]
+        else:
+            kc[i] = 0.5 * kc[i] + 0.5 * (2.0 / cycle[2]) * (ca + 1j * cb) / U
 
 
 # the describing-function march: two cycles of 64 samples ending before t = 0
@@ -150,7 +144,8 @@ def linear_start(model):
     preload, marched with the real law),
     started from the stuck stiffness kt and iterated with relaxation 1/2
     until X changes by less than ``config.SS_LINEAR_RTOL`` (at most
-    ``config.SS_LINEAR_ITERS`` solves). The iteration is one compiled call
+    ``config.SS_LINEAR_ITERS`` solves). Each iteration is a LAPACK solve
+    (:func:`_df_solve`) and one compiled call marching every contact
     (``_df_template``). Returns x, v (m, m/s) and law states at t = 0 (law
     marched over the last two cycles of the estimate), or None if the
     iteration diverges.
@@ -164,15 +159,23 @@ def linear_start(model):
     S = np.zeros((pk.ncontacts, pk.slen))
     X = np.zeros(pk.ndof, dtype=np.complex128)
     run = specialize(_df_template, INIT=pk.init, MARCH=law_marcher(pk.step))
-    xscale = pk.fmax / pk.kmin + pk.xlin
-    opts = (config.SS_LINEAR_ITERS if pk.ncontacts else 1, config.SS_LINEAR_RTOL, 1e3 * xscale)
-    try:
-        ok = run((Z0, f), (pk.B, pk.kt, pk.P), (sin_th, cos_th, ns, loads), opts, (S, X))
-    except np.linalg.LinAlgError:
-        return None
-    if not ok:
-        return None
-    return np.imag(X).copy(), w * np.real(X).copy(), S
+    xmax = 1e3 * (pk.fmax / pk.kmin + pk.xlin)
+    iters = config.SS_LINEAR_ITERS if pk.ncontacts else 1
+    kc = pk.kt.astype(np.complex128)
+    have, final, it = False, False, 0
+    while True:
+        if not final:
+            Xn = _df_solve(_df_matrix(Z0, pk.B, kc), f)
+            if Xn is None:
+                return None
+            ok, conv = _df_accept(Xn, X, have, config.SS_LINEAR_RTOL, xmax)
+            if not ok:
+                return None
+            have, it = True, it + 1
+            final = conv or it >= iters
+        run((pk.B, pk.P), (sin_th, cos_th, ns, loads), X, kc, final, S)
+        if final:
+            return np.imag(X).copy(), w * np.real(X).copy(), S
 
 
 def clean_states(model, x, v, S, rdof, count):

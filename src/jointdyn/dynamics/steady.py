@@ -26,13 +26,13 @@ from .. import config
 from .._jit import jit
 from ..systems import System
 from ._core import N_SUMMARY, S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
-from ._model import Model, make_model, refine_if_opened
+from ._model import Model, make_model, pack_system, refine_if_opened
 from ._start import clean_states, linear_start
 from .integrate import Restart, Trajectory, _omega, _trajectory
 from .monodromy import fd_monodromy
 from .status import EnergyCheck, SteadyStatus
 
-__all__ = ["SteadyState", "energy_check", "steady_state"]
+__all__ = ["SteadyState", "energy_check", "prepare_kernels", "steady_state"]
 
 
 @dataclass(frozen=True)
@@ -731,6 +731,36 @@ def energy_check(work_force_J: float, energy_contact_J: float, energy_viscous_J:
     W, Ec, Ev = float(work_force_J), float(energy_contact_J), float(energy_viscous_J)
     tol = abs(W - Ec - Ev) + config.SS_DISSIPATION_FLOOR * (abs(W) + abs(Ec) + abs(Ev))
     return EnergyCheck.NEGATIVE_DISSIPATION if Ec < -tol else EnergyCheck.PASSIVE
+
+
+def prepare_kernels(systems) -> None:
+    """Compile, or load from the disk cache, the kernels :func:`steady_state` runs for ``systems``.
+
+    Process pools call this before they fork, so that their workers inherit
+    the compiled code: each would otherwise compile (or load) the same
+    kernels at the same time (on a cold cache, k workers compile everything
+    k times). For the first system of each set of kernels (law kernels,
+    springs, forcing phases) it runs, at gamma = 1, the
+    equivalent-linearisation start, one period of the step grid, the
+    rebuilding of the law states from it and the periodicity test on a
+    history too short to pass: milliseconds once compiled. A system that
+    steady_state refuses (ValueError) is left to the solve that reports it.
+    """
+    seen = set()
+    for system in systems:
+        pack = pack_system(system)
+        if (pack.runner, pack.init) in seen:
+            continue
+        seen.add((pack.runner, pack.init))
+        try:
+            model = make_model(system, _omega(system, 1.0), config.TI_STEPS_PER_PERIOD)
+        except ValueError:
+            continue
+        x, v, S = _first_state(model, None)
+        clean_states(model, x, v, S, 0, lambda res: None)
+        _periodic_arrays(np.empty((0, N_SUMMARY)), np.zeros((1, 2 * model.n)), 1, config.SS_CHECK_PERIODS, model.n,
+                         model.w, model.pack.K_stuck, model.pack.M, _amplitude_scale(model, 0.0), config.SS_AMP_RTOL,
+                         config.SS_ENERGY_RTOL, config.SS_BALANCE_RTOL)  # fmt: skip
 
 
 def _first_state(model, start):

@@ -88,9 +88,9 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
       (the continuation's unknowns and residual in units of order one).
 
     Per contact c: ``U = Xm Bm[c]``, its normal-load samples (prescribed,
-    or ``max(0, P + kn g)`` from ``G = Xm Bnm[c]`` for a spring,
-    :func:`_contact_loads`), restart of the law at the mean displacement
-    ``U[0]`` and the first load sample (``INIT_JVP``), AFT passes of
+    or ``max(0, P + kn g)`` from ``G = Xm Bnm[c]`` for a spring:
+    :func:`_prescribed_loads`, :func:`_spring_loads`), restart of the law
+    at the mean displacement ``U[0]`` and the first load sample (``INIT_JVP``), AFT passes of
     ``STEP_JVP`` (:func:`_pass`) until the force repeats, projection, and
     scatter ``R += b F``, ``JX += b (b^T dF/dU + bn^T dF/dG)``,
     ``Jp += b dF/dp``; a spring also adds its reaction ``bn P (N - P0)``
@@ -145,7 +145,10 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
     for c in range(nc):
         # the law restarted at the mean displacement, marched until its force repeats
         _contact_samples(lin[5], Bm, c, E, U, u)
-        _contact_loads(lin[5], con, Nsamp, c, E, nrm)
+        if SPRINGS and con[4][c, 1] > 0.0:  # noqa: F821 - bound by specialize
+            _spring_loads(lin[5], con, c, E, nrm)
+        else:
+            _prescribed_loads(Nsamp, c, nrm)
         prm = Pm[c]
         _restart(INIT_JVP, prm, U[0], Nc[0], km[0], dN[c, 0] if has_p else 0.0, has_p, E, dirs,  # noqa: F821
                  (a, bb, da, dbb))
@@ -157,7 +160,7 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
         err = np.inf
         period = PERIOD_NONE
         while passes < max_passes:
-            err, err2, tmax, cur = _pass(STEP_JVP, INIT_JVP, prm, (u, U), (Nc, km, nrm[0], nrm[1], con[4][c]), dN, c, has_p, events,  # noqa: F821
+            err, err2, tmax, cur = _pass(STEP_JVP, INIT_JVP, prm, (u, U), (Nc, km, nrm[0], nrm[1], con[4][c]), dN, c, has_p, SPRINGS, events,  # noqa: F821
                                          E, dirs, (a, bb, da, dbb), (Tc, dT, T1, T2, dT1, cprev), hist, code,
                                          passes, rtol)
             if cur == 1:  # committed state back in (a, da), once per pass
@@ -176,8 +179,8 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
         _project(c, P, Tc, dT, T, proj)
         for i in range(Nc.shape[0]):
             Nout[c, i] = Nc[i]
-        _scatter(c, con, proj, has_p, R, JX, Jp)
-        if con[4][c, 1] > 0.0:
+        _scatter(c, con, proj, has_p, SPRINGS, R, JX, Jp)  # noqa: F821 - bound by specialize
+        if SPRINGS and con[4][c, 1] > 0.0:  # noqa: F821 - bound by specialize
             _normal_reaction(c, con, four, nrm, R, JX)
         _update_info(info, passes, err, period)
     _scale_outputs(R, JX, Jp, scaled)
@@ -213,7 +216,7 @@ def _workspace(con, four, has_p, code):  # pragma: no cover - compiled
     states at every sample (small states only); projected force and
     derivatives; normal approach (coefficients, samples), normal-load
     samples, their slope dN/dg (kn closed, 0 open) and the projected
-    reaction with its derivative (:func:`_contact_loads`).
+    reaction with its derivative (:func:`_spring_loads`).
     """
     E = four[0]
     ssz = con[2]
@@ -283,12 +286,15 @@ def _project(c, P, Tc, dT, T, proj):  # pragma: no cover - compiled
     for i in range(Tc.shape[0]):
         T[c, i] = Tc[i]
     F, G = proj
-    F[:] = np.dot(P, Tc)
-    G[:, :] = np.dot(P, dT)
+    # into the outputs (the same BLAS product): an assignment of np.dot's
+    # result compiles numba's shape-mismatch error message (string
+    # formatting, about 3 s of cold compile)
+    np.dot(P, Tc, F)
+    np.dot(P, dT, G)
 
 
 @jit(inline="always")
-def _pass(step_jvp, init_jvp, prm, sig, nk, dN, c, has_p, events, E, dirs, st, pw, hist, code, passes,
+def _pass(step_jvp, init_jvp, prm, sig, nk, dN, c, has_p, spr, events, E, dirs, st, pw, hist, code, passes,
           rtol):  # pragma: no cover - compiled
     """One marched period: force samples ``Tc``, derivatives ``dT`` and codes of contact c.
 
@@ -323,7 +329,6 @@ def _pass(step_jvp, init_jvp, prm, sig, nk, dN, c, has_p, events, E, dirs, st, p
     ns = u.shape[0]
     nh = E.shape[1]
     nd = dxj.shape[0]
-    spr = nd - (1 if has_p else 0) > nh
     err = 0.0
     err2 = 0.0
     tmax = 0.0
@@ -343,7 +348,7 @@ def _pass(step_jvp, init_jvp, prm, sig, nk, dN, c, has_p, events, E, dirs, st, p
                 dxj[d] = E[i, d]
             if has_p:
                 dxj[nd - 1] = 0.0
-        if km[i] > 0.0 and km[i - 1 if i > 0 else ns - 1] == 0.0:
+        if spr and km[i] > 0.0 and km[i - 1 if i > 0 else ns - 1] == 0.0:
             # a spring closing between samples: virgin restart at the root of P + kn g
             xr = _spring_event(U, Gc, sp, 2.0 * np.pi * i / ns, 2.0 * np.pi / ns, gs[i - 1 if i > 0 else ns - 1],
                                gs[i], dxj)
@@ -634,7 +639,7 @@ def _load_state(s, ds, Sh, dSh, i):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _scatter(c, con, proj, has_p, R, JX, Jp):  # pragma: no cover - compiled
+def _scatter(c, con, proj, has_p, spr, R, JX, Jp):  # pragma: no cover - compiled
     """R[h n + i] += b_i F_h; JX[(h, i), (g, j)] += b_i (b_j G_hg + bn_j G_h,nh+g); Jp[h n + i] += b_i G_h,p.
 
     ``b = Bm[c]`` the tangential row, ``bn = Bnm[c]`` the normal row (the
@@ -646,7 +651,6 @@ def _scatter(c, con, proj, has_p, R, JX, Jp):  # pragma: no cover - compiled
     n = Bm.shape[1]
     nh = F.shape[0]
     ip = G.shape[1] - 1
-    spr = con[5]
     for h in range(nh):
         for i in range(n):
             bi = Bm[c, i]
@@ -669,35 +673,41 @@ def _scatter(c, con, proj, has_p, R, JX, Jp):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _contact_loads(X, con, Nsamp, c, E, nrm):  # pragma: no cover - compiled
-    """Normal-load samples ``Nc`` of contact c and their slope ``km`` = dN/dg.
+def _prescribed_loads(Nsamp, c, nrm):  # pragma: no cover - compiled
+    """Normal-load samples ``Nc = Nsamp[c]`` of a contact with a prescribed load, slope ``km`` = dN/dg = 0."""
+    Nc, km = nrm[2], nrm[3]
+    for i in range(Nc.shape[0]):
+        Nc[i] = Nsamp[c, i]
+        km[i] = 0.0
 
-    Prescribed load: ``Nc = Nsamp[c]``, ``km = 0``. Spring (``Sp[c] = (P,
-    kn)``, kn > 0): the approach g = Bnm[c] . x sampled from the
-    coefficients, ``Nc = max(0, P + kn g)`` and ``km = kn`` where closed
-    (``P + kn g > 0``), 0 where open (the law separates at N <= 0).
+
+@jit
+def _spring_loads(X, con, c, E, nrm):  # pragma: no cover - compiled
+    """Normal-load samples ``Nc`` of spring contact c and their slope ``km`` = dN/dg.
+
+    ``Sp[c] = (P, kn)``, kn > 0: the approach g = Bnm[c] . x sampled from
+    the coefficients, ``Nc = max(0, P + kn g)`` and ``km = kn`` where closed
+    (``P + kn g > 0``), 0 where open (the law separates at N <= 0). A plain
+    compiled function, called only by evaluations of systems with springs
+    (like :func:`_normal_reaction` and :func:`_spring_event`), so that the
+    others compile none of the spring work.
     """
     Gc, gs, Nc, km = nrm[0], nrm[1], nrm[2], nrm[3]
     Sp = con[4]
     P0 = Sp[c, 0]
     kn = Sp[c, 1]
-    if kn > 0.0:
-        _contact_samples(X, con[3], c, E, Gc, gs)
-        for i in range(Nc.shape[0]):
-            v = P0 + kn * gs[i]
-            if v > 0.0:
-                Nc[i] = v
-                km[i] = kn
-            else:
-                Nc[i] = 0.0
-                km[i] = 0.0
-    else:
-        for i in range(Nc.shape[0]):
-            Nc[i] = Nsamp[c, i]
+    _contact_samples(X, con[3], c, E, Gc, gs)
+    for i in range(Nc.shape[0]):
+        v = P0 + kn * gs[i]
+        if v > 0.0:
+            Nc[i] = v
+            km[i] = kn
+        else:
+            Nc[i] = 0.0
             km[i] = 0.0
 
 
-@jit(inline="always")
+@jit
 def _normal_reaction(c, con, four, nrm, R, JX):  # pragma: no cover - compiled
     """Reaction of spring contact c: R[h n + i] += bn_i Fn_h, JX[(h, i), (g, j)] += bn_i bn_j dFn_hg.
 
@@ -758,6 +768,11 @@ def _scale_outputs(R, JX, Jp, scaled):  # pragma: no cover - compiled
                 JXs[i, j] = JX[i, j] * scl[1]
 
 
-def eval_kernel(step_jvp, init_jvp):
-    """The compiled HB evaluation with a law's ``step_jvp`` and ``init_jvp`` bound (disk-cached)."""
-    return specialize(_eval_template, STEP_JVP=step_jvp, INIT_JVP=init_jvp)
+def eval_kernel(step_jvp, init_jvp, springs: bool = False):
+    """The compiled HB evaluation with a law's ``step_jvp`` and ``init_jvp`` bound (disk-cached).
+
+    ``springs`` (some contact's normal load comes from a normal spring; it
+    must equal ``con[5]`` of every call) is a compile-time constant: the
+    evaluations of other systems compile none of the spring work.
+    """
+    return specialize(_eval_template, STEP_JVP=step_jvp, INIT_JVP=init_jvp, SPRINGS=bool(springs))

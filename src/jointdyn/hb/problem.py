@@ -222,7 +222,7 @@ class HBProblem:
         if nc:
             disp = law_dispatch([c.law for c in self.contacts])
             self._Pm, self._ssz = disp.P, disp.state_size
-            self._kernel = eval_kernel(disp.step_jvp, disp.init_jvp)
+            self._kernel = eval_kernel(disp.step_jvp, disp.init_jvp, self.has_springs)
         else:
             self._Pm, self._ssz = _pad_rows([]), 1
             self._kernel = eval_kernel(no_contact_step_jvp, no_contact_init_jvp)

@@ -33,35 +33,44 @@ import numpy as np
 from .._jit import jit, specialize
 from ._base import SEPARATION
 
-__all__ = ["MAX_LAW_SLOTS", "LawDispatch", "law_dispatch"]
+__all__ = ["MAX_LAW_SLOTS", "LawDispatch", "law_dispatch", "no_contact_step", "no_contact_step_jvp",
+           "no_contact_init", "no_contact_init_jvp"]
 
 #: most kernel families in one system (slots of the dispatchers)
 MAX_LAW_SLOTS = 4
 
 
-# --- kernels of unused slots (never reached: no row carries their slot) ------------
+# --- kernels that exert no force -------------------------------------------------------
+# bound for the unused slots of the dispatchers (no row carries their slot) and,
+# re-exported by jointdyn.kinematics, in the compiled loops of systems without
+# contacts (no contact to call them); they are not a contact law and are
+# registered nowhere
 
 
 @jit
-def _unused_step(params, s_old, s_new, x, N):  # pragma: no cover - never reached
+def no_contact_step(params, s_old, s_new, x, N):  # pragma: no cover - never reached
+    """Kernel that exerts no force (unused slots, systems without contacts)."""
     return 0.0, 0.0, SEPARATION
 
 
 @jit
-def _unused_step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT):  # pragma: no cover - never reached
+def no_contact_step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT):  # pragma: no cover - never reached
+    """Forward-mode twin of :func:`no_contact_step` (no force, no derivative)."""
     for j in range(dT.shape[0]):
         dT[j] = 0.0
     return 0.0, 0.0, SEPARATION
 
 
 @jit
-def _unused_init(params, x0, n0, s):  # pragma: no cover - never reached
+def no_contact_init(params, x0, n0, s):  # pragma: no cover - never reached
+    """Virgin state of :func:`no_contact_step` (zeros)."""
     for r in range(s.shape[0]):
         s[r] = 0.0
 
 
 @jit
-def _unused_init_jvp(params, x0, dx0, n0, dn0, s, ds):  # pragma: no cover - never reached
+def no_contact_init_jvp(params, x0, dx0, n0, dn0, s, ds):  # pragma: no cover - never reached
+    """:func:`no_contact_init` with derivatives (all zero)."""
     for r in range(s.shape[0]):
         s[r] = 0.0
         for j in range(ds.shape[1]):
@@ -128,10 +137,10 @@ def _init_jvp_template(params, x0, dx0, n0, dn0, s, ds):  # pragma: no cover - c
 
 
 _TEMPLATES = (
-    ("step", _step_template, _unused_step),
-    ("step_jvp", _step_jvp_template, _unused_step_jvp),
-    ("init", _init_template, _unused_init),
-    ("init_jvp", _init_jvp_template, _unused_init_jvp),
+    ("step", _step_template, no_contact_step),
+    ("step_jvp", _step_jvp_template, no_contact_step_jvp),
+    ("init", _init_template, no_contact_init),
+    ("init_jvp", _init_jvp_template, no_contact_init_jvp),
 )
 
 

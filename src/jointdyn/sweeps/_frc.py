@@ -248,7 +248,19 @@ def _executor(family, client, n_workers, nlines, on_point):
     workers = default_workers() if n_workers is None else n_workers
     if workers <= 1 or nlines == 1:
         return SerialExecutor(systems, on_point=on_point)
+    if config.SWEEP_POOL == "process":
+        _prepare_kernels(systems)
     return LocalExecutor(systems, min(workers, nlines), config.SWEEP_POOL)
+
+
+def _prepare_kernels(systems) -> None:
+    """Compile the steady-state kernels here before a process pool forks (its
+    workers inherit them instead of each compiling the same at once); not
+    when tests swapped the solver."""
+    from ..dynamics import prepare_kernels, steady_state
+
+    if _steady_state_fn() is steady_state:
+        prepare_kernels(systems)
 
 
 def _line_runs(family, directions, g, spp, dofs, loop_outputs) -> list:
