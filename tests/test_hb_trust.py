@@ -342,7 +342,9 @@ def test_grid_folds_are_jumps_of_time_domain_sweeps():
     assert c is not None and len(c.folds) >= 2
     assert c.verdict is FoldVerdict.CONFIRMED
     assert all(c.folds[0] < g < c.folds[-1] for g in c.inside_apart) and len(c.inside_apart) >= 3
-    outside = [i for i, g in enumerate(c.gammas) if g < c.folds[0] - 1e-4 or g > c.folds[-1] + 1e-4]
-    for i in outside:  # one orbit away from the folds: the sweeps agree there
+    # away from the folds (the closed form's time-domain jump lies within 3e-4 of the HB fold) one orbit:
+    outside = [i for i, g in enumerate(c.gammas) if g < c.folds[0] - 1e-3 or g > c.folds[-1] + 1e-3]
+    assert len(outside) >= 2
+    for i in outside:
         assert abs(c.q_up[i] - c.q_down[i]) <= 0.02 * abs(c.q_down[i])
     assert fold_check("iwan", 0.5, 2.0) is None
