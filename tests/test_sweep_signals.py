@@ -68,9 +68,12 @@ def _wait_until(cond, what: str):
 
 
 #: runs the CLI with every steady state slowed by 20 ms (the real solver's
-#: results; the delay gives the test time to interrupt halfway)
+#: results; the delay gives the test time to interrupt halfway), with SIGINT
+#: handled as in a terminal's foreground job (a test runner started in the
+#: background of a non-interactive shell passes SIGINT on ignored)
 SLOW_CLI = (
-    "import sys, time\n"
+    "import signal, sys, time\n"
+    "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
     "import jointdyn.sweeps._frc as f\n"
     "real = f._steady_state_fn()\n"
     "def slow(*a, **k):\n"
@@ -139,6 +142,7 @@ def test_sigint_keeps_finished_points_and_the_rerun_reuses_them(tmp_path):
     try:
         _wait_until(lambda: len(list(out.glob("lines/*/*.npz"))) >= 3 or p.poll() is not None,
                     "no chunk was saved")
+        assert p.poll() is None, "the sweep ended before it could be interrupted"
         workers = _children(p.pid)
         os.killpg(p.pid, signal.SIGINT)  # Ctrl-C: the whole process group
         stdout, stderr = p.communicate(timeout=HANG_GUARD_S)
