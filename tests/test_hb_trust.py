@@ -348,3 +348,14 @@ def test_grid_folds_are_jumps_of_time_domain_sweeps():
     for i in outside:
         assert abs(c.q_up[i] - c.q_down[i]) <= 0.02 * abs(c.q_down[i])
     assert fold_check("iwan", 0.5, 2.0) is None
+
+
+def test_grid_does_not_pass_a_peak_inside_a_jump():
+    """Jenkins at eta 10, beta 5: the continuation jumps from gamma 1.2007 to
+    1.2107 over the resonance (the time domain peaks near 1.202 at q 9.69,
+    the branch's highest point is q 9.50 at the jump's end): the grid calls
+    this a peak in a jump and does not pass it as 'no peak'."""
+    from jointdyn.sweeps.hb_grid import Verdict, grid_case
+
+    c = grid_case("jenkins", 10.0, 5.0)
+    assert c.verdict is Verdict.PEAK_IN_JUMP and not c.ok

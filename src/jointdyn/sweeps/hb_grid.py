@@ -59,6 +59,8 @@ class Verdict(Status):
     AGREES = "agrees", "the peak is within the tolerance of the time-domain steady state", True
     DIFFERS = "differs", "the peak is off the time-domain steady state by more than the tolerance"
     NO_PEAK = "no peak", "no peak to compare (unbounded, or the amplitude has no maximum)", True
+    PEAK_IN_JUMP = ("peak in a jump", "the highest amplitude lies at a jump of the branch over a discontinuity "
+                    "of the contact force: the peak between the jump's ends is not resolved")
     NOT_PERIODIC = "not periodic", "the time domain found no periodic steady state at the peak", True
     SUBHARMONIC = ("subharmonic", "the time-domain steady state repeats only every p > 1 forcing periods: "
                    "a period-one harmonic balance cannot be that orbit (not compared)")
@@ -148,6 +150,8 @@ def grid_case(model: str, eta: float, beta: float, gamma=GRID_GAMMA, *, time_dom
     covered = status == "complete" or (status == "unbounded" and beta < DEN_HARTOG_BETA)
     g_pk, q_pk = float(ds.attrs["peak_gamma"]), float(ds.attrs["peak_amplitude_q"])
     check = _time_check(system, br, g_pk, q_pk, rtol) if time_domain and math.isfinite(g_pk) else None
+    if not math.isfinite(g_pk) and _highest_at_jump(ds):
+        check = (Verdict.PEAK_IN_JUMP, math.nan, 0, math.nan)
     verdict, q_td, period, q_rest = check or (Verdict.NO_PEAK, math.nan, 0, math.nan)
     err = (q_pk - q_td) / q_td if verdict in (Verdict.AGREES, Verdict.DIFFERS) else math.nan
     ok = covered and verdict.ok
@@ -157,6 +161,16 @@ def grid_case(model: str, eta: float, beta: float, gamma=GRID_GAMMA, *, time_dom
                     time_period=period, rest_q=q_rest, peak_error=err, verdict=verdict, seconds=seconds,
                     harmonics=int(ds.attrs["harmonics"]), samples=int(ds.attrs["samples"]),
                     message=str(ds.attrs["message"]))
+
+
+def _highest_at_jump(ds) -> bool:
+    """True when the branch's highest amplitude is a point reached by a jump, or the point the jump left."""
+    q = np.asarray(ds["amplitude_q"].values, dtype=float)
+    if not np.isfinite(q).any():
+        return False
+    i = int(np.nanargmax(q))
+    after = np.asarray(ds["point_status"].values) == "after-jump"
+    return bool(after[i] or (i + 1 < after.size and after[i + 1]))
 
 
 def _time_check(system, br, g_pk: float, q_pk: float, rtol: float):
