@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..status import Status
+from ._points import STATUS_CODES
 from .hb_grid import GRID_GAMMA
 
 __all__ = ["FoldCheck", "FoldVerdict", "fold_check", "fold_table"]
@@ -39,7 +40,7 @@ MIN_MARGIN = 1e-3
 #: points strictly between two neighbouring folds
 INNER_POINTS = 5
 #: periodic status code of a sweep's points (``frc_sweep``'s ``status`` variable)
-PERIODIC = 0
+PERIODIC = STATUS_CODES["periodic"]
 
 
 class FoldVerdict(Status):
