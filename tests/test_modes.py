@@ -18,6 +18,7 @@ import jointdyn as jd
 import reference_modes as ref
 import tolerances as tol
 from jointdyn.modes import EPMCProblem, ModeStatus, backbone_dataset, epmc
+from modes_support import solve_at
 from reference_tmdsimpy import HARMONICS, SAMPLES, TMDSIMPY_JENKINS_EPMC
 
 M_, K_, KT, FY = 10.0, 3.9e5, 3.0e5, 50.0
@@ -36,14 +37,7 @@ def _damper(model="iwan", **kw):
     return jd.System.paper_damper(eta=0.0, model=model, **kw)
 
 
-def _at(backbone, amplitude):
-    """(omega, xi, X) of the EPMC solution at exactly ``amplitude`` (m), from the nearest backbone point."""
-    p = backbone.problem
-    i = int(np.argmin(np.abs(np.log(backbone.amplitude_m / amplitude))))
-    v, ok, _ = p.solve(amplitude, p.pack(backbone.X[i], backbone.omega_rad_s[i], backbone.xi_rad_s[i]))
-    assert ok
-    X, w, xi = p.unpack(v, math.log10(amplitude))
-    return w, xi, X
+_at = solve_at  # (omega, xi, X) of the EPMC solution at exactly an amplitude
 
 
 @pytest.mark.parametrize("model", ["jenkins", "iwan", "iwan-closed"])

@@ -17,6 +17,7 @@ import pytest
 import jointdyn as jd
 import tolerances as tol
 from jointdyn.modes import EPMCProblem, ModeStatus, epmc
+from modes_support import solve_at
 
 N = 60
 H = 3
@@ -40,11 +41,7 @@ def _chain(n=N):
 
 def _at(backbone, amplitude):
     """(omega, damping ratio, X) of the backbone's problem solved at exactly ``amplitude`` (m)."""
-    p = backbone.problem
-    i = int(np.argmin(np.abs(np.log(backbone.amplitude_m / amplitude))))
-    v, ok, _ = p.solve(amplitude, p.pack(backbone.X[i], backbone.omega_rad_s[i], backbone.xi_rad_s[i]))
-    assert ok
-    X, w, xi = p.unpack(v, math.log10(amplitude))
+    w, xi, X = solve_at(backbone, amplitude)
     return w, xi / (2.0 * w), X
 
 
