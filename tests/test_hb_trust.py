@@ -350,12 +350,52 @@ def test_grid_folds_are_jumps_of_time_domain_sweeps():
     assert fold_check("iwan", 0.5, 2.0) is None
 
 
-def test_grid_does_not_pass_a_peak_inside_a_jump():
-    """Jenkins at eta 10, beta 5: the continuation jumps from gamma 1.2007 to
-    1.2107 over the resonance (the time domain peaks near 1.202 at q 9.69,
-    the branch's highest point is q 9.50 at the jump's end): the grid calls
-    this a peak in a jump and does not pass it as 'no peak'."""
+def test_grid_finds_the_peak_the_continuation_jumped_over():
+    """Jenkins at eta 10, beta 5: the continuation stalls at gamma 1.2007 and
+    jumps to 1.2107, over the resonance the time domain finds near 1.202 at
+    q 9.69. Continued back from the jump's end, the branch reaches the peak;
+    it agrees with the time-domain steady state there."""
     from jointdyn.sweeps.hb_grid import Verdict, grid_case
 
     c = grid_case("jenkins", 10.0, 5.0)
-    assert c.verdict is Verdict.PEAK_IN_JUMP and not c.ok
+    assert c.covered and c.verdict is Verdict.AGREES and c.ok
+    assert 1.200 < c.peak_gamma < 1.203 and abs(c.peak_q - 9.69) <= 0.01 * 9.69
+    assert abs(c.peak_q - c.time_q) <= 0.01 * c.time_q
+
+
+def test_a_peak_at_a_sharp_fold_past_a_jump_is_reported_at_the_stop(capsys):
+    """Jenkins at eta 10, beta 10, 15 harmonics and 128 samples: both flanks of
+    the resonance stall near q 9.38 (gamma 1.2041 and 1.2107); the top of the
+    branch between them rises to a sharp fold near gamma 1.2038. Continued back
+    over the jump, the branch follows the top to the fold and reports the peak
+    there as found at a stop (not refined). Oracles: no harmonic-balance
+    solution solved afresh on the stretch between the flanks is higher, the
+    time-domain steady state from rest at gamma 1.208 lies on that top, below
+    the peak, and so do the flanks' stalls."""
+    from jointdyn.dynamics import steady_state
+    from jointdyn.hb import continue_hb
+
+    system = System.paper_damper(eta=10.0, beta=10.0, model="jenkins")
+    law = system.contacts[0].law
+    br = continue_hb(system, 0.6, 1.8, max_step=0.01, harmonics=15, samples=128)
+    assert br.status == "complete" and "traced back from the point after a jump" in br.message
+    top = max(br.peaks, key=lambda pk: pk.amplitude_q)
+    assert top.at_stop and not top.refined and top.segment >= 1
+    assert 1.2036 < top.gamma < 1.2042 and top.amplitude_q > 9.55
+    # the flanks' stalls (the points next to the jump) lie below it
+    left = int(np.flatnonzero(br.gap)[0]) - 1
+    assert br.point_status[left + 1] == PointStatus.AFTER_JUMP
+    assert top.amplitude_q > 1.015 * 9.38
+    # harmonic balance afresh on the stretch, from the peak's coefficients: nothing higher
+    for g in np.linspace(top.gamma, 1.2105, 7):
+        sol = harmonic_balance(system, float(g), harmonics=15, samples=128, guess=top.X)
+        if sol.converged:
+            assert law.kt * sol.amplitude_m / law.fy <= top.amplitude_q * (1 + 1e-6)
+    ss = steady_state(system, 1.208)
+    assert ss.status == "periodic" and ss.period_multiple == 1
+    q_td = law.kt * ss.amplitude_m / law.fy
+    assert 9.40 < q_td < top.amplitude_q
+    # reported as such in the CLI's JSON
+    rc, out, _ = _cli_hb(capsys, "--model", "jenkins", "--eta", "10", "--beta", "10", "--harmonics", "15",
+                         "--samples", "128")
+    assert rc == 0 and any(pk["at_stop"] and not pk["refined"] for pk in out["peaks"])

@@ -414,7 +414,7 @@ def _hb_branches(br) -> list:
         one["stable"] = [bool(s) for s in br.stable[idx]]
         one["point_status"] = [str(s) for s in br.point_status[idx]]
         one["folds"] = [int(i) for i in np.flatnonzero(br.fold[idx])]
-        one["branch"] = int(b)  # the segment (0: from START, 1: continued back from STOP)
+        one["branch"] = int(b)  # the segment (0: from START; then continued back from STOP or over a jump)
         out.append(one)
     return out
 
@@ -422,7 +422,8 @@ def _hb_branches(br) -> list:
 def _hb_peaks(br) -> list:
     """The refined peaks of an HBBranch as JSON objects."""
     return [{"gamma": pk.gamma, "amplitude_q": _jsonable([pk.amplitude_q])[0],
-             "amplitude_m": _jsonable([pk.amplitude_m])[0], "branch": pk.segment, "refined": pk.refined}
+             "amplitude_m": _jsonable([pk.amplitude_m])[0], "branch": pk.segment, "refined": pk.refined,
+             "at_stop": pk.at_stop}
             for pk in br.peaks]
 
 
@@ -502,8 +503,8 @@ _JOINED = ("joined", "corner")
 
 def _plot_hb(ax, result) -> None:
     """hb branches: stable (solid) and unstable (dashed) lines, broken before every point not joined to
-    the previous one; folds (squares), points where a segment stopped short (red x), refined peaks (^),
-    parts of the range without points (hatched)."""
+    the previous one; folds (squares), points where a segment stopped short (red x), peaks (^; open where
+    found at a stop), parts of the range without points (hatched)."""
     first = {}
     for br in result["branches"]:
         g = np.array(br["gamma"], float)
@@ -526,9 +527,11 @@ def _plot_hb(ax, result) -> None:
                 first[name] = True
     for pk in result.get("peaks", []):
         if pk["amplitude_q"] is not None:
+            # a peak where the branch could be followed only up to it: an open marker (a lower bound)
+            name = "peak at a stop (at least)" if pk.get("at_stop") else "peak"
             ax.plot([pk["gamma"]], [pk["amplitude_q"]], "^", color="C2", ms=5,
-                    label="peak" if "peak" not in first else None)
-            first["peak"] = True
+                    mfc="none" if pk.get("at_stop") else "C2", label=name if name not in first else None)
+            first[name] = True
     what = "no bounded response" if result["status"] == "unbounded" else "not computed"
     for k, (a, b) in enumerate(result["uncovered"]):
         ax.axvspan(a, b, facecolor="0.9", edgecolor="0.6", hatch="//", lw=0, label=what if k == 0 else None)

@@ -31,6 +31,12 @@ The branch computed up to that point is kept, and a second segment is
 continued from ``stop`` backwards, so the Dataset shows both flanks with
 ``attrs["status"] == "unbounded"``. The same is done after a failure of
 the corrector (status stays ``failed``, the message says where).
+
+After each jump of the continuation (over a discontinuity of the force,
+or a stretch the corrector could not follow), a segment is continued back
+from the point after the jump towards the point it left, so that a
+resonance peak in that stretch is found (:attr:`HBPeak.at_stop` where the
+curve could be followed only up to it).
 """
 
 from __future__ import annotations
@@ -145,6 +151,12 @@ class HBPeak:
         Segment of the branch it lies on.
     refined : bool
         True when the refinement converged (else the best point found).
+    at_stop : bool
+        True when the highest point found is where a segment continued
+        back over a jump stopped (the corrector could not follow the curve
+        further, typically at a sharp fold of a non-smooth branch): not
+        refined; the maximum of the branch is at least this amplitude and
+        lies between this point and the point the jump left.
     """
 
     lam: float
@@ -154,6 +166,7 @@ class HBPeak:
     amplitude_q: float
     segment: int
     refined: bool
+    at_stop: bool = False
 
 
 @dataclass(frozen=True)
@@ -179,7 +192,9 @@ class HBBranch:
         Harmonic coefficients, m.
     segment : ndarray of int (points,)
         0 for the branch from the start, 1 for the one continued back from
-        the end after a stop short of it.
+        the end after a stop short of it; then one per jump, continued back
+        from the point after the jump towards the point it left (the
+        stretch the jump passed over, where a peak may lie).
     fold : ndarray of bool
         Turning points in the parameter (see :func:`branch_dataset`).
     gap : ndarray of bool
@@ -511,6 +526,41 @@ def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress) -> 
                                        progress=bar, observe=tr.observe_step, lam_name=problem.parameter.name))
 
 
+def _gap_fills(tr: _Tracker, parts, span: float, opt: ContinuationOptions, progress) -> list:
+    """Segments continued back from the point after each jump of ``parts`` towards the point it left.
+
+    A jump passes over a stretch of the branch the corrector could not
+    follow (a fold or a sharp rise at a corner of the contact force, where
+    a resonance peak may lie). Continued from the other side, the curve is
+    usually followable up to the same obstacle, so the stretch between is
+    traced and its peak found. Only a jump that may hide a peak is filled
+    (:func:`_may_hide_a_peak`). Each fill is bounded by the parameter range
+    of its jump and one largest parameter step beyond the point the jump
+    left (so that a fold just past that point is passed); its own jumps are as long as those of the branch (range
+    ``span``, scaled), not scaled down to its short range. Its status
+    (often a stall at the obstacle) is named in the branch's message but
+    does not decide the branch's status.
+
+    Returns a list of ``(fill, y_left)``: the segment and the scaled
+    unknowns of the point the jump left.
+    """
+    name = tr.problem.parameter.name
+    fills = []
+    for p in parts:
+        for i in np.flatnonzero(p.gap):
+            if not _may_hide_a_peak(tr, p, i):
+                continue
+            end = p.lam[i - 1] + math.copysign(min(opt.max_dlam, span), p.lam[i - 1] - p.lam[i])
+            reach = abs(p.lam[i] - end)
+            fopt = dataclasses.replace(opt, jump_fractions=tuple(f * span / reach for f in opt.jump_fractions))
+            with _bar(opt.max_points, f"HB {name} (gap)", progress) as bar:
+                fill = tr.relabel(continuation(tr.residual, p.y[i], p.lam[i], end, fopt,
+                                               monitor=_FillMonitor(tr, p.lam[i - 1], p.lam[i], p.y[i - 1]),
+                                               progress=bar, observe=tr.observe_step, lam_name=name))
+            fills.append((fill, p.y[i - 1]))
+    return fills
+
+
 def continue_hb(system: System, start: float, stop: float, *, parameter="gamma", gamma: float | None = None,
                 harmonics: int | str = AUTO, samples: int | str = AUTO,
                 max_step: float | None = None, response_dof: int | None = None,
@@ -632,7 +682,8 @@ def _fixed_branch(req: _Request, level) -> HBBranch:
     # on a flank that grows without bound
     if res.status in _GO_BACK and req.backward:
         parts.append(_segment(tr, req.stop, req.start, opt, req.progress))
-    return _join(tr, parts, req.start, req.stop, opt)
+    fills = _gap_fills(tr, parts, abs(req.stop - req.start) / tr.scales[2], opt, req.progress)
+    return _join(tr, parts, fills, req.start, req.stop, opt)
 
 
 def _first_level(harmonics, samples):
@@ -802,10 +853,20 @@ def _point_status(res: ContinuationResult) -> np.ndarray:
     return out
 
 
-def _join(tr: _Tracker, parts, start, stop, opt) -> HBBranch:
-    """The HBBranch of the continued segments (unscaled), with its status, peaks and coverage."""
+def _join(tr: _Tracker, parts, fills, start, stop, opt) -> HBBranch:
+    """The HBBranch of the continued segments (unscaled), with its status, peaks and coverage.
+
+    ``parts``: the segment from the start and the one continued back from
+    the end; they decide the status. ``fills``: the segments continued back
+    over jumps with the points the jumps left (:func:`_gap_fills`),
+    appended after them.
+    """
     problem = tr.problem
     xs, _, ps = tr.scales
+    status, message, uncovered = _coverage(parts, start, stop, ps, problem.parameter.name)
+    message += _fills_message([f for f, _ in fills], ps, problem.parameter.name)
+    main = len(parts)
+    parts = [*parts, *(f for f, _ in fills)]
     lam = np.concatenate([p.lam * ps for p in parts])
     joined = _Parts(
         lam=lam,
@@ -817,15 +878,55 @@ def _join(tr: _Tracker, parts, start, stop, opt) -> HBBranch:
         counters={**{k: sum(p.counters.get(k, 0) for p in parts) for k in parts[0].counters},
                   "segments": len(parts)},
     )
-    status, message, uncovered = _coverage(parts, start, stop, ps, problem.parameter.name)
     if joined.counters.get("jumps", 0):
         message += (f"; {joined.counters['jumps']} jump(s) over discontinuities of the contact force "
                     "(points with point_status 'after-jump')")
     logqs = [np.array([tr.observe(y, 0.0) for y in p.y]) for p in parts]
-    peaks = [pk for i, (p, g) in enumerate(zip(parts, logqs)) for pk in _peaks(tr, p, g, i, opt)]
+    peaks = [pk for i, (p, g) in enumerate(zip(parts[:main], logqs)) for pk in _peaks(tr, p, g, i, opt)]
+    peaks += [pk for k, (f, y_left) in enumerate(fills)
+              for pk in _fill_peak(tr, f, logqs[main + k], tr.observe(y_left, 0.0), main + k, opt)]
     logq = np.concatenate(logqs)
     joined = dataclasses.replace(joined, fold=_turning_mask(joined.lam, logq, joined.segment, joined.gap, start, stop))
     return _make_branch(tr, status, message, joined, peaks, uncovered)
+
+
+class _FillMonitor:
+    """The tracker's monitor, and the end of a segment continued back over a jump once it is past the point
+    the jump left (parameter ``lam_left``, scaled; coming from ``lam_after``) and below its amplitude: from
+    there on it retraces the branch already computed."""
+
+    def __init__(self, tr: _Tracker, lam_left: float, lam_after: float, y_left):
+        self.tr, self.lam_left, self.g_left = tr, lam_left, tr.observe(y_left, 0.0)
+        self.direction = math.copysign(1.0, lam_left - lam_after)
+
+    def __call__(self, y, lam_s):
+        stop = self.tr.monitor(y, lam_s)
+        if stop is not None:
+            return stop
+        if (lam_s - self.lam_left) * self.direction > 0 and self.tr.observe(y, lam_s) < self.g_left:
+            name = self.tr.problem.parameter.name
+            return ContinuationStatus.COMPLETE, (f"passed the point the jump left ({name} = "
+                                                 f"{self.lam_left * self.tr.scales[2]:.6g}) below its amplitude")
+        return None
+
+
+def _may_hide_a_peak(tr: _Tracker, p: ContinuationResult, i: int) -> bool:
+    """True when the amplitude rises into the jump to point i of segment p and falls after it (a maximum
+    may lie in the stretch passed over); False for a jump on a flank (the closed forms' force jumps)."""
+    if i < 2 or i + 1 >= p.lam.size or p.gap[i - 1] or p.gap[i + 1]:
+        return False
+    g = [tr.observe(p.y[k], 0.0) for k in (i - 2, i - 1, i, i + 1)]
+    return bool(g[1] >= g[0] and g[3] <= g[2])
+
+
+def _fills_message(fills, ps, name) -> str:
+    """Where each segment continued back over a jump went, for the branch's message."""
+    out = ""
+    for f in fills:
+        if f.lam.size:
+            out += (f"; traced back from the point after a jump at {name} = {f.lam[0] * ps:.6g}: "
+                    f"{f.status} ({f.message})")
+    return out
 
 
 def _span(p: ContinuationResult, ps):
@@ -882,18 +983,45 @@ def _peaks(tr: _Tracker, res: ContinuationResult, g, segment: int, opt) -> list:
     its points (HBPeak)."""
     if res.lam.size < 3:
         return []
+    return [_refined_peak(tr, res, g, i, segment, opt) for i in local_maxima(g, res.gap, config.HB_PEAK_PROMINENCE)]
+
+
+def _refined_peak(tr: _Tracker, res: ContinuationResult, g, i: int, segment: int, opt) -> HBPeak:
+    """The HBPeak near the interior point i of a segment, refined between its neighbours."""
+    y, lam_s, gv, ok = refine_maximum(tr.residual, tr.observe, res.y[i - 1:i + 2], res.lam[i - 1:i + 2], opt)
+    if not gv >= g[i]:  # the refinement found nothing higher: keep the branch point
+        y, lam_s, gv, ok = res.y[i], res.lam[i], g[i], False
+    return _peak(tr, y, lam_s, segment, ok)
+
+
+def _peak(tr: _Tracker, y, lam_s: float, segment: int, refined: bool, at_stop: bool = False) -> HBPeak:
+    """HBPeak at the scaled unknowns y and parameter lam_s."""
     xs, _, ps = tr.scales
-    out = []
-    for i in local_maxima(g, res.gap, config.HB_PEAK_PROMINENCE):
-        y, lam_s, gv, ok = refine_maximum(tr.residual, tr.observe, res.y[i - 1:i + 2], res.lam[i - 1:i + 2], opt)
-        if not gv >= g[i]:  # the refinement found nothing higher: keep the branch point
-            y, lam_s, gv, ok = res.y[i], res.lam[i], g[i], False
-        lam = float(lam_s * ps)
-        amp = tr.amplitudes(y)[0]
-        gam = lam if tr.problem.parameter is GAMMA else float(tr.problem.gamma_fixed)
-        out.append(HBPeak(lam=lam, gamma=gam, X=y * xs, amplitude_m=float(amp), amplitude_q=float(tr.q(amp)),
-                          segment=segment, refined=ok))
-    return out
+    lam = float(lam_s * ps)
+    amp = tr.amplitudes(y)[0]
+    gam = lam if tr.problem.parameter is GAMMA else float(tr.problem.gamma_fixed)
+    return HBPeak(lam=lam, gamma=gam, X=y * xs, amplitude_m=float(amp), amplitude_q=float(tr.q(amp)),
+                  segment=segment, refined=refined, at_stop=at_stop)
+
+
+def _fill_peak(tr: _Tracker, fill: ContinuationResult, g, g_left: float, segment: int, opt) -> list:
+    """[HBPeak] of a segment continued back over a jump: its highest point when that lies above both ends
+    of the jump (log q: g along the fill, g_left at the point the jump left), else [].
+
+    Refined between its neighbours where it is an interior point; where the
+    curve could not be followed past it (the fill's last point, or the last
+    before a jump of its own) it is reported as found at a stop. The rest of
+    a fill retraces known parts of the branch (or zigzags where it stalled):
+    its other maxima are not peaks of the stretch the jump passed over.
+    """
+    if fill.lam.size < 2 or not np.isfinite(g).all():
+        return []
+    j = int(np.argmax(g))
+    if not (g[j] > g[0] and g[j] > g_left):
+        return []
+    if j == g.size - 1 or fill.gap[j + 1] or fill.gap[j]:
+        return [_peak(tr, fill.y[j], fill.lam[j], segment, False, at_stop=True)]
+    return [_refined_peak(tr, fill, g, j, segment, opt)]
 
 
 def _turning_mask(lam, observed, segment, gap, start, stop):
@@ -937,7 +1065,7 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
     harmonic: sqrt(a_k^2 + b_k^2), |a_0| for k = 0). Per peak (dim
     ``peak``): ``peak_gamma``, ``peak_<parameter>`` (if not gamma),
     ``peak_amplitude_q``, ``peak_amplitude_m``, ``peak_branch``,
-    ``peak_refined``.
+    ``peak_refined``, ``peak_at_stop`` (:attr:`HBPeak.at_stop`).
 
     Attributes: ``status`` (:class:`~jointdyn.continuation.ContinuationStatus`;
     ``complete`` only when the range is covered), ``message`` (where and
@@ -1002,6 +1130,7 @@ def _peak_variables(branch: HBBranch, dof: int, qs: float) -> dict:
         "peak_amplitude_m": ("peak", np.array(amp, dtype=float)),
         "peak_branch": ("peak", np.array([k.segment for k in pk], dtype=int)),
         "peak_refined": ("peak", np.array([k.refined for k in pk], dtype=bool)),
+        "peak_at_stop": ("peak", np.array([k.at_stop for k in pk], dtype=bool)),
     }
     if branch.parameter != "gamma":
         out["peak_" + branch.parameter] = ("peak", np.array([k.lam for k in pk], dtype=float))
