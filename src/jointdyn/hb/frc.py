@@ -536,10 +536,12 @@ def _gap_fills(tr: _Tracker, parts, span: float, opt: ContinuationOptions, progr
     traced and its peak found. Only a jump that may hide a peak is filled
     (:func:`_may_hide_a_peak`). Each fill is bounded by the parameter range
     of its jump and one largest parameter step beyond the point the jump
-    left (so that a fold just past that point is passed); its own jumps are as long as those of the branch (range
-    ``span``, scaled), not scaled down to its short range. Its status
-    (often a stall at the obstacle) is named in the branch's message but
-    does not decide the branch's status.
+    left (so that a fold just past that point is passed), and ends once
+    past that point below its amplitude (:class:`_FillMonitor`); its own
+    jumps are as long as those of the branch (range ``span``, scaled), not
+    scaled down to its short range. Its status (often a stall at the
+    obstacle) is named in the branch's message but does not decide the
+    branch's status.
 
     Returns a list of ``(fill, y_left)``: the segment and the scaled
     unknowns of the point the jump left.
