@@ -363,6 +363,24 @@ def test_grid_finds_the_peak_the_continuation_jumped_over():
     assert abs(c.peak_q - c.time_q) <= 0.01 * c.time_q
 
 
+def test_grid_flags_a_highest_amplitude_at_a_jump_above_every_peak():
+    """The grid's 'peak in a jump': the branch's highest point is one end of a
+    jump and no peak found reaches it (a secondary peak elsewhere does not
+    hide the missed resonance); a peak at least as high clears it."""
+    import xarray as xr
+
+    from jointdyn.sweeps.hb_grid import _highest_at_jump
+
+    q = np.array([0.5, 0.6, 0.55, 1.0, 1.4, 0.9, 0.8])
+    status = np.array(["start", "joined", "joined", "joined", "joined", "after-jump", "joined"])
+    ds = xr.Dataset({"amplitude_q": ("point", q), "point_status": ("point", status)})
+    assert _highest_at_jump(ds, math.nan)  # no peak at all
+    assert _highest_at_jump(ds, 0.6)  # only the small bump at the second point
+    assert not _highest_at_jump(ds, 1.4)
+    ds_mid = xr.Dataset({"amplitude_q": ("point", q), "point_status": ("point", np.roll(status, 2))})
+    assert not _highest_at_jump(ds_mid, 0.6)  # the highest point joined on both sides
+
+
 def test_a_peak_at_a_sharp_fold_past_a_jump_is_reported_at_the_stop(capsys):
     """Jenkins at eta 10, beta 10, 15 harmonics and 128 samples: both flanks of
     the resonance stall near q 9.38 (gamma 1.2041 and 1.2107); the top of the

@@ -149,9 +149,12 @@ def grid_case(model: str, eta: float, beta: float, gamma=GRID_GAMMA, *, time_dom
     status = str(ds.attrs["status"])
     covered = status == "complete" or (status == "unbounded" and beta < DEN_HARTOG_BETA)
     g_pk, q_pk = float(ds.attrs["peak_gamma"]), float(ds.attrs["peak_amplitude_q"])
-    check = _time_check(system, br, g_pk, q_pk, rtol) if time_domain and math.isfinite(g_pk) else None
-    if not math.isfinite(g_pk) and _highest_at_jump(ds):
+    if _highest_at_jump(ds, q_pk):
         check = (Verdict.PEAK_IN_JUMP, math.nan, 0, math.nan)
+    elif time_domain and math.isfinite(g_pk):
+        check = _time_check(system, br, g_pk, q_pk, rtol)
+    else:
+        check = None
     verdict, q_td, period, q_rest = check or (Verdict.NO_PEAK, math.nan, 0, math.nan)
     err = (q_pk - q_td) / q_td if verdict in (Verdict.AGREES, Verdict.DIFFERS) else math.nan
     ok = covered and verdict.ok
@@ -163,10 +166,11 @@ def grid_case(model: str, eta: float, beta: float, gamma=GRID_GAMMA, *, time_dom
                     message=str(ds.attrs["message"]))
 
 
-def _highest_at_jump(ds) -> bool:
-    """True when the branch's highest amplitude is a point reached by a jump, or the point the jump left."""
+def _highest_at_jump(ds, q_peak: float) -> bool:
+    """True when the branch's highest amplitude is a point reached by a jump, or the point the jump left,
+    above the highest peak found (``q_peak``, NaN without one): the resonance lies in the jump."""
     q = np.asarray(ds["amplitude_q"].values, dtype=float)
-    if not np.isfinite(q).any():
+    if not np.isfinite(q).any() or q_peak >= float(np.nanmax(q)):
         return False
     i = int(np.nanargmax(q))
     after = np.asarray(ds["point_status"].values) == "after-jump"
