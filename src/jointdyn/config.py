@@ -213,10 +213,11 @@ HB_EVENT_MIN_OFFSET = 0.25
 #: ~|T| / (mu |dN/dtau|) rad, a near-jump of the force inside one sampling interval at large mu N0 / F1: the
 #: AFT marches the law also at phases graded towards each separation (jointdyn.fourier.separation_grid),
 #: over this many uniform samples before it, ...
-HB_SEPARATION_SPAN = 2
-#: ... each phase's distance to the separation this fraction of the one before (spacing 30 % of the
-#: distance) ...
-HB_SEPARATION_RATIO = 0.7
+HB_SEPARATION_SPAN = 4
+#: ... each phase's distance to the separation this fraction of the one before (spacing 15 % of the
+#: distance: a slip stretch as wide as R is resolved to about 1e-4 of the force's integral; eta 10, beta 5
+#: at 7 x 128 within 5e-4 of the converged peak, against 2e-3 with 0.7 and a span of 2) ...
+HB_SEPARATION_RATIO = 0.85
 #: ... down to this distance (rad): a slip stretch shorter than it costs at most its own width times the
 #: stuck force in the force's integral
 HB_SEPARATION_FINEST = 1e-5
