@@ -32,8 +32,9 @@ __all__ = ["phases", "basis", "fourier_matrices", "event_projection", "separatio
 #: one side of a zero stretch of a signal (:func:`event_projection`): the signal is zero before the phase
 #: (it starts there) or after it (it stops there)
 STARTS, STOPS = 1, -1
-#: Gauss-Legendre points per interval of the product integration of :func:`separation_grid`
-_GAUSS_POINTS = 8
+#: Gauss-Legendre points per interval, and degree of the piecewise polynomials, of the product integration
+#: of :func:`separation_grid`
+_GAUSS_POINTS, _PRODUCT_DEGREE = 8, 3
 
 
 def phases(samples: int) -> np.ndarray:
@@ -189,18 +190,24 @@ def _cut_excess(harmonics: int, samples: int, a: int, order: int):
     return [(a - i) % samples for i in range(order + 1)], (h * h / 12.0) * g1 - (h ** 4 / 720.0) * g3
 
 
-def _hat_weights(harmonics: int, nodes: np.ndarray) -> np.ndarray:
-    """W (2H+1, len(nodes)): ``W @ u`` is the integral of u b_k over [nodes[0], nodes[-1]] for u linear between
-    the nodes (Gauss-Legendre on every interval: exact to rounding while k times the interval stays below 1)."""
+def _product_weights(harmonics: int, nodes: np.ndarray, first: int, degree: int) -> np.ndarray:
+    """W (2H+1, len(nodes)): ``W @ u`` is the integral over [nodes[first], nodes[-1]] of ``p b_k``, p on each
+    interval the polynomial of degree ``degree`` through the ``degree + 1`` nodes around it (centred where the
+    nodes allow; the nodes before ``first`` serve the stencils only). Gauss-Legendre on every interval: exact
+    to rounding while k times the interval stays below 1."""
     x, w = np.polynomial.legendre.leggauss(_GAUSS_POINTS)
-    lo, hi = nodes[:-1, None], nodes[1:, None]
-    d = hi - lo
-    t = lo + 0.5 * d * (x[None, :] + 1.0)  # (intervals, points)
-    ww = 0.5 * d * w[None, :]
-    B = basis(harmonics, t.ravel()).reshape(t.shape + (2 * harmonics + 1,))
     W = np.zeros((2 * harmonics + 1, nodes.size))
-    W[:, :-1] += np.einsum("ip,ipk->ki", ww * (hi - t) / d, B)
-    W[:, 1:] += np.einsum("ip,ipk->ki", ww * (t - lo) / d, B)
+    for i in range(first, nodes.size - 1):
+        lo = max(0, min(i - (degree - 1) // 2, nodes.size - degree - 1))
+        z = nodes[lo: lo + degree + 1]
+        d = nodes[i + 1] - nodes[i]
+        t = nodes[i] + 0.5 * d * (x + 1.0)
+        L = np.ones((t.size, z.size))  # Lagrange basis of the stencil at the quadrature points
+        for j in range(z.size):
+            for m in range(z.size):
+                if m != j:
+                    L[:, j] *= (t - z[m]) / (z[j] - z[m])
+        W[:, lo: lo + degree + 1] += basis(harmonics, t).T @ ((0.5 * d * w)[:, None] * L)
     return W
 
 
@@ -232,7 +239,8 @@ def separation_grid(harmonics: int, samples: int, events: tuple, order: int = co
     geometrically towards ``tau_e`` (spacing ``(1 - ratio)`` times the
     distance to it, down to ``finest`` rad), at which the AFT marches the
     law like at the uniform samples; the force is integrated over R as
-    linear between these nodes (zero at ``tau_e``: ``|T| <= mu N``), and
+    piecewise cubic through these nodes (zero at ``tau_e``:
+    ``|T| <= mu N``; error O(h^4) where the force is smooth), and
     over the rest of the period by the trapezoidal rule with the
     Euler-Maclaurin terms of its end at ``t_a`` (:func:`_cut_excess`) and
     the corner corrections of the re-contacts (:func:`event_projection`).
@@ -288,14 +296,16 @@ def separation_grid(harmonics: int, samples: int, events: tuple, order: int = co
         out[:, a % samples] -= 0.5 * Pu[:, a % samples]
         idx, excess = _cut_excess(harmonics, samples, a, order)
         out[:, idx] -= scale[:, None] * excess
-        # R: linear between the uniform samples and the graded phases, zero at tau_e
-        uni = np.arange(a, j0 + 1) * h
+        # R: piecewise cubic through the uniform samples (one before t_a for the first stencil) and the graded
+        # phases, zero at tau_e
+        uni = np.arange(a - 1, j0 + 1) * h
         graded = _graded_nodes(tau_e, tau_e - a * h, uni, ratio, finest)
         nodes = np.concatenate([uni, graded])
         perm = np.argsort(nodes, kind="stable")
         cols = np.empty((2 * harmonics + 1, nodes.size))
-        cols[:, perm] = _hat_weights(harmonics, np.append(nodes[perm], tau_e))[:, :-1] * scale[:, None]
-        for i, j in enumerate(range(a, j0 + 1)):
+        cols[:, perm] = (_product_weights(harmonics, np.append(nodes[perm], tau_e), 1, _PRODUCT_DEGREE)[:, :-1]
+                         * scale[:, None])
+        for i, j in enumerate(range(a - 1, j0 + 1)):
             out[:, j % samples] += cols[:, i]
         extra_tau.append(graded % (2.0 * np.pi))
         extra_cols.append(cols[:, uni.size:])
