@@ -172,6 +172,21 @@ def test_robustness_grid_subset(model, eta, beta):
 
 
 
+def test_grid_cases_on_processes_equal_the_cases_in_turn():
+    # grid_cases with two worker processes: the same branches, in the order asked, as one after the other
+    from jointdyn.sweeps.hb_grid import grid_cases
+
+    cases = [(config.MODEL, 0.5, 1000.0), ("jenkins", 0.01, 2.0), (config.MODEL, 1.5, 2.0)]
+    par = grid_cases(cases, time_domain=False, workers=2)
+    seq = grid_cases(cases, time_domain=False)
+    assert [(c.model, c.eta, c.beta) for c in par] == cases
+    for a, b in zip(par, seq):
+        assert (a.status, a.points, a.harmonics, a.samples) == (b.status, b.points, b.harmonics, b.samples)
+        assert a.peak_q == b.peak_q and a.peak_gamma == b.peak_gamma
+    with pytest.raises(ValueError, match="workers"):
+        grid_cases(cases, workers=0)
+
+
 def test_grid_does_not_compare_a_subharmonic_time_domain_orbit():
     # the full-memory closed form at eta = 0.5, beta = 5: the time-domain steady state at the HB peak repeats
     # every 4 forcing periods, so the period-one HB peak (q 1.436 against 1.371) is marked not compared, not passed
