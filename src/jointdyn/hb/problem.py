@@ -131,7 +131,10 @@ class HBProblem:
     harmonics : int
         Highest harmonic H (>= 1); the constant term is always included.
     samples : int
-        Time samples per period for the AFT (>= 2H + 2).
+        Uniform time samples per period for the AFT (>= 2H + 2); where a
+        prescribed normal load separates, the AFT also marches phases
+        graded towards each separation (:meth:`_aft_grid`), and evaluations
+        report the uniform samples.
     parameter : str or HBParameter
         Continuation parameter: a built-in name (``gamma``, ``f1``,
         ``eta``, ``n0``, ``delta``; see :mod:`jointdyn.hb.parameters`) or a
