@@ -26,7 +26,8 @@ def _reference(p, X, lam):
     R = A @ X - Fe
     JX = A.copy()
     Jp = (AC + 2.0 * w * AM) @ X * dwdp - Fp
-    nh, ns, n = p.nh, p.Ns, p.n
+    # the AFT's phases: the uniform samples, or with separations also the phases graded towards them
+    Eg, Pg, ns, n, nh = p._Eg, p._Pg, p._taug.size, p.n, p.nh
     has_p = dN is not None
     nd = nh + int(has_p)
     rtol = config.HB_PERIODIC_RTOL
@@ -36,7 +37,7 @@ def _reference(p, X, lam):
         law = contact.law
         b = p._Bm[c]
         U = X.reshape(nh, n) @ b
-        u = p.E @ U
+        u = Eg @ U
         # virgin state at the mean displacement: direction 0 moves the mean, the parameter the load
         dx0, dn0 = np.zeros(nd), np.zeros(nd)
         dx0[0] = 1.0
@@ -65,7 +66,7 @@ def _reference(p, X, lam):
                         dxr[nh] = (Er @ (derivative_matrix(p.H) @ U)) * ev_dtau[c, i]
                     law.init_jvp(law.params, float(Er @ U), dxr, float(ev_load[c]), np.zeros(nd), a, da)
                 dx = np.zeros(nd)
-                dx[:nh] = p.E[i]
+                dx[:nh] = Eg[i]
                 dn = np.zeros(nd)
                 if has_p:
                     dn[nh] = dN[c, i]
@@ -87,7 +88,7 @@ def _reference(p, X, lam):
                 T, dT = 0.5 * (T + T1), 0.5 * (dT + dT1)
                 break
             T2, T1, dT1 = T1, T, dT
-        F, G = p.P @ T, p.P @ dT
+        F, G = Pg @ T, Pg @ dT
         R += np.kron(F, b)
         JX += np.kron(G[:, :nh], np.outer(b, b))
         if has_p:
@@ -98,7 +99,8 @@ def _reference(p, X, lam):
         info[1] = max(info[1], err)
         if period == 0.0 or (period == 2.0 and info[2] == 1.0):
             info[2] = period
-    return R, JX, Jp, np.array(Ts), np.array(codes), info
+    at = np.arange(p.Ns) if p._uniform is None else p._uniform  # the evaluation reports the uniform samples
+    return R, JX, Jp, np.array(Ts)[:, at], np.array(codes)[:, at], info
 
 
 @pytest.mark.parametrize("model,kw", [("jenkins", {}), ("discrete", {"n": 4}), ("iwan", {}), ("iwan-paper", {})])

@@ -3,7 +3,7 @@
 Writes the table of docs/hb-robustness.md (between ``<!-- grid:start -->``
 and ``<!-- grid:end -->``), computed here:
 
-    PYTHONPATH=src python docs/scripts/hb_robustness.py --write
+    PYTHONPATH=src python docs/scripts/hb_robustness.py --write [--workers N]
 
 Models {default exact, closed form with full memory, the paper's rule,
 Jenkins} x eta {0.01, 0.5, 1.5, 10} x beta {0.1, 1, 2, 5, 10, 1000}, gamma
@@ -25,7 +25,7 @@ from jointdyn.sweeps.hb_grid import (
     GRID_BETAS,
     GRID_ETAS,
     GRID_MODELS,
-    grid_case,
+    grid_cases,
     grid_table,
 )
 
@@ -35,19 +35,17 @@ PAGE = Path(__file__).resolve().parents[1] / "hb-robustness.md"
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--write", action="store_true", help="update docs/hb-robustness.md")
+    ap.add_argument("--workers", type=int, default=1, help="processes running the cases (default 1)")
     ap.add_argument("--folds", action="store_true",
                     help="check the grid's folds against time-domain sweeps (the folds table) instead")
     args = ap.parse_args(argv)
     if args.folds:
         return _folds(args.write)
-    cases = []
-    for model in GRID_MODELS:
-        for eta in GRID_ETAS:
-            for beta in GRID_BETAS:
-                c = grid_case(model, eta, beta)
-                print(f"{model} eta={eta:g} beta={beta:g}: {c.status} ok={c.ok} {c.verdict} err={c.peak_error:+.3g} "
-                      f"{c.seconds:.2f} s", file=sys.stderr, flush=True)
-                cases.append(c)
+    cases = grid_cases([(m, e, b) for m in GRID_MODELS for e in GRID_ETAS for b in GRID_BETAS],
+                       workers=args.workers)
+    for c in cases:
+        print(f"{c.model} eta={c.eta:g} beta={c.beta:g}: {c.status} ok={c.ok} {c.verdict} err={c.peak_error:+.3g} "
+              f"{c.seconds:.2f} s", file=sys.stderr, flush=True)
     table = grid_table(cases)
     print(table)
     if args.write:

@@ -18,17 +18,23 @@ Matrices that depend only on (H, Ns) are built once per process and shared
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import config
 from ._cache import by_value
 from ._jit import jit
 
-__all__ = ["phases", "basis", "fourier_matrices", "event_projection", "derivative_matrix", "reconstruct", "extrema"]
+__all__ = ["phases", "basis", "fourier_matrices", "event_projection", "separation_grid", "derivative_matrix",
+           "reconstruct", "extrema"]
 
 #: one side of a zero stretch of a signal (:func:`event_projection`): the signal is zero before the phase
 #: (it starts there) or after it (it stops there)
 STARTS, STOPS = 1, -1
+#: Gauss-Legendre points per interval, and degree of the piecewise polynomials, of the product integration
+#: of :func:`separation_grid`
+_GAUSS_POINTS, _PRODUCT_DEGREE = 8, 3
 
 
 def phases(samples: int) -> np.ndarray:
@@ -73,13 +79,13 @@ def _bernoulli(m: int, x: float) -> float:
 
 
 def _basis_derivatives(harmonics: int, tau: float) -> np.ndarray:
-    """The basis functions and their first two derivatives at ``tau``: (3, 2H+1)."""
-    out = np.zeros((3, 2 * harmonics + 1))
+    """The basis functions and their first three derivatives at ``tau``: (4, 2H+1)."""
+    out = np.zeros((4, 2 * harmonics + 1))
     out[0, 0] = 1.0
     for k in range(1, harmonics + 1):
         c, s = np.cos(k * tau), np.sin(k * tau)
-        out[:, 2 * k - 1] = (c, -k * s, -k * k * c)
-        out[:, 2 * k] = (s, k * c, -k * k * s)
+        out[:, 2 * k - 1] = (c, -k * s, -k * k * c, k ** 3 * s)
+        out[:, 2 * k] = (s, k * c, -k * k * s, -k ** 3 * c)
     return out
 
 
@@ -165,6 +171,162 @@ def event_projection(harmonics: int, samples: int, events: tuple, order: int = c
         # the trapezoidal sum h sum_j g_j exceeds the integral by corr; the coefficient is weight / h times it
         out[:, idx] -= (weight / h)[:, None] * corr
     return np.ascontiguousarray(out)
+
+
+def _cut_excess(harmonics: int, samples: int, a: int, order: int):
+    """(sample indices, X): X @ u[indices] is the excess ``h sum'' g - int g`` (k = 0..2H) of the trapezoidal
+    rule over a stretch that ends at sample ``a`` (weighted one half there) for g = u b_k, u smooth up to it:
+    ``(h^2 / 12) g^(1)(t_a) - (h^4 / 720) g^(3)(t_a)`` (Euler-Maclaurin), with the derivatives of u from the
+    polynomial of degree ``order`` through the samples a, a - 1, ..., a - order."""
+    h = 2.0 * np.pi / samples
+    s = -np.arange(order + 1, dtype=float)
+    C = np.linalg.inv(s[:, None] ** np.arange(order + 1)[None, :])  # u(s h) = sum_q c_q s^q, c = C u
+    du = [np.zeros(order + 1) for _ in range(4)]
+    for m in range(min(order, 3) + 1):
+        du[m] = math.factorial(m) * C[m] / h ** m
+    b = _basis_derivatives(harmonics, a * h)
+    g1 = np.outer(b[0], du[1]) + np.outer(b[1], du[0])
+    g3 = np.outer(b[0], du[3]) + 3.0 * np.outer(b[1], du[2]) + 3.0 * np.outer(b[2], du[1]) + np.outer(b[3], du[0])
+    return [(a - i) % samples for i in range(order + 1)], (h * h / 12.0) * g1 - (h ** 4 / 720.0) * g3
+
+
+def _product_weights(harmonics: int, nodes: np.ndarray, first: int, degree: int) -> np.ndarray:
+    """W (2H+1, len(nodes)): ``W @ u`` is the integral over [nodes[first], nodes[-1]] of ``p b_k``, p on each
+    interval the polynomial of degree ``degree`` through the ``degree + 1`` nodes around it (centred where the
+    nodes allow; the nodes before ``first`` serve the stencils only). Gauss-Legendre on every interval: exact
+    to rounding while k times the interval stays below 1."""
+    x, w = np.polynomial.legendre.leggauss(_GAUSS_POINTS)
+    W = np.zeros((2 * harmonics + 1, nodes.size))
+    for i in range(first, nodes.size - 1):
+        lo = max(0, min(i - (degree - 1) // 2, nodes.size - degree - 1))
+        z = nodes[lo: lo + degree + 1]
+        d = nodes[i + 1] - nodes[i]
+        t = nodes[i] + 0.5 * d * (x + 1.0)
+        L = np.ones((t.size, z.size))  # Lagrange basis of the stencil at the quadrature points
+        for j in range(z.size):
+            for m in range(z.size):
+                if m != j:
+                    L[:, j] *= (t - z[m]) / (z[j] - z[m])
+        W[:, lo: lo + degree + 1] += basis(harmonics, t).T @ ((0.5 * d * w)[:, None] * L)
+    return W
+
+
+def _graded_nodes(tau_e: float, length: float, uniform: np.ndarray, ratio: float, finest: float) -> np.ndarray:
+    """Phases ``tau_e - length ratio^k`` (k >= 1, down to ``finest`` before ``tau_e``), less those within a
+    quarter of their spacing of a uniform sample."""
+    k = np.arange(1, int(math.log(finest / length) / math.log(ratio)) + 1)
+    d = length * ratio ** k
+    g = tau_e - d
+    near = np.abs(g[:, None] - uniform[None, :]).min(axis=1) < 0.25 * (1.0 - ratio) * d / ratio
+    return g[~near]
+
+
+@by_value()
+def separation_grid(harmonics: int, samples: int, events: tuple, order: int = config.HB_EVENT_ORDER,
+                    min_offset: float = config.HB_EVENT_MIN_OFFSET, span: int = config.HB_SEPARATION_SPAN,
+                    ratio: float = config.HB_SEPARATION_RATIO, finest: float = config.HB_SEPARATION_FINEST):
+    """AFT phases and matrices for a contact force that stops at separations (``tau, E, P, uniform``).
+
+    Before a separation the normal load N falls to zero and the friction
+    bound mu N with it: a contact that is stuck far below the bound slips
+    only in the last ``~|T| / (mu |dN/dtau|)`` rad (0.002 rad at the
+    paper's beta = 1000, eta = 1.5), and the force falls from the stuck
+    value to zero there: a near-jump inside one sampling interval, which
+    neither the trapezoidal rule nor the corner correction of
+    :func:`event_projection` (a force smooth on the sample scale) resolves.
+    Here the stretch ``R = [t_a, tau_e]`` from the ``span``-th sample
+    before each separation ``tau_e`` to it gets extra phases, graded
+    geometrically towards ``tau_e`` (spacing ``(1 - ratio)`` times the
+    distance to it, down to ``finest`` rad), at which the AFT marches the
+    law like at the uniform samples; the force is integrated over R as
+    piecewise cubic through these nodes (zero at ``tau_e``:
+    ``|T| <= mu N``; error O(h^4) where the force is smooth), and
+    over the rest of the period by the trapezoidal rule with the
+    Euler-Maclaurin terms of its end at ``t_a`` (:func:`_cut_excess`) and
+    the corner corrections of the re-contacts (:func:`event_projection`).
+    ``P`` stays linear in the samples: an AFT Jacobian through it is exact.
+    Where a closed stretch is too short for R and the polynomial before
+    it, the uniform samples with :func:`event_projection` are returned.
+    Built once per arguments and shared: do not write into the arrays.
+
+    Parameters
+    ----------
+    harmonics, samples : int
+        H and the uniform samples Ns.
+    events : tuple of (float, int)
+        As for :func:`event_projection`.
+    order, min_offset : int, float
+        As for :func:`event_projection` (``order``: also the degree of the
+        polynomial of the Euler-Maclaurin terms at ``t_a``).
+    span : int
+        Uniform samples of R (its start ``t_a`` included).
+    ratio, finest : float
+        Geometric ratio of the extra phases' distances to ``tau_e`` and the
+        smallest distance (rad).
+
+    Returns
+    -------
+    tau : ndarray (Ng,)
+        Increasing phases in [0, 2 pi) (rad), the uniform ones among them
+        (``tau[0] = 0``).
+    E : ndarray (Ng, 2H+1)
+        Basis functions at ``tau``.
+    P : ndarray (2H+1, Ng)
+        Analysis matrix: the force's coefficients are ``P @ T``.
+    uniform : ndarray (Ns,) of int
+        Position of uniform sample j in ``tau``.
+    """
+    h = 2.0 * np.pi / samples
+    starts = tuple(ev for ev in events if ev[1] == STARTS)
+    stops = [ev[0] % (2.0 * np.pi) for ev in events if ev[1] == STOPS]
+    if not stops or not _room(events, (span + order + 1) * h):
+        return (phases(samples), fourier_matrices(harmonics, samples)[0],
+                event_projection(harmonics, samples, events, order, min_offset), np.arange(samples))
+    Pu = fourier_matrices(harmonics, samples)[1]
+    out = event_projection(harmonics, samples, starts, order, min_offset).copy()
+    scale = np.full(2 * harmonics + 1, 1.0 / np.pi)  # coefficient per unit of the integral of u b_k
+    scale[0] = 0.5 / np.pi
+    extra_tau, extra_cols = [], []
+    for tau_e in stops:
+        j0 = int(np.ceil(tau_e / h)) - 1  # last sample before tau_e
+        a = j0 - span + 1
+        # the rest of the period: trapezoidal up to t_a (half its sample there), corrected for its end
+        for j in range(a + 1, j0 + 1):
+            out[:, j % samples] -= Pu[:, j % samples]
+        out[:, a % samples] -= 0.5 * Pu[:, a % samples]
+        idx, excess = _cut_excess(harmonics, samples, a, order)
+        out[:, idx] -= scale[:, None] * excess
+        # R: piecewise cubic through the uniform samples (one before t_a for the first stencil) and the graded
+        # phases, zero at tau_e
+        uni = np.arange(a - 1, j0 + 1) * h
+        graded = _graded_nodes(tau_e, tau_e - a * h, uni, ratio, finest)
+        nodes = np.concatenate([uni, graded])
+        perm = np.argsort(nodes, kind="stable")
+        cols = np.empty((2 * harmonics + 1, nodes.size))
+        cols[:, perm] = (_product_weights(harmonics, np.append(nodes[perm], tau_e), 1, _PRODUCT_DEGREE)[:, :-1]
+                         * scale[:, None])
+        for i, j in enumerate(range(a - 1, j0 + 1)):
+            out[:, j % samples] += cols[:, i]
+        extra_tau.append(graded % (2.0 * np.pi))
+        extra_cols.append(cols[:, uni.size:])
+    tau_all = np.concatenate([phases(samples)] + extra_tau)
+    perm = np.argsort(tau_all, kind="stable")
+    tau = tau_all[perm]
+    P = np.ascontiguousarray(np.concatenate([out] + extra_cols, axis=1)[:, perm])
+    uniform = np.argsort(perm, kind="stable")[:samples]
+    return tau, np.ascontiguousarray(basis(harmonics, tau)), P, uniform
+
+
+def _room(events: tuple, needed: float) -> bool:
+    """True when every stretch from a re-contact to the next separation is longer than ``needed`` (rad)."""
+    two_pi = 2.0 * np.pi
+    for tau_e, side in events:
+        if side != STOPS:
+            continue
+        closed = [(tau_e - t) % two_pi for t, s in events if s == STARTS]
+        if not closed or min(closed) <= needed:
+            return False
+    return True
 
 
 @by_value()

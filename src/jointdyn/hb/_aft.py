@@ -474,7 +474,7 @@ def _spring_event(U, G, sp, tau1, h, g0, g1, dx):  # pragma: no cover - compiled
     return x
 
 
-def recontact_events(tau, coefficients, derivatives=None):
+def recontact_events(tau, coefficients, derivatives=None, uniform: bool = True):
     """Re-contact phases of harmonic normal loads inside the sampling intervals.
 
     For N = n0 + n1 sin(tau + delta) the contact re-closes where N crosses
@@ -488,11 +488,16 @@ def recontact_events(tau, coefficients, derivatives=None):
     Parameters
     ----------
     tau : ndarray (Ns,)
-        Uniform sample phases 2 pi j / Ns, rad.
+        Increasing sample phases in [0, 2 pi), rad: the uniform ones
+        2 pi j / Ns, or (``uniform=False``) any, starting at 0.
     coefficients : ndarray (contacts, 3)
         (n0, n1, delta) per contact (N, N, rad).
     derivatives : ndarray (contacts, 3), optional
         Their derivatives along the continuation parameter.
+    uniform : bool
+        ``tau`` are the uniform phases (the sample is found from the
+        sampling interval), else the first phase after the crossing is
+        searched.
 
     Returns
     -------
@@ -529,9 +534,12 @@ def recontact_events(tau, coefficients, derivatives=None):
         dl = delta + (np.pi if n1 < 0.0 else 0.0)
         r = n0 / a1
         tr = (-dl - np.arcsin(r)) % (2.0 * np.pi)
-        i = int(np.ceil(tr / h))
-        if i * h <= tr:  # rounding: the sample must lie after the crossing
-            i += 1
+        if uniform:
+            i = int(np.ceil(tr / h))
+            if i * h <= tr:  # rounding: the sample must lie after the crossing
+                i += 1
+        else:
+            i = int(np.searchsorted(tau, tr, side="right"))
         i %= ns
         if n0 + n1 * np.sin(tau[i] + delta) <= 0.0:
             continue

@@ -38,7 +38,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ..fourier import STARTS, STOPS, event_projection, extrema, fourier_matrices, phases
+from ..fourier import STARTS, STOPS, extrema, fourier_matrices, phases, separation_grid
 from ..kinematics import NORMAL_SPRING, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
 from ..laws import law_dispatch
 from ..systems import Contact, System
@@ -131,7 +131,10 @@ class HBProblem:
     harmonics : int
         Highest harmonic H (>= 1); the constant term is always included.
     samples : int
-        Time samples per period for the AFT (>= 2H + 2).
+        Uniform time samples per period for the AFT (>= 2H + 2); where a
+        prescribed normal load separates, the AFT also marches phases
+        graded towards each separation (:meth:`_aft_grid`), and evaluations
+        report the uniform samples.
     parameter : str or HBParameter
         Continuation parameter: a built-in name (``gamma``, ``f1``,
         ``eta``, ``n0``, ``delta``; see :mod:`jointdyn.hb.parameters`) or a
@@ -187,7 +190,8 @@ class HBProblem:
         #: coefficients f sin(phi) of cos(w t) and f cos(phi) of sin(w t)
         self.phase_sin, self.phase_cos = np.sin(phi), np.cos(phi)
         self._contact_inputs(contact_kinematics(system))
-        self.P = self._projection()
+        #: the AFT's phases and matrices (:meth:`_aft_grid`); evaluations report the uniform samples
+        self._taug, self._Eg, self._Pg, self._uniform = self._aft_grid()
         self._dummy = np.zeros((1, 1))
         self._zero1 = np.zeros(1)
         self._noscale = np.zeros(3)
@@ -227,17 +231,24 @@ class HBProblem:
             self._Pm, self._ssz = _pad_rows([]), 1
             self._kernel = eval_kernel(no_contact_step_jvp, no_contact_init_jvp)
 
-    def _projection(self) -> np.ndarray:
-        """The AFT's analysis matrix: :func:`~jointdyn.fourier.event_projection` with the separations and
-        re-contacts of the prescribed normal loads, where the kernel's one matrix serves every contact (the
-        same phases for all) and the parameter does not move them; the uniform projection otherwise."""
+    def _aft_grid(self):
+        """(tau, E, P, uniform) of the AFT: the phases the laws are marched at, their synthesis and analysis
+        matrices, and the positions of the uniform samples among the phases (None: the phases are the
+        uniform samples). With separations and re-contacts of the prescribed normal loads, where one grid
+        serves every contact (the same phases for all) and the parameter does not move them:
+        :func:`~jointdyn.fourier.separation_grid` (extra phases graded towards each separation, the
+        re-contact corners taken into account); the uniform samples and projection otherwise."""
+        uniform = (self.tau, self.E, self.P, None)
         if not self.contacts or self.has_springs or self.parameter.enters_loads:
-            return self.P
+            return uniform
         events = {_load_events(*co) for co in self.load_coefficients}
         if len(events) != 1:
-            return self.P
+            return uniform
         ev = events.pop()
-        return event_projection(self.H, self.Ns, ev) if ev else self.P
+        if not ev:
+            return uniform
+        tau, E, P, at = separation_grid(self.H, self.Ns, ev)
+        return tau, E, P, (None if tau.size == self.Ns else at)
 
     @property
     def condensed(self) -> bool:
@@ -275,13 +286,14 @@ class HBProblem:
         and the re-contact events of the AFT (:func:`jointdyn.hb._aft.recontact_events`)."""
         co, d = self.parameter.contact_loads(self, p)
         nc = len(self.contacts)
-        Nsamp = np.empty((nc, self.Ns))
-        dN = None if d is None else np.empty((nc, self.Ns))
+        ng = self._taug.size
+        Nsamp = np.empty((nc, ng))
+        dN = None if d is None else np.empty((nc, ng))
         for k in range(nc):
-            Nsamp[k], dn = _load_samples(self.tau, co[k, 0], co[k, 1], co[k, 2], None if d is None else d[k])
+            Nsamp[k], dn = _load_samples(self._taug, co[k, 0], co[k, 1], co[k, 2], None if d is None else d[k])
             if dN is not None:
                 dN[k] = dn
-        events = recontact_events(self.tau, co, d)
+        events = recontact_events(self._taug, co, d, uniform=self._uniform is None)
         # a spring's re-contact phases depend on the unknowns: located in the AFT itself
         events[0][self._Sp[:, 1] > 0.0] = NO_EVENT
         return Nsamp, dN, events
@@ -358,9 +370,10 @@ class HBProblem:
         R = np.empty(size)
         JX = np.empty((size, size))
         Jp = np.empty(size)
-        T = np.empty((nc, self.Ns))
-        Nout = np.empty((nc, self.Ns))
-        code = np.empty((nc, self.Ns), dtype=np.int64)
+        ng = self._taug.size
+        T = np.empty((nc, ng))
+        Nout = np.empty((nc, ng))
+        code = np.empty((nc, ng), dtype=np.int64)
         info = np.empty(3)
         has_p = dN is not None
         if scales is None:
@@ -373,8 +386,11 @@ class HBProblem:
             scaled = (self._scl, np.empty(size), np.empty((size, size)), np.empty(size))
         self._kernel((*self._linear_terms(w), float(dwdp), X, Fe, Fp),
                      (self._Bm, self._Pm, self._ssz, self._Bnm, self._Sp, self.has_springs),
-                     (Nsamp, dN if has_p else self._dummy, has_p, events), (self.E, self.P),
+                     (Nsamp, dN if has_p else self._dummy, has_p, events), (self._Eg, self._Pg),
                      (int(self.max_passes), float(config.HB_PERIODIC_RTOL)), (R, JX, Jp, T, Nout, code, info), scaled)
+        if self._uniform is not None:
+            at = self._uniform
+            T, code, Nout = T[:, at], code[:, at], Nout[:, at]
         return _Eval(R, JX, Jp, T, code, info, None if scales is None else scaled[1:], Nout)
 
     def _evaluate_central(self, X, p, scales) -> _Eval:

@@ -21,8 +21,9 @@ Both happen only with the closed forms, whose force jumps with the normal
 load.
 
 ``docs/scripts/hb_robustness.py`` writes the table of the whole grid into
-``docs/hb-robustness.md``; the tests run a subset; ``benchmarks/bench_hb.py``
-reports the grid's time and completion rate.
+``docs/hb-robustness.md``; the tests run a subset; ``benchmarks/bench_hb_grid.py``
+reports the grid's time and completion rate. :func:`grid_cases` runs many
+cases, on several processes if asked.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from .. import config
 from ..status import Status
 
 __all__ = ["GRID_MODELS", "GRID_ETAS", "GRID_BETAS", "GRID_GAMMA", "GridCase", "Verdict", "grid_case",
-           "grid_table", "hb_restart"]
+           "grid_cases", "grid_table", "hb_restart"]
 
 #: the grid of issue 9: models (default exact, closed form with full memory, the paper's rule, Jenkins),
 #: eta = N1 / N0, beta = mu N0 / F1, gamma START:STOP:STEP
@@ -164,6 +165,47 @@ def grid_case(model: str, eta: float, beta: float, gamma=GRID_GAMMA, *, time_dom
                     time_period=period, rest_q=q_rest, peak_error=err, verdict=verdict, seconds=seconds,
                     harmonics=int(ds.attrs["harmonics"]), samples=int(ds.attrs["samples"]),
                     message=str(ds.attrs["message"]))
+
+
+def grid_cases(cases, *, time_domain: bool = True, workers: int = 1) -> list:
+    """:func:`grid_case` of every ``(model, eta, beta)`` of ``cases``, in their order.
+
+    ``workers`` > 1: the cases run on that many processes, each taking the
+    next case as it finishes one (``fork`` where the platform has it: the
+    workers inherit the compiled kernels loaded here; they ignore SIGINT
+    and end with this process, as the sweeps' workers do).
+    ``GridCase.seconds`` is the CPU time of the branch in its worker.
+    """
+    from .. import _validate as V
+
+    cases = [(str(m), float(e), float(b)) for m, e, b in cases]
+    workers = V.positive_int("workers", workers, 1)
+    if workers == 1 or len(cases) < 2:
+        return [grid_case(*c, time_domain=time_domain) for c in cases]
+    import concurrent.futures as cf
+    import multiprocessing as mp
+    import os
+
+    mpc = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+    with cf.ProcessPoolExecutor(max_workers=min(workers, len(cases)), mp_context=mpc, initializer=_init_worker,
+                                initargs=(os.getpid(),)) as pool:
+        return list(pool.map(_case_task, [(c, time_domain) for c in cases]))
+
+
+def _init_worker(parent_pid: int) -> None:
+    """Initializer of a process worker of :func:`grid_cases`: SIGINT ignored, death with the parent."""
+    import signal
+
+    from ._pool import die_with_parent
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    die_with_parent(parent_pid)
+
+
+def _case_task(task) -> GridCase:
+    """One case of :func:`grid_cases` in a worker: ``((model, eta, beta), time_domain)``."""
+    case, time_domain = task
+    return grid_case(*case, time_domain=time_domain)
 
 
 def _highest_at_jump(ds, q_peak: float) -> bool:
