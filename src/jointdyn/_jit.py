@@ -6,13 +6,53 @@ cached on disk (``cache=True``) so that a second process loads it instead of
 compiling, and the GIL released so that threads (Dask workers) run kernels in
 parallel. ``fastmath`` stays off: the contact laws compare forces with slip
 limits and need IEEE semantics for ties and infinities.
+
+Loading from the disk cache is kept light (:class:`_LoadingCache`): Numba
+installs all of its compiler's typing and lowering registries before every
+cache load, which imports most of Numba, cffi and more, although code loaded
+from the cache needs only Numba's runtime. A process that finds everything
+in the cache (a command run a second time) skips that work; a process that
+compiles gets the registries from Numba's compiler, which installs them
+itself before compiling.
 """
 
 from __future__ import annotations
 
 import numba
+from numba.core.caching import FunctionCache
+from numba.core.runtime import nrt
 
 __all__ = ["jit", "specialize"]
+
+
+class _LoadingCache(FunctionCache):
+    """Numba's disk cache of one function, loading with the runtime only.
+
+    ``FunctionCache.load_overload`` refreshes the target context first
+    (installs every typing and lowering registry of the CPU target, a few
+    tenths of a second of imports); the compiled code it loads calls
+    Numba's runtime (NRT) and C helpers only, and the environments it
+    rebuilds import their own modules. The compiler refreshes both contexts
+    before it compiles (``numba.core.compiler.CompilerBase``), so a cache
+    miss compiles as before.
+    """
+
+    def load_overload(self, sig, target_context):
+        nrt.rtsys.initialize(target_context)
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
+
+
+#: whether this Numba has the cache internals :class:`_LoadingCache` relies on (otherwise Numba's own
+#: cache is kept: the loads are then slower, never different)
+_LIGHT_LOADS = all(hasattr(FunctionCache, a) for a in ("_load_overload", "_guard_against_spurious_io_errors"))
+
+
+def _light_loads(disp):
+    """``disp`` with its disk cache loading through :class:`_LoadingCache` (where this Numba allows)."""
+    if _LIGHT_LOADS and type(getattr(disp, "_cache", None)) is FunctionCache:
+        disp._cache.__class__ = _LoadingCache
+    return disp
 
 
 def jit(*args, **kwargs):
@@ -20,8 +60,9 @@ def jit(*args, **kwargs):
     opts = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
     opts.update(kwargs)
     if args and callable(args[0]) and len(args) == 1:
-        return numba.njit(**opts)(args[0])
-    return numba.njit(*args, **opts)
+        return _light_loads(numba.njit(**opts)(args[0]))
+    wrap = numba.njit(*args, **opts)
+    return lambda fn: _light_loads(wrap(fn))
 
 
 _SPECIALIZED: dict = {}
