@@ -77,3 +77,34 @@ def test_hb_command_imports():
     assert json.loads(first) == json.loads(second)
     assert not _imported(names, NOT_FOR_HB_JSON), _imported(names, NOT_FOR_HB_JSON)
     assert not _imported(names, COMPILER_ONLY), _imported(names, COMPILER_ONLY)
+
+
+def test_process_entry_freezes_what_lives_until_exit():
+    """The console script and ``python -m jointdyn`` run :func:`jointdyn.cli.console`, which leaves the
+    objects alive after the command to the interpreter's exit (``gc.freeze``); ``main`` does not."""
+    import tomllib
+
+    with open(Path(SRC).parent / "pyproject.toml", "rb") as fh:
+        assert tomllib.load(fh)["project"]["scripts"]["jointdyn"] == "jointdyn.cli:console"
+    main_py = (Path(SRC) / "jointdyn" / "__main__.py").read_text()
+    assert "sys.exit(console())" in main_py
+    script = textwrap.dedent(
+        """
+        import gc, sys
+        from jointdyn.cli import console, main
+        sys.argv = ["jointdyn", "--version"]
+        try:
+            main()
+        except SystemExit:
+            pass
+        after_main = gc.get_freeze_count()
+        try:
+            console()
+        except SystemExit:
+            pass
+        print(after_main, gc.get_freeze_count())
+        """
+    )
+    out, _ = _run(["-c", script])
+    after_main, after_console = map(int, out.splitlines()[-1].split())  # after the two version lines
+    assert after_main == 0 and after_console > 0
