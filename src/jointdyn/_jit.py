@@ -6,22 +6,106 @@ cached on disk (``cache=True``) so that a second process loads it instead of
 compiling, and the GIL released so that threads (Dask workers) run kernels in
 parallel. ``fastmath`` stays off: the contact laws compare forces with slip
 limits and need IEEE semantics for ties and infinities.
+
+Loading from the disk cache is kept light (:class:`_LoadingCache`): Numba
+installs all of its compiler's typing and lowering registries before every
+cache load, which imports most of Numba, cffi and more, although code loaded
+from the cache needs only Numba's runtime. A process that finds everything
+in the cache (a command run a second time) skips that work; a process that
+compiles gets the registries from Numba's compiler, which installs them
+itself before compiling.
 """
 
 from __future__ import annotations
 
 import numba
+from numba.core.caching import FunctionCache
+from numba.core.runtime import nrt
 
 __all__ = ["jit", "specialize"]
 
 
+class _LoadingCache(FunctionCache):
+    """Numba's disk cache of one function, loading with the runtime only.
+
+    ``FunctionCache.load_overload`` refreshes the target context first
+    (installs every typing and lowering registry of the CPU target, a few
+    tenths of a second of imports); the compiled code it loads calls
+    Numba's runtime (NRT) and C helpers only, and the environments it
+    rebuilds import their own modules. The compiler refreshes both contexts
+    before it compiles (``numba.core.compiler.CompilerBase``), so a cache
+    miss compiles as before.
+    """
+
+    def load_overload(self, sig, target_context):
+        nrt.rtsys.initialize(target_context)
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
+
+
+class _LazyCache:
+    """The disk cache of one function, made on its first use (a :class:`_LoadingCache`).
+
+    Making a cache costs a few tenths of a millisecond (it locates and tests
+    the cache directory and stamps the source file); most dispatchers are
+    inlined helpers that are never compiled on their own, and a command
+    loads a few of the others.
+    """
+
+    def __init__(self, py_func):
+        self._py_func = py_func
+        self._made = None
+
+    def _cache(self) -> _LoadingCache:
+        if self._made is None:
+            self._made = _LoadingCache(self._py_func)
+        return self._made
+
+    def load_overload(self, sig, target_context):
+        return self._cache().load_overload(sig, target_context)
+
+    def save_overload(self, sig, data):
+        return self._cache().save_overload(sig, data)
+
+    def __getattr__(self, name):  # the rest of Numba's cache interface (flush, cache_path, ...)
+        if name in ("_py_func", "_made"):  # not set yet (an instance made without __init__)
+            raise AttributeError(name)
+        return getattr(self._cache(), name)
+
+
+#: whether this Numba has the cache internals :class:`_LoadingCache` relies on (otherwise Numba's own
+#: cache is kept: the loads are then slower, never different)
+_LIGHT_LOADS = all(hasattr(FunctionCache, a) for a in ("_load_overload", "_guard_against_spurious_io_errors"))
+
+
+def _with_cache(disp):
+    """``disp`` (made without a cache) with a :class:`_LazyCache`, or Numba's own cache where this Numba
+    does not have the internals :class:`_LoadingCache` relies on."""
+    if not hasattr(disp, "enable_caching"):  # NUMBA_DISABLE_JIT: the plain function
+        return disp
+    if _LIGHT_LOADS:
+        disp._cache = _LazyCache(disp.py_func)
+    else:
+        disp.enable_caching()
+    return disp
+
+
 def jit(*args, **kwargs):
-    """``numba.njit`` with the project's fixed options (cache, nogil, no fastmath)."""
+    """``numba.njit`` with the project's fixed options (cache, nogil, no fastmath).
+
+    The disk cache of a function is made on its first compilation or load
+    (:class:`_LazyCache`), and loads with Numba's runtime only
+    (:class:`_LoadingCache`).
+    """
     opts = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
     opts.update(kwargs)
-    if args and callable(args[0]) and len(args) == 1:
-        return numba.njit(**opts)(args[0])
-    return numba.njit(*args, **opts)
+    if args and not (callable(args[0]) and len(args) == 1) or not opts["cache"]:
+        return numba.njit(*args, **opts)  # explicit signatures compile at once: Numba's own cache
+    opts["cache"] = False
+    if args:
+        return _with_cache(numba.njit(**opts)(args[0]))
+    wrap = numba.njit(**opts)
+    return lambda fn: _with_cache(wrap(fn))
 
 
 _SPECIALIZED: dict = {}

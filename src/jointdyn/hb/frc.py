@@ -279,6 +279,28 @@ class _Parts:
     counters: dict
 
 
+@dataclass(frozen=True)
+class _Draft:
+    """A continued branch before the per-point AFT diagnostics and Hill stability of its HBBranch
+    (:func:`_make_branch`): what the automatic choice of harmonics and samples reads of a branch,
+    so that the branches it discards are never analysed."""
+
+    tr: _Tracker
+    status: ContinuationStatus
+    message: str
+    parts: _Parts
+    peaks: tuple
+    uncovered: tuple
+
+    @property
+    def problem(self) -> HBProblem:
+        return self.tr.problem
+
+    def branch(self) -> HBBranch:
+        """The HBBranch (AFT diagnostics and Hill stability of every point)."""
+        return _make_branch(self.tr, self.status, self.message, self.parts, self.peaks, self.uncovered)
+
+
 def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBranch:
     """HBBranch of the continued points: AFT diagnostics and Hill stability of every point.
 
@@ -670,7 +692,7 @@ class _Request:
     condense: bool | None
 
 
-def _fixed_branch(req: _Request, level) -> HBBranch:
+def _fixed_branch(req: _Request, level) -> _Draft:
     """The branch with H harmonics and Ns samples, ``level = (H, Ns)``."""
     problem = make_problem(req.system, condense=req.condense, response_dofs=(req.dof,), harmonics=level[0],
                            samples=level[1], parameter=req.parameter, gamma=req.gamma)
@@ -768,7 +790,7 @@ def _peak_level(req: _Request, condensed: bool, pk: HBPeak, scale: float, level,
             return at, first
 
 
-def _combined_target(req: _Request, br: HBBranch, scale: float, level, auto, wanted):
+def _combined_target(req: _Request, br: _Draft, scale: float, level, auto, wanted):
     """The level of the next branch: the most harmonics and the most samples that the peaks ask for
     (``wanted``: their levels from :func:`_peak_level`).
 
@@ -804,7 +826,7 @@ def _adaptive_branch(req: _Request, level, auto) -> HBBranch:
     levels = [level]
     br = _fixed_branch(req, level)
     if not any(auto):
-        return br
+        return br.branch()
     while True:
         scale = max([pk.amplitude_m for pk in br.peaks], default=0.0)
         checks = [_peak_level(req, br.problem.condensed, pk, scale, level, auto) for pk in br.peaks]
@@ -829,6 +851,7 @@ def _adaptive_branch(req: _Request, level, auto) -> HBBranch:
                                 check_harmonics=by_h[0] if by_h else 0, check_samples=by_s[1] if by_s else 0,
                                 harmonics_change=ch_h, samples_change=ch_s, peaks=len(checks),
                                 rtol=config.HB_AUTO_RTOL, converged=converged)
+    br = br.branch()
     message = br.message
     if not converged:
         message += (f"; the peak amplitude is not converged in the discretisation at its bound (H = {level[0]}, "
@@ -855,8 +878,8 @@ def _point_status(res: ContinuationResult) -> np.ndarray:
     return out
 
 
-def _join(tr: _Tracker, parts, fills, start, stop, opt) -> HBBranch:
-    """The HBBranch of the continued segments (unscaled), with its status, peaks and coverage.
+def _join(tr: _Tracker, parts, fills, start, stop, opt) -> _Draft:
+    """The branch of the continued segments (unscaled), with its status, peaks and coverage.
 
     ``parts``: the segment from the start and the one continued back from
     the end; they decide the status. ``fills``: the segments continued back
@@ -889,7 +912,7 @@ def _join(tr: _Tracker, parts, fills, start, stop, opt) -> HBBranch:
               for pk in _fill_peak(tr, f, logqs[main + k], tr.observe(y_left, 0.0), main + k, opt)]
     logq = np.concatenate(logqs)
     joined = dataclasses.replace(joined, fold=_turning_mask(joined.lam, logq, joined.segment, joined.gap, start, stop))
-    return _make_branch(tr, status, message, joined, peaks, uncovered)
+    return _Draft(tr, status, message, joined, tuple(peaks), tuple(uncovered))
 
 
 class _FillMonitor:
