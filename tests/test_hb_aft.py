@@ -23,7 +23,7 @@ from jointdyn.hb import HBProblem
 def _value_period(p, law, c, U, u, Nsamp, ev_tau, ev_load, s0, vbuf, Tref):
     """The compiled march's check after the second pass: one period from s0 with the law's plain
     ``step`` (restarts by ``init``), trial states alternating between a copy of s0 and ``vbuf``.
-    Returns (largest change of the force against Tref, True when it repeats Tref or ends in s0)."""
+    Returns (largest change of the force against Tref, True when it repeats Tref)."""
     rtol = config.HB_PERIODIC_RTOL
     va, vb = s0.copy(), vbuf
     Tv = np.empty(u.size)
@@ -33,9 +33,7 @@ def _value_period(p, law, c, U, u, Nsamp, ev_tau, ev_load, s0, vbuf, Tref):
         Tv[i] = law.step(law.params, va, vb, u[i], Nsamp[c, i])[0]
         va, vb = vb, va
     err, tmax = np.max(np.abs(Tv - Tref)), np.max(np.abs(Tv))
-    if err <= rtol * tmax:
-        return err, True
-    return err, not np.any(np.abs(va - s0) > rtol * np.maximum(np.abs(va), np.abs(s0)))
+    return err, bool(err <= rtol * tmax)
 
 
 def _reference(p, X, lam):
@@ -186,7 +184,7 @@ def test_second_pass_checked_without_derivatives_is_the_periodic_one(model, kw):
     X0 = p.linear_guess(1.1)
     rng = np.random.default_rng(11)
     checked = 0
-    for scale in (0.5, 1.0, 2.0, 3.0, 5.0, 10.0):
+    for scale in (0.5, 0.8, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0):
         X = X0 * scale * (1.0 + 0.2 * rng.standard_normal(X0.size))
         ev = p.evaluate(X, 1.1)
         assert ev.info[2] == 1.0
