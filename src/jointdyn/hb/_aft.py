@@ -10,7 +10,7 @@ load crosses zero upwards), the law is restarted virgin at the exact
 re-contact phase, at the displacement there (:func:`recontact_events`),
 before it steps to the next sample: the re-contact instant is not
 quantised to the sampling grid. A period that only confirms that the last one repeats is marched
-with the law's plain ``step`` (:func:`_value_pass`). Derivatives are
+along no direction (:func:`_value_pass`). Derivatives are
 carried forward through the same march with the law's ``step_jvp`` kernel, starting from the exact derivative of the
 virgin state (the law's ``init_jvp``), so the Jacobian of the force
 coefficients with respect to the displacement coefficients (and to a
@@ -27,8 +27,7 @@ period, the periodicity tests, projection and scatter.
 
 Nothing here knows the physics of a law: the kernels are called unchanged
 through the compiled template bound with :func:`jointdyn._jit.specialize`
-(``STEP``, ``STEP_JVP``, ``INIT``, ``INIT_JVP``) and passed on to the helpers
-that call them.
+(``STEP_JVP``, ``INIT_JVP``) and passed on to the helpers that call them.
 """
 
 from __future__ import annotations
@@ -118,8 +117,8 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
     derivatives are the mean of the last two passes, which is the exact
     projection of the 2T-periodic force on the T-periodic harmonics
     (:func:`_period_test`). A second pass that neither test stops is
-    checked by one more period marched without derivatives (the law's plain
-    ``step`` and ``init``, :func:`_value_pass`, a fraction of the cost of a
+    checked by one more period marched without derivatives (``step_jvp``
+    along no direction, :func:`_value_pass`, a fraction of the cost of a
     pass with them): if its force repeats the second pass's (the first
     test), the second pass is the periodic force and the result, with its
     derivatives; otherwise the march goes on with derivatives. The
@@ -188,8 +187,8 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
             if not done and passes == _CHECK_AFTER and passes < max_passes:
                 # one more period without derivatives: if it repeats this one, this pass
                 # is the periodic force and its derivatives are exact
-                done, err_v = _value_pass(STEP, INIT, prm, (u, U), (Nc, km, nrm[0], nrm[1], con[4][c]), c,  # noqa: F821
-                                          SPRINGS, events, a, vst, Tc, rtol)  # noqa: F821
+                done, err_v = _value_pass(STEP_JVP, INIT_JVP, prm, (u, U), (Nc, km, nrm[0], nrm[1], con[4][c]),  # noqa: F821
+                                          c, SPRINGS, events, a, vst, Tc, rtol)  # noqa: F821
                 checked = 1
                 if done:
                     period, err = PERIOD_ONE, err_v
@@ -262,9 +261,11 @@ def _workspace(con, four, has_p, code):  # pragma: no cover - compiled
     hist = (np.empty((nhist, ssz)), np.empty((nhist, ssz, nd)))
     proj = (np.empty(nh), np.empty((nh, nd)))
     nrm = (np.empty(nh), np.empty(ns), np.empty(ns), np.empty(ns), np.empty(nh), np.empty((nh, nh)))
-    # states of the period marched without derivatives (zeros, as ``st``) and the
-    # scratch derivative of a restart's displacement there (unused)
-    vst = (np.zeros(ssz), np.zeros(ssz), np.empty(2 * nh))
+    # states of the period marched without derivatives (zeros, as ``st``), their
+    # derivatives and directions along none (the law's step_jvp with no direction),
+    # and the scratch derivative of a restart's displacement there (unused)
+    vst = (np.zeros(ssz), np.zeros(ssz), np.zeros((ssz, 0)), np.zeros((ssz, 0)), np.zeros(0), np.zeros(0),
+           np.empty(2 * nh))
     return sig, dirs, st, pw, hist, proj, nrm, vst
 
 
@@ -425,22 +426,24 @@ def _pass(step_jvp, init_jvp, prm, sig, nk, dN, c, has_p, spr, events, E, dirs, 
 
 
 @jit(inline="always")
-def _value_pass(step, init, prm, sig, nk, c, spr, events, s0, vst, Tref, rtol):  # pragma: no cover - compiled
+def _value_pass(step_jvp, init_jvp, prm, sig, nk, c, spr, events, s0, vst, Tref, rtol):  # pragma: no cover - compiled
     """One period of contact c marched without derivatives from the committed state ``s0``.
 
     The check after the second pass (:func:`_eval_template`): the law's
-    ``step`` from a copy of ``s0`` over the samples, with the restarts of
-    :func:`_pass` (re-contact of a prescribed load, closing of a spring;
-    ``init``), its forces compared with the last pass's ``Tref``. Returns
+    ``step_jvp`` along no direction (its primal outputs are ``step``'s, bit
+    for bit; the compiled kernel already called by the passes, so the check
+    compiles no law code of its own) from a copy of ``s0`` over the
+    samples, with the restarts of :func:`_pass` (re-contact of a prescribed
+    load, closing of a spring; ``init_jvp``), its forces compared with the
+    last pass's ``Tref``. Returns
     ``(repeats, err)``: ``repeats`` True when the forces agree to ``rtol
     max|T|`` (the first test of :func:`_period_test`), so that the pass
     that ended in ``s0`` is the periodic force; ``err`` the largest force
     change, N. (A state at the end equal to ``s0`` would make this period
     periodic, not the one before it, whose start differed: it is not a
-    test here.) Costs a fraction of a pass with derivatives (the law's
-    plain step).
+    test here.) Costs a fraction of a pass with derivatives.
     """
-    va, vb, dxs = vst
+    va, vb, dva, dvb, d0, dT0, dxs = vst
     u, U = sig
     Nc, km, Gc, gs, sp = nk
     ev_tau, ev_dtau, ev_load = events
@@ -454,20 +457,20 @@ def _value_pass(step, init, prm, sig, nk, c, spr, events, s0, vst, Tref, rtol): 
         if ev_tau[c, i] != NO_EVENT:
             xr = _event_point(U, ev_tau[c, i], ev_dtau[c, i], False, dxs)
             if cur == 0:
-                init(prm, xr, ev_load[c], va)
+                init_jvp(prm, xr, d0, ev_load[c], d0, va, dva)
             else:
-                init(prm, xr, ev_load[c], vb)
+                init_jvp(prm, xr, d0, ev_load[c], d0, vb, dvb)
         if spr and km[i] > 0.0 and km[i - 1 if i > 0 else ns - 1] == 0.0:
             xr = _spring_event(U, Gc, sp, 2.0 * np.pi * i / ns, 2.0 * np.pi / ns, gs[i - 1 if i > 0 else ns - 1],
                                gs[i], dxs)
             if cur == 0:
-                init(prm, xr, sp[2], va)
+                init_jvp(prm, xr, d0, sp[2], d0, va, dva)
             else:
-                init(prm, xr, sp[2], vb)
+                init_jvp(prm, xr, d0, sp[2], d0, vb, dvb)
         if cur == 0:
-            t_ = step(prm, va, vb, u[i], Nc[i])[0]
+            t_ = step_jvp(prm, va, dva, vb, dvb, u[i], d0, Nc[i], d0, dT0)[0]
         else:
-            t_ = step(prm, vb, va, u[i], Nc[i])[0]
+            t_ = step_jvp(prm, vb, dvb, va, dva, u[i], d0, Nc[i], d0, dT0)[0]
         cur = 1 - cur
         err, tmax = _track(t_, Tref[i], err, tmax)
     return err <= rtol * tmax, err
@@ -846,14 +849,11 @@ def _scale_outputs(R, JX, Jp, scaled):  # pragma: no cover - compiled
                 JXs[i, j] = JX[i, j] * scl[1]
 
 
-def eval_kernel(step, step_jvp, init, init_jvp, springs: bool = False):
-    """The compiled HB evaluation with a law's kernels bound (disk-cached).
+def eval_kernel(step_jvp, init_jvp, springs: bool = False):
+    """The compiled HB evaluation with a law's ``step_jvp`` and ``init_jvp`` bound (disk-cached).
 
-    ``step_jvp`` and ``init_jvp`` march the passes with derivatives, ``step``
-    and ``init`` the check without them (:func:`_value_pass`). ``springs``
-    (some contact's normal load comes from a normal spring; it must equal
-    ``con[5]`` of every call) is a compile-time constant: the evaluations
-    of other systems compile none of the spring work.
+    ``springs`` (some contact's normal load comes from a normal spring; it
+    must equal ``con[5]`` of every call) is a compile-time constant: the
+    evaluations of other systems compile none of the spring work.
     """
-    return specialize(_eval_template, STEP=step, STEP_JVP=step_jvp, INIT=init, INIT_JVP=init_jvp,
-                      SPRINGS=bool(springs))
+    return specialize(_eval_template, STEP_JVP=step_jvp, INIT_JVP=init_jvp, SPRINGS=bool(springs))

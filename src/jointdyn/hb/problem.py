@@ -39,8 +39,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ..fourier import STARTS, STOPS, event_projection, extrema, fourier_matrices, phases
-from ..kinematics import (NORMAL_SPRING, contact_kinematics, no_contact_init, no_contact_init_jvp, no_contact_step,
-                          no_contact_step_jvp, selection_matrix)
+from ..kinematics import NORMAL_SPRING, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
 from ..laws import law_dispatch
 from ..systems import Contact, System
 from ._aft import NO_EVENT, eval_kernel, recontact_events
@@ -225,10 +224,10 @@ class HBProblem:
         if nc:
             disp = law_dispatch([c.law for c in self.contacts])
             self._Pm, self._ssz = disp.P, disp.state_size
-            self._kernel = eval_kernel(disp.step, disp.step_jvp, disp.init, disp.init_jvp, self.has_springs)
+            self._kernel = eval_kernel(disp.step_jvp, disp.init_jvp, self.has_springs)
         else:
             self._Pm, self._ssz = _pad_rows([]), 1
-            self._kernel = eval_kernel(no_contact_step, no_contact_step_jvp, no_contact_init, no_contact_init_jvp)
+            self._kernel = eval_kernel(no_contact_step_jvp, no_contact_init_jvp)
 
     def _projection(self) -> np.ndarray:
         """The AFT's analysis matrix: :func:`~jointdyn.fourier.event_projection` with the separations and
