@@ -444,6 +444,8 @@ class _Tracker:
         self.evaluations = {}
         #: the amplitudes of the last few unknowns asked for (observable and monitor share them)
         self._amps = {}
+        #: the amplitudes of every accepted point (the branch's observable asks for them again)
+        self._accepted_amps = {}
 
     def residual(self, y, lam_s):
         xs, _, ps = self.scales
@@ -454,7 +456,7 @@ class _Tracker:
     def amplitudes(self, y):
         """(half peak-to-peak, mean, max |x|) of the response DOF at scaled unknowns y, m."""
         key = y.tobytes()
-        hit = self._amps.get(key)
+        hit = self._amps.get(key) or self._accepted_amps.get(key)
         if hit is None:
             if len(self._amps) >= _AMPLITUDE_CACHE:
                 self._amps.clear()
@@ -487,7 +489,7 @@ class _Tracker:
         xs, _, ps = self.scales
         name = self.problem.parameter.name
         X = y * xs
-        amps = self.amplitudes(y)
+        amps = self._accepted_amps[y.tobytes()] = self.amplitudes(y)
         q = self.q(amps[0])
         lam = lam_s * ps
         if self.last is not None:

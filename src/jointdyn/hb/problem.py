@@ -173,6 +173,8 @@ class HBProblem:
         self.system = system
         #: system DOF of each unknown DOF (X[h * n + i] is harmonic h of DOF dofs[i])
         self.dofs = np.asarray(dofs, dtype=np.int64)
+        #: position of each unknown DOF among them (dof_index, asked at every continuation step)
+        self._dof_positions = {int(d): i for i, d in enumerate(self.dofs)}
         self.n = self.dofs.size
         self.nh = 2 * self.H + 1
         self.size = self.n * self.nh
@@ -257,6 +259,10 @@ class HBProblem:
 
     def dof_index(self, dof: int) -> int:
         """Position among the unknown DOFs of system DOF ``dof`` (ValueError naming it if absent)."""
+        try:
+            return self._dof_positions[dof]
+        except (KeyError, TypeError):
+            pass
         hit = np.flatnonzero(self.dofs == dof)
         if hit.size == 0:
             raise ValueError(f"dof {dof!r} is not among the unknowns of this problem ({self.dofs.tolist()})")

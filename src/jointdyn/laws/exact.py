@@ -51,7 +51,10 @@ Kernel layouts
 ``state = [x_prev (m), m, (hi_k, a_k, b_k) for k < 3 K]``: ``m`` pieces
 in increasing u; piece k covers [hi_(k-1), hi_k] (hi_(-1) = 0,
 hi_(m-1) = 2) with P(u) = a_k + b_k u (units of fy). Rows beyond the live
-pieces are not written by ``step``. A step writes at most three pieces per
+pieces are never read; ``step`` keeps them zero where the buffers started
+so (every state from ``init`` does), so that two states with the same
+pieces are equal entry by entry (the harmonic-balance AFT compares states
+to stop marching periods). A step writes at most three pieces per
 committed piece before it merges down to K, hence room for 3 K.
 
 Derivatives (``step_jvp``): rows a_k, b_k carry da_k, db_k, the derivative
@@ -416,15 +419,19 @@ def _reset_live(s, x):
 @jit(inline="always")
 def _jvp_force(s, ds, m, fy, dT):
     """dT = fy / 2 * sum over pieces of the integral of da + db u."""
+    # pieces outside, directions inside (rows are contiguous); each direction
+    # sums its pieces in the same order as a loop per direction would
     for j in range(dT.shape[0]):
-        acc = 0.0
-        lo = 0.0
-        for k in range(m):
-            r = _HEAD + 3 * k
-            hi = s[r]
-            acc += _integral(lo, hi, ds[r + 1, j], ds[r + 2, j])
-            lo = hi
-        dT[j] = 0.5 * fy * acc
+        dT[j] = 0.0
+    lo = 0.0
+    for k in range(m):
+        r = _HEAD + 3 * k
+        hi = s[r]
+        for j in range(dT.shape[0]):
+            dT[j] += _integral(lo, hi, ds[r + 1, j], ds[r + 2, j])
+        lo = hi
+    for j in range(dT.shape[0]):
+        dT[j] = 0.5 * fy * dT[j]
 
 
 @jit(inline="always")
@@ -475,12 +482,22 @@ def _exact_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
                 left = right
         lo = hi
         k_lo = k_hi
+    written = m
     if m > int(params[_P_CAP]):
         m, total, stuck = _enforce_capacity(s_new, ds_new, m, int(params[_P_CAP]), alpha, total, stuck,
                                             params[_P_INV_NREF], dN)
     if not contact:  # separation (or no friction): P = 0
         _write(s_new, 0, U_MAX, 0.0, 0.0)
         m = 1
+    # rows beyond the live pieces are zeroed up to the most this step wrote or the
+    # buffer held before (a count outside [0, room], e.g. NaN, is not trusted), so
+    # that states with equal pieces are equal entry by entry
+    top = max(written, _held(s_new[_M], 3 * int(params[_P_CAP])))
+    for rr in range(_HEAD + 3 * m, _HEAD + 3 * top):
+        s_new[rr] = 0.0
+        if ds_new is not None:
+            for j in range(ds_new.shape[1]):
+                ds_new[rr, j] = 0.0
     s_new[_X] = x
     s_new[_M] = m
     if ds_new is not None:
@@ -494,6 +511,14 @@ def _exact_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
     if alpha <= 0.0:
         code = SEPARATION
     return 0.5 * fy * total, 0.5 * params[_P_KT] * stuck, code
+
+
+@jit(inline="always")
+def _held(count, room):
+    """Pieces a state buffer held (its count entry), or 0 when that is not a count in [0, room]."""
+    if count >= 0.0 and count <= room:
+        return int(count)
+    return 0
 
 
 @jit(inline="always")
