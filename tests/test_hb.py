@@ -84,23 +84,29 @@ def test_jacobian_matches_central_differences(model, eta, par):
     p = HBProblem(sysm, harmonics=4, samples=128, parameter=par, gamma=None if par == "gamma" else g)
     lam = {"eta": eta, "delta": math.degrees(0.3), "n0": 100.0, "gamma": g, "f1": p.f1_ref}[par]
     X = harmonic_balance(sysm, g, harmonics=4, samples=128).X
+    ev = _assert_jacobian_matches_central_differences(p, X, lam, 1e-6 * max(abs(lam), 1e-3))
+    assert ev.info[2] == 1.0  # the marched force repeated
+
+
+def _assert_jacobian_matches_central_differences(p, X, lam, h_lam):
+    """Assert that the AFT Jacobians of problem p at (X, lam) match central differences (steps 1e-6 max|X|
+    and h_lam); dR/dX and dR/dp each against their own scale (N/m and N per unit of p differ by orders).
+    Returns the evaluation at (X, lam)."""
     ev = p.evaluate(X, lam)
     Ja = np.c_[ev.JX, ev.Jp]
     Jfd = np.empty_like(Ja)
     for j in range(X.size + 1):
         Xp, Xm, lp, lm = X.copy(), X.copy(), lam, lam
+        h = 1e-6 * np.abs(X).max() if j < X.size else h_lam
         if j < X.size:
-            h = 1e-6 * np.abs(X).max()
             Xp[j] += h
             Xm[j] -= h
         else:
-            h = 1e-6 * max(abs(lam), 1e-3)
             lp, lm = lam + h, lam - h
         Jfd[:, j] = (p.evaluate(Xp, lp).R - p.evaluate(Xm, lm).R) / (2 * h)
-    # dR/dX and dR/dp each against their own scale (N/m and N per unit of p differ by orders)
     assert np.max(np.abs(Ja[:, :-1] - Jfd[:, :-1])) <= tolerances.TEST_HB_JACOBIAN_RTOL * np.max(np.abs(Ja[:, :-1]))
     assert np.max(np.abs(Ja[:, -1] - Jfd[:, -1])) <= tolerances.TEST_HB_JACOBIAN_RTOL * np.max(np.abs(Ja[:, -1]))
-    assert ev.info[2] == 1.0  # the marched force repeated
+    return ev
 
 
 def test_jacobian_through_the_separation_grid_matches_central_differences():
@@ -112,21 +118,7 @@ def test_jacobian_through_the_separation_grid_matches_central_differences():
     p = HBProblem(sysm, harmonics=4, samples=128)
     assert p._uniform is not None and p._taug.size > 128
     X = harmonic_balance(sysm, g, harmonics=4, samples=128).X
-    ev = p.evaluate(X, g)
-    Ja = np.c_[ev.JX, ev.Jp]
-    Jfd = np.empty_like(Ja)
-    for j in range(X.size + 1):
-        Xp, Xm, lp, lm = X.copy(), X.copy(), g, g
-        if j < X.size:
-            h = 1e-6 * np.abs(X).max()
-            Xp[j] += h
-            Xm[j] -= h
-        else:
-            h = 1e-6
-            lp, lm = g + h, g - h
-        Jfd[:, j] = (p.evaluate(Xp, lp).R - p.evaluate(Xm, lm).R) / (2 * h)
-    assert np.max(np.abs(Ja[:, :-1] - Jfd[:, :-1])) <= tolerances.TEST_HB_JACOBIAN_RTOL * np.max(np.abs(Ja[:, :-1]))
-    assert np.max(np.abs(Ja[:, -1] - Jfd[:, -1])) <= tolerances.TEST_HB_JACOBIAN_RTOL * np.max(np.abs(Ja[:, -1]))
+    ev = _assert_jacobian_matches_central_differences(p, X, g, 1e-6)
     assert (ev.T.shape, ev.code.shape) == ((1, 128), (1, 128))  # reported at the uniform samples
 
 
