@@ -60,8 +60,8 @@ class Verdict(Status):
     AGREES = "agrees", "the peak is within the tolerance of the time-domain steady state", True
     DIFFERS = "differs", "the peak is off the time-domain steady state by more than the tolerance"
     NO_PEAK = "no peak", "no peak to compare (unbounded, or the amplitude has no maximum)", True
-    PEAK_IN_JUMP = ("peak in a jump", "the highest amplitude lies at a jump of the branch over a discontinuity "
-                    "of the contact force: the peak between the jump's ends is not resolved")
+    PEAK_IN_JUMP = ("peak in a jump", "the highest amplitude lies at a jump of the branch, above every peak "
+                    "found: the peak between the jump's ends is not resolved")
     NOT_PERIODIC = "not periodic", "the time domain found no periodic steady state at the peak", True
     SUBHARMONIC = ("subharmonic", "the time-domain steady state repeats only every p > 1 forcing periods: "
                    "a period-one harmonic balance cannot be that orbit (not compared)")
