@@ -40,7 +40,7 @@ import threading
 from .. import config
 from ._points import Context, solve_chunk
 
-__all__ = ["SerialExecutor", "LocalExecutor", "DaskExecutor", "run_chunks", "die_with_parent"]
+__all__ = ["SerialExecutor", "LocalExecutor", "DaskExecutor", "run_chunks", "die_with_parent", "detach_worker", "process_context"]
 
 #: prctl option: signal sent to this process when its parent thread exits (linux/prctl.h)
 PR_SET_PDEATHSIG = 1
@@ -78,12 +78,26 @@ def die_with_parent(parent_pid: int) -> None:
                      name="jointdyn-parent-watchdog").start()
 
 
-def _init_worker(systems, stop, counter, parent_pid) -> None:
-    """Initializer of a process worker: SIGINT ignored, death with the parent,
-    the family's Systems and the shared stop flag and point counter."""
-    global _WORKER
+def process_context():
+    """The multiprocessing context of worker processes: fork (Linux), so that workers inherit the compiled
+    kernels and the Systems and do not re-import the caller's __main__ (spawn would, breaking scripts
+    without a main guard); spawn elsewhere."""
+    import multiprocessing as mp
+
+    return mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+
+
+def detach_worker(parent_pid: int) -> None:
+    """Set up a worker process: SIGINT ignored (the parent handles Ctrl-C), death with the parent."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     die_with_parent(parent_pid)
+
+
+def _init_worker(systems, stop, counter, parent_pid) -> None:
+    """Initializer of a process worker: :func:`detach_worker`, the family's Systems and the shared stop
+    flag and point counter."""
+    global _WORKER
+    detach_worker(parent_pid)
     _WORKER = (systems, Context(stop, counter))
 
 
@@ -173,12 +187,7 @@ class LocalExecutor:
             self.ctx = Context(counter=_Counter())
             self.pool = cf.ThreadPoolExecutor(max_workers=workers)
             return
-        import multiprocessing as mp
-
-        # fork (Linux): workers inherit the compiled kernels and the Systems
-        # and do not re-import the caller's __main__ (spawn would, breaking
-        # scripts without a main guard); spawn elsewhere
-        mpc = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+        mpc = process_context()
         self.ctx = Context(stop=mpc.Event(), counter=mpc.Value("q", 0))
         self.pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=mpc, initializer=_init_worker,
                                            initargs=(systems, self.ctx.stop, self.ctx.counter, os.getpid()))

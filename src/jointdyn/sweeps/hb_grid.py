@@ -183,23 +183,13 @@ def grid_cases(cases, *, time_domain: bool = True, workers: int = 1) -> list:
     if workers == 1 or len(cases) < 2:
         return [grid_case(*c, time_domain=time_domain) for c in cases]
     import concurrent.futures as cf
-    import multiprocessing as mp
     import os
 
-    mpc = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
-    with cf.ProcessPoolExecutor(max_workers=min(workers, len(cases)), mp_context=mpc, initializer=_init_worker,
-                                initargs=(os.getpid(),)) as pool:
+    from ._pool import detach_worker, process_context
+
+    with cf.ProcessPoolExecutor(max_workers=min(workers, len(cases)), mp_context=process_context(),
+                                initializer=detach_worker, initargs=(os.getpid(),)) as pool:
         return list(pool.map(_case_task, [(c, time_domain) for c in cases]))
-
-
-def _init_worker(parent_pid: int) -> None:
-    """Initializer of a process worker of :func:`grid_cases`: SIGINT ignored, death with the parent."""
-    import signal
-
-    from ._pool import die_with_parent
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    die_with_parent(parent_pid)
 
 
 def _case_task(task) -> GridCase:
