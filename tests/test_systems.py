@@ -127,6 +127,24 @@ def test_issue_example_reference_frequency_includes_the_normal_spring():
     assert jd.System(s.M, s.C, s.K, contacts=(c,), output_dof=1).response_dof == 1
 
 
+@pytest.mark.parametrize("seed", range(5))
+def test_reference_frequency_is_the_lowest_elastic_generalised_eigenvalue(seed):
+    # oracle: scipy's generalised symmetric eigensolver (w0 uses numpy's LAPACK, so that a command
+    # does not import scipy.linalg); a full M and a K with one rigid-body mode
+    from scipy.linalg import eigh
+
+    rng = np.random.default_rng(seed)
+    n = 6
+    A = rng.normal(size=(n, n))
+    M = A @ A.T + n * np.eye(n)
+    V = rng.normal(size=(n, n - 1))
+    K = 1e5 * V @ V.T  # rank n - 1: one rigid-body mode
+    s = jd.System(M, None, K, contacts=())
+    lam = eigh(K, M, eigvals_only=True)
+    assert lam[0] < 1e-9 * lam[-1]
+    assert s.w0 == pytest.approx(math.sqrt(lam[1]), rel=1e-10)
+
+
 @pytest.mark.parametrize(
     "kw,name",
     [

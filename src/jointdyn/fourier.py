@@ -355,10 +355,20 @@ def reconstruct(coefficients, harmonics: int, points: int = config.HB_FINE_SAMPL
 @jit
 def _extrema(Ef, c):  # pragma: no cover - compiled
     """(max, min) of x = Ef c, each refined by the parabola through three samples."""
-    x = Ef @ c
-    n = x.size
-    hi_i = np.argmax(x)
-    lo_i = np.argmin(x)
+    # loops, not Ef @ c and np.argmax: code loaded from Numba's cache that
+    # calls numpy's array functions imports Numba's numpy module, which
+    # imports scipy.linalg (0.2-0.4 s of the CLI's start; see hb._aft._project)
+    n = Ef.shape[0]
+    x = np.zeros(n)
+    hi_i = 0
+    lo_i = 0
+    for i in range(n):
+        for k in range(c.size):
+            x[i] += Ef[i, k] * c[k]
+        if x[i] > x[hi_i]:
+            hi_i = i
+        if x[i] < x[lo_i]:
+            lo_i = i
     out = np.empty(2)
     for k in range(2):
         i = hi_i if k == 0 else lo_i

@@ -316,11 +316,20 @@ def _project(c, P, Tc, dT, T, proj):  # pragma: no cover - compiled
     for i in range(Tc.shape[0]):
         T[c, i] = Tc[i]
     F, G = proj
-    # into the outputs (the same BLAS product): an assignment of np.dot's
-    # result compiles numba's shape-mismatch error message (string
-    # formatting, about 3 s of cold compile)
-    np.dot(P, Tc, F)
-    np.dot(P, dT, G)
+    # plain loops, not np.dot: Numba's BLAS binding imports scipy.linalg at
+    # the first call (0.2-0.4 s of every process's start), and at these
+    # sizes (2H+1 rows, a few hundred samples) the loops are as fast
+    nd = dT.shape[1]
+    for k in range(P.shape[0]):
+        f = 0.0
+        for j in range(nd):
+            G[k, j] = 0.0
+        for i in range(P.shape[1]):
+            p = P[k, i]
+            f += p * Tc[i]
+            for j in range(nd):
+                G[k, j] += p * dT[i, j]
+        F[k] = f
 
 
 @jit(inline="always")
