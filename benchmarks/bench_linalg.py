@@ -15,6 +15,15 @@ Jacobian at a response where the contact slips part of the period.
 * Bordered solves: one Newton correction of the continuation
   (n (2H+1) + 1 unknowns: 16 to 751), by the compiled Gaussian elimination
   and by LAPACK ``dgesv`` (``numpy.linalg.solve``).
+* AFT projection: the force coefficients and their derivatives of one
+  contact, ``F = P Tc`` and ``G = P dT`` (P: 2H+1 rows by Ns samples; dT:
+  Ns rows by 2H+2 directions, as with the continuation parameter), by the
+  compiled loops of ``jointdyn.hb._aft._project`` and by ``np.dot`` (BLAS)
+  in a compiled function, beside one whole evaluation of the paper's damper
+  at the same size. The loops are slower than BLAS; they are kept because
+  Numba's ``np.dot`` imports ``scipy.linalg`` when its code is loaded from
+  the cache (0.2-0.4 s of the start of every ``jointdyn frc --method hb``),
+  and this table says what they cost in exchange.
 * Cold compile of each hand-written path (fresh ``NUMBA_CACHE_DIR``, in a
   subprocess), the cost they add to a first run.
 
@@ -153,6 +162,64 @@ def _solve_row(n, budget):
             "max_rel_diff": float(np.max(np.abs(a - b)) / np.max(np.abs(b)))}
 
 
+_DOT = None
+
+
+def _dot_projection():
+    """``np.dot`` for the projection, compiled once here (not in jointdyn: it imports scipy.linalg)."""
+    global _DOT
+    if _DOT is None:
+        import numba
+        import numpy as np
+
+        @numba.njit(cache=False)
+        def dot(P, Tc, dT, F, G):
+            F[:] = np.dot(P, Tc)
+            G[:] = np.dot(P, dT)
+
+        _DOT = dot
+    return _DOT
+
+
+def _projection_row(h, ns, budget):
+    import numpy as np
+
+    from jointdyn import System
+    from jointdyn.hb import HBProblem
+    from jointdyn.hb import _aft as A
+
+    rng = np.random.default_rng(2)
+    m = 2 * h + 1
+    nd = m + 1
+    P = rng.standard_normal((m, ns))
+    Tc = rng.standard_normal(ns)
+    dT = rng.standard_normal((ns, nd))
+    T = np.empty((1, ns))
+    proj = (np.empty(m), np.empty((m, nd)))
+    F2, G2 = np.empty(m), np.empty((m, nd))
+    dot = _dot_projection()
+    reps = 200
+
+    def loops():
+        for _ in range(reps):
+            A._project(0, P, Tc, dT, T, proj)
+
+    def blas():
+        for _ in range(reps):
+            dot(P, Tc, dT, F2, G2)
+
+    looped = _best(loops, budget) / reps
+    blased = _best(blas, budget) / reps
+    assert np.allclose(proj[0], F2) and np.allclose(proj[1], G2)
+    p = HBProblem(System.paper_damper(eta=0.5, beta=2.0), harmonics=h, samples=ns)
+    g = 1.2
+    X = p.linear_guess(g)
+    evaluation = _best(lambda: p.evaluate(X, g), budget)
+    return {"harmonics": h, "samples": ns, "directions": nd, "loops_s": looped, "blas_s": blased,
+            "loops_over_blas": looped / blased, "paper_damper_evaluation_s": evaluation,
+            "extra_share_of_evaluation": (looped - blased) / evaluation}
+
+
 def _cold_compile(which):
     env = dict(os.environ)
     env["PYTHONPATH"] = str(SRC) + os.pathsep + env.get("PYTHONPATH", "")
@@ -173,6 +240,7 @@ def run(quick: bool = False) -> dict:
         "harmonics": H,
         "hill_eigenvalues": [_hill_row(n, eta, budget) for n in dofs for eta in (0.0, 0.5)],
         "bordered_solve": [_solve_row(n, budget) for n in dofs],
+        "aft_projection": [_projection_row(h, ns, budget) for h, ns in ((7, 128), (7, 256), (15, 512))],
         "thresholds": {"HB_SMALL_EIG": config.HB_SMALL_EIG, "CONT_SMALL_SOLVE": config.CONT_SMALL_SOLVE},
     }
     if not quick:
