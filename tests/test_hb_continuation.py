@@ -29,12 +29,13 @@ def test_options_defaults_come_from_config():
     assert (opt.tol, opt.max_iter, opt.max_points) == (config.CONT_TOL, config.CONT_MAX_ITER,
                                                         config.CONT_MAX_POINTS)
     assert opt.jump_fractions == config.CONT_JUMP_FRACTIONS and opt.corner_ds == config.CONT_CORNER_DS
+    assert opt.start_extrapolation is None  # the solver decides (harmonic balance: by the contact laws)
 
 
 @pytest.mark.parametrize("field,value", [("ds", 0.0), ("ds_min", -1.0), ("max_points", 0), ("grow", -1.0),
                                          ("shrink", 1.5), ("turn_cos", 2.0), ("predictor", "euler"),
                                          ("jump_fractions", (1e-3, -1.0)), ("max_jumps", -1),
-                                         ("line_search_steps", 0)])
+                                         ("line_search_steps", 0), ("start_extrapolation", -1.0)])
 def test_bad_options_name_the_field(field, value):
     with pytest.raises(ValueError, match=field):
         ContinuationOptions(**{field: value})
@@ -137,3 +138,58 @@ def test_jenkins_at_a_jump_covers_the_range_without_a_zigzag():
     assert br.status == "complete" and "stalled" not in br.message
     assert int((br.gap & (br.segment == 0)).sum()) == 1
     assert br.lam.size < 1000 and br.lam.min() == pytest.approx(0.6) and br.lam.max() == pytest.approx(1.8)
+
+
+def _circle(y, lam):
+    # y^2 + lam^2 = 4: a smooth curve of curvature 1/2 with folds at lam = +-2
+    return np.array([y[0] ** 2 + lam ** 2 - 4.0]), np.array([[2.0 * y[0]]]), np.array([2.0 * lam])
+
+
+@pytest.mark.parametrize("ds", [0.2, 0.1, 0.05])
+def test_hermite_start_lies_on_the_hyperplane_closer_to_the_curve(ds):
+    # on a circle of radius 2, points at arc lengths -h and 0 with their exact unit tangents: the
+    # corrector's start is on its hyperplane t^T (v - u_pred) = 0 and nearer the circle's point there
+    # than the tangent prediction, by a factor that grows as the step shrinks (O(ds^3) against O(ds^2))
+    from jointdyn.continuation import _hermite_start
+
+    r, h = 2.0, ds
+
+    def pt(s):
+        return np.array([r * math.cos(s / r), r * math.sin(s / r)]), np.array([-math.sin(s / r), math.cos(s / r)])
+
+    (u_prev, t_prev), (u, t) = pt(-h), pt(0.0)
+    u_pred = u + ds * t
+    on = ContinuationOptions(start_extrapolation=2.0)
+    v0 = _hermite_start(u, t, (u_prev, t_prev), ds, u_pred, t, on)
+    assert abs(t @ (v0 - u_pred)) < 1e-14
+    # the circle meets the hyperplane x . t = ds (t = e_lam at u = (2, 0)) at (sqrt(4 - ds^2), ds)
+    exact = np.array([math.sqrt(r * r - ds * ds), ds])
+    gain = np.linalg.norm(u_pred - exact) / np.linalg.norm(v0 - exact)
+    assert gain > 0.5 / ds
+    # no extrapolation without the last step, beyond start_extrapolation times it, or when switched off
+    assert _hermite_start(u, t, None, ds, u_pred, t, on) is u_pred
+    near = u + 1.5 * h * t
+    assert _hermite_start(u, t, (u_prev, t_prev), 1.5 * h, near, t, on) is not near
+    far = u + 3.0 * h * t
+    assert _hermite_start(u, t, (u_prev, t_prev), 3.0 * h, far, t, on) is far
+    for off in (ContinuationOptions(), ContinuationOptions(start_extrapolation=0.0)):
+        assert _hermite_start(u, t, (u_prev, t_prev), ds, u_pred, t, off) is u_pred
+
+
+def test_hermite_start_gives_the_same_points_in_fewer_evaluations():
+    # the corrector's constraint is that of the tangent prediction, so the branch has the same points
+    # (to Newton's tolerance) and the same folds; it needs fewer residual evaluations
+    kw = dict(ds=0.05, ds_max=0.1)
+    on = continuation(_circle, np.array([-math.sqrt(4.0 - 1.9 ** 2)]), -1.9, 1.9, start_extrapolation=2.0, **kw)
+    off = continuation(_circle, np.array([-math.sqrt(4.0 - 1.9 ** 2)]), -1.9, 1.9, start_extrapolation=0.0, **kw)
+    assert on.status is off.status is ContinuationStatus.COMPLETE and on.lam.size == off.lam.size
+    assert np.allclose(on.lam, off.lam, atol=1e-8) and np.allclose(on.y, off.y, atol=1e-8)
+    assert on.counters["residual_evaluations"] < 0.9 * off.counters["residual_evaluations"]
+    # every point is on the circle
+    assert np.allclose(on.y[:, 0] ** 2 + on.lam ** 2, 4.0, atol=1e-8)
+    # through two folds: the same folds at the same points
+    on = continuation(_cubic, np.array([1.5]), -1.5, 1.5, start_extrapolation=2.0, **kw)
+    off = continuation(_cubic, np.array([1.5]), -1.5, 1.5, start_extrapolation=0.0, **kw)
+    assert on.counters["folds"] == off.counters["folds"] == 2 and on.lam.size == off.lam.size
+    assert np.allclose(on.lam, off.lam, atol=1e-8) and np.array_equal(on.fold, off.fold)
+    assert on.counters["residual_evaluations"] < off.counters["residual_evaluations"]

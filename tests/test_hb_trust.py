@@ -450,3 +450,43 @@ def test_a_peak_the_branch_reaches_only_from_one_side_is_reported_at_the_stop(ca
     rc, out, _ = _cli_hb(capsys, "--model", "jenkins", "--eta", "10", "--beta", "5", "--harmonics", "7",
                          "--samples", "128")
     assert rc == 0 and any(pk["at_stop"] and not pk["refined"] for pk in out["peaks"])
+
+
+@pytest.mark.parametrize("eta,beta", [(0.5, 2.0), (1.5, 5.0)])
+def test_extrapolated_corrector_start_keeps_the_branch(eta, beta):
+    # the default law has a smooth force at the onset of slip: each correction starts from the branch's
+    # extrapolation, on the same hyperplane as the tangent prediction, so the branch has the same points,
+    # the same peaks and the same discretisation, in fewer residual evaluations
+    from jointdyn.continuation import ContinuationOptions
+    from jointdyn.hb import continue_hb
+
+    s = System.paper_damper(eta=eta, beta=beta)
+    on = continue_hb(s, 0.6, 1.8, max_step=0.01, progress=False)
+    off = continue_hb(s, 0.6, 1.8, max_step=0.01, progress=False,
+                      options=ContinuationOptions(start_extrapolation=0.0))
+    assert on.status is off.status and on.lam.size == off.lam.size
+    assert (on.problem.H, on.problem.Ns) == (off.problem.H, off.problem.Ns)
+    # the points agree to Newton's tolerance, carried along the branch (each hyperplane is placed from
+    # the point before): a few 1e-8 in gamma
+    scale = np.abs(off.X).max()
+    assert np.abs(on.lam - off.lam).max() < 1e-7 and np.abs(on.X - off.X).max() < 1e-6 * scale
+    assert len(on.peaks) == len(off.peaks) >= 1
+    for p, q in zip(on.peaks, off.peaks):
+        assert p.gamma == pytest.approx(q.gamma, abs=1e-7) and p.amplitude_q == pytest.approx(q.amplitude_q, rel=1e-7)
+    assert on.counters["residual_evaluations"] < 0.9 * off.counters["residual_evaluations"]
+
+
+def test_laws_with_a_kink_at_slip_start_corrections_from_the_prediction():
+    # Jenkins has a stick-slip kink: harmonic balance leaves the option at None (tangent prediction),
+    # the branch is the one computed with the extrapolation switched off, bit for bit
+    from jointdyn.continuation import ContinuationOptions
+    from jointdyn.hb import continue_hb
+    from jointdyn.laws import Iwan, Jenkins
+
+    assert Iwan.smooth_force and not Jenkins.smooth_force
+    s = System.paper_damper(eta=0.5, beta=1.0, model="jenkins")
+    a = continue_hb(s, 0.6, 1.8, harmonics=7, samples=128, progress=False)
+    b = continue_hb(s, 0.6, 1.8, harmonics=7, samples=128, progress=False,
+                    options=ContinuationOptions(start_extrapolation=0.0))
+    assert np.array_equal(a.lam, b.lam) and np.array_equal(a.X, b.X)
+    assert a.counters["residual_evaluations"] == b.counters["residual_evaluations"]

@@ -11,7 +11,10 @@ Bifurcation and Stability Analysis*, Springer 2010, sec. 4.4):
   orientation follows the previous tangent, so folds are passed);
 * predictor ``u + ds t`` (tangent) or ``u + ds (u - u_prev)/|u - u_prev|``
   (secant);
-* corrector: damped Newton on ``R(u) = 0, d^T (u - u_pred) = 0``;
+* corrector: damped Newton on ``R(u) = 0, d^T (u - u_pred) = 0``, started
+  from the cubic Hermite extrapolation of the last two points and their
+  tangents moved onto that hyperplane (the same solution, fewer
+  iterations; from ``u_pred`` itself if that start fails);
 * step length: grown after easy corrections, shrunk after hard ones and
   where the tangent turned (folds are resolved), cut and retried after a
   failure, down to ``ds_min``; bounded so that lam moves by at most
@@ -118,6 +121,17 @@ class ContinuationOptions:
         Newton iterations per correction.
     predictor : {"tangent", "secant"}
         Direction of the predictor.
+    start_extrapolation : float or None
+        The corrector starts from the cubic Hermite extrapolation of the
+        last two points and their unit tangents, moved onto the
+        corrector's hyperplane ``d^T (v - u_pred) = 0`` (so it converges
+        to the same point as from ``u_pred``), when the step is at most
+        this many times the distance between those points and both were
+        reached along the curve (not by a jump or a corner pass); where
+        Newton fails from there it is tried again from ``u_pred``.
+        0 or None (the default: the solver decides, e.g.
+        ``config.CONT_START_EXTRAPOLATION`` in harmonic balance where
+        every contact law has a smooth force): always from ``u_pred``.
     target_iter : int
         Newton iterations aimed at per correction: the step is multiplied
         by ``grow`` after a correction in fewer (``<= target_iter - 1``),
@@ -177,6 +191,7 @@ class ContinuationOptions:
     tol: float = config.CONT_TOL
     max_iter: int = config.CONT_MAX_ITER
     predictor: str = config.CONT_PREDICTOR
+    start_extrapolation: float | None = None
     target_iter: int = config.CONT_TARGET_ITER
     grow: float = config.CONT_GROW
     shrink: float = config.CONT_SHRINK
@@ -212,6 +227,8 @@ class ContinuationOptions:
         for name in ("turn_cos", "min_tangent_dot"):
             V.in_range(name, getattr(self, name), -1.0, 1.0)
         V.nonnegative("jump_tangent_min", self.jump_tangent_min)
+        if self.start_extrapolation is not None:
+            V.nonnegative("start_extrapolation", self.start_extrapolation)
         V.choice("predictor", self.predictor, ("tangent", "secant"))
         object.__setattr__(self, "jump_fractions", tuple(V.positive("jump_fractions", f)
                                                          for f in self.jump_fractions))
@@ -570,10 +587,18 @@ class _Points:
     def __init__(self, n: int):
         self.n = n
         self.Y, self.L, self.TL, self.FOLD, self.IT, self.GAP, self.CORNER = [], [], [], [], [], [], []
+        # PATH[i]: length of the polygon through points 0..i (scaled unknowns and parameter), for the
+        # stall test (:func:`_stalled`) in constant time per point
+        self.PATH = []
         self.cnt = {"points": 0, "residual_evaluations": 0, "steps_rejected": 0, "folds": 0, "jumps": 0,
                     "corners": 0}
 
     def add(self, y, lam, t_lam, fold, it, gap, corner=False) -> None:
+        if self.Y:
+            d = y - self.Y[-1]
+            self.PATH.append(self.PATH[-1] + math.sqrt(float(d @ d) + (lam - self.L[-1]) ** 2))
+        else:
+            self.PATH.append(0.0)
         self.Y.append(y)
         self.L.append(lam)
         self.TL.append(t_lam)
@@ -584,7 +609,7 @@ class _Points:
 
     def drop(self, k: int) -> None:
         """Forget the last ``k`` points."""
-        for col in (self.Y, self.L, self.TL, self.FOLD, self.IT, self.GAP, self.CORNER):
+        for col in (self.Y, self.L, self.TL, self.FOLD, self.IT, self.GAP, self.CORNER, self.PATH):
             del col[-k:]
 
     def finish(self, status: Status, message: str) -> ContinuationResult:
@@ -762,7 +787,37 @@ def _chord_factor(err, opt) -> float:
     return min(max(0.9 * math.sqrt(opt.chord_tol / err), 0.125), opt.grow)
 
 
-def _try_step(walk: _Walk, u, t, u_prev, g_u, ds) -> _Step:
+def _hermite_start(u, t, prev, ds, u_pred, d, opt):
+    """Where the corrector starts: the cubic Hermite extrapolation to arc length ``ds`` beyond u of
+    the curve through ``prev = (u_prev, t_prev)`` and ``(u, t)``, moved along ``d`` onto the
+    hyperplane ``d^T (v - u_pred) = 0`` (``u_pred`` itself when ``prev`` is None, the step exceeds
+    ``opt.start_extrapolation`` times the distance of the two points, or the extrapolation strays more
+    than half a step from the prediction).
+
+    The tangent prediction is off the curve by O(ds^2) (its curvature);
+    the extrapolation by O(ds^3) where the curve is smooth, so that Newton
+    needs one iteration less at many points. The corrector's constraint is
+    unchanged, and so is the point it converges to.
+    """
+    if prev is None or not opt.start_extrapolation:
+        return u_pred
+    u_prev, t_prev = prev
+    h = float(np.linalg.norm(u - u_prev))
+    if not (h > 0.0 and ds <= opt.start_extrapolation * h):
+        return u_pred
+    # Hermite basis on [u_prev, u] (parameter 0 at u_prev, 1 at u, arc length ~ h), evaluated at 1 + ds / h
+    s = 1.0 + ds / h
+    s2, s3 = s * s, s * s * s
+    p = ((2.0 * s3 - 3.0 * s2 + 1.0) * u_prev + ((s3 - 2.0 * s2 + s) * h) * t_prev
+         + (3.0 * s2 - 2.0 * s3) * u + ((s3 - s2) * h) * t)
+    p -= u_pred
+    p -= (d @ p) * d
+    if not (np.isfinite(p).all() and np.linalg.norm(p) <= 0.5 * ds):
+        return u_pred
+    return u_pred + p
+
+
+def _try_step(walk: _Walk, u, t, u_prev, g_u, ds, prev=None) -> _Step:
     """Predict and correct one step of length ds, then check it.
 
     Rejected (with the factor for the next try) when the corrector failed;
@@ -771,7 +826,9 @@ def _try_step(walk: _Walk, u, t, u_prev, g_u, ds) -> _Step:
     part of the branch; ``corner_like``), or the chord to the new point
     strays more than ``opt.chord_tol`` from the curve; and when lam moved by
     more than ``opt.max_dlam``. At smaller steps sharp turns are corners of
-    a non-smooth branch (e.g. onset of slip) and are accepted.
+    a non-smooth branch (e.g. onset of slip) and are accepted. ``prev =
+    (u_prev, t_prev)``: the last step, when it followed the curve, from
+    which the corrector's start is extrapolated (:func:`_hermite_start`).
     """
     opt, n = walk.opt, walk.n
     if opt.predictor == "secant" and u_prev is not None:
@@ -783,8 +840,15 @@ def _try_step(walk: _Walk, u, t, u_prev, g_u, ds) -> _Step:
     # away from the smallest steps, a corrector that needs many iterations is
     # stopped: retrying at a smaller step is cheaper (a corner of a non-smooth branch)
     big = ds > opt.corner_ds
-    v, ok, it, (R, Jy, Jl) = _solve_damped(walk.residual, u_pred.copy(), None, d, u_pred, opt, walk.cnt,
-                                           max_evals=opt.max_evals_factor * opt.target_iter if big else None)
+    max_evals = opt.max_evals_factor * opt.target_iter if big else None
+    v0 = _hermite_start(u, t, prev, ds, u_pred, d, opt)
+    v, ok, it, (R, Jy, Jl) = _solve_damped(walk.residual, v0.copy(), None, d, u_pred, opt, walk.cnt,
+                                           max_evals=max_evals)
+    if not ok and v0 is not u_pred:
+        # the extrapolation did not help here (a corner or a jump of a piecewise-smooth residual
+        # ahead): the step is decided from the prediction, as without it
+        v, ok, it, (R, Jy, Jl) = _solve_damped(walk.residual, u_pred.copy(), None, d, u_pred, opt, walk.cnt,
+                                               max_evals=max_evals)
     if ok and big and np.linalg.norm(v - u_pred) > opt.max_distance * ds:
         return _Step(v, None, it, False, opt.corner_shrink, corner_like=True)
     t_new = _tangent(Jy, Jl, t) if ok else None
@@ -802,8 +866,9 @@ def _try_step(walk: _Walk, u, t, u_prev, g_u, ds) -> _Step:
     return _Step(v, t_new, it, True, 1.0, err=err, g=g_v)
 
 
-def _advance(walk: _Walk, u, t, u_prev, g_u, ds, ds_init):
+def _advance(walk: _Walk, u, t, u_prev, g_u, ds, ds_init, prev=None):
     """The next point: steps tried (and cut) until one is accepted, else a corner pass or a jump.
+    ``prev``: as for :func:`_try_step`.
 
     Returns ``(step, ds)`` with the accepted :class:`_Step` and the step
     length it was taken with, or ``None`` when the corrector failed at the
@@ -812,7 +877,7 @@ def _advance(walk: _Walk, u, t, u_prev, g_u, ds, ds_init):
     opt = walk.opt
     corner_tried = False
     while True:
-        st = _try_step(walk, u, t, u_prev, g_u, ds)
+        st = _try_step(walk, u, t, u_prev, g_u, ds, prev)
         if st.ok:
             return st, ds
         walk.cnt["steps_rejected"] += 1
@@ -957,11 +1022,12 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
     if stop is not None:
         return pts.finish(*stop)
     u_prev, g_u = None, walk.observed(u)
+    prev = None  # (u_prev, t_prev) when the step to u followed the curve
     while True:
         if len(pts.L) >= opt.max_points:
             return pts.finish(ContinuationStatus.MAX_POINTS,
                               f"stopped after {len(pts.L)} points at {lam_name} = {u[n]:.6g}")
-        adv = _advance(walk, u, t, u_prev, g_u, _bound_dlam(ds, t, n, opt), ds_init)
+        adv = _advance(walk, u, t, u_prev, g_u, _bound_dlam(ds, t, n, opt), ds_init, prev)
         if adv is None:
             why = "" if pts.cnt["jumps"] < opt.max_jumps else f" after {opt.max_jumps} jumps over discontinuities"
             return pts.finish(ContinuationStatus.FAILED,
@@ -973,6 +1039,7 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
         if (v[n] - lam_stop) * sgn > 0 or (v[n] - lam0) * sgn < 0:
             return pts.finish(*_range_end(walk, u, v, t, fold, pts, lam_stop, lam_name))
         u_prev, t_prev, u, t, g_u = u, t, v, t_new, st.g
+        prev = None if (st.gap or st.corner) else (u_prev, t_prev)
         pts.add(v[:n].copy(), v[n], t[n], fold, st.it, st.gap, st.corner)
         if _stalled(pts, opt):
             pts.drop(opt.stall_points)
@@ -991,9 +1058,9 @@ def _stalled(pts, opt) -> bool:
     k = opt.stall_points
     if len(pts.L) <= k:
         return False
-    U = np.column_stack([np.array(pts.Y[-k - 1:]), np.array(pts.L[-k - 1:])])
-    path = float(np.linalg.norm(np.diff(U, axis=0), axis=1).sum())
-    return path > 0.0 and float(np.linalg.norm(U[-1] - U[0])) < opt.stall_ratio * path
+    path = pts.PATH[-1] - pts.PATH[-k - 1]
+    d = pts.Y[-1] - pts.Y[-k - 1]
+    return path > 0.0 and math.sqrt(float(d @ d) + (pts.L[-1] - pts.L[-k - 1]) ** 2) < opt.stall_ratio * path
 
 
 def _accepted(v, n, monitor, progress):

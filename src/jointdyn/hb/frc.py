@@ -667,6 +667,9 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {dof!r}")
     opt = make_options(options, overrides)
     V.positive_int("max_points", opt.max_points, 2)
+    if opt.start_extrapolation is None and all(c.law.smooth_force for c in system.contacts):
+        # every force smooth at the onset of slip: the corrector starts from the branch's extrapolation
+        opt = dataclasses.replace(opt, start_extrapolation=config.CONT_START_EXTRAPOLATION)
     if max_step is None and par is GAMMA:
         max_step = config.HB_MAX_GAMMA_STEP
     if max_step is not None:

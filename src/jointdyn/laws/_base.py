@@ -273,6 +273,12 @@ class ContactLaw:
     n_ref: float
 
     name: ClassVar[str] = "base"
+    #: True when the force has no jump and no kink at the onset of slip (a distribution of
+    #: slip thresholds, as the exact Iwan law): harmonic balance then starts each Newton
+    #: correction of its continuation from an extrapolation of the branch
+    #: (``config.CONT_START_EXTRAPOLATION``); False (the safe default of a new law) starts it
+    #: from the tangent prediction
+    smooth_force: ClassVar[bool] = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "kt", V.positive("kt", self.kt))

@@ -649,6 +649,8 @@ class Iwan(ContactLaw):
         help="linear pieces kept after a step (above it, three adjacent pieces are merged into two)",
     )
     name: ClassVar[str] = "iwan"
+    #: microslip from a distribution of slip thresholds: no stick-slip kink (ContactLaw.smooth_force)
+    smooth_force: ClassVar[bool] = True
 
     @property
     def step(self):
