@@ -11,10 +11,11 @@ Bifurcation and Stability Analysis*, Springer 2010, sec. 4.4):
   orientation follows the previous tangent, so folds are passed);
 * predictor ``u + ds t`` (tangent) or ``u + ds (u - u_prev)/|u - u_prev|``
   (secant);
-* corrector: damped Newton on ``R(u) = 0, d^T (u - u_pred) = 0``, started
-  from the cubic Hermite extrapolation of the last two points and their
-  tangents moved onto that hyperplane (the same solution, fewer
-  iterations; from ``u_pred`` itself if that start fails);
+* corrector: damped Newton on ``R(u) = 0, d^T (u - u_pred) = 0`` from
+  ``u_pred``, or, where the caller sets ``start_extrapolation``, from the
+  cubic Hermite extrapolation of the last two points and their tangents
+  moved onto that hyperplane (the same solution, fewer iterations; from
+  ``u_pred`` again if Newton fails there);
 * step length: grown after easy corrections, shrunk after hard ones and
   where the tangent turned (folds are resolved), cut and retried after a
   failure, down to ``ds_min``; bounded so that lam moves by at most
