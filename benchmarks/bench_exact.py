@@ -153,10 +153,9 @@ def fig6_time_domain(quick):
 
 
 def hb_branch(quick):
+    from jointdyn.continuation import ContinuationOptions
     from jointdyn.hb import frc_hb
     from jointdyn.systems import System
-
-    from jointdyn.continuation import ContinuationOptions
 
     systems = {k: System.paper_damper(eta=0.5, beta=2.0, model=m) for k, m in MODELS.items()}
     runs = {k: (s, {}) for k, s in systems.items()}

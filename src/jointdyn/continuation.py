@@ -843,8 +843,9 @@ def _try_step(walk: _Walk, u, t, u_prev, g_u, ds, prev=None) -> _Step:
     big = ds > opt.corner_ds
     max_evals = opt.max_evals_factor * opt.target_iter if big else None
     v0 = _hermite_start(u, t, prev, ds, u_pred, d, opt)
-    v, ok, it, (R, Jy, Jl) = _solve_damped(walk.residual, v0.copy(), None, d, u_pred, opt, walk.cnt,
-                                           max_evals=max_evals)
+    # the prediction itself is kept for the constraint: Newton gets a copy of it (the extrapolation is new)
+    v, ok, it, (R, Jy, Jl) = _solve_damped(walk.residual, u_pred.copy() if v0 is u_pred else v0, None, d, u_pred,
+                                           opt, walk.cnt, max_evals=max_evals)
     if not ok and v0 is not u_pred:
         # the extrapolation did not help here (a corner or a jump of a piecewise-smooth residual
         # ahead): the step is decided from the prediction, as without it
