@@ -31,6 +31,11 @@ COMPILER_ONLY = ("numba.misc.cffiimpl", "numba.np.polynomial.polynomial_function
 #: numpy's array functions implemented in numba.np.arraymath (np.argmax, np.sum, ...)
 NOT_FOR_HB_JSON = ("xarray", "pandas", "matplotlib", "dask", "distributed", "tqdm", "scipy.linalg")
 
+#: Numba's array implementation, whose compiled helpers every kernel that makes an array contains: a
+#: cached kernel's environments are rebuilt without importing their modules
+#: (:func:`jointdyn._jit._rebuild_env_unimported`), which nopython code never reads
+ENVIRONMENT_ONLY = ("numba.np.arrayobj",)
+
 #: the hb command of tests/test_cli_frc.py (its kernels are compiled there in the same cache)
 HB_ARGS = ("frc", "--method", "hb", "--gamma", "1.1:1.3:0.1", "--eta", "0.5", "--beta", "2", "--json")
 
@@ -80,6 +85,39 @@ def test_hb_command_imports():
     assert json.loads(first) == json.loads(second)
     assert not _imported(names, NOT_FOR_HB_JSON), _imported(names, NOT_FOR_HB_JSON)
     assert not _imported(names, COMPILER_ONLY), _imported(names, COMPILER_ONLY)
+    assert not _imported(names, ENVIRONMENT_ONLY), _imported(names, ENVIRONMENT_ONLY)
+
+
+def test_environment_rebuilt_without_import_still_compiles_and_caches():
+    """After a cached load (environments rebuilt without their modules), Numba's own rebuilder is back,
+    the rebuilt environments can be pickled into a cache again, and a new function that contains the
+    same Numba helpers compiles and runs."""
+    script = textwrap.dedent(
+        """
+        import json
+        import numba
+        import numba.core.environment as E
+        import numpy as np
+        from jointdyn import _jit, fourier
+        c = np.array([0.1, 1.0, -0.5, 0.25, 0.125])
+        fourier.extrema(c, 2)
+        restored = E._rebuild_env is _jit._NUMBA_REBUILD_ENV
+        envs = list(E.Environment._memo.values())
+        cacheable = all(e.can_cache() for e in envs)
+
+        @numba.njit
+        def fresh(n):
+            a = np.zeros(n)
+            a[:] = 0.5
+            return a.sum()
+
+        print(json.dumps({"restored": restored, "cacheable": cacheable, "n": len(envs), "fresh": fresh(4)}))
+        """
+    )
+    _run(["-c", script])
+    out, names = _run(["-c", script])
+    got = json.loads(out)
+    assert got == {"restored": True, "cacheable": True, "n": got["n"], "fresh": 2.0} and got["n"] > 0
 
 
 def test_process_entry_freezes_what_lives_until_exit():

@@ -19,6 +19,7 @@ itself before compiling.
 from __future__ import annotations
 
 import numba
+from numba.core import environment as _environment
 from numba.core.caching import FunctionCache
 from numba.core.runtime import nrt
 
@@ -39,8 +40,40 @@ class _LoadingCache(FunctionCache):
 
     def load_overload(self, sig, target_context):
         nrt.rtsys.initialize(target_context)
-        with self._guard_against_spurious_io_errors():
-            return self._load_overload(sig, target_context)
+        _environment._rebuild_env = _rebuild_env_unimported
+        try:
+            with self._guard_against_spurious_io_errors():
+                return self._load_overload(sig, target_context)
+        finally:
+            _environment._rebuild_env = _NUMBA_REBUILD_ENV
+
+
+#: Numba's own rebuilder of a compiled function's environment (put back after every load)
+_NUMBA_REBUILD_ENV = _environment._rebuild_env
+
+
+def _rebuild_env_unimported(modname, consts, env_name):
+    """Numba's ``_rebuild_env`` without importing the function's module.
+
+    A cached function's pickle rebuilds one environment per compiled
+    function it contains, Numba's own array helpers included, and Numba
+    imports the module of each to take its ``__dict__`` as the
+    environment's globals (``numba.np.arrayobj`` alone costs tens of
+    milliseconds). Only object-mode code reads those globals; jointdyn
+    compiles in nopython mode, whose code reads the environment's constants
+    only. The globals here hold the module's name, which is what Numba
+    keeps of them when it pickles an environment again. Pickle looks the
+    rebuilder up by name when it loads, so :meth:`_LoadingCache.load_overload`
+    puts this one in place for the duration of a load.
+    """
+    env = _environment.lookup_environment(env_name)
+    if env is not None:
+        return env
+    env = _environment.Environment({"__name__": modname})
+    env.consts[:] = consts
+    env.env_name = env_name
+    _environment.Environment._memo[env_name] = env
+    return env
 
 
 class _LazyCache:
@@ -75,7 +108,9 @@ class _LazyCache:
 
 #: whether this Numba has the cache internals :class:`_LoadingCache` relies on (otherwise Numba's own
 #: cache is kept: the loads are then slower, never different)
-_LIGHT_LOADS = all(hasattr(FunctionCache, a) for a in ("_load_overload", "_guard_against_spurious_io_errors"))
+_LIGHT_LOADS = all(
+    hasattr(FunctionCache, a) for a in ("_load_overload", "_guard_against_spurious_io_errors")
+) and callable(getattr(_environment, "_rebuild_env", None)) and hasattr(_environment.Environment, "_memo")
 
 
 def _with_cache(disp):
