@@ -41,6 +41,8 @@ from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 CLI_ROUNDS = 3
+#: issue 9's target for the whole process, s (set where the import floor was about 0.3 s)
+TARGET_CLI_SECONDS = 0.7
 #: processes of the Fig 6 data set (the target's 2 cores)
 FIG6_WORKERS = 2
 CLI_ARGS = ("-m", "jointdyn", "frc", "--method", "hb", "--model", "jenkins", "--gamma", "0.6:1.8:0.01", "--json")
@@ -80,6 +82,14 @@ def cli_process_seconds(rounds: int = CLI_ROUNDS) -> dict:
     return best
 
 
+def cli_process(rounds: int = CLI_ROUNDS) -> dict:
+    """:func:`cli_process_seconds` under ``cli_hb_process_*`` names, with the target and whether it is met."""
+    out = {f"cli_hb_process_{k}_seconds": v for k, v in cli_process_seconds(rounds).items()}
+    out["cli_hb_process_target_seconds"] = TARGET_CLI_SECONDS
+    out["cli_hb_process_target_met"] = bool(out["cli_hb_process_wall_seconds"] <= TARGET_CLI_SECONDS)
+    return out
+
+
 def run(quick: bool = False) -> dict:
     sys.path.insert(0, str(SRC))
     from jointdyn import config
@@ -99,7 +109,7 @@ def run(quick: bool = False) -> dict:
                                         f"({slowest.harmonics} x {slowest.samples})",
         "fig6_hb_default_covered_rate": sum(c.covered for c in fig6) / len(fig6),
     }
-    out.update({f"cli_hb_process_{k}_seconds": v for k, v in cli_process_seconds(2 if quick else CLI_ROUNDS).items()})
+    out.update(cli_process(2 if quick else CLI_ROUNDS))
     if quick:
         return out
     t = time.perf_counter()

@@ -307,6 +307,51 @@ def test_auto_keeps_a_converged_branch_as_it_is():
     assert "check_converged" not in fixed.attrs
 
 
+def test_a_peak_that_asks_for_more_stops_the_coarse_branch(monkeypatch):
+    # Jenkins at eta = 0.5, beta = 1 (the CLI's benchmark case): the peak near gamma 1.06 asks for 256 samples.
+    # The branch with 128 stops once past that peak (the rest of it would be discarded), the branch with 256
+    # confirms the stop, and the branch returned is the one computed with 256, bit for bit
+    from jointdyn.hb import frc as hb_frc
+
+    made = []
+    real = hb_frc._fixed_branch
+    monkeypatch.setattr(hb_frc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
+    system = System.paper_damper(eta=0.5, beta=1.0, model="jenkins")
+    auto = frc_hb(system, 0.6, 1.8, max_step=0.01)
+    assert auto.attrs["discretisation_levels"] == f"{config.HB_HARMONICS}x{config.HB_SAMPLES}, " \
+                                                  f"{config.HB_HARMONICS}x{2 * config.HB_SAMPLES}"
+    assert auto.attrs["check_converged"] == 1 and auto.attrs["status"] == "complete"
+    stop = made[0]
+    assert isinstance(stop, hb_frc._Refine) and stop.level == (config.HB_HARMONICS, 2 * config.HB_SAMPLES)
+    assert abs(stop.lam - float(auto.peak_gamma.values[0])) < 0.01
+    fixed = frc_hb(system, 0.6, 1.8, max_step=0.01, harmonics=config.HB_HARMONICS, samples=2 * config.HB_SAMPLES)
+    np.testing.assert_array_equal(auto.amplitude_q.values, fixed.amplitude_q.values)
+    np.testing.assert_array_equal(auto.gamma.values, fixed.gamma.values)
+    np.testing.assert_array_equal(auto.peak_amplitude_q.values, fixed.peak_amplitude_q.values)
+
+
+def test_a_stop_the_finished_branch_does_not_confirm_is_undone(monkeypatch):
+    # with every local maximum checked as soon as the amplitude falls (drop 1), the full-memory closed form at
+    # eta = 0.5, beta = 2 stops at a wiggle near gamma 0.652, six times lower than its resonance, whose change
+    # is within the tolerance of the resonance's amplitude: the finished branch does not confirm the stop and
+    # the choice is made again without stops, giving the branch of the default drop, which checks only passed
+    # resonances
+    from jointdyn.hb import frc as hb_frc
+
+    system = System.paper_damper(eta=0.5, beta=2.0, model="iwan-closed")
+    default = frc_hb(system, 0.6, 1.8, max_step=0.01)
+    made = []
+    real = hb_frc._fixed_branch
+    monkeypatch.setattr(hb_frc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
+    monkeypatch.setattr(config, "HB_AUTO_EARLY_DROP", 1.0)
+    every = frc_hb(system, 0.6, 1.8, max_step=0.01)
+    assert isinstance(made[0], hb_frc._Refine) and made[0].lam < 0.7
+    assert any(not isinstance(m, hb_frc._Refine) and m.status.value == "failed" for m in made)
+    assert every.attrs["status"] == default.attrs["status"] == "complete"
+    assert every.attrs["discretisation_levels"] == default.attrs["discretisation_levels"]
+    np.testing.assert_array_equal(every.amplitude_q.values, default.amplitude_q.values)
+
+
 def test_auto_at_its_bound_says_it_is_not_converged(monkeypatch):
     # with the samples bounded at their start, the check of eta = 0.01, beta = 1 fails and the branch says so
     monkeypatch.setattr(config, "HB_AUTO_MAX_SAMPLES", config.HB_SAMPLES)

@@ -532,8 +532,9 @@ def _bar(total: int, desc: str, progress):
     return tqdm(total=total, desc=desc, disable=None if progress is None else not progress, leave=False)
 
 
-def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress) -> ContinuationResult:
-    """One continued segment from lam_a to lam_b (the start from the stuck linear solution)."""
+def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress, monitor=None) -> ContinuationResult:
+    """One continued segment from lam_a to lam_b (the start from the stuck linear solution); ``monitor``
+    defaults to the tracker's."""
     problem = tr.problem
     xs, _, ps = tr.scales
     with _bar(opt.max_points, f"HB {problem.parameter.name}", progress) as bar:
@@ -546,7 +547,8 @@ def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress) -> 
                                    condense=problem.condensed)
             if sol.converged:
                 y0 = sol.X / xs
-        return tr.relabel(continuation(tr.residual, y0, lam_a / ps, lam_b / ps, opt, monitor=tr.monitor,
+        return tr.relabel(continuation(tr.residual, y0, lam_a / ps, lam_b / ps, opt,
+                                       monitor=tr.monitor if monitor is None else monitor,
                                        progress=bar, observe=tr.observe_step, lam_name=problem.parameter.name))
 
 
@@ -697,20 +699,30 @@ class _Request:
     condense: bool | None
 
 
-def _fixed_branch(req: _Request, level) -> _Draft:
-    """The branch with H harmonics and Ns samples, ``level = (H, Ns)``."""
+def _fixed_branch(req: _Request, level, auto=(False, False), watch: bool = False):
+    """The branch with H harmonics and Ns samples, ``level = (H, Ns)``: a :class:`_Draft`, or, with
+    ``watch``, a :class:`_Refine` where a peak asked for a finer level while the branch was continued
+    (``auto``: which of (harmonics, samples) may change; :class:`_PeakWatch`)."""
     problem = make_problem(req.system, condense=req.condense, response_dofs=(req.dof,), harmonics=level[0],
                            samples=level[1], parameter=req.parameter, gamma=req.gamma)
     tr = _Tracker(problem, _scales(problem, req.start), req.dof)
     opt = req.options
     if req.max_step is not None:
         opt = dataclasses.replace(opt, max_dlam=req.max_step / tr.scales[2])
-    res = _segment(tr, req.start, req.stop, opt, req.progress)
+    watch = _PeakWatch(tr, req, level, auto) if watch and any(auto) else None
+    res = _segment(tr, req.start, req.stop, opt, req.progress, watch)
+    if watch is not None and watch.target is not None:
+        return watch.target
     parts = [res]
     # the segment back from the end has a bound of its own: the first one may have spent its points
     # on a flank that grows without bound
     if res.status in _GO_BACK and req.backward:
-        parts.append(_segment(tr, req.stop, req.start, opt, req.progress))
+        if watch is not None:
+            watch.restart()
+        back = _segment(tr, req.stop, req.start, opt, req.progress, watch)
+        if watch is not None and watch.target is not None:
+            return watch.target
+        parts.append(back)
     fills = _gap_fills(tr, parts, abs(req.stop - req.start) / tr.scales[2], opt, req.progress)
     return _join(tr, parts, fills, req.start, req.stop, opt)
 
@@ -752,18 +764,39 @@ def _next_level(level, auto, bad_h: bool, bad_s: bool):
     return level
 
 
-def _solve_at(req: _Request, condensed: bool, lam: float, X, level):
-    """(amplitude of the response DOF (m; NaN where Newton failed), X) at parameter ``lam`` with
-    ``level = (H, Ns)``, by Newton from the harmonics X (zero above their H)."""
+def _at_level(req: _Request, condensed: bool, X, level):
+    """(tracker of the problem with ``level = (H, Ns)``, the harmonics X there in its scaled unknowns,
+    zero above their H)."""
     problem = make_problem(req.system, condense=condensed, response_dofs=(req.dof,), harmonics=level[0],
                            samples=level[1], parameter=req.parameter, gamma=req.gamma)
     tr = _Tracker(problem, _scales(problem, req.start), req.dof)
-    xs, _, ps = tr.scales
     Xm = np.asarray(X).reshape(-1, problem.n)
     X0 = np.zeros((problem.nh, problem.n))
     X0[: min(Xm.shape[0], problem.nh)] = Xm[: problem.nh]
-    y, ok, _ = newton(tr.residual, X0.ravel() / xs, lam / ps, req.options)
+    return tr, X0.ravel() / tr.scales[0]
+
+
+def _solve_at(req: _Request, condensed: bool, lam: float, X, level):
+    """(amplitude of the response DOF (m; NaN where Newton failed), X) at parameter ``lam`` with
+    ``level = (H, Ns)``, by Newton from the harmonics X (zero above their H)."""
+    tr, y0 = _at_level(req, condensed, X, level)
+    xs, _, ps = tr.scales
+    y, ok, _ = newton(tr.residual, y0, lam / ps, req.options)
     return (tr.amplitudes(y)[0] if ok else math.nan), y * xs
+
+
+def _first_step_amplitude(req: _Request, condensed: bool, lam: float, X, level) -> float:
+    """Amplitude of the response DOF (m) after one Newton step from the harmonics X at parameter
+    ``lam`` with ``level = (H, Ns)``: the solution's amplitude there to first order in the change
+    (one evaluation; NaN where the step cannot be made)."""
+    tr, y0 = _at_level(req, condensed, X, level)
+    R, JX, _ = tr.residual(y0, lam / tr.scales[2])
+    try:
+        dy = np.linalg.solve(JX, -R)
+    except np.linalg.LinAlgError:
+        return math.nan
+    y = y0 + dy
+    return tr.amplitudes(y)[0] if np.all(np.isfinite(y)) else math.nan
 
 
 def _change(amp: float, ref: float, scale: float) -> float:
@@ -795,7 +828,7 @@ def _peak_level(req: _Request, condensed: bool, pk: HBPeak, scale: float, level,
             return at, first
 
 
-def _combined_target(req: _Request, br: _Draft, scale: float, level, auto, wanted):
+def _combined_target(req: _Request, condensed: bool, peaks, scale: float, level, auto, wanted):
     """The level of the next branch: the most harmonics and the most samples that the peaks ask for
     (``wanted``: their levels from :func:`_peak_level`).
 
@@ -810,13 +843,121 @@ def _combined_target(req: _Request, br: _Draft, scale: float, level, auto, wante
         return target
     at = (level[0], target[1])
     again = []
-    for pk in br.peaks:
-        amp, X = _solve_at(req, br.problem.condensed, pk.lam, pk.X, at)
+    for pk in peaks:
+        amp, X = _solve_at(req, condensed, pk.lam, pk.X, at)
         if not math.isfinite(amp):
             return target
-        again.append(_peak_level(req, br.problem.condensed, dataclasses.replace(pk, X=X, amplitude_m=amp),
+        again.append(_peak_level(req, condensed, dataclasses.replace(pk, X=X, amplitude_m=amp),
                                  scale, at, auto)[0])
     return (max([at[0]] + [w[0] for w in again]), max([at[1]] + [w[1] for w in again]))
+
+
+@dataclass(frozen=True)
+class _Refine:
+    """What :func:`_fixed_branch` returns where a peak asked for a finer level during the continuation:
+    that level, the parameter value of the peak and the change of its amplitude found there (m)."""
+
+    level: tuple
+    lam: float
+    change_m: float
+
+
+@dataclass(frozen=True)
+class _Candidate:
+    """The highest accepted point of a branch being continued (the fields of :class:`HBPeak` that the
+    discretisation check reads)."""
+
+    lam: float
+    X: np.ndarray
+    amplitude_m: float
+
+
+class _PeakWatch:
+    """The tracker's monitor, and the discretisation check of each resonance of the branch as soon as it
+    is passed.
+
+    The highest accepted point so far is checked once the amplitude has
+    fallen below ``config.HB_AUTO_EARLY_DROP`` times its amplitude (and
+    again for a higher point later): one Newton step from it with twice
+    the samples (with 2H + 1 harmonics where the samples are fixed), one
+    evaluation, gives the change of its amplitude to first order. Where
+    that exceeds ``config.HB_AUTO_RTOL`` of its amplitude, the point is
+    checked as the finished branch's peaks are (:func:`_peak_level`,
+    :func:`_combined_target`), and where that asks for a finer level the
+    branch stops there (``target``: a :class:`_Refine`): the rest of it
+    would be discarded, and continuing it costs more than the check. A
+    stop is made relative to the point's own amplitude, the finished
+    branch's check relative to its highest peak; :func:`_adaptive_branch`
+    keeps a stop only where the finished finer branch confirms it. The
+    finished branch's peaks are checked again (refined between points), so
+    a branch that passes here can still be refined.
+    """
+
+    def __init__(self, tr: _Tracker, req: _Request, level, auto):
+        self.tr, self.req, self.level, self.auto = tr, req, level, auto
+        self.top = None  # (log q, lam scaled, y) of the highest accepted point not checked yet
+        self.checked = -math.inf  # log q of the highest point checked
+        self.target = None
+
+    def restart(self):
+        """Forget the highest point (a new segment starts)."""
+        self.top = None
+
+    def __call__(self, y, lam_s):
+        stop = self.tr.monitor(y, lam_s)
+        if stop is not None:
+            return stop
+        g = self.tr.observe(y, lam_s)
+        if not math.isfinite(g):
+            return None
+        if g > self.checked and (self.top is None or g > self.top[0]):
+            self.top = (g, lam_s, np.array(y))
+            return None
+        if self.top is None or g >= self.top[0] + math.log(config.HB_AUTO_EARLY_DROP):
+            return None
+        top, self.top = self.top, None
+        self.checked = top[0]
+        return self._check(top[1], top[2])
+
+    def _check(self, lam_s, y):
+        xs, _, ps = self.tr.scales
+        cand = _Candidate(lam=lam_s * ps, X=y * xs, amplitude_m=self.tr.amplitudes(y)[0])
+        condensed = self.tr.problem.condensed
+        by_h, by_s = _check_levels(self.level, self.auto)
+        first = by_s if by_s is not None else by_h  # the cheaper check (more samples are checked first)
+        if first is None:
+            return None
+        amp = _first_step_amplitude(self.req, condensed, cand.lam, cand.X, first)
+        if _change(amp, cand.amplitude_m, cand.amplitude_m) <= config.HB_AUTO_RTOL:
+            return None  # the finished branch's check decides
+        wanted, changes = _peak_level(self.req, condensed, cand, cand.amplitude_m, self.level, self.auto)
+        target = _combined_target(self.req, condensed, [cand], cand.amplitude_m, self.level, self.auto, [wanted])
+        if target == self.level:
+            return None
+        self.target = _Refine(target, cand.lam, _worst(changes) * cand.amplitude_m)
+        name = self.tr.problem.parameter.name
+        return ContinuationStatus.STOPPED, (f"the peak near {name} = {cand.lam:.6g} asks for H = {target[0]}, "
+                                            f"Ns = {target[1]}")
+
+
+def _watched_branch(req: _Request, level, auto, levels, retry_failed: bool, stops):
+    """(branch, its level): :func:`_fixed_branch` at ``level``, again at the level a peak asks for
+    wherever one stops it (each :class:`_Refine` appended to ``stops``), and with twice the samples
+    where a branch asked for fails (after a stop by a peak, or where ``retry_failed``: a finer level may
+    fail where the coarser went on, because a closed form's force jumps with the normal load and Newton
+    fails at one sampling and not at the next). Each further level is appended to ``levels``."""
+    br = _fixed_branch(req, level, auto, watch=stops is not None)
+    while True:
+        if isinstance(br, _Refine):
+            stops.append(br)
+            level, retry_failed = br.level, True
+        elif (retry_failed and br.status is ContinuationStatus.FAILED and auto[1]
+              and 2 * level[1] <= config.HB_AUTO_MAX_SAMPLES):
+            level = (level[0], 2 * level[1])
+        else:
+            return br, level
+        levels.append(level)
+        br = _fixed_branch(req, level, auto, watch=stops is not None)
 
 
 def _worst(values) -> float:
@@ -825,30 +966,33 @@ def _worst(values) -> float:
     return max(v) if v else math.nan
 
 
-def _adaptive_branch(req: _Request, level, auto) -> HBBranch:
+def _adaptive_branch(req: _Request, level, auto, watch: bool = True) -> HBBranch:
     """The branch at ``level``, computed again at a finer level while its peaks ask for one (``auto``:
-    which of (harmonics, samples) may change); with its :class:`DiscretisationCheck`."""
+    which of (harmonics, samples) may change); with its :class:`DiscretisationCheck`.
+
+    With ``watch``, a branch stops at a passed resonance that asks for a
+    finer level (:class:`_PeakWatch`); where the finished branch does not
+    confirm such a stop (the change found there is within
+    ``config.HB_AUTO_RTOL`` of its highest peak: the stop was made for a
+    peak lower than one found later), the whole choice is made again
+    without stops.
+    """
+    first = level
     levels = [level]
-    br = _fixed_branch(req, level)
     if not any(auto):
-        return br.branch()
+        return _fixed_branch(req, level).branch()
+    stops = [] if watch else None
+    br, level = _watched_branch(req, level, auto, levels, False, stops)
     while True:
         scale = max([pk.amplitude_m for pk in br.peaks], default=0.0)
         checks = [_peak_level(req, br.problem.condensed, pk, scale, level, auto) for pk in br.peaks]
-        target = _combined_target(req, br, scale, level, auto, [c[0] for c in checks])
+        target = _combined_target(req, br.problem.condensed, br.peaks, scale, level, auto, [c[0] for c in checks])
         if target == level:
             break
-        level = target
-        levels.append(level)
-        finer = _fixed_branch(req, level)
-        # a finer level may fail where the coarser covered the range (a closed form's force jumps with the
-        # normal load: Newton fails at one sampling and not at the next): the next samples are tried
-        while (finer.status is ContinuationStatus.FAILED and br.status is not ContinuationStatus.FAILED
-               and auto[1] and 2 * level[1] <= config.HB_AUTO_MAX_SAMPLES):
-            level = (level[0], 2 * level[1])
-            levels.append(level)
-            finer = _fixed_branch(req, level)
-        br = finer
+        levels.append(target)
+        br, level = _watched_branch(req, target, auto, levels, br.status is not ContinuationStatus.FAILED, stops)
+    if stops and any(not st.change_m > config.HB_AUTO_RTOL * scale for st in stops):
+        return _adaptive_branch(req, first, auto, watch=False)
     by_h, by_s = _check_levels(level, auto)
     ch_h, ch_s = _worst(c[1][0] for c in checks), _worst(c[1][1] for c in checks)
     converged = not (ch_h > config.HB_AUTO_RTOL or ch_s > config.HB_AUTO_RTOL)
