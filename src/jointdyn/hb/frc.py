@@ -709,7 +709,7 @@ def _fixed_branch(req: _Request, level, auto=(False, False), watch: bool = False
     opt = req.options
     if req.max_step is not None:
         opt = dataclasses.replace(opt, max_dlam=req.max_step / tr.scales[2])
-    watch = _PeakWatch(tr, req, level, auto) if watch and any(auto) else None
+    watch = _PeakWatch(tr, req, level, auto, opt) if watch and any(auto) else None
     res = _segment(tr, req.start, req.stop, opt, req.progress, watch)
     if watch is not None and watch.target is not None:
         return watch.target
@@ -814,6 +814,11 @@ def _peak_level(req: _Request, condensed: bool, pk: HBPeak, scale: float, level,
     ``config.HB_AUTO_RTOL`` the peak is solved at the refined level and
     checked there again.
     """
+    return _peak_levels(req, condensed, pk, scale, level, auto)[:2]
+
+
+def _peak_levels(req: _Request, condensed: bool, pk, scale: float, level, auto):
+    """:func:`_peak_level`, and whether the peak's check passed at the level returned (not at a bound)."""
     at, X, amp, first = level, pk.X, pk.amplitude_m, None
     while True:
         solved = {lv: _solve_at(req, condensed, pk.lam, X, lv) for lv in _check_levels(at, auto) if lv}
@@ -821,11 +826,11 @@ def _peak_level(req: _Request, condensed: bool, pk: HBPeak, scale: float, level,
         first = ch if first is None else first
         nxt = _next_level(at, auto, ch[0] > config.HB_AUTO_RTOL, ch[1] > config.HB_AUTO_RTOL)
         if nxt == at:
-            return at, first
+            return at, first, not (ch[0] > config.HB_AUTO_RTOL or ch[1] > config.HB_AUTO_RTOL)
         amp, X = solved[nxt] if nxt in solved else _solve_at(req, condensed, pk.lam, X, nxt)
         at = nxt
         if not math.isfinite(amp):
-            return at, first
+            return at, first, False
 
 
 def _combined_target(req: _Request, condensed: bool, peaks, scale: float, level, auto, wanted):
@@ -855,17 +860,21 @@ def _combined_target(req: _Request, condensed: bool, peaks, scale: float, level,
 @dataclass(frozen=True)
 class _Refine:
     """What :func:`_fixed_branch` returns where a peak asked for a finer level during the continuation:
-    that level, the parameter value of the peak and the change of its amplitude found there (m)."""
+    that level, the peak (a :class:`_Candidate`) and the level of the branch it stopped."""
 
     level: tuple
-    lam: float
-    change_m: float
+    peak: object = dataclasses.field(repr=False)
+    stopped: tuple = ()
+
+    @property
+    def lam(self) -> float:
+        return self.peak.lam
 
 
 @dataclass(frozen=True)
 class _Candidate:
-    """The highest accepted point of a branch being continued (the fields of :class:`HBPeak` that the
-    discretisation check reads)."""
+    """A peak of a branch being continued (the fields of :class:`HBPeak` that the discretisation check
+    reads)."""
 
     lam: float
     X: np.ndarray
@@ -873,91 +882,120 @@ class _Candidate:
 
 
 class _PeakWatch:
-    """The tracker's monitor, and the discretisation check of each resonance of the branch as soon as it
-    is passed.
+    """The tracker's monitor, and the discretisation check of the first level's resonances as soon as
+    they are passed.
 
-    The highest accepted point so far is checked once the amplitude has
-    fallen below ``config.HB_AUTO_EARLY_DROP`` times its amplitude (and
-    again for a higher point later): one Newton step from it with twice
-    the samples (with 2H + 1 harmonics where the samples are fixed), one
-    evaluation, gives the change of its amplitude to first order. Where
-    that exceeds ``config.HB_AUTO_RTOL`` of its amplitude, the point is
-    checked as the finished branch's peaks are (:func:`_peak_level`,
-    :func:`_combined_target`), and where that asks for a finer level the
-    branch stops there (``target``: a :class:`_Refine`): the rest of it
-    would be discarded, and continuing it costs more than the check. A
-    stop is made relative to the point's own amplitude, the finished
-    branch's check relative to its highest peak; :func:`_adaptive_branch`
-    keeps a stop only where the finished finer branch confirms it. The
-    finished branch's peaks are checked again (refined between points), so
-    a branch that passes here can still be refined.
+    The highest accepted point of the segment so far is checked once the
+    amplitude has fallen below ``config.HB_AUTO_EARLY_DROP`` times its
+    amplitude (and again for a higher point later): one Newton step from
+    it with twice the samples (with 2H + 1 harmonics where the samples are
+    fixed), one evaluation, gives the change of its amplitude to first
+    order. Where that exceeds ``config.HB_AUTO_RTOL`` of its amplitude, the
+    maximum is refined between the point and its neighbours and checked as
+    the finished branch's peaks are (:func:`_peak_levels`,
+    :func:`_combined_target`, relative to its own amplitude); where that
+    converges at a finer level, the branch stops there (``target``: a
+    :class:`_Refine`): the rest of it would be discarded, and continuing
+    it costs more than the check. A stop is made relative to the peak's own
+    amplitude, the finished branch's check relative to its highest peak:
+    :func:`_adaptive_branch` keeps a stop only where the finished branch is
+    converged and the peak asks for the same level relative to the
+    finished branch's highest peak (:func:`_confirmed`). The finished branch's peaks are
+    checked again, so a branch that passes here can still be refined.
     """
 
-    def __init__(self, tr: _Tracker, req: _Request, level, auto):
-        self.tr, self.req, self.level, self.auto = tr, req, level, auto
-        self.top = None  # (log q, lam scaled, y) of the highest accepted point not checked yet
+    def __init__(self, tr: _Tracker, req: _Request, level, auto, opt: ContinuationOptions):
+        self.tr, self.req, self.level, self.auto, self.opt = tr, req, level, auto, opt
+        self.points = []  # (log q, lam scaled, y) of the segment's accepted points
+        self.top = None  # index in points of the highest point not checked yet
         self.checked = -math.inf  # log q of the highest point checked
         self.target = None
 
     def restart(self):
-        """Forget the highest point (a new segment starts)."""
-        self.top = None
+        """Forget the segment's points (a new segment starts)."""
+        self.points, self.top = [], None
 
     def __call__(self, y, lam_s):
         stop = self.tr.monitor(y, lam_s)
         if stop is not None:
             return stop
         g = self.tr.observe(y, lam_s)
+        pts = self.points
+        pts.append((g, lam_s, np.array(y)))
         if not math.isfinite(g):
             return None
-        if g > self.checked and (self.top is None or g > self.top[0]):
-            self.top = (g, lam_s, np.array(y))
+        if g > self.checked and (self.top is None or g > pts[self.top][0]):
+            self.top = len(pts) - 1
             return None
-        if self.top is None or g >= self.top[0] + math.log(config.HB_AUTO_EARLY_DROP):
+        if self.top is None or g >= pts[self.top][0] + math.log(config.HB_AUTO_EARLY_DROP):
             return None
-        top, self.top = self.top, None
-        self.checked = top[0]
-        return self._check(top[1], top[2])
+        i, self.top = self.top, None
+        self.checked = pts[i][0]
+        return self._check(i)
 
-    def _check(self, lam_s, y):
-        xs, _, ps = self.tr.scales
-        cand = _Candidate(lam=lam_s * ps, X=y * xs, amplitude_m=self.tr.amplitudes(y)[0])
-        condensed = self.tr.problem.condensed
+    def _check(self, i: int):
+        tr = self.tr
+        xs, _, ps = tr.scales
+        g, lam_s, y = self.points[i]
+        condensed = tr.problem.condensed
         by_h, by_s = _check_levels(self.level, self.auto)
         first = by_s if by_s is not None else by_h  # the cheaper check (more samples are checked first)
-        if first is None:
+        if first is None or i == 0:
             return None
-        amp = _first_step_amplitude(self.req, condensed, cand.lam, cand.X, first)
-        if _change(amp, cand.amplitude_m, cand.amplitude_m) <= config.HB_AUTO_RTOL:
+        amp = tr.amplitudes(y)[0]
+        if _change(_first_step_amplitude(self.req, condensed, lam_s * ps, y * xs, first), amp, amp) \
+                <= config.HB_AUTO_RTOL:
             return None  # the finished branch's check decides
-        wanted, changes = _peak_level(self.req, condensed, cand, cand.amplitude_m, self.level, self.auto)
-        target = _combined_target(self.req, condensed, [cand], cand.amplitude_m, self.level, self.auto, [wanted])
-        if target == self.level:
-            return None
-        self.target = _Refine(target, cand.lam, _worst(changes) * cand.amplitude_m)
-        name = self.tr.problem.parameter.name
-        return ContinuationStatus.STOPPED, (f"the peak near {name} = {cand.lam:.6g} asks for H = {target[0]}, "
+        # the peak as the finished branch has it: refined between the point and its neighbours
+        last = tr.last
+        near = self.points[i - 1:i + 2]
+        y_pk, lam_pk, g_pk, _ = refine_maximum(tr.residual, tr.observe, [p[2] for p in near],
+                                               [p[1] for p in near], self.opt)
+        tr.last = last
+        if not g_pk >= g:
+            y_pk, lam_pk = y, lam_s
+        pk = _Candidate(lam=float(lam_pk * ps), X=y_pk * xs, amplitude_m=float(tr.amplitudes(y_pk)[0]))
+        target, converged = _peak_target(self.req, condensed, pk, pk.amplitude_m, self.level, self.auto)
+        if not converged or target == self.level:
+            return None  # the finished branch decides
+        self.target = _Refine(target, pk, self.level)
+        name = tr.problem.parameter.name
+        return ContinuationStatus.STOPPED, (f"the peak near {name} = {pk.lam:.6g} asks for H = {target[0]}, "
                                             f"Ns = {target[1]}")
 
 
+def _peak_target(req: _Request, condensed: bool, pk, scale: float, level, auto):
+    """(level the peak alone asks for from ``level``, changes relative to ``scale``; whether its check
+    converged there)."""
+    wanted, _, converged = _peak_levels(req, condensed, pk, scale, level, auto)
+    return _combined_target(req, condensed, [pk], scale, level, auto, [wanted]), converged
+
+
+def _confirmed(req: _Request, condensed: bool, stop: _Refine, scale: float, auto) -> bool:
+    """Whether the peak that stopped a branch asks for the same level with its changes relative to
+    ``scale`` (the highest peak of the finished branch) as relative to its own amplitude."""
+    return _peak_target(req, condensed, stop.peak, scale, stop.stopped, auto) == (stop.level, True)
+
+
 def _watched_branch(req: _Request, level, auto, levels, retry_failed: bool, stops):
-    """(branch, its level): :func:`_fixed_branch` at ``level``, again at the level a peak asks for
-    wherever one stops it (each :class:`_Refine` appended to ``stops``), and with twice the samples
-    where a branch asked for fails (after a stop by a peak, or where ``retry_failed``: a finer level may
-    fail where the coarser went on, because a closed form's force jumps with the normal load and Newton
-    fails at one sampling and not at the next). Each further level is appended to ``levels``."""
+    """(branch, its level): :func:`_fixed_branch` at ``level``, watched by a :class:`_PeakWatch` where
+    ``stops`` is a list (the :class:`_Refine` appended to it), computed again at the level a peak asks
+    for where one stops it, and with twice the samples where a branch asked for fails (after a stop by
+    a peak, or where ``retry_failed``: a finer level may fail where the coarser went on, because a closed
+    form's force jumps with the normal load and Newton fails at one sampling and not at the next). Each
+    further level is appended to ``levels``."""
     br = _fixed_branch(req, level, auto, watch=stops is not None)
-    while True:
-        if isinstance(br, _Refine):
-            stops.append(br)
-            level, retry_failed = br.level, True
-        elif (retry_failed and br.status is ContinuationStatus.FAILED and auto[1]
-              and 2 * level[1] <= config.HB_AUTO_MAX_SAMPLES):
-            level = (level[0], 2 * level[1])
-        else:
-            return br, level
+    if isinstance(br, _Refine):
+        stops.append(br)
+        level, retry_failed = br.level, True
         levels.append(level)
-        br = _fixed_branch(req, level, auto, watch=stops is not None)
+        br = _fixed_branch(req, level, auto)
+    while retry_failed and br.status is ContinuationStatus.FAILED and auto[1] \
+            and 2 * level[1] <= config.HB_AUTO_MAX_SAMPLES:
+        level = (level[0], 2 * level[1])
+        levels.append(level)
+        br = _fixed_branch(req, level, auto)
+    return br, level
 
 
 def _worst(values) -> float:
@@ -970,12 +1008,12 @@ def _adaptive_branch(req: _Request, level, auto, watch: bool = True) -> HBBranch
     """The branch at ``level``, computed again at a finer level while its peaks ask for one (``auto``:
     which of (harmonics, samples) may change); with its :class:`DiscretisationCheck`.
 
-    With ``watch``, a branch stops at a passed resonance that asks for a
-    finer level (:class:`_PeakWatch`); where the finished branch does not
-    confirm such a stop (the change found there is within
-    ``config.HB_AUTO_RTOL`` of its highest peak: the stop was made for a
-    peak lower than one found later), the whole choice is made again
-    without stops.
+    With ``watch``, the first branch stops at a passed resonance that asks
+    for a finer level (:class:`_PeakWatch`); where the finished branch does
+    not confirm such a stop (it is not converged, or the peak asks for
+    another level relative to the finished branch's highest peak: the stop
+    was made at a resonance lower than one found later), the whole choice
+    is made again without stops.
     """
     first = level
     levels = [level]
@@ -990,12 +1028,12 @@ def _adaptive_branch(req: _Request, level, auto, watch: bool = True) -> HBBranch
         if target == level:
             break
         levels.append(target)
-        br, level = _watched_branch(req, target, auto, levels, br.status is not ContinuationStatus.FAILED, stops)
-    if stops and any(not st.change_m > config.HB_AUTO_RTOL * scale for st in stops):
-        return _adaptive_branch(req, first, auto, watch=False)
+        br, level = _watched_branch(req, target, auto, levels, br.status is not ContinuationStatus.FAILED, None)
     by_h, by_s = _check_levels(level, auto)
     ch_h, ch_s = _worst(c[1][0] for c in checks), _worst(c[1][1] for c in checks)
     converged = not (ch_h > config.HB_AUTO_RTOL or ch_s > config.HB_AUTO_RTOL)
+    if stops and not (converged and all(_confirmed(req, br.problem.condensed, st, scale, auto) for st in stops)):
+        return _adaptive_branch(req, first, auto, watch=False)
     check = DiscretisationCheck(harmonics_auto=auto[0], samples_auto=auto[1], levels=tuple(levels),
                                 check_harmonics=by_h[0] if by_h else 0, check_samples=by_s[1] if by_s else 0,
                                 harmonics_change=ch_h, samples_change=ch_s, peaks=len(checks),
