@@ -900,8 +900,9 @@ class _PeakWatch:
     amplitude, the finished branch's check relative to its highest peak:
     :func:`_adaptive_branch` keeps a stop only where the finished branch is
     converged and the peak asks for the same level relative to the
-    finished branch's highest peak (:func:`_confirmed`). The finished branch's peaks are
-    checked again, so a branch that passes here can still be refined.
+    finished branch's highest peak (:func:`_confirmed`). The finished
+    branch's peaks are checked again, so a branch that passes here can
+    still be refined.
     """
 
     def __init__(self, tr: _Tracker, req: _Request, level, auto, opt: ContinuationOptions):
@@ -965,8 +966,8 @@ class _PeakWatch:
 
 
 def _peak_target(req: _Request, condensed: bool, pk, scale: float, level, auto):
-    """(level the peak alone asks for from ``level``, changes relative to ``scale``; whether its check
-    converged there)."""
+    """(the level the peak alone asks for, checked from ``level`` with its changes relative to
+    ``scale``; whether its check passed there)."""
     wanted, _, converged = _peak_levels(req, condensed, pk, scale, level, auto)
     return _combined_target(req, condensed, [pk], scale, level, auto, [wanted]), converged
 
