@@ -16,6 +16,8 @@ must be ``step``'s bit for bit.
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import law_histories as H
 
@@ -161,3 +163,39 @@ def test_init_jvp_is_the_exact_derivative_of_the_virgin_state(name):
                   - law.initial_state(x0 - h * dx0[j], n0 - h * dn0[j])) / (2 * h)
             scale = max(np.max(np.abs(fd)), np.max(np.abs(ds[:, j])), 1e-300)
             np.testing.assert_allclose(ds[:, j], fd, rtol=0, atol=C.TEST_JVP_RTOL * scale)
+
+
+@given(
+    steps=st.lists(
+        st.tuples(st.floats(-2e-3, 2e-3), st.floats(-50.0, 250.0)), min_size=1, max_size=40
+    ),
+    seed=st.integers(0, 2**32 - 1),
+)
+@settings(max_examples=60, deadline=None)
+def test_jenkins_kernels_are_the_one_element_discrete_kernels_bit_for_bit(steps, seed):
+    # Jenkins has kernels of its own (the one element inlined); the same operations as the n-element
+    # kernels, so the same bits: force, stiffness, code, states and derivatives, in and out of separation
+    from jointdyn.laws import DiscreteIwan, Jenkins
+    from jointdyn.laws.discrete import discrete_step, discrete_step_jvp, jenkins_step, jenkins_step_jvp
+
+    jk, d1 = Jenkins(3e5, 0.5, 100.0), DiscreteIwan(3e5, 0.5, 100.0, n=1)
+    np.testing.assert_array_equal(jk.params, d1.params)
+    p = jk.params
+    rng = np.random.default_rng(seed)
+    nd = 3
+    s = [np.zeros(jk.state_size) for _ in range(4)]
+    ds = [np.zeros((jk.state_size, nd)) for _ in range(4)]
+    jk.init(p, 0.0, 100.0, s[0])
+    jk.init(p, 0.0, 100.0, s[2])
+    for x, N in steps:
+        dx, dN = rng.normal(size=nd), rng.normal(size=nd)
+        dTa, dTb = np.empty(nd), np.empty(nd)
+        a = jenkins_step_jvp(p, s[0], ds[0], s[1], ds[1], x, dx, N, dN, dTa)
+        b = discrete_step_jvp(p, s[2], ds[2], s[3], ds[3], x, dx, N, dN, dTb)
+        assert [v.hex() if isinstance(v, float) else v for v in a] == \
+               [v.hex() if isinstance(v, float) else v for v in b]
+        assert jenkins_step(p, s[0], np.empty_like(s[0]), x, N) == discrete_step(p, s[2], np.empty_like(s[2]), x, N)
+        for u, v in ((s[1], s[3]), (ds[1], ds[3]), (dTa, dTb)):
+            assert u.tobytes() == v.tobytes()
+        s = [s[1], s[0], s[3], s[2]]
+        ds = [ds[1], ds[0], ds[3], ds[2]]

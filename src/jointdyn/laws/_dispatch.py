@@ -7,7 +7,7 @@ own parameter row. :func:`law_dispatch` gives such a set of kernels for the
 laws of a system's contacts:
 
 * one kernel family (every contact's law has the same kernels, e.g.
-  ``discrete`` and ``jenkins``): the laws' own kernels, bound directly, and
+  ``discrete`` with several ``n``): the laws' own kernels, bound directly, and
   parameter rows exactly as today (``law.params``, zero padded to a common
   width), so results and speed are those of a single-law system;
 * several families (at most :data:`MAX_LAW_SLOTS`): dispatchers compiled
