@@ -51,16 +51,11 @@ def _lane_sum(a, lo, hi):
     return t
 
 
-@jit
-def _discrete_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
-    # Derivative arguments are all arrays or all None (pruned at compile time).
-    # Not inlined into callers: as a function of its own, the element loop
-    # below compiles to SIMD code (AVX-512 where available); inlined into a
-    # time loop it did not vectorise.
-    kt = params[0]
-    n_ref = params[2]
-    n = int(params[3])
-    alpha = N / n_ref
+@jit(inline="always")
+def _start(s_new, x, alpha, n, ds_new, dx, dT):
+    """The start of a step of n elements at load ratio ``alpha``: ``x_prev`` (and its derivatives) set
+    to x, ``dT`` zeroed, and where ``alpha <= 0`` (separation) every element force and its derivatives
+    zeroed. Returns ``(alpha, number of directions)``."""
     nd = 0
     if dx is not None:
         nd = dx.shape[0]
@@ -76,6 +71,20 @@ def _discrete_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
             for i in range(n):
                 for j in range(nd):
                     ds_new[_S_HEAD + i, j] = 0.0
+    return alpha, nd
+
+
+@jit
+def _discrete_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
+    # Derivative arguments are all arrays or all None (pruned at compile time).
+    # Not inlined into callers: as a function of its own, the element loop
+    # below compiles to SIMD code (AVX-512 where available); inlined into a
+    # time loop it did not vectorise.
+    kt = params[0]
+    n_ref = params[2]
+    n = int(params[3])
+    alpha, nd = _start(s_new, x, N / n_ref, n, ds_new, dx, dT)
+    if alpha <= 0.0:
         return 0.0, 0.0, SEPARATION
     ke = kt / n
     inc = ke * (x - s_old[0])
@@ -116,20 +125,8 @@ def _single_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
     of one element (about 90 ns against 40 ns per step with it inlined)."""
     kt = params[0]
     n_ref = params[2]
-    alpha = N / n_ref
-    nd = 0
-    if dx is not None:
-        nd = dx.shape[0]
-    s_new[0] = x
-    if ds_new is not None:
-        for j in range(nd):
-            ds_new[0, j] = dx[j]
-            dT[j] = 0.0
+    alpha, nd = _start(s_new, x, N / n_ref, 1, ds_new, dx, dT)
     if alpha <= 0.0:
-        s_new[_S_HEAD] = 0.0
-        if ds_new is not None:
-            for j in range(nd):
-                ds_new[_S_HEAD, j] = 0.0
         return 0.0, 0.0, SEPARATION
     ke = kt / 1
     inc = ke * (x - s_old[0])
