@@ -323,7 +323,7 @@ def test_a_peak_that_asks_for_more_stops_the_coarse_branch(monkeypatch):
     assert auto.attrs["check_converged"] == 1 and auto.attrs["status"] == "complete"
     stop = made[0]
     assert isinstance(stop, hb_frc._Refine) and stop.level == (config.HB_HARMONICS, 2 * config.HB_SAMPLES)
-    assert abs(stop.lam - float(auto.peak_gamma.values[0])) < 0.01
+    assert abs(stop.peak.lam - float(auto.peak_gamma.values[0])) < 0.01
     fixed = frc_hb(system, 0.6, 1.8, max_step=0.01, harmonics=config.HB_HARMONICS, samples=2 * config.HB_SAMPLES)
     np.testing.assert_array_equal(auto.amplitude_q.values, fixed.amplitude_q.values)
     np.testing.assert_array_equal(auto.gamma.values, fixed.gamma.values)
@@ -345,7 +345,7 @@ def test_a_stop_the_finished_branch_does_not_confirm_is_undone(monkeypatch):
     monkeypatch.setattr(hb_frc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
     monkeypatch.setattr(config, "HB_AUTO_EARLY_DROP", 1.0)
     every = frc_hb(system, 0.6, 1.8, max_step=0.01)
-    assert isinstance(made[0], hb_frc._Refine) and made[0].lam < 0.7
+    assert isinstance(made[0], hb_frc._Refine) and made[0].peak.lam < 0.7
     assert any(not isinstance(m, hb_frc._Refine) and m.status.value == "failed" for m in made)
     assert every.attrs["status"] == default.attrs["status"] == "complete"
     assert every.attrs["discretisation_levels"] == default.attrs["discretisation_levels"]

@@ -863,12 +863,8 @@ class _Refine:
     that level, the peak (a :class:`_Candidate`) and the level of the branch it stopped."""
 
     level: tuple
-    peak: object = dataclasses.field(repr=False)
-    stopped: tuple = ()
-
-    @property
-    def lam(self) -> float:
-        return self.peak.lam
+    peak: _Candidate = dataclasses.field(repr=False)
+    stopped: tuple
 
 
 @dataclass(frozen=True)
@@ -978,17 +974,18 @@ def _confirmed(req: _Request, condensed: bool, stop: _Refine, scale: float, auto
     return _peak_target(req, condensed, stop.peak, scale, stop.stopped, auto) == (stop.level, True)
 
 
-def _watched_branch(req: _Request, level, auto, levels, retry_failed: bool, stops):
-    """(branch, its level): :func:`_fixed_branch` at ``level``, watched by a :class:`_PeakWatch` where
-    ``stops`` is a list (the :class:`_Refine` appended to it), computed again at the level a peak asks
-    for where one stops it, and with twice the samples where a branch asked for fails (after a stop by
-    a peak, or where ``retry_failed``: a finer level may fail where the coarser went on, because a closed
-    form's force jumps with the normal load and Newton fails at one sampling and not at the next). Each
-    further level is appended to ``levels``."""
-    br = _fixed_branch(req, level, auto, watch=stops is not None)
+def _watched_branch(req: _Request, level, auto, levels, retry_failed: bool, watch: bool):
+    """(branch, its level, the :class:`_Refine` of a stop or None): :func:`_fixed_branch` at ``level``
+    (with ``watch``, watched by a :class:`_PeakWatch`), computed again at the level a peak asks for where
+    one stops it, and with twice the samples where a branch asked for fails (after a stop by a peak, or
+    where ``retry_failed``: a finer level may fail where the coarser went on, because a closed form's
+    force jumps with the normal load and Newton fails at one sampling and not at the next). Each further
+    level is appended to ``levels``."""
+    br = _fixed_branch(req, level, auto, watch=watch)
+    stop = None
     if isinstance(br, _Refine):
-        stops.append(br)
-        level, retry_failed = br.level, True
+        stop = br
+        level, retry_failed = stop.level, True
         levels.append(level)
         br = _fixed_branch(req, level, auto)
     while retry_failed and br.status is ContinuationStatus.FAILED and auto[1] \
@@ -996,7 +993,7 @@ def _watched_branch(req: _Request, level, auto, levels, retry_failed: bool, stop
         level = (level[0], 2 * level[1])
         levels.append(level)
         br = _fixed_branch(req, level, auto)
-    return br, level
+    return br, level, stop
 
 
 def _worst(values) -> float:
@@ -1020,8 +1017,7 @@ def _adaptive_branch(req: _Request, level, auto, watch: bool = True) -> HBBranch
     levels = [level]
     if not any(auto):
         return _fixed_branch(req, level).branch()
-    stops = [] if watch else None
-    br, level = _watched_branch(req, level, auto, levels, False, stops)
+    br, level, stop = _watched_branch(req, level, auto, levels, False, watch)
     while True:
         scale = max([pk.amplitude_m for pk in br.peaks], default=0.0)
         checks = [_peak_level(req, br.problem.condensed, pk, scale, level, auto) for pk in br.peaks]
@@ -1029,11 +1025,11 @@ def _adaptive_branch(req: _Request, level, auto, watch: bool = True) -> HBBranch
         if target == level:
             break
         levels.append(target)
-        br, level = _watched_branch(req, target, auto, levels, br.status is not ContinuationStatus.FAILED, None)
+        br, level, _ = _watched_branch(req, target, auto, levels, br.status is not ContinuationStatus.FAILED, False)
     by_h, by_s = _check_levels(level, auto)
     ch_h, ch_s = _worst(c[1][0] for c in checks), _worst(c[1][1] for c in checks)
     converged = not (ch_h > config.HB_AUTO_RTOL or ch_s > config.HB_AUTO_RTOL)
-    if stops and not (converged and all(_confirmed(req, br.problem.condensed, st, scale, auto) for st in stops)):
+    if stop is not None and not (converged and _confirmed(req, br.problem.condensed, stop, scale, auto)):
         return _adaptive_branch(req, first, auto, watch=False)
     check = DiscretisationCheck(harmonics_auto=auto[0], samples_auto=auto[1], levels=tuple(levels),
                                 check_harmonics=by_h[0] if by_h else 0, check_samples=by_s[1] if by_s else 0,
