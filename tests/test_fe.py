@@ -209,3 +209,17 @@ def test_match_nodes_is_one_to_one():
         match_nodes(pts, [0, 2], [2, 3])
     with pytest.raises(ValueError, match="node 4 of set B is the nearest of several"):
         match_nodes(pts, [0, 1], [4, 5], tol=0.6)
+
+
+def test_pair_springs_with_ground_and_subsets():
+    from jointdyn.fe import pair_springs
+
+    pairs = np.array([[0, 1, 2, 3, 4, 5], [6, 7, 8, -1, -1, -1]])
+    S = pair_springs(pairs, [10.0, 20.0], [30.0, 40.0], 9).toarray()
+    x = np.random.default_rng(2).normal(size=9)
+    u = np.array([x[0] - x[3], x[1] - x[4], x[2] - x[5], x[6], x[7], x[8]])
+    k = np.array([10.0, 10.0, 30.0, 20.0, 20.0, 40.0])
+    assert x @ S @ x == pytest.approx(np.sum(k * u**2), rel=1e-14)
+    S = pair_springs(pairs, 10.0, 30.0, 9, stuck=[True, False], closed=[False, True]).toarray()
+    k = np.array([10.0, 10.0, 0.0, 0.0, 0.0, 30.0])
+    assert x @ S @ x == pytest.approx(np.sum(k * u**2), rel=1e-14)

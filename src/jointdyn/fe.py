@@ -42,8 +42,8 @@ import numpy as np
 
 from . import config
 
-__all__ = ["PairTable", "interface_from_mesh", "interface_from_triplets", "match_nodes", "pair_frames",
-           "read_node_sets"]  # fmt: skip
+__all__ = ["LapJoint", "PairTable", "interface_from_mesh", "interface_from_triplets", "lap_joint", "match_nodes",
+           "pair_frames", "pair_springs", "read_node_sets"]  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -397,3 +397,122 @@ def interface_from_mesh(path, set_a: str, set_b: str, normal, *, tangent=None, t
         ndof = int(table.max()) + 1
     return interface_from_triplets(table[ids_a], table[ids_b], normal, ndof, tangents=tangent,
                                    nodes=np.stack([ids_a, ids_b], axis=1))  # fmt: skip
+
+
+def pair_springs(pairs, kt, kn, ndof: int, *, stuck=None, closed=None):
+    """Stiffness of node pairs replaced by linear springs (kt, kt, kn), sparse (ndof, ndof), N/m.
+
+    The linear structure of an interface with every pair stuck is K + this;
+    with every pair open, K alone.
+
+    Parameters
+    ----------
+    pairs : array_like of int (npairs, 6)
+        a_t1, a_t2, a_n, b_t1, b_t2, b_n per pair (-1: fixed).
+    kt, kn : float or array_like (npairs,)
+        Tangential and normal stiffness per pair, N/m.
+    ndof : int
+        Size of the model.
+    stuck, closed : array_like of bool (npairs,), optional
+        Pairs with tangential springs (default all) and with the normal
+        spring (default all).
+    """
+    import scipy.sparse as sp
+
+    p = np.asarray(pairs, dtype=np.int64)
+    npairs = p.shape[0]
+    kt = np.broadcast_to(np.asarray(kt, dtype=np.float64), (npairs,))
+    kn = np.broadcast_to(np.asarray(kn, dtype=np.float64), (npairs,))
+    on_t = np.ones(npairs, bool) if stuck is None else np.asarray(stuck, bool)
+    on_n = np.ones(npairs, bool) if closed is None else np.asarray(closed, bool)
+    rows, cols, vals = [], [], []
+    for k, stiff in ((0, kt * on_t), (1, kt * on_t), (2, kn * on_n)):
+        a, b = p[:, k], p[:, 3 + k]
+        for i, j, sign in ((a, a, 1.0), (b, b, 1.0), (a, b, -1.0), (b, a, -1.0)):
+            ok = (i >= 0) & (j >= 0)
+            rows.append(i[ok])
+            cols.append(j[ok])
+            vals.append(sign * stiff[ok])
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(ndof, ndof))
+
+
+@dataclass(frozen=True)
+class LapJoint:
+    """The bolted lap joint shipped with jointdyn, reduced onto its interface (:func:`lap_joint`).
+
+    Two steel plates (100 x 25 x 5 mm each, clamped at their far ends)
+    overlap over a 25 x 25 mm patch held by one bolt (12 kN); made by
+    ``docs/scripts/lap_joint_model.py`` (docs/lap-joint.md).
+
+    Attributes
+    ----------
+    M, K : ndarray (r, r)
+        Craig-Bampton mass (kg) and stiffness (N/m), pairs open.
+    pairs : ndarray of int (npairs, 6)
+        Reduced coordinates a_t1, a_t2, a_n, b_t1, b_t2, b_n of each pair
+        (A: lower plate, B: upper; t1 = x along the beam, t2 = y, n = z).
+    kt, kn, mu, preload : ndarray (npairs,)
+        Tangential and normal stiffness (N/m), friction coefficient and
+        normal load at rest (N; 0 where the patch is open at rest).
+    area : ndarray (npairs,)
+        Contact area of each pair, m^2.
+    xy : ndarray (npairs, 2)
+        Position of each pair in the patch, m.
+    output_dof : int
+        Reduced coordinate of the output (z at the top of the lower plate,
+        37.5 mm from its clamp, mid-width).
+    frequencies_hz : dict
+        The four lowest natural frequencies (Hz) of the reduced model as the
+        script computed them, with every pair stuck ("stuck"), the preloaded
+        pairs stuck and the others open ("preloaded stuck"), every pair open
+        ("open").
+    """
+
+    M: np.ndarray
+    K: np.ndarray
+    pairs: np.ndarray
+    kt: np.ndarray
+    kn: np.ndarray
+    mu: np.ndarray
+    preload: np.ndarray
+    area: np.ndarray
+    xy: np.ndarray
+    output_dof: int
+    frequencies_hz: dict
+
+    @property
+    def npairs(self) -> int:
+        """Number of node pairs."""
+        return self.pairs.shape[0]
+
+    def linear_K(self, state: str = "stuck") -> np.ndarray:
+        """Stiffness of a linear state: "stuck", "preloaded stuck" or "open", N/m."""
+        if state == "open":
+            return self.K.copy()
+        if state not in ("stuck", "preloaded stuck"):
+            raise ValueError(f"state must be 'stuck', 'preloaded stuck' or 'open', got {state!r}")
+        on = None if state == "stuck" else self.preload > 0.0
+        return self.K + pair_springs(self.pairs, self.kt, self.kn, self.K.shape[0], stuck=on, closed=on).toarray()
+
+
+#: the linear states of :attr:`LapJoint.frequencies_hz`, in the order stored
+_LAP_STATES = ("stuck", "preloaded stuck", "open")
+
+
+def _unpack_upper(upper: np.ndarray) -> np.ndarray:
+    n = int(round((np.sqrt(8 * upper.size + 1) - 1) / 2))
+    A = np.zeros((n, n))
+    A[np.triu_indices(n)] = upper
+    return A + np.triu(A, 1).T
+
+
+def lap_joint() -> LapJoint:
+    """The shipped bolted lap joint (reduced FE model and interface table), see :class:`LapJoint`."""
+    from importlib.resources import files
+
+    with files("jointdyn").joinpath("data/lap_joint.npz").open("rb") as fh, np.load(fh) as z:
+        d = {k: z[k] for k in z.files}
+    freq = {s: d["frequencies_hz"][i] for i, s in enumerate(_LAP_STATES)}
+    return LapJoint(M=_unpack_upper(d["M_upper"]), K=_unpack_upper(d["K_upper"]), pairs=d["pairs"], kt=d["kt"],
+                    kn=d["kn"], mu=d["mu"], preload=d["preload"], area=d["area"], xy=d["xy"],
+                    output_dof=int(d["output_dof"]), frequencies_hz=freq)  # fmt: skip
