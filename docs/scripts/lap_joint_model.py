@@ -32,8 +32,8 @@ clamps them with a preload of 12 kN. The script
    stuck and the others open, and with every pair open, and writes the
    reduced model to src/jointdyn/data/lap_joint.npz (``--write``).
 
-Run: ``python docs/scripts/lap_joint_model.py [--write]`` (needs the
-``fe`` extra: scikit-fem).
+Run: ``python docs/scripts/lap_joint_model.py [--write] [--figure
+docs/img/lap-joint-preload.png]`` (needs the ``fe`` extra: scikit-fem).
 """
 
 from __future__ import annotations
@@ -243,12 +243,41 @@ def save(data: dict, path: Path) -> None:
     np.savez_compressed(path, M_upper=data["M"][iu], K_upper=data["K"][iu], **arrays)
 
 
+def preload_figure(data: dict, path: Path) -> None:
+    """The pairs over the patch, coloured by their preload (pressure P_i / A_i, MPa)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    xy = 1e3 * data["xy"]
+    p = data["preload"] / data["area"] / 1e6
+    fig, ax = plt.subplots(figsize=(5.2, 4.2))
+    sc = ax.scatter(xy[:, 0], xy[:, 1], c=p, s=60, cmap="viridis", edgecolors="k", linewidths=0.4)
+    opened = p == 0.0
+    ax.scatter(xy[opened, 0], xy[opened, 1], s=60, facecolors="white", edgecolors="k", linewidths=0.4,
+               label="open at rest")  # fmt: skip
+    cx, cy = 1e3 * (LENGTH - 0.5 * OVERLAP), 1e3 * 0.5 * WIDTH
+    for r, style in ((BOLT["hole"], "-"), (BOLT["head"], "--")):
+        ax.add_patch(plt.Circle((cx, cy), 1e3 * r, fill=False, ls=style, color="0.3"))
+    fig.colorbar(sc, ax=ax, label="contact pressure at rest, MPa")
+    ax.set(xlabel="x, mm (along the beam)", ylabel="y, mm", aspect="equal",
+           title=f"{len(p)} pairs, bolt {BOLT['force'] / 1e3:.0f} kN: static contact solve")  # fmt: skip
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), frameon=False)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--write", action="store_true", help=f"write {OUT.relative_to(ROOT)}")
+    parser.add_argument("--figure", type=Path, help="draw the preload over the patch into this PNG")
     args = parser.parse_args(argv)
     data, report = build()
     print(json.dumps(report, indent=1))
+    if args.figure:
+        preload_figure(data, args.figure)
     if args.write:
         save(data, OUT)
         print(f"wrote {OUT.relative_to(ROOT)} ({OUT.stat().st_size / 1e6:.2f} MB)")
