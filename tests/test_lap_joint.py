@@ -95,3 +95,29 @@ def test_first_mode_is_bending_with_the_joint_stuck(model):
     assert z > 5.0 * xy and abs(v[model.output_dof]) > 0.0
     # stuck, the two plates move together at the joint: no relative normal motion beyond rounding
     assert np.max(np.abs(v[model.pairs[:, 2]] - v[model.pairs[:, 5]])) < 0.05 * np.max(np.abs(v[model.pairs[:, 2]]))
+
+
+def test_the_script_on_a_coarse_mesh(monkeypatch):
+    """docs/scripts/lap_joint_model.py end to end on a coarse mesh (needs the ``fe`` extra)."""
+    pytest.importorskip("skfem")
+    import sys
+    from pathlib import Path
+
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[1] / "docs" / "scripts"))
+    sys.modules.pop("lap_joint_model", None)
+    import lap_joint_model as script
+
+    monkeypatch.setattr(script, "ELEMENTS", dict(free=3, overlap=2, width=2, thick=1))
+    monkeypatch.setattr(script, "N_MODES", 4)
+    data, report = script.build()
+    assert report["pairs"] == 24  # the 5 x 5 node grid of the patch without its centre (in the hole)
+    assert report["reduced_dof"] == 6 * 24 + 1 + 4
+    P = data["preload"]
+    assert np.all(P >= 0.0) and 0 < np.count_nonzero(P) <= 24
+    assert P.sum() == pytest.approx(script.BOLT["force"], rel=1e-2)
+    f = report["frequencies_hz"]
+    for state in f:  # Craig-Bampton: from above, close
+        full, red = f[state]["full"][0], f[state]["reduced"][0]
+        assert 0.0 <= (red - full) / full < 1e-3
+    assert f["stuck"]["full"][0] > f["preloaded stuck"]["full"][0] > f["open"]["full"][0]
+    np.testing.assert_allclose(data["area"].sum(), 0.025**2 - (2 * 0.0125 / 6) ** 2, rtol=1e-12)  # the hole: centre

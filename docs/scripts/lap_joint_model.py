@@ -158,16 +158,17 @@ def bolt_loads(points, triplets, side, ndof):
     """Nodal forces of the head (down on B's top) and the nut (up on A's bottom): uniform pressure on the
     bearing annulus hole < r <= head, by nodal areas (Simpson weights on the patch grid)."""
     cx, cy = LENGTH - 0.5 * OVERLAP, 0.5 * WIDTH
-    h = OVERLAP / (2 * ELEMENTS["overlap"])
+    hx, hy = OVERLAP / (2 * ELEMENTS["overlap"]), WIDTH / (2 * ELEMENTS["width"])
     r = np.hypot(points[:, 0] - cx, points[:, 1] - cy)
     ring = (r > BOLT["hole"] - 1e-9) & (r <= BOLT["head"] + 1e-9)
-    w1 = simpson_weights(_grid(0.0, 2 * h * ELEMENTS["overlap"], 2 * ELEMENTS["overlap"]))
+    wx = simpson_weights(_grid(0.0, OVERLAP, 2 * ELEMENTS["overlap"]))
+    wy = simpson_weights(_grid(0.0, WIDTH, 2 * ELEMENTS["width"]))
     f = np.zeros(ndof)
     for s, z, sign in ((1, 2 * THICK, -1.0), (0, 0.0, 1.0)):
         sel = np.flatnonzero(ring & (side == s) & np.isclose(points[:, 2], z))
-        ix = np.rint((points[sel, 0] - (LENGTH - OVERLAP)) / h).astype(int)
-        iy = np.rint(points[sel, 1] / h).astype(int)
-        area = w1[ix] * w1[iy]
+        ix = np.rint((points[sel, 0] - (LENGTH - OVERLAP)) / hx).astype(int)
+        iy = np.rint(points[sel, 1] / hy).astype(int)
+        area = wx[ix] * wy[iy]
         f[triplets[sel, 2]] += sign * BOLT["force"] * area / area.sum()
     return f
 
