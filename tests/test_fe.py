@@ -9,6 +9,8 @@ groups) are paired with the nodes at the same place.
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from jointdyn.fe import interface_from_mesh, interface_from_triplets, match_nodes, pair_frames, read_node_sets
 
@@ -28,6 +30,20 @@ def test_frames_are_orthonormal_right_handed_and_keep_the_normal(normals):
         np.testing.assert_allclose(R @ R.T, np.eye(3), atol=1e-14)
         np.testing.assert_allclose(np.cross(R[0], R[1]), R[2], atol=1e-14)
     n = np.atleast_2d(normals)
+    np.testing.assert_allclose(F[:, 2], n / np.linalg.norm(n, axis=1)[:, None], atol=1e-15)
+
+
+_coord = st.floats(-1e3, 1e3, allow_nan=False).filter(lambda v: v == 0.0 or abs(v) > 1e-6)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(_coord, _coord, _coord).filter(lambda v: max(map(abs, v)) > 1e-3), min_size=1,
+                max_size=5))  # fmt: skip
+def test_frames_of_any_normals(normals):
+    n = np.array(normals)
+    F = pair_frames(n)
+    np.testing.assert_allclose(F @ np.transpose(F, (0, 2, 1)), np.broadcast_to(np.eye(3), F.shape), atol=1e-13)
+    np.testing.assert_allclose(np.linalg.det(F), 1.0, atol=1e-13)
     np.testing.assert_allclose(F[:, 2], n / np.linalg.norm(n, axis=1)[:, None], atol=1e-15)
 
 

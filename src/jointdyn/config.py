@@ -193,6 +193,9 @@ FE_MATCH_RTOL = 1e-6
 #: a node in two pairs must get the same frame from both: rows t1, t2, n
 #: equal to this (unit vectors)
 FE_FRAME_ATOL = 1e-9
+#: a given tangent is along the normal when its part normal to n is below
+#: this fraction of its length
+FE_TANGENT_RTOL = 1e-8
 #: linear modes compared by the error report of a sparse Craig-Bampton
 #: reduction (the lowest ones; a dense reduction compares all of its size)
 REDUCTION_SPARSE_ERROR_MODES = 12

@@ -138,9 +138,9 @@ def pair_frames(normals, tangents=None) -> np.ndarray:
     given = np.linalg.norm(t, axis=1)
     t = t - np.sum(t * n, axis=1)[:, None] * n
     tl = np.linalg.norm(t, axis=1)
-    if not np.all(tl > 1e-8 * given):
-        raise ValueError(f"tangents must be finite, non-zero and not along the normal "
-                         f"(pair {int(np.flatnonzero(~(tl > 1e-8 * given))[0])})")
+    bad = ~(tl > config.FE_TANGENT_RTOL * given)
+    if np.any(bad):
+        raise ValueError(f"tangents must be finite, non-zero and not along the normal (pair {int(np.argmax(bad))})")
     t1 = t / tl[:, None]
     return np.stack([t1, np.cross(n, t1), n], axis=1)
 
