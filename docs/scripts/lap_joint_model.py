@@ -18,9 +18,8 @@ clamps them with a preload of 12 kN. The script
 4. distributes the preload over the patch by a static contact solve: the
    bolt head and the nut press (uniform pressure on their bearing annulus,
    as nodal forces over the nodal areas) on the top of B and the bottom of
-   A, the pairs are stuck tangentially and carry kn_i in the normal
-   direction while closed, and an active set removes the pairs that would
-   pull; the preload of pair i is its normal force P_i (sum = the bolt
+   A, the closed pairs are stuck (springs kt_i, kt_i, kn_i), and an active
+   set removes the pairs that would pull (an open pair carries nothing); the preload of pair i is its normal force P_i (sum = the bolt
    force; pairs that open get P_i = 0). The bolt's own axial stiffness is
    left out: it acts as a constant force;
 5. reduces the model by Craig-Bampton onto the 672 pair DOFs (t1, t2, n of
@@ -174,8 +173,9 @@ def bolt_loads(points, triplets, side, ndof):
 
 
 def interface_springs(pairs, kt, kn, active, ndof):
-    """Stiffness of the pairs as springs: kt, kt on every pair (stuck), kn on the active ones."""
-    return pair_springs(pairs, kt, kn, ndof, closed=np.asarray(active) > 0.0)
+    """Stiffness of the pairs as springs: kt, kt, kn on the active (closed, stuck) ones, none on the others."""
+    closed = np.asarray(active) > 0.0
+    return pair_springs(pairs, kt, kn, ndof, stuck=closed, closed=closed)
 
 
 def preload(K, pairs, kt, kn, f, max_iter: int = 50):
