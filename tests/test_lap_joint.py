@@ -121,3 +121,22 @@ def test_the_script_on_a_coarse_mesh(monkeypatch):
         assert 0.0 <= (red - full) / full < 1e-3
     assert f["stuck"]["full"][0] > f["preloaded stuck"]["full"][0] > f["open"]["full"][0]
     np.testing.assert_allclose(data["area"].sum(), 0.025**2 - (2 * 0.0125 / 6) ** 2, rtol=1e-12)  # the hole: centre
+
+
+def test_the_tutorial_page_runs(tmp_path, monkeypatch, capsys):
+    """The Python blocks of docs/lap-joint.md, in order, in one namespace, print what the page says."""
+    pytest.importorskip("skfem")
+    import re
+    from pathlib import Path
+
+    page = Path(__file__).resolve().parents[1] / "docs" / "lap-joint.md"
+    text = page.read_text()
+    code = "\n".join(re.findall(r"```python\n(.*?)```", text, re.S))
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, str(page), "exec"), {"__name__": "docs_lap_joint"})
+    out = capsys.readouterr().out
+    for said in ("25 pairs over 400.0 mm^2", "159 reduced DOFs from 1080", "stuck: [2049.8", "open: [949.3",
+                 "first bending mode, joint stuck: 823.7 Hz"):  # fmt: skip
+        assert said in out, f"{said!r} not in the output:\n{out}"
+    assert "It prints 25 pairs over 400 mm^2, 159 reduced DOFs from 1080" in text
+    assert "2049.8 Hz stuck and 949.3 Hz open" in text
