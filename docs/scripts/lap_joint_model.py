@@ -19,9 +19,10 @@ clamps them with a preload of 12 kN. The script
    bolt head and the nut press (uniform pressure on their bearing annulus,
    as nodal forces over the nodal areas) on the top of B and the bottom of
    A, the closed pairs are stuck (springs kt_i, kt_i, kn_i), and an active
-   set removes the pairs that would pull (an open pair carries nothing); the preload of pair i is its normal force P_i (sum = the bolt
-   force; pairs that open get P_i = 0). The bolt's own axial stiffness is
-   left out: it acts as a constant force;
+   set removes the pairs that would pull (an open pair carries nothing);
+   the preload of pair i is its normal force P_i (their sum is the bolt
+   force up to what the clamps carry; pairs that open get P_i = 0). The
+   bolt's own axial stiffness is left out: it acts as a constant force;
 5. reduces the model by Craig-Bampton onto the 672 pair DOFs (t1, t2, n of
    both nodes of each pair, which here are x, y, z: the frames are the
    global axes), the output DOF (z at the top of plate A, 37.5 mm from its

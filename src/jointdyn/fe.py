@@ -179,8 +179,9 @@ def _rotation(trip: np.ndarray, frames: np.ndarray, pair_of: np.ndarray, ndof: i
     if np.any(counts > 1):
         d = int(values[np.argmax(counts > 1)])
         rows = np.flatnonzero(np.any(trip == d, axis=1))
-        raise ValueError(f"DOF {d} belongs to two different node triplets (pairs {sorted(set(pair_of[rows].tolist()))}): "
-                         "a DOF is one direction of one node")  # fmt: skip
+        pairs = sorted(set(pair_of[rows].tolist()))
+        raise ValueError(f"DOF {d} belongs to two different node triplets (pairs {pairs}): a DOF is one direction "
+                         "of one node")  # fmt: skip
     R = frames[pair_of]
     diff = np.max(np.abs(R - R[first][inv]), axis=(1, 2))
     if np.any(diff > config.FE_FRAME_ATOL):
