@@ -311,10 +311,10 @@ def test_a_peak_that_asks_for_more_stops_the_coarse_branch(monkeypatch):
     # Jenkins at eta = 0.5, beta = 1 (the CLI's benchmark case): the peak near gamma 1.06 asks for 256 samples.
     # The branch with 128 stops once past that peak (the rest of it would be discarded), the branch with 256
     # confirms the stop, and the branch returned is the one computed with 256, bit for bit
-    from jointdyn.hb import frc as hb_frc
+    from jointdyn.hb import discretisation as hb_disc
 
     made = []
-    real = hb_frc._fixed_branch
+    real = hb_disc._fixed_branch
     monkeypatch.setattr(hb_frc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
     system = System.paper_damper(eta=0.5, beta=1.0, model="jenkins")
     auto = frc_hb(system, 0.6, 1.8, max_step=0.01)
@@ -322,7 +322,7 @@ def test_a_peak_that_asks_for_more_stops_the_coarse_branch(monkeypatch):
                                                   f"{config.HB_HARMONICS}x{2 * config.HB_SAMPLES}"
     assert auto.attrs["check_converged"] == 1 and auto.attrs["status"] == "complete"
     stop = made[0]
-    assert isinstance(stop, hb_frc._Refine) and stop.level == (config.HB_HARMONICS, 2 * config.HB_SAMPLES)
+    assert isinstance(stop, hb_disc._Refine) and stop.level == (config.HB_HARMONICS, 2 * config.HB_SAMPLES)
     assert abs(stop.peak.lam - float(auto.peak_gamma.values[0])) < 0.01
     fixed = frc_hb(system, 0.6, 1.8, max_step=0.01, harmonics=config.HB_HARMONICS, samples=2 * config.HB_SAMPLES)
     np.testing.assert_array_equal(auto.amplitude_q.values, fixed.amplitude_q.values)
@@ -336,17 +336,17 @@ def test_a_stop_the_finished_branch_does_not_confirm_is_undone(monkeypatch):
     # is within the tolerance of the resonance's amplitude: the finished branch does not confirm the stop and
     # the choice is made again without stops, giving the branch of the default drop, which checks only passed
     # resonances
-    from jointdyn.hb import frc as hb_frc
+    from jointdyn.hb import discretisation as hb_disc
 
     system = System.paper_damper(eta=0.5, beta=2.0, model="iwan-closed")
     default = frc_hb(system, 0.6, 1.8, max_step=0.01)
     made = []
-    real = hb_frc._fixed_branch
+    real = hb_disc._fixed_branch
     monkeypatch.setattr(hb_frc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
     monkeypatch.setattr(config, "HB_AUTO_EARLY_DROP", 1.0)
     every = frc_hb(system, 0.6, 1.8, max_step=0.01)
-    assert isinstance(made[0], hb_frc._Refine) and made[0].peak.lam < 0.7
-    assert any(not isinstance(m, hb_frc._Refine) and m.status.value == "failed" for m in made)
+    assert isinstance(made[0], hb_disc._Refine) and made[0].peak.lam < 0.7
+    assert any(not isinstance(m, hb_disc._Refine) and m.status.value == "failed" for m in made)
     assert every.attrs["status"] == default.attrs["status"] == "complete"
     assert every.attrs["discretisation_levels"] == default.attrs["discretisation_levels"]
     np.testing.assert_array_equal(every.amplitude_q.values, default.amplitude_q.values)

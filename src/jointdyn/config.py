@@ -201,7 +201,7 @@ HB_AUTO_RTOL = 1e-3
 #: while the first branch is continued, its highest point so far is checked once the amplitude has fallen
 #: below this fraction of it (a resonance passed); where that peak converges at a finer level, the branch
 #: stops there and is computed at that level (the rest of it would be discarded), and the finished branch
-#: must confirm the stop, else the choice is made again without stops (jointdyn.hb.frc._PeakWatch)
+#: must confirm the stop, else the choice is made again without stops (jointdyn.hb.discretisation._PeakWatch)
 HB_AUTO_EARLY_DROP = 0.5
 #: the largest H and Ns an automatic choice takes (the check solves go one level beyond); with separation
 #: the samples decide, H = 7 already within 2e-4 of H = 15 on the paper's grid

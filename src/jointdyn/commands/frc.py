@@ -430,7 +430,7 @@ def _hb_peaks(br) -> list:
 def _run_hb(args, gammas):
     """The hb branch: ``(branch, result)`` (the Dataset is built only for files: xarray takes time to import)."""
     from ..hb import continue_hb
-    from ..hb.frc import discretisation_attrs
+    from ..hb.export import discretisation_attrs
 
     system = _system(args)
     if gammas.size < 2:
