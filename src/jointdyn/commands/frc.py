@@ -542,9 +542,9 @@ def _plot_hb(ax, result) -> None:
 
 
 def exit_status(result) -> int:
-    """0, or :data:`jointdyn.cli.EXIT_INCOMPLETE` for an hb branch that does not cover the range and is
+    """0, or :data:`jointdyn._exit.EXIT_INCOMPLETE` for an hb branch that does not cover the range and is
     not unbounded (failed, turned back, stopped at its point bound)."""
-    from ..cli import EXIT_INCOMPLETE
+    from .._exit import EXIT_INCOMPLETE
 
     if result["method"] == "hb" and result["status"] not in ("complete", "unbounded"):
         return EXIT_INCOMPLETE

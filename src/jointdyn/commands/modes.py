@@ -14,7 +14,7 @@ Everything is validated before computing; ``--out`` files (``modes.nc``,
 ``modes.csv``, ``modes.png``) are written atomically after computing.
 
 Exit status: 0 for a complete backbone; 2 for bad input (one line, no
-file); :data:`EXIT_PARTIAL` (3) when the backbone stops short (status
+file); :data:`jointdyn._exit.EXIT_INCOMPLETE` (3) when the backbone stops short (status
 ``failed``, ``max-points`` or ``no-start``): the files are still written
 and carry the status, and ``--json`` prints it.
 """
@@ -29,13 +29,14 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
+from .._exit import EXIT_INCOMPLETE
 from ._law_args import add_law_arguments, law_params, model_help
 from ._system_args import load_system_file
 
 NAME = "modes"
 HELP = "backbone of a nonlinear mode (natural frequency and damping ratio against amplitude) by EPMC or QSMA"
-#: exit status of a backbone that stops short of the amplitude range (files are still written)
-EXIT_PARTIAL = 3
+#: deprecated alias of :data:`jointdyn._exit.EXIT_INCOMPLETE` (a backbone that stops short; files are still written)
+EXIT_PARTIAL = EXIT_INCOMPLETE
 #: options of the EPMC only
 _EPMC_ONLY = ("harmonics", "samples", "max_points")
 
@@ -196,7 +197,7 @@ def run(args) -> int:
         print(json.dumps(result))
     else:
         _print_table(result)
-    return 0 if backbone.status.ok else EXIT_PARTIAL
+    return 0 if backbone.status.ok else EXIT_INCOMPLETE
 
 
 def _print_table(result) -> None:
