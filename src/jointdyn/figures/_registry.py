@@ -120,9 +120,8 @@ def _load_all() -> None:
     import importlib
     import pkgutil
 
-    from . import __path__ as pkg_path
-
-    for info in pkgutil.iter_modules(pkg_path):
+    # this package's directory (the package itself is not imported back from here)
+    for info in pkgutil.iter_modules([str(Path(__file__).parent)]):
         if not info.name.startswith("_"):
             importlib.import_module(f"{__package__}.{info.name}")
     _LOADED.append(True)

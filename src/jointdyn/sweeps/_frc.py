@@ -50,6 +50,7 @@ from .. import _validate as V
 from .. import config
 from .._io import atomic_path
 from ..laws import STATE_NAMES
+from . import _points
 from ._checkpoint import load_line, save_chunk
 from ._family import LineSpec, fingerprint, paper_family, system_family
 from ._points import (
@@ -101,13 +102,6 @@ def default_workers() -> int:
         return max(1, len(os.sched_getaffinity(0)))
     except AttributeError:  # pragma: no cover - non-Linux
         return max(1, os.cpu_count() or 1)
-
-
-def _steady_state_fn():
-    """The time-domain steady-state solver (resolved late; tests may swap it)."""
-    from ..dynamics import steady_state
-
-    return steady_state
 
 
 class _LineRun:
@@ -259,7 +253,7 @@ def _prepare_kernels(systems) -> None:
     when tests swapped the solver."""
     from ..dynamics import prepare_kernels, steady_state
 
-    if _steady_state_fn() is steady_state:
+    if _points._steady_state_fn() is steady_state:
         prepare_kernels(systems)
 
 

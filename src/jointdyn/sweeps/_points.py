@@ -297,11 +297,15 @@ class Context:
             self.on_point()
 
 
-def _solver():
-    """The steady-state solver: ``jointdyn.sweeps._frc._steady_state_fn()``,
-    looked up at every chunk (the one place tests swap it)."""
-    from ._frc import _steady_state_fn
+def _steady_state_fn():
+    """The time-domain steady-state solver (resolved late; tests may swap it: the one place they do)."""
+    from ..dynamics import steady_state
 
+    return steady_state
+
+
+def _solver():
+    """The steady-state solver: :func:`_steady_state_fn`, looked up at every chunk."""
     return _steady_state_fn()
 
 
