@@ -4,7 +4,7 @@ The layers of the package, imports pointing one way (a module may import its
 own layer and the layers below it, never one above)::
 
     cli, commands, figures                        (front ends)
-    sweeps                                        (many points, processes, files)
+    sweeps, validation                            (many points, processes, files; validation studies)
     dynamics, hb, modes                           (solvers)
     continuation, drivers                         (generic continuation, quasi-static drivers)
     systems, kinematics, fourier, files, reduction (what a structure and its contacts are)
@@ -36,7 +36,7 @@ LAYERS = {
     "systems": 1, "kinematics": 1, "fourier": 1, "reduction": 1, "files": 1,
     "continuation": 2, "drivers": 2,
     "dynamics": 3, "hb": 3, "modes": 3,
-    "sweeps": 4,
+    "sweeps": 4, "validation": 4,
     "cli": 5, "commands": 5, "figures": 5, "__main__": 5,
 }
 #: helpers outside the layers, importable from anywhere
