@@ -384,11 +384,13 @@ def test_bad_system_form(call, word, fake):
     assert fake.calls == []
 
 
-def test_status_codes_match_config():
-    from jointdyn import config
+def test_status_codes_are_the_steady_state_statuses_own_codes():
+    from jointdyn.dynamics import SteadyStatus
+    from jointdyn.sweeps._points import NOT_COMPUTED, NOT_COMPUTED_NAME
 
-    assert STATUS_CODES == {n: i for i, n in enumerate(config.SWEEP_STATUS)}
-    assert status_name(-1) == "not-computed"
+    assert STATUS_CODES == {s.value: s.code for s in SteadyStatus} == {"periodic": 0, "not-settled": 1, "unbounded": 2}
+    assert all(status_name(s.code) == s.value for s in SteadyStatus)
+    assert status_name(NOT_COMPUTED) == NOT_COMPUTED_NAME == "not-computed"
 
 
 def test_gamma_order_does_not_matter(fake):

@@ -159,10 +159,6 @@ SWEEP_SCHEDULER_TIMEOUT_S = 5.0
 #: local pool for sweep lines when no Dask client is given: "process" or
 #: "thread" (the compiled kernels release the GIL)
 SWEEP_POOL = "process"
-#: status codes of a swept point (netCDF-friendly int8); index = code
-SWEEP_STATUS = ("periodic", "not-settled", "unbounded")
-#: code of a point that was not computed (never written by a finished sweep)
-SWEEP_STATUS_MISSING = -1
 #: consecutive points of a line solved as one task and saved as one resume
 #: checkpoint (an interrupt stops a task after its current point, so this
 #: bounds what a killed run loses, not what an interrupted one loses)

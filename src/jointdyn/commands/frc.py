@@ -473,6 +473,7 @@ def _plot(result, path: Path) -> None:
 
     from .._io import atomic_path
     from ..sweeps._plot import mark_legend, plot_frc_curve
+    from ..sweeps._points import NOT_COMPUTED, STATUS_CODES
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     if result["method"] == "time":
@@ -481,7 +482,7 @@ def _plot(result, path: Path) -> None:
                 continue
             r = result["directions"][d]
             amp = np.array([np.nan if v is None else v for v in r["amplitude_q"]], float)
-            codes = [config.SWEEP_STATUS.index(s) for s in r["status"]]
+            codes = [STATUS_CODES.get(s, NOT_COMPUTED) for s in r["status"]]
             plot_frc_curve(ax, r["gamma"], amp, codes, color="C0" if d == "up" else "C3",
                            linestyle=style, label=f"sweep {d}", rug_y=0.03 if d == "up" else 0.07)
         mark_legend(ax, fontsize=8)

@@ -83,11 +83,11 @@ RUG_MARKERS = {"not-settled": ("o", "none"), "unbounded": ("x", None)}
 
 
 def _status_names(codes):
-    """Sweep status names of integer codes (``config.SWEEP_STATUS``; "missing" otherwise)."""
-    from .. import config
+    """Sweep status names of integer codes (:func:`jointdyn.sweeps.status_name`: the steady-state statuses,
+    ``not-computed`` otherwise)."""
+    from ..sweeps import status_name
 
-    known = config.SWEEP_STATUS
-    return np.array([known[c] if 0 <= c < len(known) else "missing" for c in np.asarray(codes, int)])
+    return np.array([status_name(c) for c in np.asarray(codes, int)])
 
 
 def _linear_limits(ax):

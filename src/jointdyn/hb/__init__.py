@@ -20,7 +20,7 @@ from .frc import continue_hb, frc_hb, harmonic_balance
 from .parameters import DELTA, ETA, F1, GAMMA, N0, PARAMETERS, HBParameter, SystemParameter, parameter_named
 from .problem import HBProblem
 from .monodromy import monodromy_multipliers
-from .results import AUTO, DiscretisationCheck, HBBranch, HBPeak, HBSolution, PointStatus
+from .results import AUTO, DiscretisationCheck, HBBranch, HBPeak, HBSolution, PointStatus, SolveStatus
 from .stability import hill_exponents, hill_growth, hill_stability
 
 __all__ = [
@@ -35,6 +35,7 @@ __all__ = [
     "HBBranch",
     "HBPeak",
     "PointStatus",
+    "SolveStatus",
     "HBProblem",
     "CondensedHBProblem",
     "make_problem",

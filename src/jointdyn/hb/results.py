@@ -18,7 +18,7 @@ from ..status import Status
 from .parameters import GAMMA
 from .problem import HBProblem
 
-__all__ = ["AUTO", "DiscretisationCheck", "HBBranch", "HBPeak", "HBSolution", "PointStatus"]
+__all__ = ["AUTO", "DiscretisationCheck", "HBBranch", "HBPeak", "HBSolution", "PointStatus", "SolveStatus"]
 
 
 class PointStatus(Status):
@@ -214,6 +214,14 @@ class HBBranch:
         return out[:, 0], out[:, 1], out[:, 2]
 
 
+class SolveStatus(Status):
+    """Outcome of a harmonic-balance solve at one point (:attr:`HBSolution.status`)."""
+
+    CONVERGED = "converged", "Newton converged: the scaled residual is within the tolerance", True
+    NOT_CONVERGED = "not-converged", ("Newton did not converge within its iterations: the last iterate is "
+                                      "returned, not a solution")
+
+
 @dataclass(frozen=True)
 class HBSolution:
     """One harmonic-balance solution at fixed parameters (built by :func:`harmonic_balance`).
@@ -224,6 +232,7 @@ class HBSolution:
     X : ndarray
         Harmonic coefficients (harmonic-major), m.
     converged : bool
+        Newton converged (``status`` says the same with a message).
     iterations : int
     residual_norm : float
         max |R| at X, N.
@@ -251,3 +260,13 @@ class HBSolution:
     growth: float
     multipliers: np.ndarray
     aft_info: np.ndarray
+
+    @property
+    def status(self) -> SolveStatus:
+        """``converged`` or ``not-converged`` (:class:`SolveStatus`)."""
+        return SolveStatus.CONVERGED if self.converged else SolveStatus.NOT_CONVERGED
+
+    @property
+    def message(self) -> str:
+        """The status's message, with the residual and the iterations."""
+        return f"{self.status.message} (max |R| = {self.residual_norm:.4g} N after {self.iterations} iterations)"

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import config
+from ..dynamics.status import SteadyStatus
 
 __all__ = ["plot_frc_curve", "mark_legend"]
 
@@ -33,7 +33,8 @@ def plot_frc_curve(ax, gamma, amplitude, status, *, color=None, linestyle="-", l
     (line,) = ax.plot(gamma, y, linestyle=linestyle, color=color, label=label, lw=1.2)
     color = line.get_color()
     trans = ax.get_xaxis_transform()
-    for code, name in enumerate(config.SWEEP_STATUS):
+    for s in SteadyStatus:
+        code, name = s.code, s.value
         if name not in _MARKS:
             continue
         sel = status == code
