@@ -22,14 +22,12 @@ and carry the status, and ``--json`` prints it.
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
-
-import numpy as np
 
 from .. import _validate as V
 from .. import config
 from .._exit import EXIT_INCOMPLETE
+from .._io import jsonable as _jsonable
 from ._law_args import add_law_arguments, law_params, model_help
 from ._system_args import load_system_file
 
@@ -131,16 +129,6 @@ def _compute(args, system, amps):
     return b, backbone_dataset(b)
 
 
-def _jsonable(values):
-    """Nested lists of an array, NaN and infinities as None (JSON has no NaN)."""
-    def clean(v):
-        if isinstance(v, list):
-            return [clean(x) for x in v]
-        return None if isinstance(v, float) and not math.isfinite(v) else v
-
-    return clean(np.asarray(values).tolist())
-
-
 def _result(args, ds, label) -> dict:
     keys = ("amplitude_m", "amplitude_q", "omega_rad_s", "frequency_hz", "damping_ratio", "damping_ratio_contacts",
             "damping_ratio_viscous", "energy_contact_j")
@@ -177,13 +165,9 @@ def _plot(ds, title: str, path: Path) -> None:
 
 
 def _write(ds, out: Path, title: str) -> None:
-    from .._io import atomic_path
+    from .._io import write_dataset
 
-    with atomic_path(out / "modes.nc") as tmp:
-        ds.to_netcdf(tmp, engine="scipy")
-    with atomic_path(out / "modes.csv") as tmp:  # one row per point (per-DOF and per-contact data in modes.nc)
-        flat = ds.drop_dims([d for d in ds.dims if d != "point"])
-        flat.to_dataframe().reset_index().to_csv(tmp, index=False)
+    write_dataset(ds, out, "modes")  # modes.csv: one row per point (per-DOF and per-contact data in modes.nc)
     _plot(ds, title, out / "modes.png")
 
 

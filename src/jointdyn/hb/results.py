@@ -18,7 +18,7 @@ from ..status import Status
 from .parameters import GAMMA
 from .problem import HBProblem
 
-__all__ = ["AUTO", "DiscretisationCheck", "HBBranch", "HBPeak", "HBSolution", "PointStatus", "SolveStatus"]
+__all__ = ["AUTO", "JOINED", "DiscretisationCheck", "HBBranch", "HBPeak", "HBSolution", "PointStatus", "SolveStatus"]
 
 
 class PointStatus(Status):
@@ -32,6 +32,10 @@ class PointStatus(Status):
                                 "previous point")
     STOPPED = "stopped", "last point of a segment that stopped short (the branch message says where and why)"
 
+
+#: point statuses joined to the point before them: a branch is drawn as one line per run of them
+#: (:func:`jointdyn.figures.curves.branch_pieces`)
+JOINED = (PointStatus.JOINED.value, PointStatus.CORNER.value)
 
 #: ``harmonics`` / ``samples`` value asking for the automatic choice (:func:`continue_hb`)
 AUTO = config.HB_AUTO

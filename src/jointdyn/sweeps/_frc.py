@@ -48,7 +48,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from .._io import atomic_path
+from .._io import write_dataset
 from ..dynamics.status import SteadyStatus
 from ..laws import STATE_NAMES
 from . import _points
@@ -556,10 +556,4 @@ def write_outputs(ds, out) -> list[Path]:
     res = ds.copy()
     for key in RUN_ATTRIBUTES:
         res.attrs.pop(key, None)
-    nc = out / "frc.nc"
-    with atomic_path(nc) as tmp:
-        res.to_netcdf(tmp, engine="scipy")
-    csv = out / "frc.csv"
-    with atomic_path(csv) as tmp:
-        to_frame(res).to_csv(tmp, index=False)
-    return [nc, csv]
+    return write_dataset(res, out, "frc", table=to_frame)
