@@ -59,11 +59,10 @@ branch) and :mod:`~jointdyn.continuation.post` (turning points, maxima and
 their refinement on a computed branch).
 """
 
-from .linalg import lu_solve
 from .newton import newton
 from .options import ContinuationOptions, ContinuationResult, ContinuationStatus, make_options
 from .post import local_maxima, refine_maximum, turning_points
 from .walk import continuation
 
 __all__ = ["ContinuationOptions", "ContinuationStatus", "ContinuationResult", "continuation", "newton",
-           "turning_points", "make_options", "local_maxima", "refine_maximum", "lu_solve"]
+           "turning_points", "make_options", "local_maxima", "refine_maximum"]
