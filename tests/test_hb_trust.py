@@ -315,7 +315,7 @@ def test_a_peak_that_asks_for_more_stops_the_coarse_branch(monkeypatch):
 
     made = []
     real = hb_disc._fixed_branch
-    monkeypatch.setattr(hb_frc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
+    monkeypatch.setattr(hb_disc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
     system = System.paper_damper(eta=0.5, beta=1.0, model="jenkins")
     auto = frc_hb(system, 0.6, 1.8, max_step=0.01)
     assert auto.attrs["discretisation_levels"] == f"{config.HB_HARMONICS}x{config.HB_SAMPLES}, " \
@@ -342,7 +342,7 @@ def test_a_stop_the_finished_branch_does_not_confirm_is_undone(monkeypatch):
     default = frc_hb(system, 0.6, 1.8, max_step=0.01)
     made = []
     real = hb_disc._fixed_branch
-    monkeypatch.setattr(hb_frc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
+    monkeypatch.setattr(hb_disc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
     monkeypatch.setattr(config, "HB_AUTO_EARLY_DROP", 1.0)
     every = frc_hb(system, 0.6, 1.8, max_step=0.01)
     assert isinstance(made[0], hb_disc._Refine) and made[0].peak.lam < 0.7
