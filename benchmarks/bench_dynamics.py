@@ -27,7 +27,7 @@ def _sweep(system, gammas):
             prev = r if r.ok else None
             per.append(r.periods)
             steps.append(r.steps)
-            key = r.status if r.ok else f"{r.status}:{r.detail}"
+            key = r.status if r.ok else f"{r.status}:{r.message}"
             status[key] = status.get(key, 0) + 1
     dt = time.perf_counter() - t0
     return dt, np.array(per), np.array(steps), status

@@ -2,7 +2,7 @@
 
 Reported:
 
-* ``grid_*``: the whole grid of :mod:`jointdyn.sweeps.hb_grid` (4 models x
+* ``grid_*``: the whole grid of :mod:`jointdyn.validation.hb_grid` (4 models x
   4 eta x 6 beta, default CLI settings, gamma 0.6:1.8:0.01, each highest
   peak checked against the time domain): wall seconds, CPU seconds of the
   branches, the fraction of branches that cover the range (or are
@@ -13,7 +13,7 @@ Reported:
 * ``fig6_hb_default_*``: the Fig 6 harmonic-balance data set with the
   default (exact) model, 4 eta x 6 beta, default settings (harmonics and
   samples chosen automatically), without the time-domain checks, run by
-  :func:`~jointdyn.sweeps.hb_grid.grid_cases` on ``FIG6_WORKERS``
+  :func:`~jointdyn.validation.hb_grid.grid_cases` on ``FIG6_WORKERS``
   processes: wall seconds (target <= 5 s on 2 cores), the CPU seconds of
   the branches summed over the cases, and the slowest case;
 
@@ -93,7 +93,7 @@ def cli_process(rounds: int = CLI_ROUNDS) -> dict:
 def run(quick: bool = False) -> dict:
     sys.path.insert(0, str(SRC))
     from jointdyn import config
-    from jointdyn.sweeps.hb_grid import GRID_BETAS, GRID_ETAS, GRID_MODELS, Verdict, grid_case, grid_cases
+    from jointdyn.validation.hb_grid import GRID_BETAS, GRID_ETAS, GRID_MODELS, Verdict, grid_case, grid_cases
 
     grid_case(config.MODEL, 0.5, 2.0, time_domain=False)  # warm-up (compiles or loads the cache)
     t = time.perf_counter()

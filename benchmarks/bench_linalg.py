@@ -54,7 +54,7 @@ import sys, time
 import numpy as np
 which = sys.argv[1]
 from jointdyn.hb import stability as S
-from jointdyn import continuation as K
+from jointdyn.continuation import linalg as K
 t = time.process_time()
 if which == "eig":
     M = np.eye(1); C = np.zeros((1, 1))
@@ -140,7 +140,7 @@ def _hill_row(n, eta, budget):
 def _solve_row(n, budget):
     import numpy as np
 
-    from jointdyn import continuation as K
+    from jointdyn.continuation import linalg as K
 
     p, JX, w = _jacobian(n, 0.0)
     rng = np.random.default_rng(1)

@@ -28,7 +28,7 @@ import jointdyn
 from jointdyn import config
 from jointdyn.cli import main
 from jointdyn.drivers import harmonic_history, quasistatic, read_history_csv
-from jointdyn.sweeps import _frc, frc_sweep
+from jointdyn.sweeps import _points, frc_sweep
 
 SRC = str(Path(__file__).resolve().parents[1] / "src")
 #: a hang guard for subprocesses, not a speed requirement
@@ -58,7 +58,7 @@ def no_compute(monkeypatch, tmp_path):
     monkeypatch.setattr(jointdyn.sweeps, "frc_sweep", _boom)
     monkeypatch.setattr(frc_cmd, "_run_hb", _boom)
     monkeypatch.setattr(jointdyn.figures, "make_figure", _boom)
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: _boom)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: _boom)
     work = tmp_path / "work"
     work.mkdir()
     monkeypatch.chdir(work)
@@ -205,7 +205,7 @@ def test_input_unreadable_permissions(no_compute, capsys, tmp_path):
 
 
 def test_api_frc_sweep_out_is_a_file(monkeypatch, tmp_path):
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: _boom)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: _boom)
     f = tmp_path / "file.csv"
     f.write_text("keep")
     for out in (f, f / "below"):
@@ -499,7 +499,7 @@ def test_frc_malformed_scheduler_address(address, no_compute, capsys, tmp_path):
 # --- wrong types in the API --------------------------------------------------------------------
 @pytest.mark.parametrize("client", ["tcp://x", 8786, object()], ids=["address", "int", "object"])
 def test_api_frc_sweep_client_type(client, monkeypatch, tmp_path):
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: _boom)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: _boom)
     with pytest.raises(ValueError, match=r"^client must be a distributed\.Client") as exc:
         frc_sweep([1.0], client=client, progress=False, out=tmp_path / "o")
     assert "connect first" in str(exc.value)
@@ -519,7 +519,7 @@ def test_api_frc_sweep_client_type(client, monkeypatch, tmp_path):
     ids=["period-str", "cycles-str", "steps-float", "missing-file", "workers-str", "out-int"],
 )
 def test_api_wrong_types(call, word, monkeypatch, tmp_path):
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: _boom)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: _boom)
     monkeypatch.chdir(tmp_path)
     with pytest.raises(ValueError) as exc:
         call()

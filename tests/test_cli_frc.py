@@ -13,7 +13,7 @@ import pytest
 
 from jointdyn.cli import main
 from jointdyn.commands.frc import parse_gamma
-from jointdyn.sweeps import _frc
+from jointdyn.sweeps import _points
 
 from test_sweeps import _Fake
 
@@ -21,7 +21,7 @@ from test_sweeps import _Fake
 @pytest.fixture
 def fake(monkeypatch):
     f = _Fake()
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: f)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: f)
     return f
 
 

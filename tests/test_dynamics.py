@@ -121,7 +121,7 @@ def test_lightly_damped_peak_at_stuck_frequency(eta):
         out, prev = [], None
         for g in gammas:
             r = steady_state(s, g, start=prev, keep_loop=False)
-            assert r.status == "periodic", (g, r.status, r.detail)
+            assert r.status == "periodic", (g, r.status, r.message)
             # no thousands of periods even at this light damping
             assert r.periods < 1000, (g, r.periods)
             out.append(r.amplitude_q)
@@ -355,7 +355,7 @@ def test_blow_up_is_reported():
     assert tr.status is RunStatus.BLOW_UP and not tr.status.ok
     assert tr.t[-1] < 200 * 2 * math.pi / 10.0
     r = steady_state(s, 1.0)
-    assert r.status is SteadyStatus.UNBOUNDED and r.detail == "blow-up"
+    assert r.status is SteadyStatus.UNBOUNDED and r.message == "blow-up"
 
 
 def test_full_sample_buffer_is_enlarged_and_the_run_repeated():

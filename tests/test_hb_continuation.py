@@ -110,7 +110,8 @@ def test_large_bordered_systems_go_through_lapack():
 
 
 def test_a_zigzag_in_place_is_a_stall_and_a_branch_is_not():
-    from jointdyn.continuation import ContinuationOptions, _Points, _stalled
+    from jointdyn.continuation import ContinuationOptions
+    from jointdyn.continuation.walk import _Points, _stalled
 
     opt = ContinuationOptions()
     k = opt.stall_points
@@ -150,7 +151,7 @@ def test_hermite_start_lies_on_the_hyperplane_closer_to_the_curve(ds):
     # on a circle of radius 2, points at arc lengths -h and 0 with their exact unit tangents: the
     # corrector's start is on its hyperplane t^T (v - u_pred) = 0 and nearer the circle's point there
     # than the tangent prediction, by a factor that grows as the step shrinks (O(ds^3) against O(ds^2))
-    from jointdyn.continuation import _hermite_start
+    from jointdyn.continuation.walk import _hermite_start
 
     r, h = 2.0, ds
 

@@ -160,7 +160,7 @@ def test_api_status_of_a_partial_branch():
 def test_robustness_grid_subset(model, eta, beta):
     # docs/hb-robustness.md: covered (or unbounded below Den Hartog's bound, beta = 0.1) and the highest
     # peak within 1 % of the time domain started on the HB orbit
-    from jointdyn.sweeps.hb_grid import grid_case, grid_table
+    from jointdyn.validation.hb_grid import grid_case, grid_table
 
     c = grid_case(model, eta, beta)
     assert c.covered and c.ok, c.message
@@ -174,7 +174,7 @@ def test_robustness_grid_subset(model, eta, beta):
 
 def test_grid_cases_on_processes_equal_the_cases_in_turn():
     # grid_cases with two worker processes: the same branches, in the order asked, as one after the other
-    from jointdyn.sweeps.hb_grid import grid_cases
+    from jointdyn.validation.hb_grid import grid_cases
 
     cases = [(config.MODEL, 0.5, 1000.0), ("jenkins", 0.01, 2.0), (config.MODEL, 1.5, 2.0)]
     par = grid_cases(cases, time_domain=False, workers=2)
@@ -190,7 +190,7 @@ def test_grid_cases_on_processes_equal_the_cases_in_turn():
 def test_grid_does_not_compare_a_subharmonic_time_domain_orbit():
     # the full-memory closed form at eta = 0.5, beta = 5: the time-domain steady state at the HB peak repeats
     # every 4 forcing periods, so the period-one HB peak (q 1.436 against 1.371) is marked not compared, not passed
-    from jointdyn.sweeps.hb_grid import Verdict, grid_case, grid_table
+    from jointdyn.validation.hb_grid import Verdict, grid_case, grid_table
 
     c = grid_case("iwan-closed", 0.5, 5.0)
     assert c.covered and c.verdict is Verdict.SUBHARMONIC and c.time_period > 1 and not c.ok
@@ -264,7 +264,7 @@ def test_default_model_with_separation_matches_the_time_domain(eta, beta):
     # separation) the peak changes by 0.4 % from level to level up to 15 x 2048 with the corner terms alone:
     # the phases graded towards separation (jointdyn.fourier.separation_grid) resolve that slip, and the first
     # level passes the check
-    from jointdyn.sweeps.hb_grid import grid_case
+    from jointdyn.validation.hb_grid import grid_case
 
     c = grid_case(config.MODEL, eta, beta)
     assert c.status == "complete" and c.ok, c.message
@@ -311,18 +311,18 @@ def test_a_peak_that_asks_for_more_stops_the_coarse_branch(monkeypatch):
     # Jenkins at eta = 0.5, beta = 1 (the CLI's benchmark case): the peak near gamma 1.06 asks for 256 samples.
     # The branch with 128 stops once past that peak (the rest of it would be discarded), the branch with 256
     # confirms the stop, and the branch returned is the one computed with 256, bit for bit
-    from jointdyn.hb import frc as hb_frc
+    from jointdyn.hb import discretisation as hb_disc
 
     made = []
-    real = hb_frc._fixed_branch
-    monkeypatch.setattr(hb_frc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
+    real = hb_disc._fixed_branch
+    monkeypatch.setattr(hb_disc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
     system = System.paper_damper(eta=0.5, beta=1.0, model="jenkins")
     auto = frc_hb(system, 0.6, 1.8, max_step=0.01)
     assert auto.attrs["discretisation_levels"] == f"{config.HB_HARMONICS}x{config.HB_SAMPLES}, " \
                                                   f"{config.HB_HARMONICS}x{2 * config.HB_SAMPLES}"
     assert auto.attrs["check_converged"] == 1 and auto.attrs["status"] == "complete"
     stop = made[0]
-    assert isinstance(stop, hb_frc._Refine) and stop.level == (config.HB_HARMONICS, 2 * config.HB_SAMPLES)
+    assert isinstance(stop, hb_disc._Refine) and stop.level == (config.HB_HARMONICS, 2 * config.HB_SAMPLES)
     assert abs(stop.peak.lam - float(auto.peak_gamma.values[0])) < 0.01
     fixed = frc_hb(system, 0.6, 1.8, max_step=0.01, harmonics=config.HB_HARMONICS, samples=2 * config.HB_SAMPLES)
     np.testing.assert_array_equal(auto.amplitude_q.values, fixed.amplitude_q.values)
@@ -336,17 +336,17 @@ def test_a_stop_the_finished_branch_does_not_confirm_is_undone(monkeypatch):
     # is within the tolerance of the resonance's amplitude: the finished branch does not confirm the stop and
     # the choice is made again without stops, giving the branch of the default drop, which checks only passed
     # resonances
-    from jointdyn.hb import frc as hb_frc
+    from jointdyn.hb import discretisation as hb_disc
 
     system = System.paper_damper(eta=0.5, beta=2.0, model="iwan-closed")
     default = frc_hb(system, 0.6, 1.8, max_step=0.01)
     made = []
-    real = hb_frc._fixed_branch
-    monkeypatch.setattr(hb_frc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
+    real = hb_disc._fixed_branch
+    monkeypatch.setattr(hb_disc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
     monkeypatch.setattr(config, "HB_AUTO_EARLY_DROP", 1.0)
     every = frc_hb(system, 0.6, 1.8, max_step=0.01)
-    assert isinstance(made[0], hb_frc._Refine) and made[0].peak.lam < 0.7
-    assert any(not isinstance(m, hb_frc._Refine) and m.status.value == "failed" for m in made)
+    assert isinstance(made[0], hb_disc._Refine) and made[0].peak.lam < 0.7
+    assert any(not isinstance(m, hb_disc._Refine) and m.status.value == "failed" for m in made)
     assert every.attrs["status"] == default.attrs["status"] == "complete"
     assert every.attrs["discretisation_levels"] == default.attrs["discretisation_levels"]
     np.testing.assert_array_equal(every.amplitude_q.values, default.amplitude_q.values)
@@ -408,7 +408,7 @@ def test_grid_folds_are_jumps_of_time_domain_sweeps():
     """The closed form's folds at eta 1.5, beta 2 (grid case): time-domain
     sweeps up and down settle on different periodic orbits between them;
     a branch without folds has nothing to check."""
-    from jointdyn.sweeps.hb_folds import FoldVerdict, fold_check
+    from jointdyn.validation.hb_folds import FoldVerdict, fold_check
 
     c = fold_check("iwan-closed", 1.5, 2.0)
     assert c is not None and len(c.folds) >= 2
@@ -427,7 +427,7 @@ def test_grid_finds_the_peak_the_continuation_jumped_over():
     jumps to 1.2107, over the resonance the time domain finds near 1.202 at
     q 9.69. Continued back from the jump's end, the branch reaches the peak;
     it agrees with the time-domain steady state there."""
-    from jointdyn.sweeps.hb_grid import Verdict, grid_case
+    from jointdyn.validation.hb_grid import Verdict, grid_case
 
     c = grid_case("jenkins", 10.0, 5.0)
     assert c.covered and c.verdict is Verdict.AGREES and c.ok
@@ -441,7 +441,7 @@ def test_grid_flags_a_highest_amplitude_at_a_jump_above_every_peak():
     hide the missed resonance); a peak at least as high clears it."""
     import xarray as xr
 
-    from jointdyn.sweeps.hb_grid import _highest_at_jump
+    from jointdyn.validation.hb_grid import _highest_at_jump
 
     q = np.array([0.5, 0.6, 0.55, 1.0, 1.4, 0.9, 0.8])
     status = np.array(["start", "joined", "joined", "joined", "joined", "after-jump", "joined"])

@@ -10,7 +10,8 @@ import pytest
 import xarray as xr
 
 from jointdyn.cli import main
-from jointdyn.commands.modes import EXIT_PARTIAL, parse_amplitude
+from jointdyn._exit import EXIT_INCOMPLETE
+from jointdyn.commands.modes import parse_amplitude
 
 FILES = ("modes.nc", "modes.csv", "modes.png")
 
@@ -62,7 +63,7 @@ def test_qsma_table(capsys):
 
 def test_partial_backbone_exits_3_and_writes_its_status(capsys, tmp_path):
     rc = main(["modes", "--max-points", "5", "--json", "--out", str(tmp_path)])
-    assert rc == EXIT_PARTIAL == 3
+    assert rc == EXIT_INCOMPLETE == 3
     out = json.loads(capsys.readouterr().out)
     assert out["status"] == "max-points" and len(out["branches"][0]["amplitude_m"]) == 5
     assert xr.load_dataset(tmp_path / "modes.nc").attrs["status"] == "max-points"

@@ -74,7 +74,7 @@ def _wait_until(cond, what: str):
 SLOW_CLI = (
     "import signal, sys, time\n"
     "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
-    "import jointdyn.sweeps._frc as f\n"
+    "import jointdyn.sweeps._points as f\n"
     "real = f._steady_state_fn()\n"
     "def slow(*a, **k):\n"
     "    time.sleep(0.02)\n"

@@ -24,7 +24,7 @@ from hypothesis import strategies as st
 import jointdyn as jd
 from jointdyn.dynamics import Restart
 from jointdyn.sweeps import STATUS_CODES, LineSpec, frc_sweep, status_name, to_frame
-from jointdyn.sweeps import _frc
+from jointdyn.sweeps import _frc, _points
 from tolerances import (
     TEST_SWEEP_CONTACT_ENERGY_RTOL,
     TEST_SWEEP_NORMAL_EXTREME_RTOL,
@@ -79,7 +79,7 @@ class _Fake:
 @pytest.fixture
 def fake(monkeypatch):
     f = _Fake()
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: f)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: f)
     return f
 
 
@@ -157,16 +157,16 @@ def test_interrupt_keeps_finished_points_and_resume_reuses_them(monkeypatch, tmp
     monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", 4)
     kw = dict(etas=[0.5, 1.5], betas=[1.0], n_workers=1, progress=False)
     ref = _Fake()
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: ref)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: ref)
     full = frc_sweep(GAMMAS, **kw)
     stop = _Fake(interrupt_at=10)
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: stop)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: stop)
     with pytest.raises(KeyboardInterrupt):
         frc_sweep(GAMMAS, **kw, out=tmp_path)
     assert _checkpoint_points(tmp_path) == 9
     assert not (tmp_path / "frc.nc").exists()
     again = _Fake()
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: again)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: again)
     ds = frc_sweep(GAMMAS, **kw, out=tmp_path)
     assert ds.attrs["reused_points"] == 9 and ds.attrs["stale_points"] == 0
     assert len(again.calls) == 4 * len(GAMMAS) - 9
@@ -190,14 +190,14 @@ def test_resume_from_any_interruption(k, chunk):
     kw = dict(etas=[0.5, 1.5], betas=[1.0, 2.0], directions=("up",), n_workers=1, progress=False)
     total = 4 * len(GAMMAS)
     with mock.patch.object(_frc.config, "SWEEP_CHUNK_POINTS", chunk), tempfile.TemporaryDirectory() as d:
-        with mock.patch.object(_frc, "_steady_state_fn", lambda: _Fake()):
+        with mock.patch.object(_points, "_steady_state_fn", lambda: _Fake()):
             full = frc_sweep(GAMMAS, **kw)
         stop = _Fake(interrupt_at=k)
-        with mock.patch.object(_frc, "_steady_state_fn", lambda: stop):
+        with mock.patch.object(_points, "_steady_state_fn", lambda: stop):
             with pytest.raises(KeyboardInterrupt):
                 frc_sweep(GAMMAS, **kw, out=Path(d))
         f = _Fake()
-        with mock.patch.object(_frc, "_steady_state_fn", lambda: f):
+        with mock.patch.object(_points, "_steady_state_fn", lambda: f):
             again = frc_sweep(GAMMAS, **kw, out=Path(d))
         assert again.attrs["reused_points"] == k - 1
         assert len(f.calls) == total - (k - 1)
@@ -303,7 +303,7 @@ def test_dask_progress_moves_per_point(monkeypatch):
             pass
 
     monkeypatch.setattr(tqdm, "tqdm", Bar)
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: solver)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: solver)
     gammas = [0.7, 0.75, 0.8, 0.85, 0.9, 0.95]  # one chunk of six points
     with LocalCluster(n_workers=1, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
         with Client(lc) as client:
@@ -384,11 +384,13 @@ def test_bad_system_form(call, word, fake):
     assert fake.calls == []
 
 
-def test_status_codes_match_config():
-    from jointdyn import config
+def test_status_codes_are_the_steady_state_statuses_own_codes():
+    from jointdyn.dynamics import SteadyStatus
+    from jointdyn.sweeps._points import NOT_COMPUTED, NOT_COMPUTED_NAME
 
-    assert STATUS_CODES == {n: i for i, n in enumerate(config.SWEEP_STATUS)}
-    assert status_name(-1) == "not-computed"
+    assert STATUS_CODES == {s.value: s.code for s in SteadyStatus} == {"periodic": 0, "not-settled": 1, "unbounded": 2}
+    assert all(status_name(s.code) == s.value for s in SteadyStatus)
+    assert status_name(NOT_COMPUTED) == NOT_COMPUTED_NAME == "not-computed"
 
 
 def test_gamma_order_does_not_matter(fake):
@@ -666,7 +668,7 @@ def test_refused_system_is_named_and_the_finished_points_kept(pool, tmp_path, mo
     family = {f"eta{e}": jd.System.paper_damper(eta=e, beta=2.0) for e in (0.5, 1.5)}
     kw = dict(directions=("up",), loop_outputs=False, progress=False, n_workers=1 if pool == "serial" else 2)
     refusing = _Refusing()
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: refusing)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: refusing)
     with pytest.raises(ValueError) as exc:
         frc_sweep(family, GAMMAS, **kw, out=tmp_path)
     assert str(exc.value) == "system 'eta1.5': contact 0: refused by this solver"
@@ -677,11 +679,11 @@ def test_refused_system_is_named_and_the_finished_points_kept(pool, tmp_path, mo
         assert saved["eta0.5"] == len(GAMMAS)
     assert not (tmp_path / "frc.nc").exists()
     again = _Fake()
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: again)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: again)
     ds = frc_sweep(family, GAMMAS, **kw, out=tmp_path)
     assert ds.attrs["reused_points"] == sum(saved.values())
     assert len(again.calls) == 2 * len(GAMMAS) - sum(saved.values())
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: _Fake())
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: _Fake())
     xr.testing.assert_identical(_results(ds), _results(frc_sweep(family, GAMMAS, **kw)))
 
 
@@ -694,10 +696,10 @@ def test_interrupt_on_dask_keeps_every_finished_point(tmp_path, monkeypatch):
 
     monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", 4)
     kw = dict(etas=[0.5, 1.5], betas=[1.0, 2.0], directions=("up",), progress=False)
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: _Fake())
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: _Fake())
     full = frc_sweep(GAMMAS, **kw, n_workers=1)
     stop = _Fake(interrupt_at=9)
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: stop)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: stop)
     with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
         with Client(lc) as client:
             with pytest.raises(KeyboardInterrupt):
@@ -706,7 +708,7 @@ def test_interrupt_on_dask_keeps_every_finished_point(tmp_path, monkeypatch):
     assert 0 < finished < 4 * len(GAMMAS)
     assert _checkpoint_points(tmp_path) == finished
     again = _Fake()
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: again)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: again)
     ds = frc_sweep(GAMMAS, **kw, n_workers=1, out=tmp_path)
     assert ds.attrs["reused_points"] == finished and len(again.calls) == 4 * len(GAMMAS) - finished
     xr.testing.assert_identical(_results(ds), _results(full))

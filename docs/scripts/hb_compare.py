@@ -119,7 +119,7 @@ def run_jointdyn(f1: float, max_step: float | None = None) -> dict:
     """
     import jointdyn
     from jointdyn.hb import continue_hb
-    from jointdyn.hb.frc import branch_dataset
+    from jointdyn.hb import branch_dataset
 
     system = _system(f1)
 

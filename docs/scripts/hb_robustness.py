@@ -8,7 +8,7 @@ and ``<!-- grid:end -->``), computed here:
 Models {default exact, closed form with full memory, the paper's rule,
 Jenkins} x eta {0.01, 0.5, 1.5, 10} x beta {0.1, 1, 2, 5, 10, 1000}, gamma
 0.6:1.8:0.01, every other setting the CLI's default
-(:mod:`jointdyn.sweeps.hb_grid`): each branch must cover the range (or be
+(:mod:`jointdyn.validation.hb_grid`): each branch must cover the range (or be
 unbounded where Den Hartog's bound says it must), and its highest peak
 must agree with the time-domain steady state at the same gamma within 1 %.
 """
@@ -20,8 +20,8 @@ import sys
 from pathlib import Path
 
 from jointdyn._io import atomic_write_text
-from jointdyn.sweeps.hb_folds import fold_check, fold_table
-from jointdyn.sweeps.hb_grid import (
+from jointdyn.validation.hb_folds import fold_check, fold_table
+from jointdyn.validation.hb_grid import (
     GRID_BETAS,
     GRID_ETAS,
     GRID_MODELS,

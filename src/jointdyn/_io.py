@@ -1,13 +1,20 @@
-"""Atomic file output: nothing half-written is ever left behind."""
+"""The one home of writing outputs: atomic files (nothing half-written is ever left behind), a
+Dataset as netCDF + CSV, values for JSON.
+
+xarray and pandas are not imported here: the Dataset's own methods write it.
+"""
 
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_path", "atomic_write_text"]
+import numpy as np
+
+__all__ = ["atomic_path", "atomic_write_text", "jsonable", "point_table", "write_dataset"]
 
 
 @contextlib.contextmanager
@@ -40,3 +47,37 @@ def atomic_write_text(path, text: str) -> Path:
     with atomic_path(path) as tmp:
         Path(tmp).write_text(text)
     return Path(path)
+
+
+def jsonable(values):
+    """``values`` as JSON takes them: arrays, lists and tuples as (nested) lists of Python numbers (through
+    NumPy), NaN and infinities as None (JSON has no NaN); any other value as it is, a non-finite float as
+    None."""
+    if isinstance(values, (np.ndarray, list, tuple)):
+        return _clean(np.asarray(values).tolist())
+    return None if isinstance(values, float) and not math.isfinite(values) else values
+
+
+def _clean(v):
+    if isinstance(v, list):
+        return [_clean(x) for x in v]
+    return None if isinstance(v, float) and not math.isfinite(v) else v
+
+
+def point_table(ds):
+    """The variables of ``ds`` on its dimension ``point`` alone, one row per point (a pandas DataFrame with
+    the ``point`` column first)."""
+    flat = ds.drop_dims([d for d in ds.dims if d != "point"])
+    return flat.to_dataframe().reset_index()
+
+
+def write_dataset(ds, out, stem: str, table=point_table) -> list:
+    """Write ``ds`` as ``out/<stem>.nc`` (netCDF3, scipy engine) and ``out/<stem>.csv`` (``table(ds)``,
+    default :func:`point_table`), each atomically; returns both paths."""
+    out = Path(out)
+    nc, csv = out / f"{stem}.nc", out / f"{stem}.csv"
+    with atomic_path(nc) as tmp:
+        ds.to_netcdf(tmp, engine="scipy")
+    with atomic_path(csv) as tmp:
+        table(ds).to_csv(tmp, index=False)
+    return [nc, csv]

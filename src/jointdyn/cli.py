@@ -6,8 +6,8 @@ subcommand. Commands validate everything (options, input files, the
 writability of ``--out``, sizes and derived quantities) before computing,
 and write their files only after all computing is done, each atomically.
 
-Exit status
------------
+Exit status (:mod:`jointdyn._exit`)
+------------------------------------
 - 0: success.
 - 2: bad input (a ``ValueError`` from validation, or an argparse usage
   error): one line on stderr naming the parameter, no file written.
@@ -33,15 +33,11 @@ import os
 import pkgutil
 import sys
 
-__all__ = ["main", "console"]
+# the exit statuses live below the commands (jointdyn._exit); re-exported here for callers of main()
+from ._exit import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INCOMPLETE, EXIT_INTERRUPTED, EXIT_OS_ERROR
 
-#: exit status when stdout's reader went away (128 + SIGPIPE)
-EXIT_BROKEN_PIPE = 141
-EXIT_BAD_INPUT = 2
-EXIT_OS_ERROR = 1
-#: the run finished but its result does not cover the request (see the module docstring)
-EXIT_INCOMPLETE = 3
-EXIT_INTERRUPTED = 130
+__all__ = ["main", "console", "EXIT_BAD_INPUT", "EXIT_BROKEN_PIPE", "EXIT_INCOMPLETE", "EXIT_INTERRUPTED",
+           "EXIT_OS_ERROR"]
 
 
 class _Parser(argparse.ArgumentParser):

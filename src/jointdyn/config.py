@@ -1,4 +1,6 @@
-"""Numerical defaults of jointdyn, grouped by subject.
+"""Numerical defaults of jointdyn, one section per package in the order of the layers, bottom up:
+contact laws; systems and system files; continuation and the quasi-static driver; the time march and
+its steady states; harmonic balance; nonlinear modes; sweeps.
 
 Solvers and front ends (CLI, sweeps, figures) read their defaults from here
 and nowhere else, so that a change of accuracy policy is one edit. Test
@@ -26,6 +28,124 @@ IWAN_CLOSED_MAX_DEPTH = 64
 #: reversal point (normalised displacement kt x / fy) has reached it (Masing
 #: rejoin); the force error is of the same order in units of fy
 IWAN_CLOSED_WIPE_TOL = 1e-9
+
+# --- systems (jointdyn.systems) ---------------------------------------------------------
+#: eigenvalues of (M, K_reference) below this fraction of the largest are
+#: rigid-body modes (zero up to rounding), skipped by the default w0
+SYSTEM_RIGID_MODE_RTOL = 1e-10
+
+# --- system files (jointdyn.files) ------------------------------------------------------
+#: most degrees of freedom of a matrix read from a system file (its dense
+#: float64 copy takes 8 n^2 bytes: 800 MB at the bound)
+FILES_MAX_DOF = 10_000
+
+# --- FE interfaces and reduction (jointdyn.fe, jointdyn.reduction) ---------------------
+#: two mesh nodes are the same point (a node pair) when their distance is
+#: within this fraction of the diagonal of the two node sets' bounding box
+FE_MATCH_RTOL = 1e-6
+#: a node in two pairs must get the same frame from both: rows t1, t2, n
+#: equal to this (unit vectors)
+FE_FRAME_ATOL = 1e-9
+#: a given tangent is along the normal when its part normal to n is below
+#: this fraction of its length
+FE_TANGENT_RTOL = 1e-8
+#: linear modes compared by the error report of a sparse Craig-Bampton
+#: reduction (the lowest ones; a dense reduction compares all of its size)
+REDUCTION_SPARSE_ERROR_MODES = 12
+
+# --- continuation (jointdyn.continuation; unknowns, parameter and residual scaled) ----
+#: Newton converged when max|R| <= this (scaled residual; harmonic balance
+#: scales R by max(F1, fy))
+CONT_TOL = 1e-9
+#: Newton iterations per correction
+CONT_MAX_ITER = 12
+#: arc-length step: first, smallest, largest
+CONT_DS_START = 0.05
+CONT_DS_MIN = 1e-6
+CONT_DS_MAX = 0.1
+#: ... or this fraction of the norm of the unknowns where that is larger
+#: (a flank growing without bound: as many points per decade as a small one)
+CONT_DS_MAX_REL = 0.02
+#: bound on the points of a branch
+CONT_MAX_POINTS = 2000
+#: predictor direction: "tangent" or "secant"
+CONT_PREDICTOR = "tangent"
+#: where a solver asks for it (harmonic balance, when every contact law has a smooth force:
+#: ContactLaw.smooth_force), the corrector starts from the cubic Hermite extrapolation of the
+#: last two points and their tangents (moved onto the corrector's hyperplane, so that the point
+#: it converges to is the same) when the step is at most this many times the last one. On the
+#: paper damper's branch with the default law (eta 0.5, beta 2) it saves 14 % of the residual
+#: evaluations, 17 % at eta 1.5, beta 5 (a start about 10x closer to the curve: one Newton
+#: iteration less at many points). Laws with kinks or jumps at the onset of slip (Jenkins, the
+#: discrete model, the closed forms) do not use it: there Newton from the extrapolation lands
+#: on other points of the piecewise-smooth residual, and the step control follows another path
+CONT_START_EXTRAPOLATION = 2.0
+#: Newton iterations aimed at per correction; the step grows by CONT_GROW
+#: after a correction in fewer, shrinks by CONT_SHRINK after one in more
+CONT_TARGET_ITER = 4
+CONT_GROW = 1.6
+CONT_SHRINK = 0.6
+#: the step is multiplied by CONT_TURN_SHRINK after the unit tangent turned
+#: by more than ~10 degrees (cosine below CONT_TURN_COS): folds are resolved
+CONT_TURN_COS = 0.985
+CONT_TURN_SHRINK = 0.5
+#: step factor after a rejected step (corrector failed)
+CONT_REJECT_SHRINK = 0.5
+#: trial steps of the damped Newton line search (the full step, then
+#: halved each time) before the iteration counts as failed
+CONT_LINE_SEARCH_STEPS = 9
+#: above CONT_CORNER_DS, a corrector is stopped after this many times
+#: CONT_TARGET_ITER residual evaluations (retrying smaller is cheaper)
+CONT_MAX_EVALS_FACTOR = 2
+#: below this step a sharp turn or a long correction is a corner of a
+#: piecewise-smooth branch, not a jump to another branch
+CONT_CORNER_DS = 2e-3
+#: step factor after a rejection for a sharp turn or a far-away correction
+#: (a step accepted only at corner size, reached in fewer rejections)
+CONT_CORNER_SHRINK = 0.25
+#: above CONT_CORNER_DS a step is rejected when the new unit tangent's dot
+#: product with the previous one is below this (a turn by more than 60 deg)
+CONT_MIN_TANGENT_DOT = 0.5
+#: ... or when the corrector moved farther than this many steps from the
+#: predicted point
+CONT_MAX_DISTANCE = 2.0
+#: jumps over a discontinuity of the residual (corrector failed at the
+#: smallest step): Newton at fixed parameter tried this far beyond the last
+#: point (fractions of the parameter range), at most CONT_MAX_JUMPS times
+CONT_JUMP_FRACTIONS = (1e-4, 1e-3, 1e-2)
+CONT_MAX_JUMPS = 5
+#: a branch that goes back and forth without getting anywhere (the corrector keeps accepting
+#: points that alternate between the same states at a jump of a piecewise-smooth residual):
+#: over the last CONT_STALL_POINTS points, the distance from the first to the last (scaled
+#: unknowns and parameter) is below CONT_STALL_RATIO times the path through them; the branch
+#: stops there as failed, without those points. Such a stall measures about 1e-14 (Jenkins at
+#: eta 10, beta 1000, 7 x 128 samples); the zigzags at the non-smooth corners of branches that
+#: do get through stay above 6e-4 (Jenkins with separation on the grid of docs/hb-robustness.md)
+CONT_STALL_POINTS = 100
+CONT_STALL_RATIO = 1e-6
+#: a jump's guess follows the tangent when its parameter component exceeds
+#: this (else the last point's unknowns)
+CONT_JUMP_TANGENT_MIN = 1e-3
+#: largest deviation between the straight line joining consecutive points of
+#: a branch and the curve, in the plane (parameter, observable) (harmonic
+#: balance: gamma and the logarithm of the norm of the response DOF's
+#: harmonics, so 0.005 is half a percent of the amplitude or 0.005 in gamma;
+#: measured against the reported amplitude the chords stay within 1 %,
+#: tests/test_hb_trust.py)
+CONT_CHORD_TOL = 0.005
+#: refinement of a maximum along a branch (peaks): at most this many
+#: corrections, until the bracket is this fraction of its first width or the
+#: observable varies by at most CONT_REFINE_GTOL across it (harmonic
+#: balance: log q, so 1e-7 is a relative 1e-7 of the amplitude)
+CONT_REFINE_ITER = 20
+CONT_REFINE_STOL = 1e-4
+CONT_REFINE_GTOL = 1e-7
+#: bordered linear systems (Newton corrections, tangents) of at most this
+#: many unknowns are solved by the compiled elimination of
+#: jointdyn.continuation, larger ones by LAPACK (benchmarks/bench_linalg.py:
+#: the compiled elimination is 1.2-3.5x faster at 16 to 751 unknowns with
+#: single-threaded BLAS; beyond the sizes measured, LAPACK)
+CONT_SMALL_SOLVE = 800
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history
@@ -149,57 +269,6 @@ SS_GROWTH_RATIO = 0.9
 #: the first contact (friction saturated: only then can friction lose)
 SS_UNBOUNDED_Q = 20.0
 
-# --- sweeps --------------------------------------------------------------------------
-#: gamma grid START:STOP:STEP (the paper's Fig 6 range)
-SWEEP_GAMMA_DEFAULT = (0.6, 1.8, 0.01)
-#: most points of a gamma grid given as START:STOP:STEP
-SWEEP_MAX_GAMMA_POINTS = 100_000
-#: seconds to wait for a Dask scheduler to answer (--scheduler)
-SWEEP_SCHEDULER_TIMEOUT_S = 5.0
-#: local pool for sweep lines when no Dask client is given: "process" or
-#: "thread" (the compiled kernels release the GIL)
-SWEEP_POOL = "process"
-#: status codes of a swept point (netCDF-friendly int8); index = code
-SWEEP_STATUS = ("periodic", "not-settled", "unbounded")
-#: code of a point that was not computed (never written by a finished sweep)
-SWEEP_STATUS_MISSING = -1
-#: consecutive points of a line solved as one task and saved as one resume
-#: checkpoint (an interrupt stops a task after its current point, so this
-#: bounds what a killed run loses, not what an interrupted one loses)
-SWEEP_CHUNK_POINTS = 8
-#: tasks kept queued per worker (lines in progress at once), so that no
-#: worker waits for the next chunk of a line
-SWEEP_TASKS_PER_WORKER = 2
-#: seconds between refreshes of the progress bar while chunks run
-SWEEP_PROGRESS_POLL_S = 0.2
-#: seconds between checks of a worker process that its parent is alive (the
-#: fallback where the kernel's parent-death signal is not available)
-SWEEP_PARENT_POLL_S = 0.5
-
-# --- systems (jointdyn.systems) ---------------------------------------------------------
-#: eigenvalues of (M, K_reference) below this fraction of the largest are
-#: rigid-body modes (zero up to rounding), skipped by the default w0
-SYSTEM_RIGID_MODE_RTOL = 1e-10
-
-# --- system files (jointdyn.files) ------------------------------------------------------
-#: most degrees of freedom of a matrix read from a system file (its dense
-#: float64 copy takes 8 n^2 bytes: 800 MB at the bound)
-FILES_MAX_DOF = 10_000
-
-# --- FE interfaces and reduction (jointdyn.fe, jointdyn.reduction) ---------------------
-#: two mesh nodes are the same point (a node pair) when their distance is
-#: within this fraction of the diagonal of the two node sets' bounding box
-FE_MATCH_RTOL = 1e-6
-#: a node in two pairs must get the same frame from both: rows t1, t2, n
-#: equal to this (unit vectors)
-FE_FRAME_ATOL = 1e-9
-#: a given tangent is along the normal when its part normal to n is below
-#: this fraction of its length
-FE_TANGENT_RTOL = 1e-8
-#: linear modes compared by the error report of a sparse Craig-Bampton
-#: reduction (the lowest ones; a dense reduction compares all of its size)
-REDUCTION_SPARSE_ERROR_MODES = 12
-
 # --- harmonic balance: discretisation and AFT ------------------------------------------
 #: harmonics 0..H of the unknowns
 HB_HARMONICS = 7
@@ -215,7 +284,7 @@ HB_AUTO_RTOL = 1e-3
 #: while the first branch is continued, its highest point so far is checked once the amplitude has fallen
 #: below this fraction of it (a resonance passed); where that peak converges at a finer level, the branch
 #: stops there and is computed at that level (the rest of it would be discarded), and the finished branch
-#: must confirm the stop, else the choice is made again without stops (jointdyn.hb.frc._PeakWatch)
+#: must confirm the stop, else the choice is made again without stops (jointdyn.hb.discretisation._PeakWatch)
 HB_AUTO_EARLY_DROP = 0.5
 #: the largest H and Ns an automatic choice takes (the check solves go one level beyond); with separation
 #: the samples decide, H = 7 already within 2e-4 of H = 15 on the paper's grid
@@ -253,109 +322,15 @@ HB_PERIODIC_RTOL = 1e-10
 #: in contact and at rest there, as the time integrator's TI_RECONTACT_ALPHA)
 HB_RECONTACT_ALPHA = 1e-12
 
-# --- continuation (jointdyn.continuation; unknowns, parameter and residual scaled) ----
-#: Newton converged when max|R| <= this (scaled residual; harmonic balance
-#: scales R by max(F1, fy))
-CONT_TOL = 1e-9
-#: Newton iterations per correction
-CONT_MAX_ITER = 12
-#: arc-length step: first, smallest, largest
-CONT_DS_START = 0.05
-CONT_DS_MIN = 1e-6
-CONT_DS_MAX = 0.1
-#: ... or this fraction of the norm of the unknowns where that is larger
-#: (a flank growing without bound: as many points per decade as a small one)
-CONT_DS_MAX_REL = 0.02
-#: bound on the points of a branch
-CONT_MAX_POINTS = 2000
-#: predictor direction: "tangent" or "secant"
-CONT_PREDICTOR = "tangent"
-#: where a solver asks for it (harmonic balance, when every contact law has a smooth force:
-#: ContactLaw.smooth_force), the corrector starts from the cubic Hermite extrapolation of the
-#: last two points and their tangents (moved onto the corrector's hyperplane, so that the point
-#: it converges to is the same) when the step is at most this many times the last one. On the
-#: paper damper's branch with the default law (eta 0.5, beta 2) it saves 14 % of the residual
-#: evaluations, 17 % at eta 1.5, beta 5 (a start about 10x closer to the curve: one Newton
-#: iteration less at many points). Laws with kinks or jumps at the onset of slip (Jenkins, the
-#: discrete model, the closed forms) do not use it: there Newton from the extrapolation lands
-#: on other points of the piecewise-smooth residual, and the step control follows another path
-CONT_START_EXTRAPOLATION = 2.0
-#: Newton iterations aimed at per correction; the step grows by CONT_GROW
-#: after a correction in fewer, shrinks by CONT_SHRINK after one in more
-CONT_TARGET_ITER = 4
-CONT_GROW = 1.6
-CONT_SHRINK = 0.6
-#: the step is multiplied by CONT_TURN_SHRINK after the unit tangent turned
-#: by more than ~10 degrees (cosine below CONT_TURN_COS): folds are resolved
-CONT_TURN_COS = 0.985
-CONT_TURN_SHRINK = 0.5
-#: step factor after a rejected step (corrector failed)
-CONT_REJECT_SHRINK = 0.5
-#: trial steps of the damped Newton line search (the full step, then
-#: halved each time) before the iteration counts as failed
-CONT_LINE_SEARCH_STEPS = 9
-#: above CONT_CORNER_DS, a corrector is stopped after this many times
-#: CONT_TARGET_ITER residual evaluations (retrying smaller is cheaper)
-CONT_MAX_EVALS_FACTOR = 2
-#: below this step a sharp turn or a long correction is a corner of a
-#: piecewise-smooth branch, not a jump to another branch
-CONT_CORNER_DS = 2e-3
-#: step factor after a rejection for a sharp turn or a far-away correction
-#: (a step accepted only at corner size, reached in fewer rejections)
-CONT_CORNER_SHRINK = 0.25
-#: above CONT_CORNER_DS a step is rejected when the new unit tangent's dot
-#: product with the previous one is below this (a turn by more than 60 deg)
-CONT_MIN_TANGENT_DOT = 0.5
-#: ... or when the corrector moved farther than this many steps from the
-#: predicted point
-CONT_MAX_DISTANCE = 2.0
-#: jumps over a discontinuity of the residual (corrector failed at the
-#: smallest step): Newton at fixed parameter tried this far beyond the last
-#: point (fractions of the parameter range), at most CONT_MAX_JUMPS times
-CONT_JUMP_FRACTIONS = (1e-4, 1e-3, 1e-2)
-CONT_MAX_JUMPS = 5
-#: a branch that goes back and forth without getting anywhere (the corrector keeps accepting
-#: points that alternate between the same states at a jump of a piecewise-smooth residual):
-#: over the last CONT_STALL_POINTS points, the distance from the first to the last (scaled
-#: unknowns and parameter) is below CONT_STALL_RATIO times the path through them; the branch
-#: stops there as failed, without those points. Such a stall measures about 1e-14 (Jenkins at
-#: eta 10, beta 1000, 7 x 128 samples); the zigzags at the non-smooth corners of branches that
-#: do get through stay above 6e-4 (Jenkins with separation on the grid of docs/hb-robustness.md)
-CONT_STALL_POINTS = 100
-CONT_STALL_RATIO = 1e-6
-#: a jump's guess follows the tangent when its parameter component exceeds
-#: this (else the last point's unknowns)
-CONT_JUMP_TANGENT_MIN = 1e-3
-#: largest deviation between the straight line joining consecutive points of
-#: a branch and the curve, in the plane (parameter, observable) (harmonic
-#: balance: gamma and the logarithm of the norm of the response DOF's
-#: harmonics, so 0.005 is half a percent of the amplitude or 0.005 in gamma;
-#: measured against the reported amplitude the chords stay within 1 %,
-#: tests/test_hb_trust.py)
-CONT_CHORD_TOL = 0.005
+# --- harmonic balance: branches, starts and single solutions -------------------------------------
 #: harmonic balance in gamma: largest gamma spacing of a branch when the
 #: caller gives none (the command line passes the STEP of --gamma). The chord
-#: bound above is a distance in (gamma, ln amplitude); on a steep flank a
+#: bound CONT_CHORD_TOL is a distance in (gamma, ln amplitude); on a steep flank a
 #: chord within it can still miss the amplitude at the same gamma by more
 #: than 1 % (1.4 % at 0.1 gamma spacing on the Jenkins benchmark branch,
 #: F1 = 5 N, docs/hb-comparison.md); 0.02 keeps it below 1 % (0.9 %) for
 #: about 25 % more points
 HB_MAX_GAMMA_STEP = 0.02
-#: refinement of a maximum along a branch (peaks): at most this many
-#: corrections, until the bracket is this fraction of its first width or the
-#: observable varies by at most CONT_REFINE_GTOL across it (harmonic
-#: balance: log q, so 1e-7 is a relative 1e-7 of the amplitude)
-CONT_REFINE_ITER = 20
-CONT_REFINE_STOL = 1e-4
-CONT_REFINE_GTOL = 1e-7
-#: bordered linear systems (Newton corrections, tangents) of at most this
-#: many unknowns are solved by the compiled elimination of
-#: jointdyn.continuation, larger ones by LAPACK (benchmarks/bench_linalg.py:
-#: the compiled elimination is 1.2-3.5x faster at 16 to 751 unknowns with
-#: single-threaded BLAS; beyond the sizes measured, LAPACK)
-CONT_SMALL_SOLVE = 800
-
-# --- harmonic balance: starts and single solutions -------------------------------------
 #: Newton iterations of the start of a branch (from the stuck linear solution)
 HB_START_MAX_ITER = 30
 #: Newton iterations of a single solution (harmonic_balance)
@@ -396,6 +371,37 @@ HB_SMALL_EIG = 200
 #: whose branches are close in the parameter): the jitter of points at a
 #: non-smooth corner stays within both
 HB_TURNING_BAND = 5e-4
+HB_TURNING_BAND_LOG_Q = 5e-3
+#: a turning point is a fold only with an unstable point between it and the
+#: neighbouring turning points (without one on a side: within this many
+#: points): a saddle-node changes the number of unstable multipliers
+HB_FOLD_WINDOW = 3
+#: a local maximum of the amplitude along a branch is a peak when the
+#: amplitude falls by more than this fraction of it on both sides (before
+#: rising above it again)
+HB_PEAK_PROMINENCE = 1e-3
+
+# --- harmonic balance: condensation onto the contact DOFs (jointdyn.hb.condense) -------
+#: automatic choice: condense systems of at least this many DOFs ...
+HB_CONDENSE_MIN_DOFS = 12
+#: ... whose retained DOFs (contacts, DOF 0, response DOFs) are at most this
+#: fraction of all DOFs
+HB_CONDENSE_MAX_FRACTION = 0.5
+#: the damping is modal (receptance by the undamped modes) when C = alpha M +
+#: beta K to this fraction of max |C|, or when the off-diagonal entries of
+#: Phi^T C Phi are at most this fraction of its largest entry; otherwise the
+#: damped (state-space) eigenproblem is used
+HB_CONDENSE_MODAL_RTOL = 1e-12
+#: the static Schur complement comes from the expansion (H_cc(0)^-1) when every
+#: static factor |1 / g_r(0)| is at least this fraction of the largest (K
+#: positive definite); otherwise from a Cholesky factorisation of K_oo
+HB_CONDENSE_STATIC_RTOL = 1e-6
+#: the spectral expansion H of the receptance must satisfy Z(W) H(W) = I at one
+#: frequency to this, relative to max |Z| max |H| (backward error)
+HB_CONDENSE_CHECK_RTOL = 1e-9
+#: a condensed problem computes Hill stability (on the full Jacobian it
+#: assembles) when the full companion matrix has at most this many rows
+HB_CONDENSED_HILL_ROWS = 200
 
 # --- nonlinear modes (jointdyn.modes) ------------------------------------------------
 #: default amplitude range of a backbone (first-harmonic amplitude of the
@@ -437,33 +443,26 @@ QSMA_MAX_ITER = 50
 #: single-nonlinear-mode synthesis: the resonance peak is located on the
 #: backbone to this relative tolerance in amplitude
 SYNTHESIS_PEAK_RTOL = 1e-10
-# --- harmonic balance: condensation onto the contact DOFs (jointdyn.hb.condense) -------
-#: automatic choice: condense systems of at least this many DOFs ...
-HB_CONDENSE_MIN_DOFS = 12
-#: ... whose retained DOFs (contacts, DOF 0, response DOFs) are at most this
-#: fraction of all DOFs
-HB_CONDENSE_MAX_FRACTION = 0.5
-#: the damping is modal (receptance by the undamped modes) when C = alpha M +
-#: beta K to this fraction of max |C|, or when the off-diagonal entries of
-#: Phi^T C Phi are at most this fraction of its largest entry; otherwise the
-#: damped (state-space) eigenproblem is used
-HB_CONDENSE_MODAL_RTOL = 1e-12
-#: the static Schur complement comes from the expansion (H_cc(0)^-1) when every
-#: static factor |1 / g_r(0)| is at least this fraction of the largest (K
-#: positive definite); otherwise from a Cholesky factorisation of K_oo
-HB_CONDENSE_STATIC_RTOL = 1e-6
-#: the spectral expansion H of the receptance must satisfy Z(W) H(W) = I at one
-#: frequency to this, relative to max |Z| max |H| (backward error)
-HB_CONDENSE_CHECK_RTOL = 1e-9
-#: a condensed problem computes Hill stability (on the full Jacobian it
-#: assembles) when the full companion matrix has at most this many rows
-HB_CONDENSED_HILL_ROWS = 200
-HB_TURNING_BAND_LOG_Q = 5e-3
-#: a turning point is a fold only with an unstable point between it and the
-#: neighbouring turning points (without one on a side: within this many
-#: points): a saddle-node changes the number of unstable multipliers
-HB_FOLD_WINDOW = 3
-#: a local maximum of the amplitude along a branch is a peak when the
-#: amplitude falls by more than this fraction of it on both sides (before
-#: rising above it again)
-HB_PEAK_PROMINENCE = 1e-3
+
+# --- sweeps --------------------------------------------------------------------------
+#: gamma grid START:STOP:STEP (the paper's Fig 6 range)
+SWEEP_GAMMA_DEFAULT = (0.6, 1.8, 0.01)
+#: most points of a gamma grid given as START:STOP:STEP
+SWEEP_MAX_GAMMA_POINTS = 100_000
+#: seconds to wait for a Dask scheduler to answer (--scheduler)
+SWEEP_SCHEDULER_TIMEOUT_S = 5.0
+#: local pool for sweep lines when no Dask client is given: "process" or
+#: "thread" (the compiled kernels release the GIL)
+SWEEP_POOL = "process"
+#: consecutive points of a line solved as one task and saved as one resume
+#: checkpoint (an interrupt stops a task after its current point, so this
+#: bounds what a killed run loses, not what an interrupted one loses)
+SWEEP_CHUNK_POINTS = 8
+#: tasks kept queued per worker (lines in progress at once), so that no
+#: worker waits for the next chunk of a line
+SWEEP_TASKS_PER_WORKER = 2
+#: seconds between refreshes of the progress bar while chunks run
+SWEEP_PROGRESS_POLL_S = 0.2
+#: seconds between checks of a worker process that its parent is alive (the
+#: fallback where the kernel's parent-death signal is not available)
+SWEEP_PARENT_POLL_S = 0.5

@@ -33,6 +33,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
+from .._io import jsonable as _jsonable
 from ._law_args import add_law_arguments, law_params, model_help
 from ._system_args import add_system_argument, load_system_file, refuse_paper_options
 from ..systems import PAPER
@@ -127,16 +128,6 @@ def _count_or_auto(name: str, value, minimum: int):
     if count is None or count < minimum:
         raise ValueError(f"{name} must be an integer >= {minimum} or {AUTO!r}, got {value!r}")
     return count
-
-
-def _jsonable(values):
-    out = []
-    for v in np.asarray(values).tolist():
-        if isinstance(v, float) and not math.isfinite(v):
-            out.append(None)
-        else:
-            out.append(v)
-    return out
 
 
 #: options of one method only, with the reason they do not apply to the other
@@ -430,7 +421,7 @@ def _hb_peaks(br) -> list:
 def _run_hb(args, gammas):
     """The hb branch: ``(branch, result)`` (the Dataset is built only for files: xarray takes time to import)."""
     from ..hb import continue_hb
-    from ..hb.frc import discretisation_attrs
+    from ..hb.export import discretisation_attrs
 
     system = _system(args)
     if gammas.size < 2:
@@ -472,7 +463,8 @@ def _plot(result, path: Path) -> None:
     plt = pyplot()
 
     from .._io import atomic_path
-    from ..sweeps._plot import mark_legend, plot_frc_curve
+    from ..figures.curves import mark_legend, plot_frc_curve
+    from ..sweeps._points import NOT_COMPUTED, STATUS_CODES
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     if result["method"] == "time":
@@ -481,7 +473,7 @@ def _plot(result, path: Path) -> None:
                 continue
             r = result["directions"][d]
             amp = np.array([np.nan if v is None else v for v in r["amplitude_q"]], float)
-            codes = [config.SWEEP_STATUS.index(s) for s in r["status"]]
+            codes = [STATUS_CODES.get(s, NOT_COMPUTED) for s in r["status"]]
             plot_frc_curve(ax, r["gamma"], amp, codes, color="C0" if d == "up" else "C3",
                            linestyle=style, label=f"sweep {d}", rug_y=0.03 if d == "up" else 0.07)
         mark_legend(ax, fontsize=8)
@@ -497,20 +489,18 @@ def _plot(result, path: Path) -> None:
     plt.close(fig)
 
 
-#: point statuses of an hb branch that are joined to the point before them by a line
-_JOINED = ("joined", "corner")
-
-
 def _plot_hb(ax, result) -> None:
     """hb branches: stable (solid) and unstable (dashed) lines, broken before every point not joined to
     the previous one; folds (squares), points where a segment stopped short (red x), peaks (^; open where
     found at a stop), parts of the range without points (hatched)."""
+    from ..figures.curves import branch_pieces
+
     first = {}
     for br in result["branches"]:
         g = np.array(br["gamma"], float)
         a = np.array([np.nan if v is None else v for v in br["amplitude_q"]], float)
         st = np.array(br["stable"], bool)
-        cut = np.flatnonzero([s not in _JOINED for s in br["point_status"]])
+        cut = np.array([piece[0] for piece in branch_pieces(br["point_status"])], dtype=int)
         # a NaN row between two points that are not joined breaks the line there
         g, a, st = (np.insert(v, cut[cut > 0], f) for v, f in ((g, np.nan), (a, np.nan), (st, True)))
         for sel, style, c, name in ((st, "-", "C0", "stable"), (~st, "--", "C1", "unstable")):
@@ -542,9 +532,9 @@ def _plot_hb(ax, result) -> None:
 
 
 def exit_status(result) -> int:
-    """0, or :data:`jointdyn.cli.EXIT_INCOMPLETE` for an hb branch that does not cover the range and is
+    """0, or :data:`jointdyn._exit.EXIT_INCOMPLETE` for an hb branch that does not cover the range and is
     not unbounded (failed, turned back, stopped at its point bound)."""
-    from ..cli import EXIT_INCOMPLETE
+    from .._exit import EXIT_INCOMPLETE
 
     if result["method"] == "hb" and result["status"] not in ("complete", "unbounded"):
         return EXIT_INCOMPLETE
@@ -564,15 +554,11 @@ def run(args) -> int:
 
             write_outputs(ds, out)
         else:
-            from .._io import atomic_path
+            from .._io import write_dataset
             from ..hb import branch_dataset
 
-            ds = branch_dataset(ds)
-            with atomic_path(out / "frc.nc") as tmp:
-                ds.to_netcdf(tmp, engine="scipy")
-            with atomic_path(out / "frc.csv") as tmp:  # one row per point (per-harmonic data in frc.nc)
-                flat = ds.drop_dims([d for d in ds.dims if d != "point"])
-                flat.to_dataframe().reset_index().to_csv(tmp, index=False)
+            # frc.csv: one row per point (per-harmonic data in frc.nc)
+            write_dataset(branch_dataset(ds), out, "frc")
         _plot(result, out / "frc.png")
     if args.json:
         print(json.dumps(result))
@@ -612,6 +598,8 @@ def _print_table(result) -> None:
                              f"{r['status'][i]:>11s}")
             print(f"{gi:<{w}.{p}g} " + "  ".join(cells))
     else:
+        from ..hb.results import JOINED
+
         print(f"status: {result['status']} {result['message']}")
         p = _digits([g for br in result["branches"] for g in br["gamma"]])
         w = max(8, p + 6)
@@ -619,7 +607,7 @@ def _print_table(result) -> None:
             print(f"branch {br['branch']}: {len(br['gamma'])} points, folds at {br['folds']}")
             for g, a, s, ps in zip(br["gamma"], br["amplitude_q"], br["stable"], br["point_status"]):
                 print(f"  {g:<{w}.{p}g} {a if a is not None else float('nan'):>12.5g} "
-                      f"{'stable' if s else 'unstable':<8s}{'' if ps in _JOINED else ' ' + ps}")
+                      f"{'stable' if s else 'unstable':<8s}{'' if ps in JOINED else ' ' + ps}")
         for pk in result["peaks"]:
             q = float("nan") if pk["amplitude_q"] is None else pk["amplitude_q"]
             print(f"peak: gamma = {pk['gamma']:.6g}, q = {q:.6g} (branch {pk['branch']}"

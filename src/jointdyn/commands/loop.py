@@ -32,13 +32,13 @@ from __future__ import annotations
 
 import io
 import json
-import math
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from .. import config
+from .._io import jsonable as _jsonable
 from ._law_args import add_law_arguments, law_params, model_help
 
 NAME = "loop"
@@ -186,12 +186,6 @@ def _plot_png(res, title) -> bytes:
     fig.savefig(buf, format="png")
     plt.close(fig)
     return buf.getvalue()
-
-
-def _jsonable(v):
-    if isinstance(v, float) and not math.isfinite(v):
-        return None
-    return v
 
 
 def _history(args, law):

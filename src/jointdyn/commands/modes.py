@@ -14,7 +14,7 @@ Everything is validated before computing; ``--out`` files (``modes.nc``,
 ``modes.csv``, ``modes.png``) are written atomically after computing.
 
 Exit status: 0 for a complete backbone; 2 for bad input (one line, no
-file); :data:`EXIT_PARTIAL` (3) when the backbone stops short (status
+file); :data:`jointdyn._exit.EXIT_INCOMPLETE` (3) when the backbone stops short (status
 ``failed``, ``max-points`` or ``no-start``): the files are still written
 and carry the status, and ``--json`` prints it.
 """
@@ -22,20 +22,19 @@ and carry the status, and ``--json`` prints it.
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
-
-import numpy as np
 
 from .. import _validate as V
 from .. import config
+from .._exit import EXIT_INCOMPLETE
+from .._io import jsonable as _jsonable
 from ._law_args import add_law_arguments, law_params, model_help
 from ._system_args import load_system_file
 
 NAME = "modes"
 HELP = "backbone of a nonlinear mode (natural frequency and damping ratio against amplitude) by EPMC or QSMA"
-#: exit status of a backbone that stops short of the amplitude range (files are still written)
-EXIT_PARTIAL = 3
+#: deprecated alias of :data:`jointdyn._exit.EXIT_INCOMPLETE` (a backbone that stops short; files are still written)
+EXIT_PARTIAL = EXIT_INCOMPLETE
 #: options of the EPMC only
 _EPMC_ONLY = ("harmonics", "samples", "max_points")
 
@@ -130,16 +129,6 @@ def _compute(args, system, amps):
     return b, backbone_dataset(b)
 
 
-def _jsonable(values):
-    """Nested lists of an array, NaN and infinities as None (JSON has no NaN)."""
-    def clean(v):
-        if isinstance(v, list):
-            return [clean(x) for x in v]
-        return None if isinstance(v, float) and not math.isfinite(v) else v
-
-    return clean(np.asarray(values).tolist())
-
-
 def _result(args, ds, label) -> dict:
     keys = ("amplitude_m", "amplitude_q", "omega_rad_s", "frequency_hz", "damping_ratio", "damping_ratio_contacts",
             "damping_ratio_viscous", "energy_contact_j")
@@ -176,13 +165,9 @@ def _plot(ds, title: str, path: Path) -> None:
 
 
 def _write(ds, out: Path, title: str) -> None:
-    from .._io import atomic_path
+    from .._io import write_dataset
 
-    with atomic_path(out / "modes.nc") as tmp:
-        ds.to_netcdf(tmp, engine="scipy")
-    with atomic_path(out / "modes.csv") as tmp:  # one row per point (per-DOF and per-contact data in modes.nc)
-        flat = ds.drop_dims([d for d in ds.dims if d != "point"])
-        flat.to_dataframe().reset_index().to_csv(tmp, index=False)
+    write_dataset(ds, out, "modes")  # modes.csv: one row per point (per-DOF and per-contact data in modes.nc)
     _plot(ds, title, out / "modes.png")
 
 
@@ -196,7 +181,7 @@ def run(args) -> int:
         print(json.dumps(result))
     else:
         _print_table(result)
-    return 0 if backbone.status.ok else EXIT_PARTIAL
+    return 0 if backbone.status.ok else EXIT_INCOMPLETE
 
 
 def _print_table(result) -> None:

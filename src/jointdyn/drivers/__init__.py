@@ -1,6 +1,7 @@
 """Drivers: march contact laws over prescribed histories."""
 
 from ._march import march
-from .quasistatic import LoopResult, cycle_count, harmonic_history, harmonic_loop, quasistatic, read_history_csv
+from .quasistatic import LoopResult, LoopStatus, cycle_count, harmonic_history, harmonic_loop, quasistatic, read_history_csv
 
-__all__ = ["march", "quasistatic", "harmonic_loop", "harmonic_history", "read_history_csv", "cycle_count", "LoopResult"]
+__all__ = ["march", "quasistatic", "harmonic_loop", "harmonic_history", "read_history_csv", "cycle_count", "LoopResult",
+           "LoopStatus"]

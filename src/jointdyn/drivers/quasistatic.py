@@ -29,11 +29,13 @@ from .. import _validate as V
 from .. import config
 from ..kinematics import HarmonicLoad, NormalSpring
 from ..laws import MACROSLIP, SEPARATION, STATE_NAMES, STICK_SLIP, ContactLaw
+from ..status import Status
 from ._csv import read_history_csv
 from ._march import march
 
 __all__ = [
     "LoopResult",
+    "LoopStatus",
     "harmonic_history",
     "read_history_csv",
     "quasistatic",
@@ -173,6 +175,18 @@ def harmonic_history(
 # --------------------------------------------------------------------------
 # result
 # --------------------------------------------------------------------------
+class LoopStatus(Status):
+    """Outcome of a quasi-static march (:attr:`LoopResult.status`).
+
+    Bad input raises ``ValueError`` before marching and the march itself
+    cannot fail, so a result is always ``ok``; the status is there so that a
+    loop says what it is as every other result does (``status.ok``,
+    ``message``).
+    """
+
+    OK = "ok", "the law was marched over the whole history", True
+
+
 @dataclass(frozen=True, eq=False)
 class LoopResult:
     """Response of a contact law to a prescribed history, with loop metrics.
@@ -196,9 +210,9 @@ class LoopResult:
         :func:`quasistatic` for the definitions).
     law_name : str
         The law's registry name.
-    status : str
+    status : LoopStatus
         ``"ok"`` (bad input raises ValueError before marching; the march
-        itself cannot fail).
+        itself cannot fail); ``message`` says what it means.
     n_inserted : int
         Number of zero-crossing instants of N inserted into the input history.
     inserted : ndarray of bool
@@ -215,9 +229,14 @@ class LoopResult:
     period: float | None
     cycles: pd.DataFrame
     law_name: str
-    status: str = "ok"
+    status: LoopStatus = LoopStatus.OK
     n_inserted: int = 0
     inserted: np.ndarray | None = None
+
+    @property
+    def message(self) -> str:
+        """What the status means, in one line."""
+        return self.status.message
 
     @property
     def n_cycles(self) -> int:
@@ -544,7 +563,7 @@ def quasistatic(law, t, x, N, *, period=None, state=None) -> LoopResult:
         period=period,
         cycles=cycles,
         law_name=getattr(law, "name", type(law).__name__),
-        status="ok",
+        status=LoopStatus.OK,
         n_inserted=int(np.count_nonzero(inserted)),
         inserted=inserted,
     )

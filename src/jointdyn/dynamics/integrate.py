@@ -79,6 +79,11 @@ class Trajectory:
     final: Restart
     status: RunStatus = RunStatus.OK
 
+    @property
+    def message(self) -> str:
+        """What the status means, in one line."""
+        return self.status.message
+
 
 def _omega(system: System, gamma) -> float:
     g = V.positive("gamma", gamma)

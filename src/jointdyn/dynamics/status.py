@@ -41,7 +41,7 @@ class SteadyStatus(Status):
     """Classification of a :func:`~jointdyn.dynamics.steady_state` result."""
 
     PERIODIC = "periodic", "the response repeats with the forcing period or a small multiple of it", True
-    NOT_SETTLED = "not-settled", "no periodic state within the period budget (see the detail)"
+    NOT_SETTLED = "not-settled", "no periodic state within the period budget (see the message)"
     UNBOUNDED = "unbounded", "the response grows without bound (or the integration blew up)"
 
 

@@ -48,8 +48,8 @@ class SteadyState:
     status : SteadyStatus
         ``"periodic"``, ``"not-settled"`` or ``"unbounded"`` (its ``message``
         says what it means).
-    detail : str
-        More on the status: ``"integration"`` or ``"shooting"`` (how a
+    message : str
+        More on the status (``detail`` is a deprecated alias): ``"integration"`` or ``"shooting"`` (how a
         periodic state was reached); ``"growing"``, ``"blow-up"``
         (unbounded); ``"period-P"`` (repeats every P > SS_MAX_MULTIPLE
         periods), ``"slowly-converging"`` (Poincare distance still
@@ -93,7 +93,7 @@ class SteadyState:
     """
 
     status: SteadyStatus
-    detail: str
+    message: str
     period_multiple: int
     gamma: float
     omega: float
@@ -118,10 +118,15 @@ class SteadyState:
         """True when a periodic steady state was found."""
         return SteadyStatus(self.status).ok
 
+    @property
+    def detail(self) -> str:
+        """Deprecated alias of :attr:`message`."""
+        return self.message
+
     def to_record(self) -> dict:
         """The scalar fields as a flat dict (one row of a sweep table)."""
         keys = (
-            "status", "detail", "period_multiple", "gamma", "omega", "amplitude_q", "amplitude_m",
+            "status", "message", "period_multiple", "gamma", "omega", "amplitude_q", "amplitude_m",
             "offset_m", "max_abs_m", "energy_contact_J", "energy_viscous_J", "work_force_J",
             "periods", "steps", "shooting_iterations", "floquet_max", "energy_check", "last_amplitude_m",
         )  # fmt: skip
@@ -706,7 +711,7 @@ def steady_state(
                           f"per period (< 0 beyond the energy-balance residual): {check.message}",
                           RuntimeWarning, stacklevel=2)  # fmt: skip
     return SteadyState(
-        status=status, detail=detail, period_multiple=int(p_found), gamma=float(gamma), omega=w,
+        status=status, message=detail, period_multiple=int(p_found), gamma=float(gamma), omega=w,
         periods=int(math.ceil(st.counters["periods"])), steps=int(st.counters["steps"]),
         shooting_iterations=int(st.counters["shoot"]), floquet_max=float(st.floq), energy_check=check,
         last_amplitude_m=float(last_amp), restart=Restart(st.x.copy(), st.v.copy(), st.S.copy()), loop=loop,

@@ -25,21 +25,15 @@ from .._io import atomic_path
 __all__ = ["Figure", "register_figure", "figure_names", "make_figure", "FIGURES", "pyplot", "save_figure",
            "model_label"]
 
-#: how figure titles and legends name the registered contact laws
-MODEL_LABELS = {
-    "iwan": "exact Iwan model",
-    "iwan-closed": "closed-form Iwan, full memory",
-    "iwan-paper": "closed-form Iwan, paper's last-reversal rule",
-    "discrete": "discrete Iwan",
-    "jenkins": "Jenkins element",
-}
-
-
 def model_label(model: str) -> str:
-    """Name of a contact law in a figure: its description and registered
-    name, e.g. ``"exact Iwan model (iwan)"``."""
-    label = MODEL_LABELS.get(model)
-    return f"{label} ({model})" if label else str(model)
+    """Name of a contact law in a figure: its label registered with the law
+    (:func:`jointdyn.laws.law_label`) and its registered name, e.g.
+    ``"exact Iwan model (iwan)"``; the name alone for a law registered
+    without a label, or for a name that is not registered."""
+    from ..laws import law_label, law_names
+
+    label = law_label(model) if model in law_names() else model
+    return f"{label} ({model})" if label != model else str(model)
 
 
 class _Registry(dict):
@@ -120,9 +114,8 @@ def _load_all() -> None:
     import importlib
     import pkgutil
 
-    from . import __path__ as pkg_path
-
-    for info in pkgutil.iter_modules(pkg_path):
+    # this package's directory (the package itself is not imported back from here)
+    for info in pkgutil.iter_modules([str(Path(__file__).parent)]):
         if not info.name.startswith("_"):
             importlib.import_module(f"{__package__}.{info.name}")
     _LOADED.append(True)

@@ -33,6 +33,7 @@ import pandas as pd
 
 from .. import config
 from ._registry import model_label, pyplot, register_figure, save_figure
+from .curves import RUG_MARKERS
 
 #: Fig 6 grid (the paper's groups)
 FIG6_ETAS = (0.01, 0.5, 1.5, 10.0)
@@ -78,16 +79,14 @@ def fig6():
 
 #: one colour per beta, dark enough on white (ColorBrewer Dark2 without its yellow)
 BETA_COLORS = ("#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#a6761d", "#666666")
-#: rug marker per non-periodic status name (marker, face colour or None for filled)
-RUG_MARKERS = {"not-settled": ("o", "none"), "unbounded": ("x", None)}
 
 
 def _status_names(codes):
-    """Sweep status names of integer codes (``config.SWEEP_STATUS``; "missing" otherwise)."""
-    from .. import config
+    """Sweep status names of integer codes (:func:`jointdyn.sweeps.status_name`: the steady-state statuses,
+    ``not-computed`` otherwise)."""
+    from ..sweeps import status_name
 
-    known = config.SWEEP_STATUS
-    return np.array([known[c] if 0 <= c < len(known) else "missing" for c in np.asarray(codes, int)])
+    return np.array([status_name(c) for c in np.asarray(codes, int)])
 
 
 def _linear_limits(ax):

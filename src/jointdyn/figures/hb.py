@@ -19,6 +19,7 @@ import pandas as pd
 
 from .. import config
 from ._registry import model_label, pyplot, register_figure, save_figure
+from .curves import branch_pieces
 
 #: cases of fig6_hb (kept small: one HB branch is ~0.1-1 s, the time-domain
 #: sweep dominates the compute time)
@@ -41,7 +42,7 @@ def fig6_hb_data(etas=HB_ETAS, betas=HB_BETAS, gamma=HB_GAMMA, time_step=HB_TIME
             # (docs/hb-robustness.md)
             ds = frc_hb(System.paper_damper(eta=eta, beta=beta, model=model), gamma[0], gamma[1], progress=False)
             df = pd.DataFrame({v: ds[v].values for v in ("gamma", "amplitude_q", "offset_m", "stable", "fold",
-                                                          "gap", "branch")})
+                                                          "gap", "branch", "point_status")})
             df.insert(0, "beta", beta)
             df.insert(0, "eta", eta)
             df["status"] = ds.attrs["status"]
@@ -74,14 +75,12 @@ def _runs(mask):
 
 def _hb_curve(ax, sub, color):
     """One HB branch: stable pieces solid, unstable dashed, folds as squares;
-    a new piece starts at a change of branch or a gap."""
+    a new piece starts at every point not joined to the one before it
+    (:func:`~jointdyn.figures.curves.branch_pieces`, from ``point_status``)."""
     g = sub.gamma.to_numpy()
     a = sub.amplitude_q.to_numpy()
     st = sub.stable.to_numpy().astype(bool)
-    brk = np.r_[False, (np.diff(sub.branch.to_numpy()) != 0) | sub.gap.to_numpy().astype(bool)[1:]]
-    piece = np.cumsum(brk)
-    for pc in np.unique(piece):
-        idx = np.flatnonzero(piece == pc)
+    for idx in branch_pieces(sub.point_status.to_numpy()):
         for run in _runs(st[idx]):
             j = idx[run[0]: run[-1] + 2] if run[-1] + 1 < idx.size else idx[run]
             ax.plot(g[j], a[j], "-", color=color, lw=1.4)

@@ -32,14 +32,15 @@ from ._registry import model_label, pyplot, register_figure, save_figure
 #: paper section 2.2 (Figs 3-4)
 PAPER_QS = dict(kt=1.0e5, mu=0.1, n0=100.0, amplitude=0.5e-3, frequency=1.0)
 ETAS = (0.0, 0.3, 0.6, 0.9, 1.2)
-_CYCLES = 2
-_STEPS = 2000
-_N_DISCRETE = 1000
-_MODEL_LABEL = {
-    "iwan-closed": "closed form (full memory, iwan-closed)",
-    "iwan-paper": "closed form (paper: last reversal, iwan-paper)",
-    "discrete": f"discrete, n = {_N_DISCRETE}",
-}
+_CYCLES = config.QS_CYCLES
+_STEPS = config.QS_STEPS_PER_CYCLE
+_N_DISCRETE = config.LAW_DISCRETE_N
+
+
+def _legend_label(model) -> str:
+    """The law's label (registered with the law), with n for the discrete model."""
+    label = model_label(model)
+    return f"{label}, n = {_N_DISCRETE}" if "n" in {q.name for q in law_parameters(model)} else label
 
 
 def _law(model):
@@ -309,7 +310,7 @@ def _plot_fig4_discrete(tables, out_dir):
             if g.empty:
                 continue
             c, ls, lw = _DISCRETE_STYLE[model]
-            _draw_loop(ax, g, c, _MODEL_LABEL[model] if j == 0 else None, lw=lw, ls=ls,
+            _draw_loop(ax, g, c, _legend_label(model) if j == 0 else None, lw=lw, ls=ls,
                        mark_states=(model == "discrete"), macroslip=False)
             if model != "discrete" and not ref.empty:
                 # same time grid for every model: compare sample by sample

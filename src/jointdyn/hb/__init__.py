@@ -3,13 +3,24 @@ Jacobians, arc-length continuation (:mod:`jointdyn.continuation`) in a
 parameter object (:mod:`jointdyn.hb.parameters`), Hill stability,
 unbounded-response detection, per-DOF forcing phases, and exact
 condensation onto the contact DOFs for large structures
-(:mod:`jointdyn.hb.condense`; see docs/harmonic-balance.md)."""
+(:mod:`jointdyn.hb.condense`; see docs/harmonic-balance.md).
+
+Read top to bottom: the entry points (:mod:`~jointdyn.hb.frc`), the
+Dataset export (:mod:`~jointdyn.hb.export`), the automatic choice of
+harmonics and samples (:mod:`~jointdyn.hb.discretisation`), one branch at a
+fixed discretisation (:mod:`~jointdyn.hb.branch`), the result types
+(:mod:`~jointdyn.hb.results`), then the problem (:mod:`~jointdyn.hb.problem`,
+:mod:`~jointdyn.hb.condense`, :mod:`~jointdyn.hb.parameters`) and its
+evaluation (:mod:`~jointdyn.hb._aft`, :mod:`~jointdyn.hb.stability`,
+:mod:`~jointdyn.hb.monodromy`)."""
 
 from .condense import CondensedHBProblem, Receptance, make_problem, receptance
-from .frc import HBBranch, HBPeak, HBSolution, PointStatus, branch_dataset, continue_hb, frc_hb, harmonic_balance
+from .export import branch_dataset, discretisation_attrs
+from .frc import continue_hb, frc_hb, harmonic_balance
 from .parameters import DELTA, ETA, F1, GAMMA, N0, PARAMETERS, HBParameter, SystemParameter, parameter_named
 from .problem import HBProblem
 from .monodromy import monodromy_multipliers
+from .results import AUTO, DiscretisationCheck, HBBranch, HBPeak, HBSolution, PointStatus, SolveStatus
 from .stability import hill_exponents, hill_growth, hill_stability
 
 __all__ = [
@@ -18,9 +29,13 @@ __all__ = [
     "harmonic_balance",
     "HBSolution",
     "branch_dataset",
+    "discretisation_attrs",
+    "DiscretisationCheck",
+    "AUTO",
     "HBBranch",
     "HBPeak",
     "PointStatus",
+    "SolveStatus",
     "HBProblem",
     "CondensedHBProblem",
     "make_problem",

@@ -41,7 +41,6 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from .._cache import by_value
 
 __all__ = ["HBParameter", "Gamma", "F1Amplitude", "LoadRatio", "StaticLoad", "LoadPhase", "SystemParameter",
            "GAMMA", "F1", "ETA", "N0", "DELTA", "PARAMETERS", "parameter_named"]
@@ -254,35 +253,11 @@ class SystemParameter(HBParameter):
 
     def problem_at(self, problem, p: float):
         """The harmonic-balance problem of ``build(p)`` at the problem's fixed frequency (cached);
-        condensed onto the same DOFs when ``problem`` is."""
-        return _problem_at(self, problem.H, problem.Ns, problem.max_passes, problem.gamma_fixed * problem.w0,
-                           problem.system.ndof, len(problem.contacts), float(p),
-                           tuple(int(d) for d in problem.dofs) if problem.condensed else None)
+        condensed onto the same DOFs when ``problem`` is: ``problem.problem_at(p)``
+        (:meth:`jointdyn.hb.HBProblem.problem_at`, which problems call; kept for callers of this name)."""
+        return problem.problem_at(p)
 
     def step(self, p: float) -> float:
         """Central-difference step h at p: ``config.HB_PARAMETER_FD_STEP`` times the scale (or |p|, or 1)."""
         unit = self.scale_value if self.scale_value is not None else (abs(p) if p != 0.0 else 1.0)
         return config.HB_PARAMETER_FD_STEP * unit
-
-
-@by_value(maxsize=8)
-def _problem_at(parameter, H, Ns, max_passes, w, ndof, ncontacts, p, dofs):
-    """HBProblem of ``parameter.build(p)`` at frequency w (the last few values of p are kept),
-    condensed onto ``dofs`` unless None."""
-    from ..systems import System
-    from .condense import CondensedHBProblem
-    from .problem import HBProblem
-
-    system = parameter.build(p)
-    if not isinstance(system, System):
-        raise ValueError(f"build({parameter.name} = {p!r}) must return a jointdyn.System")
-    if system.ndof != ndof or len(system.contacts) != ncontacts:
-        raise ValueError(f"build({parameter.name} = {p!r}) must keep {ndof} DOFs and {ncontacts} contacts")
-    kw = {"harmonics": H, "samples": Ns, "parameter": _FixedFrequency(w), "max_passes": max_passes}
-    if dofs is None:
-        return HBProblem(system, **kw)
-    q = CondensedHBProblem(system, response_dofs=dofs, **kw)
-    if tuple(int(d) for d in q.dofs) != dofs:
-        raise ValueError(f"build({parameter.name} = {p!r}) must keep the contacts on the same DOFs "
-                         f"(condensed onto {list(dofs)}, got {q.dofs.tolist()})")
-    return q

@@ -38,12 +38,13 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
+from .._cache import by_value
 from ..fourier import STARTS, STOPS, extrema, fourier_matrices, phases, separation_grid
 from ..kinematics import NORMAL_SPRING, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
 from ..laws import law_dispatch
 from ..systems import Contact, System
 from ._aft import NO_EVENT, eval_kernel, recontact_events
-from .parameters import SystemParameter, parameter_named
+from .parameters import SystemParameter, _FixedFrequency, parameter_named
 from .stability import hill_growth, hill_stability
 
 __all__ = ["HBProblem"]
@@ -335,7 +336,7 @@ class HBProblem:
         Used to start Newton and continuation (docs/model.md section 6: all
         stuck -> linear system with K + kt).
         """
-        q = self.parameter.problem_at(self, p) if isinstance(self.parameter, SystemParameter) else self
+        q = self.problem_at(p) if isinstance(self.parameter, SystemParameter) else self
         w = self.omega(p)
         A = q.linear_matrix(w)
         if stuck:
@@ -399,13 +400,22 @@ class HBProblem:
             T, code, Nout = T[:, at], code[:, at], Nout[:, at]
         return _Eval(R, JX, Jp, T, code, info, None if scales is None else scaled[1:], Nout)
 
+    def problem_at(self, p: float):
+        """The harmonic-balance problem of the System that this problem's
+        :class:`~jointdyn.hb.parameters.SystemParameter` builds at p, at this problem's fixed frequency
+        (cached); condensed onto the same DOFs when this one is."""
+        par = self.parameter
+        return _problem_at(type(self), par, self.H, self.Ns, self.max_passes, self.gamma_fixed * self.w0,
+                           self.system.ndof, len(self.contacts), float(p),
+                           tuple(int(d) for d in self.dofs) if self.condensed else None)
+
     def _evaluate_central(self, X, p, scales) -> _Eval:
         """Residual of the System built at p; dR/dp by a central difference (SystemParameter)."""
         par = self.parameter
         h = par.step(p)
-        ev = par.problem_at(self, p).evaluate(X, p)
-        Rp = par.problem_at(self, p + h).evaluate(X, p + h).R
-        Rm = par.problem_at(self, p - h).evaluate(X, p - h).R
+        ev = self.problem_at(p).evaluate(X, p)
+        Rp = self.problem_at(p + h).evaluate(X, p + h).R
+        Rm = self.problem_at(p - h).evaluate(X, p - h).R
         Jp = (Rp - Rm) / (2.0 * h)
         scaled = None
         if scales is not None:
@@ -461,3 +471,23 @@ def contact_of(system: System) -> Contact:
     if not system.contacts:
         raise ValueError("system must have at least one contact")
     return system.contacts[0]
+
+
+@by_value(maxsize=8)
+def _problem_at(cls, parameter, H, Ns, max_passes, w, ndof, ncontacts, p, dofs):
+    """Problem of class ``cls`` (:class:`HBProblem`, or the condensed problem when ``dofs`` is not None) of
+    ``parameter.build(p)`` at frequency w (the last few values of p are kept), condensed onto ``dofs``
+    unless None."""
+    system = parameter.build(p)
+    if not isinstance(system, System):
+        raise ValueError(f"build({parameter.name} = {p!r}) must return a jointdyn.System")
+    if system.ndof != ndof or len(system.contacts) != ncontacts:
+        raise ValueError(f"build({parameter.name} = {p!r}) must keep {ndof} DOFs and {ncontacts} contacts")
+    kw = {"harmonics": H, "samples": Ns, "parameter": _FixedFrequency(w), "max_passes": max_passes}
+    if dofs is None:
+        return cls(system, **kw)
+    q = cls(system, response_dofs=dofs, **kw)
+    if tuple(int(d) for d in q.dofs) != dofs:
+        raise ValueError(f"build({parameter.name} = {p!r}) must keep the contacts on the same DOFs "
+                         f"(condensed onto {list(dofs)}, got {q.dofs.tolist()})")
+    return q

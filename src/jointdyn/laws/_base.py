@@ -120,6 +120,7 @@ __all__ = [
     "law_names",
     "law_parameters",
     "law_summary",
+    "law_label",
     "canonical_law_params",
 ]
 
@@ -438,12 +439,14 @@ class _Entry:
     law: type
     fixed: tuple
     summary: str
+    label: str
 
 
 _REGISTRY: dict[str, _Entry] = {}
 
 
-def register(name: str, law: type, *, fixed: dict | None = None, summary: str | None = None) -> None:
+def register(name: str, law: type, *, fixed: dict | None = None, summary: str | None = None,
+             label: str | None = None) -> None:
     """Make a law constructible by name (:func:`make_law`, CLI ``--model``).
 
     Parameters
@@ -457,6 +460,9 @@ def register(name: str, law: type, *, fixed: dict | None = None, summary: str | 
         ``iwan-paper``); they are not listed nor accepted by :func:`make_law`.
     summary : str, optional
         One-line description (default: the first line of the class docstring).
+    label : str, optional
+        Short name in figure titles and legends (e.g. ``"exact Iwan model"``;
+        default: the registered name); see :func:`law_label`.
     """
     if not (isinstance(law, type) and issubclass(law, ContactLaw)):
         raise ValueError(f"law must be a ContactLaw subclass, got {law!r}")
@@ -473,7 +479,8 @@ def register(name: str, law: type, *, fixed: dict | None = None, summary: str | 
         # a module imported again (reload) registers the same class again; a
         # different class under a taken name is an error
         raise ValueError(f"law name {name!r} is already registered by {old.law.__module__}.{old.law.__qualname__}")
-    _REGISTRY[name] = _Entry(law=law, fixed=tuple(sorted(fixed.items())), summary=summary)
+    _REGISTRY[name] = _Entry(law=law, fixed=tuple(sorted(fixed.items())), summary=summary,
+                             label=name if label is None else str(label))
 
 
 def law_names() -> list[str]:
@@ -489,6 +496,11 @@ def _entry(name: str) -> _Entry:
 def law_summary(name: str) -> str:
     """One-line description of a registered law."""
     return _entry(name).summary
+
+
+def law_label(name: str) -> str:
+    """Short name of a registered law in figure titles and legends (its ``label``, or its name)."""
+    return _entry(name).label
 
 
 def law_parameters(name: str) -> tuple:

@@ -313,5 +313,6 @@ class Jenkins(DiscreteIwan):
         super().__post_init__()
 
 
-register("discrete", DiscreteIwan, summary="n Jenkins elements in parallel, the exact discrete Iwan model and ground truth")
-register("jenkins", Jenkins, summary="one Jenkins element: spring kt in series with a slider mu N")
+register("discrete", DiscreteIwan, summary="n Jenkins elements in parallel, the exact discrete Iwan model and ground truth",
+         label="discrete Iwan")
+register("jenkins", Jenkins, summary="one Jenkins element: spring kt in series with a slider mu N", label="Jenkins element")

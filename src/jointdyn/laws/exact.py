@@ -734,4 +734,5 @@ def piece_count(state) -> int:
 register(
     "iwan", Iwan,
     summary="exact Iwan model with varying normal load (the discrete model at n -> infinity; default)",
+    label="exact Iwan model",
 )

@@ -570,8 +570,10 @@ register(
     "iwan-closed", IwanClosedForm, fixed={"memory": "full"},
     summary="closed-form Iwan with full Masing memory: exact at constant N for any history, "
     "misses slip caused by a falling N within a branch",
+    label="closed-form Iwan, full memory",
 )
 register(
     "iwan-paper", IwanClosedForm, fixed={"memory": "last"},
     summary="closed-form Iwan with the paper's last-reversal rule (Li & Xu)",
+    label="closed-form Iwan, paper's last-reversal rule",
 )

@@ -38,7 +38,7 @@ import numpy as np
 
 from .. import config
 from .._jit import jit, specialize
-from ..continuation import _lu_solve
+from ..continuation.linalg import lu_solve
 from ..kinematics import contact_kinematics, selection_matrix
 from ._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
 from .backbone import Backbone, ModeStatus
@@ -89,7 +89,7 @@ def _push_template(grid, lin, con, ctl, out):  # pragma: no cover - compiled
             if _assemble(K, f, j, Bm, Ts[i + 1], kTs[i + 1], x, alpha, a, A, r) <= tol:
                 ok = True
                 break
-            if not _lu_solve(A, r):
+            if not lu_solve(A, r):
                 return i
             for k in range(n):
                 x[k] -= r[k]

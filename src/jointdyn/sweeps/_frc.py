@@ -48,14 +48,18 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from .._io import atomic_path
+from .._io import write_dataset
+from ..dynamics.status import SteadyStatus
 from ..laws import STATE_NAMES
+from . import _points
 from ._checkpoint import load_line, save_chunk
 from ._family import LineSpec, fingerprint, paper_family, system_family
 from ._points import (
     CONTACT_VARIABLES,
     DOF_VARIABLES,
     INT_VARIABLES,
+    NOT_COMPUTED,
+    NOT_COMPUTED_NAME,
     STATE_VARIABLE,
     STATUS_CODES,
     VARIABLES,
@@ -78,8 +82,8 @@ __all__ = [
     "default_workers",
 ]
 
-_MISSING = config.SWEEP_STATUS_MISSING
-_LEGEND = ", ".join(f"{i}: {n}" for i, n in enumerate(config.SWEEP_STATUS)) + f", {_MISSING}: not computed"
+_MISSING = NOT_COMPUTED
+_LEGEND = ", ".join(f"{s.code}: {s.value}" for s in SteadyStatus) + f", {NOT_COMPUTED}: {NOT_COMPUTED_NAME}"
 _DIRECTIONS = ("up", "down")
 #: keyword arguments that describe the paper damper's grid (not a System's)
 _PAPER_KEYS = ("etas", "betas", "f1s", "deltas", "model", "law_params", "n", "zeta", "m", "k", "kt", "mu", "n0")
@@ -90,9 +94,9 @@ RUN_ATTRIBUTES = ("reused_points", "stale_points")
 def status_name(code: int) -> str:
     """Name of a status code of the ``status`` variable."""
     code = int(code)
-    if 0 <= code < len(config.SWEEP_STATUS):
-        return config.SWEEP_STATUS[code]
-    return "not-computed"
+    if 0 <= code < len(SteadyStatus):
+        return SteadyStatus.from_code(code).value
+    return NOT_COMPUTED_NAME
 
 
 def default_workers() -> int:
@@ -101,13 +105,6 @@ def default_workers() -> int:
         return max(1, len(os.sched_getaffinity(0)))
     except AttributeError:  # pragma: no cover - non-Linux
         return max(1, os.cpu_count() or 1)
-
-
-def _steady_state_fn():
-    """The time-domain steady-state solver (resolved late; tests may swap it)."""
-    from ..dynamics import steady_state
-
-    return steady_state
 
 
 class _LineRun:
@@ -259,7 +256,7 @@ def _prepare_kernels(systems) -> None:
     when tests swapped the solver."""
     from ..dynamics import prepare_kernels, steady_state
 
-    if _steady_state_fn() is steady_state:
+    if _points._steady_state_fn() is steady_state:
         prepare_kernels(systems)
 
 
@@ -496,8 +493,8 @@ def _assemble(family, runs, directions, g, dofs, spp, loop_outputs):
                                    else np.nan), {"units": unit, "long_name": desc})
     data["status"] = (dims, _stack(runs, family, directions, "status", (m,), np.int8, _MISSING), {
         "legend": _LEGEND,
-        "flag_values": np.arange(len(config.SWEEP_STATUS), dtype=np.int8),
-        "flag_meanings": " ".join(config.SWEEP_STATUS),
+        "flag_values": np.array([s.code for s in SteadyStatus], dtype=np.int8),
+        "flag_meanings": " ".join(s.value for s in SteadyStatus),
         "missing_code": _MISSING,
     })
     coords = dict(family.coords)
@@ -559,10 +556,4 @@ def write_outputs(ds, out) -> list[Path]:
     res = ds.copy()
     for key in RUN_ATTRIBUTES:
         res.attrs.pop(key, None)
-    nc = out / "frc.nc"
-    with atomic_path(nc) as tmp:
-        res.to_netcdf(tmp, engine="scipy")
-    csv = out / "frc.csv"
-    with atomic_path(csv) as tmp:
-        to_frame(res).to_csv(tmp, index=False)
-    return [nc, csv]
+    return write_dataset(res, out, "frc", table=to_frame)

@@ -22,8 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import config
-from ..dynamics.status import EnergyCheck
+from ..dynamics.status import EnergyCheck, SteadyStatus
 from ..laws import STATE_NAMES
 
 __all__ = [
@@ -40,9 +39,13 @@ __all__ = [
     "solve_chunk",
 ]
 
-#: status name -> int8 code stored in the Dataset (``status`` variable)
-STATUS_CODES = {name: i for i, name in enumerate(config.SWEEP_STATUS)}
-MISSING = config.SWEEP_STATUS_MISSING
+#: status name -> int8 code stored in the Dataset (``status`` variable): the steady-state statuses' own codes
+STATUS_CODES = {s.value: s.code for s in SteadyStatus}
+#: code of a point that was not computed (never written by a finished sweep), and its name
+NOT_COMPUTED = -1
+NOT_COMPUTED_NAME = "not-computed"
+#: deprecated alias of :data:`NOT_COMPUTED`
+MISSING = NOT_COMPUTED
 
 #: float result variables of a point, with units and meaning
 VARIABLES = {
@@ -297,19 +300,23 @@ class Context:
             self.on_point()
 
 
-def _solver():
-    """The steady-state solver: ``jointdyn.sweeps._frc._steady_state_fn()``,
-    looked up at every chunk (the one place tests swap it)."""
-    from ._frc import _steady_state_fn
+def _steady_state_fn():
+    """The time-domain steady-state solver (resolved late; tests may swap it: the one place they do)."""
+    from ..dynamics import steady_state
 
+    return steady_state
+
+
+def _solver():
+    """The steady-state solver: :func:`_steady_state_fn`, looked up at every chunk."""
     return _steady_state_fn()
 
 
 def empty_arrays(m: int, ndofs: int, nc: int, loop_outputs: bool) -> dict:
-    """Result arrays of ``m`` points, not computed (NaN, 0, status MISSING)."""
+    """Result arrays of ``m`` points, not computed (NaN, 0, status NOT_COMPUTED)."""
     out = {name: np.full(m, np.nan) for name in VARIABLES}
     out.update({name: np.zeros(m, dtype=np.int32) for name in INT_VARIABLES})
-    out["status"] = np.full(m, MISSING, dtype=np.int8)
+    out["status"] = np.full(m, NOT_COMPUTED, dtype=np.int8)
     if loop_outputs:
         out.update({name: np.full((m, ndofs), np.nan) for name in DOF_VARIABLES})
         out.update({name: np.full((m, nc), np.nan) for name in CONTACT_VARIABLES})

@@ -1,16 +1,21 @@
-"""Drawing frequency-response curves: steady amplitudes as lines, points
-without a steady state as markers on the axis (never as numbers)."""
+"""The one home of drawing response curves: time-domain sweeps (steady amplitudes as lines, points
+without a steady state as markers on a rug, never as numbers) and harmonic-balance branches (one line
+per run of joined points: :func:`branch_pieces`, the one break rule, from ``point_status``).
+
+Used by the command line (``jointdyn frc``) and the figures.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .. import config
+from ..dynamics.status import SteadyStatus
 
-__all__ = ["plot_frc_curve", "mark_legend"]
+__all__ = ["RUG_MARKERS", "plot_frc_curve", "mark_legend", "branch_pieces"]
 
-#: marker per non-periodic status name
-_MARKS = {"not-settled": ("o", "none"), "unbounded": ("x", None)}
+#: rug marker per non-periodic status name (marker, face colour or None for filled)
+RUG_MARKERS = {"not-settled": ("o", "none"), "unbounded": ("x", None)}
+_MARKS = RUG_MARKERS
 
 
 def plot_frc_curve(ax, gamma, amplitude, status, *, color=None, linestyle="-", label=None, rug_y=0.03):
@@ -33,7 +38,8 @@ def plot_frc_curve(ax, gamma, amplitude, status, *, color=None, linestyle="-", l
     (line,) = ax.plot(gamma, y, linestyle=linestyle, color=color, label=label, lw=1.2)
     color = line.get_color()
     trans = ax.get_xaxis_transform()
-    for code, name in enumerate(config.SWEEP_STATUS):
+    for s in SteadyStatus:
+        code, name = s.code, s.value
         if name not in _MARKS:
             continue
         sel = status == code
@@ -55,3 +61,21 @@ def mark_legend(ax, **kw):
     ]
     labels += ["unbounded (no steady state)", "not settled"]
     ax.legend(handles, labels, **kw)
+
+
+def branch_pieces(point_status) -> list:
+    """Index runs of a harmonic-balance branch, each drawn as one line.
+
+    A line is drawn to a point only where it is joined to the point before
+    it (``point_status`` in :data:`jointdyn.hb.results.JOINED`: ``joined`` or ``corner``); every
+    other point (the start of a segment, a point reached by a jump, the
+    point where a segment stopped short) starts a new run.
+    """
+    from ..hb.results import JOINED
+
+    ps = np.asarray(point_status, dtype=str)
+    if ps.size == 0:
+        return []
+    starts = np.flatnonzero(~np.isin(ps, JOINED))
+    starts = starts[starts > 0]
+    return np.split(np.arange(ps.size), starts)

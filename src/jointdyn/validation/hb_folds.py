@@ -13,9 +13,9 @@ and its surroundings, and points between each pair of neighbouring folds.
 
 The verdict (:class:`FoldVerdict`) says whether the two sweeps settle on
 periodic orbits that differ by more than ``rtol`` somewhere between the
-outermost folds (``confirmed``), whether they agree there (``not seen``:
+outermost folds (``confirmed``), whether they agree there (``not-seen``:
 the fold is not confirmed), or whether the time domain finds no periodic
-steady state between them in at least one direction (``not periodic``:
+steady state between them in at least one direction (``not-periodic``:
 nothing to compare). ``docs/scripts/hb_robustness.py --folds`` writes the
 table of the grid's folds into ``docs/hb-robustness.md``.
 """
@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..status import Status
-from ._points import STATUS_CODES
+from ..sweeps import STATUS_CODES
 from .hb_grid import GRID_GAMMA
 
 __all__ = ["FoldCheck", "FoldVerdict", "fold_check", "fold_table"]
@@ -48,9 +48,9 @@ class FoldVerdict(Status):
 
     CONFIRMED = ("confirmed", "time-domain sweeps up and down settle on different periodic orbits between "
                  "the folds: the response jumps there", True)
-    NOT_SEEN = ("not seen", "time-domain sweeps up and down agree between the folds: the folds are not "
+    NOT_SEEN = ("not-seen", "time-domain sweeps up and down agree between the folds: the folds are not "
                 "confirmed by the time domain")
-    NOT_PERIODIC = ("not periodic", "between the folds the time domain finds no periodic steady state in at "
+    NOT_PERIODIC = ("not-periodic", "between the folds the time domain finds no periodic steady state in at "
                     "least one direction: nothing to compare")
 
 
@@ -115,7 +115,7 @@ def fold_check(model: str, eta: float, beta: float, gamma=GRID_GAMMA, *, rtol: f
     """
     from ..hb import continue_hb
     from ..systems import System
-    from ._frc import frc_sweep
+    from ..sweeps import frc_sweep
 
     system = System.paper_damper(eta=eta, beta=beta, model=model)
     br = continue_hb(system, gamma[0], gamma[1], max_step=gamma[2], progress=False)

@@ -59,13 +59,13 @@ class Verdict(Status):
 
     AGREES = "agrees", "the peak is within the tolerance of the time-domain steady state", True
     DIFFERS = "differs", "the peak is off the time-domain steady state by more than the tolerance"
-    NO_PEAK = "no peak", "no peak to compare (unbounded, or the amplitude has no maximum)", True
-    PEAK_IN_JUMP = ("peak in a jump", "the highest amplitude lies at a jump of the branch, above every peak "
+    NO_PEAK = "no-peak", "no peak to compare (unbounded, or the amplitude has no maximum)", True
+    PEAK_IN_JUMP = ("peak-in-a-jump", "the highest amplitude lies at a jump of the branch, above every peak "
                     "found: the peak between the jump's ends is not resolved")
-    NOT_PERIODIC = "not periodic", "the time domain found no periodic steady state at the peak", True
+    NOT_PERIODIC = "not-periodic", "the time domain found no periodic steady state at the peak", True
     SUBHARMONIC = ("subharmonic", "the time-domain steady state repeats only every p > 1 forcing periods: "
                    "a period-one harmonic balance cannot be that orbit (not compared)")
-    NOT_UNIQUE = ("not unique", "the time-domain steady state depends on the start (from the harmonic-balance "
+    NOT_UNIQUE = ("not-unique", "the time-domain steady state depends on the start (from the harmonic-balance "
                   "orbit and from rest it settles on amplitudes farther apart than the tolerance; not compared)")
 
 
@@ -87,7 +87,7 @@ class GridCase:
         Hartog's bound, and its highest peak (if any, where the time
         domain is periodic) is within ``rtol`` of the time domain. False
         also where the peak could not be compared (``verdict``
-        ``subharmonic`` or ``not unique``): the table marks those ``n/c``.
+        ``subharmonic`` or ``not-unique``): the table marks those ``n/c``.
     points, folds, unstable : int
         Points, folds and unstable points of the branch.
     peak_gamma, peak_q : float
@@ -185,7 +185,7 @@ def grid_cases(cases, *, time_domain: bool = True, workers: int = 1) -> list:
     import concurrent.futures as cf
     import os
 
-    from ._pool import detach_worker, process_context
+    from ..sweeps._pool import detach_worker, process_context
 
     with cf.ProcessPoolExecutor(max_workers=min(workers, len(cases)), mp_context=process_context(),
                                 initializer=detach_worker, initargs=(os.getpid(),)) as pool:

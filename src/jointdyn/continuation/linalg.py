@@ -1,0 +1,197 @@
+"""Linear algebra of the continuation: the bordered systems of the Newton step and of the tangent.
+
+LAPACK ``dgesv`` (through NumPy) for most sizes; below ``config.CONT_SMALL_SOLVE``
+unknowns a compiled Gaussian elimination with partial pivoting
+(:func:`lu_solve`, also used by :mod:`jointdyn.modes.qsma`), faster there
+because NumPy's per-call overhead costs more than the arithmetic
+(``benchmarks/bench_linalg.py``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import config
+from .._jit import jit
+
+__all__ = ["lu_solve"]
+
+
+@jit
+def _merit(R, d, v, u_pred):  # pragma: no cover - compiled
+    """max |R| (and |d^T (v - u_pred)| when d has entries); NaN if any entry is NaN."""
+    m = 0.0
+    for i in range(R.shape[0]):
+        a = abs(R[i])
+        if a != a:
+            return np.nan
+        if a > m:
+            m = a
+    if d.shape[0]:
+        c = 0.0
+        for i in range(d.shape[0]):
+            c += d[i] * (v[i] - u_pred[i])
+        c = abs(c)
+        if c != c:
+            return np.nan
+        if c > m:
+            m = c
+    return m
+
+
+@jit
+def _bordered(Jy, Jl, d):  # pragma: no cover - compiled
+    """The matrix [[R_y, R_lam], [d^T]] (or R_y alone when d is empty)."""
+    n = Jy.shape[0]
+    if d.shape[0] == 0:
+        return Jy.copy()
+    A = np.empty((n + 1, n + 1))
+    for i in range(n):
+        for j in range(n):
+            A[i, j] = Jy[i, j]
+        A[i, n] = Jl[i]
+    for j in range(n + 1):
+        A[n, j] = d[j]
+    return A
+
+
+@jit
+def lu_solve(A, b):  # pragma: no cover - compiled
+    """Solve A x = b in place by Gaussian elimination with partial pivoting.
+
+    The algorithm of LAPACK ``dgesv`` (row interchanges by the largest
+    pivot, LU factors overwrite A, b becomes x), written out: for small
+    systems NumPy's per-call overhead costs more than the arithmetic.
+    Returns False for an exactly singular matrix (a zero pivot, where
+    ``dgesv`` reports info > 0) or a non-finite solution.
+    """
+    n = A.shape[0]
+    for k in range(n):
+        p = k
+        amax = abs(A[k, k])
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > amax:
+                amax = abs(A[i, k])
+                p = i
+        if amax == 0.0 or amax != amax:
+            return False
+        if p != k:
+            for j in range(n):
+                t = A[k, j]
+                A[k, j] = A[p, j]
+                A[p, j] = t
+            t = b[k]
+            b[k] = b[p]
+            b[p] = t
+        piv = A[k, k]
+        for i in range(k + 1, n):
+            f = A[i, k] / piv
+            if f != 0.0:
+                A[i, k] = f
+                for j in range(k + 1, n):
+                    A[i, j] -= f * A[k, j]
+                b[i] -= f * b[k]
+    for i in range(n - 1, -1, -1):
+        acc = b[i]
+        for j in range(i + 1, n):
+            acc -= A[i, j] * b[j]
+        b[i] = acc / A[i, i]
+        if not np.isfinite(b[i]):
+            return False
+    return True
+
+
+@jit
+def _border_rhs(R, d, v, u_pred):  # pragma: no cover - compiled
+    """Right-hand side (-R, -d^T (v - u_pred)) of a Newton step (-R alone when d is empty)."""
+    n = R.shape[0]
+    m = n + (1 if d.shape[0] else 0)
+    rhs = np.empty(m)
+    for i in range(n):
+        rhs[i] = -R[i]
+    if m > n:
+        c = 0.0
+        for i in range(m):
+            c += d[i] * (v[i] - u_pred[i])
+        rhs[n] = -c
+    return rhs
+
+
+@jit
+def _normalise(t):  # pragma: no cover - compiled
+    """(t / |t|, ok); ok is False for a zero or non-finite norm."""
+    nt = 0.0
+    for i in range(t.shape[0]):
+        nt += t[i] * t[i]
+    nt = np.sqrt(nt)
+    if not np.isfinite(nt) or nt == 0:
+        return t, False
+    return t / nt, True
+
+
+@jit
+def _newton_direction_small(Jy, Jl, d, R, v, u_pred):  # pragma: no cover - compiled
+    """Newton step by the compiled elimination: ``(dv, ok)``."""
+    rhs = _border_rhs(R, d, v, u_pred)
+    ok = lu_solve(_bordered(Jy, Jl, d), rhs)
+    return rhs, ok
+
+
+@jit
+def _tangent_small(Jy, Jl, t_prev):  # pragma: no cover - compiled
+    """Unit tangent by the compiled elimination: ``(t, ok)``."""
+    n = Jy.shape[0]
+    t = np.zeros(n + 1)
+    t[n] = 1.0
+    if not lu_solve(_bordered(Jy, Jl, t_prev), t):
+        return t, False
+    return _normalise(t)
+
+
+def _lapack_solve(A, b):
+    """Solve A x = b by LAPACK ``dgesv``: ``(x, ok)``, ok False for a singular matrix or a non-finite x."""
+    try:
+        x = np.linalg.solve(A, b)
+    except np.linalg.LinAlgError:
+        return b, False
+    return x, bool(np.isfinite(x).all())
+
+
+def _small(Jy) -> bool:
+    """True when the bordered system of R_y is solved by the compiled elimination (see the module docstring)."""
+    return Jy.shape[0] + 1 <= config.CONT_SMALL_SOLVE
+
+
+def _newton_direction(Jy, Jl, d, R, v, u_pred):
+    """Newton step of R(y, lam) = 0 (and d^T (v - u_pred) = 0 when d has entries): ``(dv, ok)``."""
+    if _small(Jy):
+        return _newton_direction_small(Jy, Jl, d, R, v, u_pred)
+    return _lapack_solve(_bordered(Jy, Jl, d), _border_rhs(R, d, v, u_pred))
+
+
+def _tangent(Jy, Jl, t_prev):
+    """Unit t with [R_y R_lam] t = 0, t_prev^T t = 1 (normalised), or None if singular."""
+    f = np.float64
+    Jl = np.ascontiguousarray(Jl, dtype=f).reshape(-1)
+    Jy = np.ascontiguousarray(Jy, dtype=f).reshape(Jl.size, -1)
+    t_prev = np.ascontiguousarray(t_prev, dtype=f)
+    if _small(Jy):
+        t, ok = _tangent_small(Jy, Jl, t_prev)
+    else:
+        e = np.zeros(Jy.shape[0] + 1)
+        e[-1] = 1.0
+        t, ok = _lapack_solve(_bordered(Jy, Jl, t_prev), e)
+        if ok:
+            t, ok = _normalise(t)
+    return t if ok else None
+
+
+def _as_arrays(R, Jy, Jl):
+    """(R, R_y, R_lam) as C-contiguous float64 arrays of dims 1, 2, 1 (no copy when they are)."""
+    f = np.float64
+    if (type(R) is np.ndarray and type(Jy) is np.ndarray and type(Jl) is np.ndarray and R.dtype == f
+            and Jy.dtype == f and Jl.dtype == f and R.ndim == 1 and Jy.ndim == 2 and Jl.ndim == 1
+            and R.flags.c_contiguous and Jy.flags.c_contiguous and Jl.flags.c_contiguous):
+        return R, Jy, Jl
+    R = np.ascontiguousarray(R, dtype=f).reshape(-1)
+    return R, np.ascontiguousarray(Jy, dtype=f).reshape(R.size, -1), np.ascontiguousarray(Jl, dtype=f).reshape(-1)

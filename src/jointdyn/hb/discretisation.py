@@ -1,0 +1,351 @@
+"""The automatic choice of harmonics and samples of a harmonic-balance branch.
+
+A branch is computed at a first level (H, Ns); every refined peak is solved
+again with more harmonics and with more samples, and where its amplitude
+changes by more than ``config.HB_AUTO_RTOL`` the branch is computed again
+at the level the peaks ask for (:func:`_adaptive_branch`). While the first
+branch is continued, a passed resonance that already asks for a finer level
+stops it (:class:`_PeakWatch`). Each branch at a fixed level is
+:func:`jointdyn.hb.branch.continued_branch`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _validate as V
+from .. import config
+from ..continuation import ContinuationOptions, ContinuationStatus, newton, refine_maximum
+from .branch import _Request, _scales, _Tracker, continued_branch
+from .condense import make_problem
+from .results import AUTO, DiscretisationCheck, HBBranch, HBPeak
+
+
+def _fixed_branch(req: _Request, level, auto=(False, False), watch: bool = False):
+    """The branch with H harmonics and Ns samples, ``level = (H, Ns)``: a :class:`~jointdyn.hb.branch._Draft`,
+    or, with ``watch``, a :class:`_Refine` where a peak asked for a finer level while the branch was continued
+    (``auto``: which of (harmonics, samples) may change; :class:`_PeakWatch`)."""
+    watch_for = (lambda tr, opt: _PeakWatch(tr, req, level, auto, opt)) if watch and any(auto) else None
+    return continued_branch(req, level, watch_for)
+
+
+def _first_level(harmonics, samples):
+    """((H, Ns) of the first branch, (harmonics auto, samples auto)); validates both."""
+    auto_h, auto_s = harmonics == AUTO, samples == AUTO
+    for name, v, auto in (("harmonics", harmonics, auto_h), ("samples", samples, auto_s)):
+        if isinstance(v, str) and not auto:
+            raise ValueError(f"{name} must be an integer or {AUTO!r}, got {v!r}")
+    H = config.HB_HARMONICS if auto_h else V.positive_int("harmonics", harmonics, 1)
+    if auto_s:
+        return (H, max(config.HB_SAMPLES, 2 * H + 2)), (auto_h, auto_s)
+    return (H, V.positive_int("samples", samples, 2 * H + 2)), (auto_h, auto_s)
+
+
+def _check_levels(level, auto):
+    """(H, Ns) of the harmonics check and of the samples check one level above ``level`` (None: not made)."""
+    H, Ns = level
+    h2 = 2 * H + 1
+    by_h = (h2, max(Ns, 2 * h2 + 2) if auto[1] else Ns) if auto[0] else None
+    if by_h is not None and by_h[1] < 2 * h2 + 2:
+        by_h = None  # the samples fixed by the caller cannot carry more harmonics
+    return by_h, ((H, 2 * Ns) if auto[1] else None)
+
+
+def _next_level(level, auto, bad_h: bool, bad_s: bool):
+    """The level the checks ask for, within ``config.HB_AUTO_MAX_*`` (equal to ``level``: no refinement).
+
+    The samples first: with too few, the sampling error of the contact
+    force also moves the solution with more harmonics, so H is raised
+    only once the samples pass their check.
+    """
+    by_h, by_s = _check_levels(level, auto)
+    if bad_s and by_s is not None:
+        return by_s if by_s[1] <= config.HB_AUTO_MAX_SAMPLES else level
+    if bad_h and by_h is not None and by_h[0] <= config.HB_AUTO_MAX_HARMONICS:
+        return by_h
+    return level
+
+
+def _at_level(req: _Request, condensed: bool, X, level):
+    """(tracker of the problem with ``level = (H, Ns)``, the harmonics X there in its scaled unknowns,
+    zero above their H)."""
+    problem = make_problem(req.system, condense=condensed, response_dofs=(req.dof,), harmonics=level[0],
+                           samples=level[1], parameter=req.parameter, gamma=req.gamma)
+    tr = _Tracker(problem, _scales(problem, req.start), req.dof)
+    Xm = np.asarray(X).reshape(-1, problem.n)
+    X0 = np.zeros((problem.nh, problem.n))
+    X0[: min(Xm.shape[0], problem.nh)] = Xm[: problem.nh]
+    return tr, X0.ravel() / tr.scales[0]
+
+
+def _solve_at(req: _Request, condensed: bool, lam: float, X, level):
+    """(amplitude of the response DOF (m; NaN where Newton failed), X) at parameter ``lam`` with
+    ``level = (H, Ns)``, by Newton from the harmonics X (zero above their H)."""
+    tr, y0 = _at_level(req, condensed, X, level)
+    xs, _, ps = tr.scales
+    y, ok, _ = newton(tr.residual, y0, lam / ps, req.options)
+    return (tr.amplitudes(y)[0] if ok else math.nan), y * xs
+
+
+def _first_step_amplitude(req: _Request, condensed: bool, lam: float, X, level) -> float:
+    """Amplitude of the response DOF (m) after one Newton step from the harmonics X at parameter
+    ``lam`` with ``level = (H, Ns)``: the solution's amplitude there to first order in the change
+    (one evaluation; NaN where the step cannot be made)."""
+    tr, y0 = _at_level(req, condensed, X, level)
+    R, JX, _ = tr.residual(y0, lam / tr.scales[2])
+    try:
+        dy = np.linalg.solve(JX, -R)
+    except np.linalg.LinAlgError:
+        return math.nan
+    y = y0 + dy
+    return tr.amplitudes(y)[0] if np.all(np.isfinite(y)) else math.nan
+
+
+def _change(amp: float, ref: float, scale: float) -> float:
+    """|amp - ref| / scale (inf where the check solve failed)."""
+    return abs(amp - ref) / scale if math.isfinite(amp) and scale > 0 else math.inf
+
+
+def _peak_level(req: _Request, condensed: bool, pk: HBPeak, scale: float, level, auto):
+    """(level at which the peak converges (or the bound), (harmonics change, samples change) at ``level``).
+
+    The peak is solved with more harmonics and with more samples
+    (:func:`_check_levels`); the changes are relative to ``scale`` (the
+    highest peak of the branch, so that a small secondary peak asks for no
+    more than its share of the curve). Where a change exceeds
+    ``config.HB_AUTO_RTOL`` the peak is solved at the refined level and
+    checked there again.
+    """
+    return _peak_levels(req, condensed, pk, scale, level, auto)[:2]
+
+
+def _peak_levels(req: _Request, condensed: bool, pk, scale: float, level, auto):
+    """:func:`_peak_level`, and whether the peak's check passed at the level returned (not at a bound)."""
+    at, X, amp, first = level, pk.X, pk.amplitude_m, None
+    while True:
+        solved = {lv: _solve_at(req, condensed, pk.lam, X, lv) for lv in _check_levels(at, auto) if lv}
+        ch = tuple(_change(solved[lv][0], amp, scale) if lv else math.nan for lv in _check_levels(at, auto))
+        first = ch if first is None else first
+        nxt = _next_level(at, auto, ch[0] > config.HB_AUTO_RTOL, ch[1] > config.HB_AUTO_RTOL)
+        if nxt == at:
+            return at, first, not (ch[0] > config.HB_AUTO_RTOL or ch[1] > config.HB_AUTO_RTOL)
+        amp, X = solved[nxt] if nxt in solved else _solve_at(req, condensed, pk.lam, X, nxt)
+        at = nxt
+        if not math.isfinite(amp):
+            return at, first, False
+
+
+def _combined_target(req: _Request, condensed: bool, peaks, scale: float, level, auto, wanted):
+    """The level of the next branch: the most harmonics and the most samples that the peaks ask for
+    (``wanted``: their levels from :func:`_peak_level`).
+
+    Where the peaks ask for both more harmonics and more samples, the
+    harmonics are checked again at the higher samples first (the peaks
+    solved there): a harmonics check made with too few samples also
+    measures the sampling error of the contact force, and more harmonics
+    cost as much as more samples in every AFT evaluation of the branch.
+    """
+    target = (max([level[0]] + [w[0] for w in wanted]), max([level[1]] + [w[1] for w in wanted]))
+    if not (target[0] > level[0] and target[1] > level[1]):
+        return target
+    at = (level[0], target[1])
+    again = []
+    for pk in peaks:
+        amp, X = _solve_at(req, condensed, pk.lam, pk.X, at)
+        if not math.isfinite(amp):
+            return target
+        again.append(_peak_level(req, condensed, dataclasses.replace(pk, X=X, amplitude_m=amp),
+                                 scale, at, auto)[0])
+    return (max([at[0]] + [w[0] for w in again]), max([at[1]] + [w[1] for w in again]))
+
+
+@dataclass(frozen=True)
+class _Refine:
+    """What :func:`_fixed_branch` returns where a peak asked for a finer level during the continuation:
+    that level, the peak (a :class:`_Candidate`) and the level of the branch it stopped."""
+
+    level: tuple
+    peak: _Candidate = dataclasses.field(repr=False)
+    stopped: tuple
+
+
+@dataclass(frozen=True)
+class _Candidate:
+    """A peak of a branch being continued (the fields of :class:`HBPeak` that the discretisation check
+    reads)."""
+
+    lam: float
+    X: np.ndarray
+    amplitude_m: float
+
+
+class _PeakWatch:
+    """The tracker's monitor, and the discretisation check of the first level's resonances as soon as
+    they are passed.
+
+    The highest accepted point of the segment so far is checked once the
+    amplitude has fallen below ``config.HB_AUTO_EARLY_DROP`` times its
+    amplitude (and again for a higher point later): one Newton step from
+    it with twice the samples (with 2H + 1 harmonics where the samples are
+    fixed), one evaluation, gives the change of its amplitude to first
+    order. Where that exceeds ``config.HB_AUTO_RTOL`` of its amplitude, the
+    maximum is refined between the point and its neighbours and checked as
+    the finished branch's peaks are (:func:`_peak_levels`,
+    :func:`_combined_target`, relative to its own amplitude); where that
+    converges at a finer level, the branch stops there (``target``: a
+    :class:`_Refine`): the rest of it would be discarded, and continuing
+    it costs more than the check. A stop is made relative to the peak's own
+    amplitude, the finished branch's check relative to its highest peak:
+    :func:`_adaptive_branch` keeps a stop only where the finished branch is
+    converged and the peak asks for the same level relative to the
+    finished branch's highest peak (:func:`_confirmed`). The finished
+    branch's peaks are checked again, so a branch that passes here can
+    still be refined.
+    """
+
+    def __init__(self, tr: _Tracker, req: _Request, level, auto, opt: ContinuationOptions):
+        self.tr, self.req, self.level, self.auto, self.opt = tr, req, level, auto, opt
+        self.points = []  # (log q, lam scaled, y) of the segment's accepted points
+        self.top = None  # index in points of the highest point not checked yet
+        self.checked = -math.inf  # log q of the highest point checked
+        self.target = None
+
+    def restart(self):
+        """Forget the segment's points (a new segment starts)."""
+        self.points, self.top = [], None
+
+    def __call__(self, y, lam_s):
+        stop = self.tr.monitor(y, lam_s)
+        if stop is not None:
+            return stop
+        g = self.tr.observe(y, lam_s)
+        pts = self.points
+        pts.append((g, lam_s, np.array(y)))
+        if not math.isfinite(g):
+            return None
+        if g > self.checked and (self.top is None or g > pts[self.top][0]):
+            self.top = len(pts) - 1
+            return None
+        if self.top is None or g >= pts[self.top][0] + math.log(config.HB_AUTO_EARLY_DROP):
+            return None
+        i, self.top = self.top, None
+        self.checked = pts[i][0]
+        return self._check(i)
+
+    def _check(self, i: int):
+        tr = self.tr
+        xs, _, ps = tr.scales
+        g, lam_s, y = self.points[i]
+        condensed = tr.problem.condensed
+        by_h, by_s = _check_levels(self.level, self.auto)
+        first = by_s if by_s is not None else by_h  # the cheaper check (more samples are checked first)
+        if first is None or i == 0:
+            return None
+        amp = tr.amplitudes(y)[0]
+        if _change(_first_step_amplitude(self.req, condensed, lam_s * ps, y * xs, first), amp, amp) \
+                <= config.HB_AUTO_RTOL:
+            return None  # the finished branch's check decides
+        # the peak as the finished branch has it: refined between the point and its neighbours
+        last = tr.last
+        near = self.points[i - 1:i + 2]
+        y_pk, lam_pk, g_pk, _ = refine_maximum(tr.residual, tr.observe, [p[2] for p in near],
+                                               [p[1] for p in near], self.opt)
+        tr.last = last
+        if not g_pk >= g:
+            y_pk, lam_pk = y, lam_s
+        pk = _Candidate(lam=float(lam_pk * ps), X=y_pk * xs, amplitude_m=float(tr.amplitudes(y_pk)[0]))
+        target, converged = _peak_target(self.req, condensed, pk, pk.amplitude_m, self.level, self.auto)
+        if not converged or target == self.level:
+            return None  # the finished branch decides
+        self.target = _Refine(target, pk, self.level)
+        name = tr.problem.parameter.name
+        return ContinuationStatus.STOPPED, (f"the peak near {name} = {pk.lam:.6g} asks for H = {target[0]}, "
+                                            f"Ns = {target[1]}")
+
+
+def _peak_target(req: _Request, condensed: bool, pk, scale: float, level, auto):
+    """(the level the peak alone asks for, checked from ``level`` with its changes relative to
+    ``scale``; whether its check passed there)."""
+    wanted, _, converged = _peak_levels(req, condensed, pk, scale, level, auto)
+    return _combined_target(req, condensed, [pk], scale, level, auto, [wanted]), converged
+
+
+def _confirmed(req: _Request, condensed: bool, stop: _Refine, scale: float, auto) -> bool:
+    """Whether the peak that stopped a branch asks for the same level with its changes relative to
+    ``scale`` (the highest peak of the finished branch) as relative to its own amplitude."""
+    return _peak_target(req, condensed, stop.peak, scale, stop.stopped, auto) == (stop.level, True)
+
+
+def _watched_branch(req: _Request, level, auto, levels, retry_failed: bool, watch: bool):
+    """(branch, its level, the :class:`_Refine` of a stop or None): :func:`_fixed_branch` at ``level``
+    (with ``watch``, watched by a :class:`_PeakWatch`), computed again at the level a peak asks for where
+    one stops it, and with twice the samples where a branch asked for fails (after a stop by a peak, or
+    where ``retry_failed``: a finer level may fail where the coarser went on, because a closed form's
+    force jumps with the normal load and Newton fails at one sampling and not at the next). Each further
+    level is appended to ``levels``."""
+    br = _fixed_branch(req, level, auto, watch=watch)
+    stop = None
+    if isinstance(br, _Refine):
+        stop = br
+        level, retry_failed = stop.level, True
+        levels.append(level)
+        br = _fixed_branch(req, level, auto)
+    while retry_failed and br.status is ContinuationStatus.FAILED and auto[1] \
+            and 2 * level[1] <= config.HB_AUTO_MAX_SAMPLES:
+        level = (level[0], 2 * level[1])
+        levels.append(level)
+        br = _fixed_branch(req, level, auto)
+    return br, level, stop
+
+
+def _worst(values) -> float:
+    """Largest of the values that are not NaN (NaN when there is none)."""
+    v = [x for x in values if not math.isnan(x)]
+    return max(v) if v else math.nan
+
+
+def _adaptive_branch(req: _Request, level, auto, watch: bool = True) -> HBBranch:
+    """The branch at ``level``, computed again at a finer level while its peaks ask for one (``auto``:
+    which of (harmonics, samples) may change); with its :class:`DiscretisationCheck`.
+
+    With ``watch``, the first branch stops at a passed resonance that asks
+    for a finer level (:class:`_PeakWatch`); where the finished branch does
+    not confirm such a stop (it is not converged, or the peak asks for
+    another level relative to the finished branch's highest peak: the stop
+    was made at a resonance lower than one found later), the whole choice
+    is made again without stops.
+    """
+    first = level
+    levels = [level]
+    if not any(auto):
+        return _fixed_branch(req, level).branch()
+    br, level, stop = _watched_branch(req, level, auto, levels, False, watch)
+    while True:
+        scale = max([pk.amplitude_m for pk in br.peaks], default=0.0)
+        checks = [_peak_level(req, br.problem.condensed, pk, scale, level, auto) for pk in br.peaks]
+        target = _combined_target(req, br.problem.condensed, br.peaks, scale, level, auto, [c[0] for c in checks])
+        if target == level:
+            break
+        levels.append(target)
+        br, level, _ = _watched_branch(req, target, auto, levels, br.status is not ContinuationStatus.FAILED, False)
+    by_h, by_s = _check_levels(level, auto)
+    ch_h, ch_s = _worst(c[1][0] for c in checks), _worst(c[1][1] for c in checks)
+    converged = not (ch_h > config.HB_AUTO_RTOL or ch_s > config.HB_AUTO_RTOL)
+    if stop is not None and not (converged and _confirmed(req, br.problem.condensed, stop, scale, auto)):
+        return _adaptive_branch(req, first, auto, watch=False)
+    check = DiscretisationCheck(harmonics_auto=auto[0], samples_auto=auto[1], levels=tuple(levels),
+                                check_harmonics=by_h[0] if by_h else 0, check_samples=by_s[1] if by_s else 0,
+                                harmonics_change=ch_h, samples_change=ch_s, peaks=len(checks),
+                                rtol=config.HB_AUTO_RTOL, converged=converged)
+    br = br.branch()
+    message = br.message
+    if not converged:
+        message += (f"; the peak amplitude is not converged in the discretisation at its bound (H = {level[0]}, "
+                    f"Ns = {level[1]}): it changes by {100 * _worst([ch_h, ch_s]):.3g} % with "
+                    f"{check.check_harmonics or level[0]} harmonics or {check.check_samples or level[1]} samples "
+                    f"(tolerance {100 * config.HB_AUTO_RTOL:g} %)")
+    return dataclasses.replace(br, discretisation=check, message=message)

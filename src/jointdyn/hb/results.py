@@ -1,0 +1,276 @@
+"""What harmonic balance returns: the branch, its peaks, the per-point status, the check of the
+discretisation and the solution at one point.
+
+Frozen dataclasses built by :mod:`jointdyn.hb.branch` (a branch at a fixed
+discretisation), :mod:`jointdyn.hb.discretisation` (the automatic choice of
+harmonics and samples) and :mod:`jointdyn.hb.frc` (the entry points).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import config
+from ..continuation import ContinuationStatus
+from ..status import Status
+from .parameters import GAMMA
+from .problem import HBProblem
+
+__all__ = ["AUTO", "JOINED", "DiscretisationCheck", "HBBranch", "HBPeak", "HBSolution", "PointStatus", "SolveStatus"]
+
+
+class PointStatus(Status):
+    """How a point of a harmonic-balance branch joins the point before it (Dataset ``point_status``)."""
+
+    START = "start", "first point of a segment: not joined to the point before it", True
+    JOINED = "joined", "joined to the previous point along the branch", True
+    CORNER = "corner", ("joined to the previous point past a sharp corner of the branch (found at fixed "
+                        "parameter; the curve is continuous)"), True
+    AFTER_JUMP = "after-jump", ("reached by a jump over a discontinuity of the contact force: not joined to the "
+                                "previous point")
+    STOPPED = "stopped", "last point of a segment that stopped short (the branch message says where and why)"
+
+
+#: point statuses joined to the point before them: a branch is drawn as one line per run of them
+#: (:func:`jointdyn.figures.curves.branch_pieces`)
+JOINED = (PointStatus.JOINED.value, PointStatus.CORNER.value)
+
+#: ``harmonics`` / ``samples`` value asking for the automatic choice (:func:`continue_hb`)
+AUTO = config.HB_AUTO
+
+
+@dataclass(frozen=True)
+class DiscretisationCheck:
+    """The convergence check of a branch's peaks in the harmonics and the samples.
+
+    Every refined peak is solved again at its parameter value with 2H + 1
+    harmonics (same samples, at least 2(2H + 1) + 2) and with 2 Ns samples
+    (same harmonics), from the peak's own solution; the changes are
+    relative to the peak's amplitude of the response DOF.
+
+    Attributes
+    ----------
+    harmonics_auto, samples_auto : bool
+        Which of the two were chosen automatically.
+    levels : tuple of (int, int)
+        (H, Ns) of every branch computed, the last one reported.
+    check_harmonics, check_samples : int
+        H and Ns of the check solves at the last level.
+    harmonics_change, samples_change : float
+        Largest change of a peak amplitude with ``check_harmonics``
+        harmonics and with ``check_samples`` samples, relative to the
+        highest peak of the branch (NaN without a peak; inf where a check
+        solve did not converge).
+    peaks : int
+        Peaks checked.
+    rtol : float
+        Tolerance on the changes (``config.HB_AUTO_RTOL``).
+    converged : bool
+        Both changes within ``rtol`` (True without a peak).
+    """
+
+    harmonics_auto: bool
+    samples_auto: bool
+    levels: tuple
+    check_harmonics: int
+    check_samples: int
+    harmonics_change: float
+    samples_change: float
+    peaks: int
+    rtol: float
+    converged: bool
+
+
+@dataclass(frozen=True)
+class HBPeak:
+    """A maximum of the response amplitude along a branch, refined between its points.
+
+    Attributes
+    ----------
+    lam : float
+        Parameter value at the peak.
+    gamma : float
+        w / w0 at the peak.
+    X : ndarray
+        Harmonic coefficients there, m.
+    amplitude_m : float
+        Half peak-to-peak amplitude of the response DOF, m.
+    amplitude_q : float
+        kt X / fy of the first contact.
+    segment : int
+        Segment of the branch it lies on.
+    refined : bool
+        True when the refinement converged (else the best point found).
+    at_stop : bool
+        True when the highest point found is where a segment continued
+        back over a jump stopped (the corrector could not follow the curve
+        further, typically at a sharp fold of a non-smooth branch): not
+        refined; the maximum of the branch is at least this amplitude and
+        lies between this point and the point the jump left.
+    """
+
+    lam: float
+    gamma: float
+    X: np.ndarray
+    amplitude_m: float
+    amplitude_q: float
+    segment: int
+    refined: bool
+    at_stop: bool = False
+
+
+@dataclass(frozen=True)
+class HBBranch:
+    """A harmonic-balance branch with stability and amplitudes (built by :func:`continue_hb`).
+
+    Attributes
+    ----------
+    problem : HBProblem
+    parameter : str
+        Name of the continuation parameter.
+    status : ContinuationStatus
+        ``complete`` only when the computed points cover the requested
+        range; ``unbounded`` when the response grows without bound inside
+        it (both flanks computed); otherwise what stopped it (``failed``,
+        ``turned-back``, ``max-points``, ``stopped``).
+    message : str
+        Where and why each segment stopped, and the parts of the range
+        not computed.
+    lam : ndarray (points,)
+        Parameter values.
+    X : ndarray (points, n(2H+1))
+        Harmonic coefficients, m.
+    segment : ndarray of int (points,)
+        0 for the branch from the start, 1 for the one continued back from
+        the end after a stop short of it; then one per jump, continued back
+        from the point after the jump towards the point it left (the
+        stretch the jump passed over, where a peak may lie).
+    fold : ndarray of bool
+        Turning points in the parameter (see :func:`branch_dataset`).
+    gap : ndarray of bool
+        Point reached by a jump over a discontinuity of the contact force
+        (do not join it to the previous point).
+    counters : dict
+    stable : ndarray of bool
+        Hill's method.
+    growth : ndarray
+        max Re(s) / w of the selected Floquet exponents.
+    passes, periodic_error, force_period : ndarray
+        AFT periods marched, last-pass force difference (N), and the period
+        of the marched force in forcing periods (1; 2 when the law's state
+        alternates between two cycles, the mean of both is then used; 0 if
+        it did not repeat within ``config.HB_MAX_PASSES``).
+    response0 : ndarray (points, 3)
+        (half peak-to-peak, mean, max |x|) of the response DOF where the
+        continuation monitor computed them (NaN elsewhere; see :meth:`response`).
+    point_status : ndarray of PointStatus (points,)
+        How each point joins the one before it.
+    peaks : tuple of HBPeak
+        Maxima of the response amplitude, refined between the points.
+    uncovered : tuple of (float, float)
+        Parts of the requested range without a computed point (empty for a
+        complete branch; for an unbounded one, where the response has no
+        bound).
+    response_dof : int
+        DOF of ``response0``, of the peaks and of the step control.
+    discretisation : DiscretisationCheck or None
+        The automatic choice of harmonics and samples and the convergence
+        check of the peaks (None when both were given).
+    """
+
+    problem: HBProblem
+    parameter: str
+    status: ContinuationStatus
+    message: str
+    lam: np.ndarray
+    X: np.ndarray
+    segment: np.ndarray
+    fold: np.ndarray
+    gap: np.ndarray
+    counters: dict
+    stable: np.ndarray
+    growth: np.ndarray
+    passes: np.ndarray
+    periodic_error: np.ndarray
+    force_period: np.ndarray
+    response0: np.ndarray
+    point_status: np.ndarray
+    peaks: tuple
+    uncovered: tuple
+    response_dof: int
+    discretisation: DiscretisationCheck | None = None
+
+    def gamma(self):
+        """gamma = w / w0 per point."""
+        if self.parameter == GAMMA.name:
+            return self.lam.copy()
+        return np.full(self.lam.size, self.problem.gamma_fixed)
+
+    def response(self, dof: int | None = None):
+        """(amplitude_m, offset_m, max_abs_m) per point for DOF ``dof`` (default: the response DOF)."""
+        dof = self.response_dof if dof is None else dof
+        out = self.response0.copy() if dof == self.response_dof else np.full((self.lam.size, 3), np.nan)
+        # rows computed by the monitor for the same X are kept; the others computed here
+        for i in np.flatnonzero(np.isnan(out[:, 0])):
+            out[i] = self.problem.amplitudes(self.X[i], dof, self.lam[i])
+        return out[:, 0], out[:, 1], out[:, 2]
+
+
+class SolveStatus(Status):
+    """Outcome of a harmonic-balance solve at one point (:attr:`HBSolution.status`)."""
+
+    CONVERGED = "converged", "Newton converged: the scaled residual is within the tolerance", True
+    NOT_CONVERGED = "not-converged", ("Newton did not converge within its iterations: the last iterate is "
+                                      "returned, not a solution")
+
+
+@dataclass(frozen=True)
+class HBSolution:
+    """One harmonic-balance solution at fixed parameters (built by :func:`harmonic_balance`).
+
+    Attributes
+    ----------
+    problem : HBProblem
+    X : ndarray
+        Harmonic coefficients (harmonic-major), m.
+    converged : bool
+        Newton converged (``status`` says the same with a message).
+    iterations : int
+    residual_norm : float
+        max |R| at X, N.
+    amplitude_m, offset_m, max_abs_m : float
+        Half peak-to-peak, mean and max |x| of ``response_dof``, m.
+    stable : bool
+        Hill's method.
+    growth : float
+        max Re(s) / w of the selected Floquet exponents.
+    multipliers : ndarray complex
+        Floquet multipliers exp(2 pi s / w) of the selected exponents.
+    aft_info : ndarray
+        AFT diagnostics (see ``jointdyn.hb._aft.INFO_*``).
+    """
+
+    problem: HBProblem
+    X: np.ndarray
+    converged: bool
+    iterations: int
+    residual_norm: float
+    amplitude_m: float
+    offset_m: float
+    max_abs_m: float
+    stable: bool
+    growth: float
+    multipliers: np.ndarray
+    aft_info: np.ndarray
+
+    @property
+    def status(self) -> SolveStatus:
+        """``converged`` or ``not-converged`` (:class:`SolveStatus`)."""
+        return SolveStatus.CONVERGED if self.converged else SolveStatus.NOT_CONVERGED
+
+    @property
+    def message(self) -> str:
+        """The status's message, with the residual and the iterations."""
+        return f"{self.status.message} (max |R| = {self.residual_norm:.4g} N after {self.iterations} iterations)"
