@@ -69,7 +69,10 @@ myst_all_links_external = False
 # --- autodoc / numpydoc -------------------------------------------------------
 autosummary_generate = True
 autosummary_imported_members = True
-autodoc_default_options = {"members": False}
+# no "members" default here: it would override the ``:members:`` of the
+# class template (docs/_templates/autosummary/class.rst), and the class pages
+# would list no method or property (tests/test_docs.py checks they do)
+autodoc_default_options: dict[str, object] = {}
 autodoc_typehints = "none"
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
@@ -190,9 +193,6 @@ def cli_help() -> str:
     return "\n".join(out)
 
 
-write_api_pages()
-
-
 # ------------------------------------------------------------------------------
 # Docstrings write absolute values as |x|, which reStructuredText would read
 # as a substitution reference: escape the bars outside literal text
@@ -235,6 +235,9 @@ def constant_values(app, what, name, obj, options, lines):
 
 
 def setup(app):
+    # the API pages are written before autosummary reads them (builder-inited);
+    # here rather than at import, so that tests can import this file
+    write_api_pages()
     app.connect("autodoc-process-docstring", constant_values, priority=400)
     # after numpydoc (priority 500) has turned the sections into reST
     app.connect("autodoc-process-docstring", escape_absolute_values, priority=600)
