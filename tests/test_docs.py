@@ -206,3 +206,18 @@ def test_relative_links_resolve(page):
         if not (base / file).exists():
             broken.append(target)
     assert not broken, f"{page}: links to missing files: {broken}"
+
+
+#: a reference to the project's internal issue tracker ("issue 9", "issue #9")
+_ISSUE = re.compile(r"\bissues? #?\d+\b", re.I)
+
+
+def test_user_pages_cite_no_internal_issue_numbers():
+    """README, the docs, the examples and the docstrings speak for themselves:
+    an internal issue number means nothing to a user."""
+    files = [ROOT / "README.md", ROOT / "CHANGELOG.md", *DOCS.glob("**/*.md"), *DOCS.glob("scripts/*.py"),
+             *(ROOT / "examples").glob("*.py"), *(ROOT / "src" / "jointdyn").glob("**/*.py")]
+    offenders = [f"{p.relative_to(ROOT)}:{no}: {line.strip()[:100]}"
+                 for p in files if not {"_build", "generated", "auto_examples"} & set(p.parts)
+                 for no, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) if _ISSUE.search(line)]
+    assert not offenders, "\n".join(offenders)
