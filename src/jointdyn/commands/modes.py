@@ -96,13 +96,17 @@ def _validate(args):
         if args.model is not None or args.law_param or args.n is not None:
             raise ValueError("--model, --law-param and --n cannot be combined with --system: the system file "
                              "names the law of each contact")
-        system = load_system_file(args).system
+        sf = load_system_file(args)
+        system = sf.system
         label = Path(args.system).name
+        args.title = sf.title  # the file's title, in the JSON, modes.nc and modes.png
+        args.figure_label = f"{sf.title} ({label})"
     else:
         args.model = config.MODEL if args.model is None else V.choice("--model", args.model, law_names())
         args.law_params = law_params(args)
         system = System.paper_damper(eta=0.0, model=args.model, law_params=args.law_params)
         label = f"paper's damper, {args.model}"
+        args.title = args.figure_label = label
     check_free_vibration(system, args.method.upper(), springs=args.method == "epmc")
     amps = amplitude_range(system, None if args.amplitude is None else parse_amplitude(args.amplitude))
     args.output_dof = output_dof_of(system, args.output_dof)
@@ -143,7 +147,7 @@ def _jsonable(values):
 def _result(args, ds, label) -> dict:
     keys = ("amplitude_m", "amplitude_q", "omega_rad_s", "frequency_hz", "damping_ratio", "damping_ratio_contacts",
             "damping_ratio_viscous", "energy_contact_j")
-    return {"method": args.method, "system": label, "mode": int(ds.attrs["linear_mode"]),
+    return {"method": args.method, "system": label, "title": args.title, "mode": int(ds.attrs["linear_mode"]),
             "output_dof": int(ds.attrs["output_dof"]), "harmonics": int(ds.attrs["harmonics"]),
             "samples": int(ds.attrs["samples"]), "omega_linear_rad_s": float(ds.attrs["omega_linear_rad_s"]),
             "branches": [{k: _jsonable(ds[k].values) for k in keys}],
@@ -152,7 +156,8 @@ def _result(args, ds, label) -> dict:
 
 def _plot(ds, title: str, path: Path) -> None:
     from .._io import atomic_path
-    from ..figures import pyplot
+    from ..figures import pyplot, use_math_text
+    from ._frc_report import wrap
 
     plt = pyplot()
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(6.4, 6.0), sharex=True)
@@ -167,8 +172,9 @@ def _plot(ds, title: str, path: Path) -> None:
     for ax in (ax1, ax2):
         ax.set_xscale("log")
         ax.grid(alpha=0.3, which="both")
-    ax1.set_title(f"{ds.attrs['method'].upper()} backbone of mode {ds.attrs['linear_mode']} ({title}); "
-                  f"status {ds.attrs['status']}", fontsize=9)
+    ax1.set_title(wrap(f"{ds.attrs['method'].upper()} backbone of mode {ds.attrs['linear_mode']} ({title}); "
+                       f"status {ds.attrs['status']}"), fontsize=9)
+    use_math_text(fig)
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=120)
@@ -190,7 +196,8 @@ def run(args) -> int:
     system, amps, label = _validate(args)
     backbone, ds = _compute(args, system, amps)
     if args.out is not None:
-        _write(ds, Path(args.out), label)
+        ds.attrs["title"] = args.title
+        _write(ds, Path(args.out), args.figure_label)
     result = _result(args, ds, label)
     if args.json:
         print(json.dumps(result))
