@@ -163,6 +163,11 @@ SWEEP_POOL = "process"
 SWEEP_STATUS = ("periodic", "not-settled", "unbounded")
 #: code of a point that was not computed (never written by a finished sweep)
 SWEEP_STATUS_MISSING = -1
+#: why a swept point is not-settled (``not_settled_reason``; index = code, 0
+#: for every other point): still converging at the period budget, stalled
+#: (quasi-periodic or chaotic), or repeating only after more than
+#: SS_MAX_MULTIPLE periods
+SWEEP_NOT_SETTLED_REASONS = ("none", "slowly-converging", "quasi-periodic-or-chaotic", "long-period")
 #: consecutive points of a line solved as one task and saved as one resume
 #: checkpoint (an interrupt stops a task after its current point, so this
 #: bounds what a killed run loses, not what an interrupted one loses)

@@ -12,7 +12,7 @@ import textwrap
 import numpy as np
 
 __all__ = ["output_dofs", "dof_mm", "y_values", "peak_value", "y_label", "first_dof_suffix", "wrap",
-           "print_system_table"]
+           "print_system_table", "reason_name", "status_cell", "print_notes"]
 
 #: characters per line of a wrapped plot title (fontsize 9 on a 6.4 in wide figure)
 TITLE_WIDTH = 80
@@ -76,6 +76,44 @@ def first_dof_suffix(result) -> str:
     return f", DOF {dofs[0]}" if len(dofs) > 1 else ""
 
 
+def reason_name(status_code, reason_code):
+    """Name of why a point is not-settled (None for the other points)."""
+    from .. import config
+
+    reasons = config.SWEEP_NOT_SETTLED_REASONS
+    if int(status_code) != config.SWEEP_STATUS.index("not-settled"):
+        return None
+    return reasons[int(reason_code)] if 0 < int(reason_code) < len(reasons) else "unknown"
+
+
+def status_cell(r, i: int) -> str:
+    """The status of point ``i`` of a sweep direction for the table: a
+    steady state that repeats every K > 1 forcing periods is ``periodic-KT``."""
+    status = r["status"][i]
+    multiple = r.get("period_multiple", [1] * (i + 1))[i]
+    return f"{status}-{multiple}T" if status == "periodic" and multiple > 1 else status
+
+
+#: what each not-settled reason means, for the notes under the table
+REASON_TEXT = {
+    "slowly-converging": "still converging when the period budget ran out",
+    "quasi-periodic-or-chaotic": "the mismatch over a period stopped shrinking: quasi-periodic or chaotic",
+    "long-period": "repeats only after more forcing periods than the largest multiple looked for",
+}
+
+
+def print_notes(result, digits: int) -> None:
+    """Under the table of a time sweep: what ``periodic-KT`` means, and why
+    each not-settled point did not settle."""
+    dirs = result["directions"]
+    if any(p > 1 for r in dirs.values() for p in r.get("period_multiple", [])):
+        print("periodic-KT: the steady state repeats every K forcing periods (period_multiple in the JSON and files)")
+    for d, r in dirs.items():
+        for g, reason in zip(r["gamma"], r.get("not_settled_reason", [])):
+            if reason is not None:
+                print(f"not settled at gamma {g:.{digits}g} ({d}): {reason}, {REASON_TEXT.get(reason, '')}".rstrip(", "))
+
+
 def _cell(value, ok: bool = True) -> str:
     return "-" if value is None or not ok or not np.isfinite(value) else f"{value:.5g}"
 
@@ -99,8 +137,9 @@ def print_system_table(result, digits: int, joined) -> None:
             for d in dirs:
                 status = result["directions"][d]["status"][i]
                 cells.append(" ".join(f"{_cell(v[i], status == 'periodic'):>12s}" for _, v in cols[d])
-                             + f" {status:>11s}")
+                             + f" {status_cell(result['directions'][d], i):>11s}")
             print(f"{g:<{w}.{digits}g} " + "  ".join(cells))
+        print_notes(result, digits)
         return
     print(f"status: {result['status']} {result['message']}")
     for br in result["branches"]:

@@ -382,6 +382,10 @@ def _run_time(args, gammas):
             "gamma": _jsonable(one.gamma.values),
             **{v: _jsonable(one[v].values) for v in ("amplitude_q", "amplitude_m", "offset_m", "max_abs_m")},
             "status": [status_name(c) for c in one.status.values],
+            # a steady state that repeats every K periods: K (1: the forcing period; 0: not periodic)
+            "period_multiple": [int(p) for p in one.period_multiple.values],
+            "not_settled_reason": [report.reason_name(s, r) for s, r in zip(one.status.values,
+                                                                            one.not_settled_reason.values)],
             "negative_dissipation": [bool(v) for v in one.negative_dissipation.values],
         }
         if "contact" in one.dims or "dof" in one.dims:
@@ -647,8 +651,9 @@ def _print_table(result) -> None:
                 r = result["directions"][d]
                 a = r["amplitude_q"][i]
                 cells.append(f"{'-' if a is None or r['status'][i] != 'periodic' else f'{a:.5g}':>12s} "
-                             f"{r['status'][i]:>11s}")
+                             f"{report.status_cell(r, i):>11s}")
             print(f"{gi:<{w}.{p}g} " + "  ".join(cells))
+        report.print_notes(result, p)
     else:
         print(f"status: {result['status']} {result['message']}")
         p = _digits([g for br in result["branches"] for g in br["gamma"]])

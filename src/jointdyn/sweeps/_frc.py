@@ -494,6 +494,9 @@ def _assemble(family, runs, directions, g, dofs, spp, loop_outputs):
         dtype = np.int32 if name in INT_VARIABLES else np.float64
         data[name] = (dims, _stack(runs, family, directions, name, (m,), dtype, 0 if name in INT_VARIABLES
                                    else np.nan), {"units": unit, "long_name": desc})
+    reasons = config.SWEEP_NOT_SETTLED_REASONS
+    data["not_settled_reason"][2].update(flag_values=np.arange(len(reasons), dtype=np.int32),
+                                         flag_meanings=" ".join(reasons))
     data["status"] = (dims, _stack(runs, family, directions, "status", (m,), np.int8, _MISSING), {
         "legend": _LEGEND,
         "flag_values": np.arange(len(config.SWEEP_STATUS), dtype=np.int8),
@@ -543,6 +546,10 @@ def to_frame(ds):
             label = "_".join(_column_part(d, p) for d, p in zip(extra, parts))
             df[f"{name}_{label}"] = stacked.isel(_col=j).values.reshape(-1)
     df["status_name"] = [status_name(c) for c in df["status"]]
+    if "not_settled_reason" in df:
+        reasons = config.SWEEP_NOT_SETTLED_REASONS
+        df["not_settled_reason_name"] = ["" if s != 1 else reasons[int(r)] if 0 < int(r) < len(reasons) else ""
+                                         for s, r in zip(df["status"], df["not_settled_reason"])]
     return df
 
 
