@@ -66,7 +66,7 @@ from ._jit import jit
 from .status import Status
 
 __all__ = ["ContinuationOptions", "ContinuationStatus", "ContinuationResult", "continuation", "newton",
-           "turning_points", "make_options", "local_maxima", "refine_maximum"]
+           "turning_points", "make_options", "local_maxima", "refine_maximum", "ParameterProgress"]
 
 #: a step is sized to move lam by at most this fraction of ``max_dlam`` (the
 #: corrector moves lam a little more or less than the prediction)
@@ -991,7 +991,8 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
         accepted point; a tuple stops the branch with that status (a
         :class:`~jointdyn.status.Status`; the point is kept).
     progress : tqdm-like, optional
-        Its ``update(1)`` is called per accepted point.
+        Its ``update(1)`` is called per accepted point, and its
+        ``reached(lam)`` where it has one (:class:`ParameterProgress`).
     observe : callable, optional
         ``observe(y, lam) -> float``, the quantity a plot of the branch
         shows against lam (e.g. the logarithm of an amplitude, so that the
@@ -1039,7 +1040,10 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
         fold = bool(np.sign(t_new[n]) != np.sign(t[n]) and t[n] != 0.0) and not (st.gap or st.corner)
         pts.cnt["folds"] += fold
         if (v[n] - lam_stop) * sgn > 0 or (v[n] - lam0) * sgn < 0:
-            return pts.finish(*_range_end(walk, u, v, t, fold, pts, lam_stop, lam_name))
+            end = _range_end(walk, u, v, t, fold, pts, lam_stop, lam_name)
+            if hasattr(progress, "reached"):  # the point landed on the end of the range
+                progress.reached(float(pts.L[-1]))
+            return pts.finish(*end)
         u_prev, t_prev, u, t, g_u = u, t, v, t_new, st.g
         prev = None if (st.gap or st.corner) else (u_prev, t_prev)
         pts.add(v[:n].copy(), v[n], t[n], fold, st.it, st.gap, st.corner)
@@ -1069,6 +1073,8 @@ def _accepted(v, n, monitor, progress):
     """Progress and monitor at an accepted point: None or the monitor's (status, message)."""
     if progress is not None:
         progress.update(1)
+        if hasattr(progress, "reached"):  # a bar over the parameter's range (ParameterProgress)
+            progress.reached(float(v[n]))
     if monitor is not None:
         return monitor(v[:n], v[n])
     return None
@@ -1204,3 +1210,74 @@ def refine_maximum(residual: Callable, observe: Callable, y, lam, options: Conti
             U[k], g[k], s[k] = v, gv, x
     converged = _bracketed(s, g, width0)
     return U[1, :n].copy(), float(U[1, n]), float(g[1]), bool(converged)
+
+
+class ParameterProgress:
+    """A progress bar over the continued parameter's range, for :func:`continuation`.
+
+    The bar stands at the farthest fraction ``|lam - start| / |stop - start|``
+    reached (in per mille), so that it fills as the branch covers the range
+    and its estimate of the time left means something; a count of points
+    against ``max_points`` (a bound that a complete branch never reaches)
+    would do neither. The current value of the parameter is shown beside
+    it.
+
+    Parameters
+    ----------
+    start, stop : float
+        The range, in the units ``continuation`` sees (scaled).
+    desc : str
+        Label of the bar.
+    progress : bool or None
+        True: always shown; None: shown on a terminal only; False: no bar
+        (tqdm is not even imported).
+    name : str
+        Name of the parameter shown beside the bar (``"gamma"``).
+    scale : float
+        Factor from the continued value to the shown one.
+    """
+
+    STEPS = 1000
+
+    def __init__(self, start: float, stop: float, desc: str, progress=None, *, name: str = "lam",
+                 scale: float = 1.0):
+        self.start, self.span = float(start), float(stop) - float(start)
+        self.name, self.scale = name, float(scale)
+        self.done = 0
+        self.bar = None
+        if progress is not False:
+            from tqdm.auto import tqdm
+
+            self.bar = tqdm(total=self.STEPS, desc=desc, disable=None if progress is None else not progress,
+                            leave=False, bar_format="{desc}: {percentage:3.0f}%|{bar}| {postfix} "
+                                                    "[{elapsed}<{remaining}]")
+
+    def fraction(self, lam: float) -> float:
+        """Share of the range between ``start`` and ``lam`` (0 to 1)."""
+        if not self.span or not math.isfinite(lam):
+            return 0.0
+        return min(max((lam - self.start) / self.span, 0.0), 1.0)
+
+    def update(self, n: int = 1) -> None:
+        """Points are not progress: the bar moves in :meth:`reached`."""
+
+    def reached(self, lam: float) -> None:
+        """An accepted point at ``lam``: the bar moves to the farthest fraction reached."""
+        k = int(self.STEPS * self.fraction(lam))
+        if self.bar is None:
+            self.done = max(self.done, k)
+            return
+        if k > self.done:
+            self.bar.update(k - self.done)
+            self.done = k
+        self.bar.set_postfix_str(f"{self.name} = {lam * self.scale:.5g}", refresh=False)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

@@ -62,7 +62,8 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ..continuation import ContinuationOptions, ContinuationStatus, continuation, make_options, newton
+from ..continuation import (ContinuationOptions, ContinuationStatus, ParameterProgress, continuation, make_options,
+                            newton)
 from ..fourier import derivative_matrix
 from ..hb import HBProblem
 from ..kinematics import contact_kinematics, selection_matrix
@@ -333,8 +334,6 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         modes against the full model's; :meth:`Backbone.full_shape`: the
         harmonics of the mode shape on the full model's DOFs).
     """
-    from tqdm.auto import tqdm
-
     check_free_vibration(system, "EPMC")
     lo, hi = amplitude_range(system, amplitude)
     reduction = None
@@ -357,8 +356,8 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         if last is not None and last[0].tobytes() == X.tobytes():
             stash[X.tobytes()] = last[3]
 
-    with tqdm(total=opt.max_points, desc="EPMC", disable=None if progress is None else not progress,
-              leave=False) as bar:
+    # the bar fills over the range of log10(amplitude), not against max_points
+    with ParameterProgress(lam0, lam1, "EPMC", progress, name="log10(a / m)") as bar:
         res = continuation(problem.residual, v0, lam0, lam1, opt, monitor=keep, progress=bar)
     status = _STATUS.get(res.status, ModeStatus.FAILED if res.lam.size else ModeStatus.NO_START)
     message = res.message.replace("lam = ", "log10(amplitude / m) = ")
