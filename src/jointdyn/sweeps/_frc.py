@@ -425,7 +425,7 @@ def _resume(runs, line_root) -> tuple:
         return 0, 0
     names = tuple(runs[0].arrays) if runs else ()
     for run in runs:
-        ck = load_line(line_root / run.spec.key, run.spec.checkpoint_key(), names, run.index, len(run.gammas))
+        ck = load_line(line_root / run.spec.folder, run.spec.resume_key(), names, run.index, run.gammas)
         for chunk in ck.chunks:
             run.accept(chunk)
         reused += ck.reused
@@ -458,7 +458,8 @@ def _run(runs, family, client, n_workers, out, progress, on_line) -> tuple:
 
     def on_chunk(run, chunk):
         if line_root is not None and chunk.done:
-            save_chunk(line_root / run.spec.key, run.spec.checkpoint_key(), chunk)
+            save_chunk(line_root / run.spec.folder, run.spec.resume_key(), chunk,
+                       run.gammas[:chunk.first + chunk.done])
         show()
         if run.finished and on_line is not None:
             on_line(run.spec, True)
