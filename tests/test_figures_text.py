@@ -165,8 +165,9 @@ def test_fig6_hb_legend_names_only_what_is_drawn():
 
 
 def test_fig7_subtitle_reads():
-    jump = D._drop_text(1.01, 0.0)
+    jump = D._drop_text(1.01, 0.0, 5.9)
     assert jump == "T at A, where opening starts: 1.01 N, lost with no travel (a jump)"
-    assert D._drop_text(0.0535, 0.04).endswith("lost within 4 % of the amplitude")
-    assert D._drop_text(math.nan, math.nan) == "the contact does not open"
+    assert D._drop_text(1.01, 0.04, 5.9).endswith("lost within 4 % of the amplitude")
+    assert D._drop_text(0.0535, 0.0, 6.3).endswith("0.0535 N, next to nothing: no force jump")
+    assert D._drop_text(math.nan, math.nan, 6.3) == "the contact does not open"
     assert "over 0 of" not in jump

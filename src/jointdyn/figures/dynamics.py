@@ -309,12 +309,19 @@ def _label_opening(ax, df, color):
                     fontweight="bold", ha="right")
 
 
-def _drop_text(force_N: float, travel: float) -> str:
+#: a force at A below this fraction of the loop's largest |T| is no jump: the contact opens unloaded
+DROP_CONTINUOUS = 0.01
+
+
+def _drop_text(force_N: float, travel: float, force_max_N: float) -> str:
     """What the contact carries at A and over how much travel it loses it, in
     words (``travel``: the displacement from A to the opening over the loop's
-    half peak-to-peak amplitude; below 0.5 % it is a jump)."""
+    half peak-to-peak amplitude, below 0.5 % a jump; ``force_max_N``: the
+    loop's largest |T|, against which a force at A is nothing or a load)."""
     if not math.isfinite(force_N):
         return "the contact does not open"
+    if abs(force_N) < DROP_CONTINUOUS * force_max_N:
+        return f"T at A, where opening starts: {force_N:.3g} N, next to nothing: no force jump"
     where = (f"within {100 * travel:.0f} % of the amplitude" if travel >= 0.005 else
              "with no travel (a jump)")
     return f"T at A, where opening starts: {force_N:.3g} N, lost {where}"
@@ -332,7 +339,7 @@ def _plot_fig7(tables, out_dir):
         _path_arrows(ax, df["x"].to_numpy() * 1e6, df["T"].to_numpy(), "C0")
         _label_opening(ax, df, "C0")
         ax.set_title(f"({tag}) delta = {row.delta_deg:g} deg: {row.case.split(': ', 1)[-1]}\n"
-                     + _drop_text(row.drop_T_N, row.drop_dx_over_amp), fontsize=9)
+                     + _drop_text(row.drop_T_N, row.drop_dx_over_amp, float(df["T"].abs().max())), fontsize=9)
         ax.set_xlabel("tangential displacement x (um)")
         ax.set_ylabel("tangential force T (N)")
         ax.grid(alpha=0.3)
