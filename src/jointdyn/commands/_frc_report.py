@@ -111,7 +111,8 @@ def print_notes(result, digits: int) -> None:
     for d, r in dirs.items():
         for g, reason in zip(r["gamma"], r.get("not_settled_reason", [])):
             if reason is not None:
-                print(f"not settled at gamma {g:.{digits}g} ({d}): {reason}, {REASON_TEXT.get(reason, '')}".rstrip(", "))
+                why = f"{reason}, {REASON_TEXT[reason]}" if reason in REASON_TEXT else reason
+                print(f"not settled at gamma {g:.{digits}g} ({d}): {why}")
 
 
 def _cell(value, ok: bool = True) -> str:

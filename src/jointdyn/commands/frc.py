@@ -495,7 +495,8 @@ def _plot(result, path: Path) -> None:
             r = result["directions"][d]
             codes = [config.SWEEP_STATUS.index(s) for s in r["status"]]
             plot_frc_curve(ax, r["gamma"], report.y_values(r, result), codes, color="C0" if d == "up" else "C3",
-                           linestyle=style, label=f"sweep {d}{report.first_dof_suffix(result)}", rug_y=0.03 if d == "up" else 0.07)
+                           linestyle=style, label=f"sweep {d}{report.first_dof_suffix(result)}",
+                           rug_y=0.03 if d == "up" else 0.07)
             for k, dof in enumerate(report.output_dofs(result)[1:]):  # the other [output] DOFs, thinner
                 y = report.dof_mm(r, result, dof)
                 if y is not None:
