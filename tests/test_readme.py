@@ -57,3 +57,16 @@ def test_gitignore_covers_what_the_readme_writes():
     proc = subprocess.run([git, "check-ignore", "--no-index", *probes], cwd=root, capture_output=True, text=True)
     ignored = set(proc.stdout.split())
     assert set(probes) <= ignored, f"not ignored: {sorted(set(probes) - ignored)}"
+
+
+def test_performance_page_gives_what_the_readme_promises():
+    """The README sends readers to docs/performance.md for install, first-run and test-suite times: the
+    page has them (outside the part its script rewrites)."""
+    text = README.read_text()
+    assert "docs/performance.md#install-first-run-and-test-suite" in text
+    page = (README.parent / "docs" / "performance.md").read_text()
+    head, _, _ = page.partition("<!-- performance:begin -->")
+    assert "## Install, first run and test suite" in head
+    rows = [line for line in head.splitlines() if line.startswith("| ")]
+    assert any(r.startswith("| install") for r in rows) and any(r.startswith("| first run") for r in rows)
+    assert re.search(r"\*\*Test suite\*\*.*?\d+ to \d+ s", head, re.S)
