@@ -406,6 +406,9 @@ MODES_DS_MAX = 0.0625
 MODES_TOL = 1e-12
 #: Newton iterations of the first EPMC point (from the linear stuck mode)
 MODES_START_MAX_ITER = 30
+#: points of an EPMC backbone (spread over it, plus its largest damping) where
+#: harmonics="auto" / samples="auto" check the discretisation (jointdyn.modes._auto)
+MODES_AUTO_CHECK_POINTS = 12
 #: a DOF moves in a linear mode when |phi_dof| exceeds this fraction of max |phi|
 MODES_MIN_PARTICIPATION = 1e-8
 #: K (tangential contacts free) is positive definite for nonlinear modes when

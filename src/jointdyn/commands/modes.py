@@ -5,7 +5,8 @@ The system is the paper's friction damper at its constant normal load
 forcing is not used, its normal loads must be autonomous). ``--method
 epmc`` (default) follows the extended periodic motion concept by harmonic
 balance (:func:`jointdyn.modes.epmc`, ``--harmonics``, ``--samples``,
-``--max-points``); ``--method qsma`` is the quasi-static estimate
+``--max-points``; harmonics and samples chosen automatically unless given,
+as ``frc --method hb`` does); ``--method qsma`` is the quasi-static estimate
 (:func:`jointdyn.modes.qsma`). The amplitude is the first-harmonic
 amplitude of the output DOF in metres (``--amplitude MIN:MAX``, stepped
 logarithmically).
@@ -56,9 +57,12 @@ def add_arguments(p) -> None:
     p.add_argument("--mode", type=int, default=1, help="linear stuck mode to start from, 1-based (default 1)")
     p.add_argument("--output-dof", type=int, default=None,
                    help="DOF whose amplitude is the modal amplitude (default: the system's output DOF)")
-    p.add_argument("--harmonics", type=int, default=None, help=f"epmc: harmonics (default {config.HB_HARMONICS})")
-    p.add_argument("--samples", type=int, default=None,
-                   help=f"epmc: AFT time samples per period (default {config.HB_SAMPLES})")
+    p.add_argument("--harmonics", default=None, metavar="H|auto",
+                   help=f"epmc: harmonics, or auto (default: from {config.HB_HARMONICS}, raised while the backbone "
+                        "changes with more, as frc --method hb does)")
+    p.add_argument("--samples", default=None, metavar="NS|auto",
+                   help=f"epmc: AFT time samples per period, or auto (default: from {config.HB_SAMPLES}, doubled "
+                        "while the backbone changes with more: where a contact separates)")
     p.add_argument("--max-points", type=int, default=None,
                    help=f"epmc: bound on the points of the backbone (default {config.CONT_MAX_POINTS})")
     p.add_argument("--out", default=None, metavar="DIR", help="write modes.nc, modes.csv, modes.png here")
@@ -112,10 +116,12 @@ def _validate(args):
     args.output_dof = output_dof_of(system, args.output_dof)
     linear_stuck_mode(system, V.positive_int("--mode", args.mode, 1), args.output_dof)
     if args.method == "epmc":
-        args.harmonics = V.positive_int("--harmonics", config.HB_HARMONICS if args.harmonics is None
-                                        else args.harmonics, 1)
-        args.samples = V.positive_int("--samples", config.HB_SAMPLES if args.samples is None else args.samples,
-                                      2 * args.harmonics + 2)
+        from .frc import _count_or_auto
+
+        auto = config.HB_AUTO
+        args.harmonics = _count_or_auto("--harmonics", auto if args.harmonics is None else args.harmonics, 1)
+        h = config.HB_HARMONICS if args.harmonics == auto else args.harmonics
+        args.samples = _count_or_auto("--samples", auto if args.samples is None else args.samples, 2 * h + 2)
         args.max_points = V.positive_int("--max-points", config.CONT_MAX_POINTS if args.max_points is None
                                          else args.max_points, 2)
     if args.out is not None:
