@@ -82,10 +82,10 @@ def test_plot_shows_mm_of_the_output_dof_for_a_system_and_q_for_the_paper():
     np.testing.assert_array_equal(report.dof_mm(r, system, 0), [3.0, np.nan])
     assert report.output_dofs(system) == [2, 0]
     assert report.y_label(system) == "amplitude of the output DOFs, mm (half peak-to-peak)"
-    assert report.first_dof_suffix(system) == ", DOF 2"
+    assert report.curve_label(system, "sweep up") == "DOF 2, sweep up"
     alone = {"method": "time", "system": {**sysd, "dofs": [2]}}
     assert report.y_label(alone) == "amplitude of DOF 2, mm (half peak-to-peak)"
-    assert report.first_dof_suffix(alone) == ""
+    assert report.curve_label(alone, "sweep up") == "sweep up"
     paper = {"method": "time", "eta": 0.5}
     np.testing.assert_array_equal(report.y_values(r, paper), [5.0, np.nan])
     assert "q = kt x / fy" in report.y_label(paper) and report.output_dofs(paper) == []

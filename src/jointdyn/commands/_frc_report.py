@@ -11,7 +11,7 @@ import textwrap
 
 import numpy as np
 
-__all__ = ["output_dofs", "dof_mm", "y_values", "peak_value", "y_label", "first_dof_suffix", "wrap",
+__all__ = ["output_dofs", "dof_mm", "y_values", "peak_value", "y_label", "curve_label", "wrap",
            "print_system_table", "reason_name", "status_cell", "print_notes"]
 
 #: characters per line of a wrapped plot title (fontsize 9 on a 6.4 in wide figure)
@@ -70,10 +70,11 @@ def y_label(result) -> str:
     return "amplitude of q = kt x / fy (half peak-to-peak)"
 
 
-def first_dof_suffix(result) -> str:
-    """``", DOF n"`` for the legend entries of the output DOF when other DOFs are drawn beside it."""
+def curve_label(result, what: str) -> str:
+    """Legend entry ``what`` of the output DOF's curve, ``"DOF n, what"`` when other DOFs are drawn
+    beside it (their entries are ``"DOF k, ..."``)."""
     dofs = output_dofs(result)
-    return f", DOF {dofs[0]}" if len(dofs) > 1 else ""
+    return f"DOF {dofs[0]}, {what}" if len(dofs) > 1 else what
 
 
 def reason_name(status_code, reason_code):

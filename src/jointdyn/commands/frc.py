@@ -495,7 +495,7 @@ def _plot(result, path: Path) -> None:
             r = result["directions"][d]
             codes = [config.SWEEP_STATUS.index(s) for s in r["status"]]
             plot_frc_curve(ax, r["gamma"], report.y_values(r, result), codes, color="C0" if d == "up" else "C3",
-                           linestyle=style, label=f"sweep {d}{report.first_dof_suffix(result)}",
+                           linestyle=style, label=report.curve_label(result, f"sweep {d}"),
                            rug_y=0.03 if d == "up" else 0.07)
             for k, dof in enumerate(report.output_dofs(result)[1:]):  # the other [output] DOFs, thinner
                 y = report.dof_mm(r, result, dof)
@@ -534,7 +534,7 @@ def _plot_hb(ax, result) -> None:
         # a NaN row between two points that are not joined breaks the line there
         g, a, st = (np.insert(v, cut[cut > 0], f) for v, f in ((g, np.nan), (a, np.nan), (st, True)))
         for sel, style, c, name in ((st, "-", "C0", "stable"), (~st, "--", "C1", "unstable")):
-            name += report.first_dof_suffix(result)
+            name = report.curve_label(result, name)
             shown = bool(np.any(sel & np.isfinite(a)))  # no legend entry for a style never drawn
             ax.plot(g, np.where(sel, a, np.nan), style, color=c, label=name if shown and name not in first else None)
             first[name] = first.get(name) or shown
