@@ -12,6 +12,7 @@ runs every script of ``examples/``.
 
 from __future__ import annotations
 
+import enum
 import importlib
 import inspect
 import os
@@ -234,7 +235,18 @@ def constant_values(app, what, name, obj, options, lines):
         lines[:] = [f"Value: ``{text if len(text) <= 300 else text[:300] + ' ...'}``"]
 
 
+def enum_members(app, what, name, obj, skip, options):
+    """``autodoc-skip-member`` handler: the members of a status enumeration
+    (``PERIODIC``, ``COMPLETE`` ...) have no docstring of their own, so
+    autodoc would leave them out, but they are what a user compares results
+    with: list them (with their values)."""
+    if what == "class" and isinstance(obj, enum.Enum):
+        return False
+    return None
+
+
 def setup(app):
+    app.connect("autodoc-skip-member", enum_members)
     # the API pages are written before autosummary reads them (builder-inited);
     # here rather than at import, so that tests can import this file
     write_api_pages()

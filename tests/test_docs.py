@@ -102,7 +102,8 @@ def _public_members(cls) -> list[str]:
         if name.startswith("_") or owner is None or not owner.__module__.startswith("jointdyn"):
             continue
         raw = owner.__dict__[name]
-        if inspect.isfunction(raw) or isinstance(raw, kinds) or isinstance(raw, enum.Enum):
+        if inspect.isfunction(raw) or isinstance(raw, kinds) or (issubclass(cls, enum.Enum)
+                                                                 and isinstance(raw, enum.Enum)):
             names.append(name)
     return names
 

@@ -1273,6 +1273,7 @@ class ParameterProgress:
         self.bar.set_postfix_str(f"{self.name} = {lam * self.scale:.5g}", refresh=False)
 
     def close(self) -> None:
+        """Close the bar (leaves nothing on the terminal)."""
         if self.bar is not None:
             self.bar.close()
 
