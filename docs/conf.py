@@ -245,8 +245,20 @@ def enum_members(app, what, name, obj, skip, options):
     return None
 
 
+def status_messages(app, what, name, obj, options, lines):
+    """``autodoc-process-docstring`` handler: a status enumeration's page
+    says what each of its members means (its ``message``), which the
+    members' own entries cannot (they have no docstring)."""
+    if what == "class" and isinstance(obj, type) and issubclass(obj, enum.Enum) and len(obj):
+        if all(isinstance(getattr(m, "message", None), str) for m in obj):
+            lines += ["", "Members, their values and what they mean:", ""]
+            lines += [f"- ``{m.name}`` (``{m.value!r}``): {m.message}" for m in obj] + [""]
+
+
 def setup(app):
     app.connect("autodoc-skip-member", enum_members)
+    # after numpydoc (priority 500), before the bars are escaped (600)
+    app.connect("autodoc-process-docstring", status_messages, priority=550)
     # the API pages are written before autosummary reads them (builder-inited);
     # here rather than at import, so that tests can import this file
     write_api_pages()
