@@ -1249,8 +1249,8 @@ class ParameterProgress:
             from tqdm.auto import tqdm
 
             self.bar = tqdm(total=self.STEPS, desc=desc, disable=None if progress is None else not progress,
-                            leave=False, bar_format="{desc}: {percentage:3.0f}%|{bar}| {postfix} "
-                                                    "[{elapsed}<{remaining}]")
+                            leave=False,  # tqdm writes the postfix as ", gamma = ..."
+                            bar_format="{desc}: {percentage:3.0f}%|{bar}| [{elapsed}<{remaining}{postfix}]")
 
     def fraction(self, lam: float) -> float:
         """Share of the range between ``start`` and ``lam`` (0 to 1)."""
