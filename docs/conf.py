@@ -12,6 +12,7 @@ runs every script of ``examples/``.
 
 from __future__ import annotations
 
+import enum
 import importlib
 import inspect
 import os
@@ -69,7 +70,10 @@ myst_all_links_external = False
 # --- autodoc / numpydoc -------------------------------------------------------
 autosummary_generate = True
 autosummary_imported_members = True
-autodoc_default_options = {"members": False}
+# no "members" default here: it would override the ``:members:`` of the
+# class template (docs/_templates/autosummary/class.rst), and the class pages
+# would list no method or property (tests/test_docs.py checks they do)
+autodoc_default_options: dict[str, object] = {}
 autodoc_typehints = "none"
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
@@ -190,9 +194,6 @@ def cli_help() -> str:
     return "\n".join(out)
 
 
-write_api_pages()
-
-
 # ------------------------------------------------------------------------------
 # Docstrings write absolute values as |x|, which reStructuredText would read
 # as a substitution reference: escape the bars outside literal text
@@ -234,7 +235,33 @@ def constant_values(app, what, name, obj, options, lines):
         lines[:] = [f"Value: ``{text if len(text) <= 300 else text[:300] + ' ...'}``"]
 
 
+def enum_members(app, what, name, obj, skip, options):
+    """``autodoc-skip-member`` handler: the members of a status enumeration
+    (``PERIODIC``, ``COMPLETE`` ...) have no docstring of their own, so
+    autodoc would leave them out, but they are what a user compares results
+    with: list them (with their values)."""
+    if what == "class" and isinstance(obj, enum.Enum):
+        return False
+    return None
+
+
+def status_messages(app, what, name, obj, options, lines):
+    """``autodoc-process-docstring`` handler: a status enumeration's page
+    says what each of its members means (its ``message``), which the
+    members' own entries cannot (they have no docstring)."""
+    if what == "class" and isinstance(obj, type) and issubclass(obj, enum.Enum) and len(obj):
+        if all(isinstance(getattr(m, "message", None), str) for m in obj):
+            lines += ["", "Members, their values and what they mean:", ""]
+            lines += [f"- ``{m.name}`` (``{m.value!r}``): {m.message}" for m in obj] + [""]
+
+
 def setup(app):
+    app.connect("autodoc-skip-member", enum_members)
+    # after numpydoc (priority 500), before the bars are escaped (600)
+    app.connect("autodoc-process-docstring", status_messages, priority=550)
+    # the API pages are written before autosummary reads them (builder-inited);
+    # here rather than at import, so that tests can import this file
+    write_api_pages()
     app.connect("autodoc-process-docstring", constant_values, priority=400)
     # after numpydoc (priority 500) has turned the sections into reST
     app.connect("autodoc-process-docstring", escape_absolute_values, priority=600)

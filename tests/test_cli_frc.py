@@ -36,7 +36,8 @@ def test_json_time(fake, capsys, tmp_path):
     assert up["gamma"] == pytest.approx([0.8, 0.9, 1.0, 1.1, 1.2, 1.3])
     assert up["status"] == ["periodic", "periodic", "unbounded", "unbounded", "periodic", "periodic"]
     assert up["amplitude_q"][2] is None  # NaN goes out as null
-    assert set(up) == {"gamma", "amplitude_q", "amplitude_m", "offset_m", "max_abs_m", "status", "negative_dissipation"}
+    assert set(up) == {"gamma", "amplitude_q", "amplitude_m", "offset_m", "max_abs_m", "status", "negative_dissipation",
+                       "period_multiple", "not_settled_reason"}
     assert up["negative_dissipation"] == [False] * 6
     assert down["amplitude_q"][4] == pytest.approx(1 / 0.15 + 0.5 / 0.25)
     for name in ("frc.nc", "frc.csv", "frc.png"):

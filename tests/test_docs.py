@@ -8,6 +8,11 @@ leaves them out locally); they run by default.
 
 from __future__ import annotations
 
+import enum
+import functools
+import importlib
+import importlib.util
+import inspect
 import os
 import re
 import shutil
@@ -58,6 +63,81 @@ def test_site_builds_strict_and_runs_the_gallery(tmp_path):
                and f'id="module-jointdyn.{n}"' not in api
                and not re.search(rf'id="jointdyn\.[a-z_]+\.{re.escape(n)}"', api)]
     assert not missing, f"public names without an API entry: {missing}"
+    # every public method, property and status member of every public class has its entry
+    missing = [f"{q}.{m}" for q, cls in _public_classes().items() for m in _public_members(cls)
+               if f'id="{q}.{m}"' not in api]
+    assert not missing, f"public members without an API entry: {missing}"
+
+
+def _docs_conf():
+    """docs/conf.py as a module (importing it writes nothing: the pages are
+    written by its ``setup``)."""
+    spec = importlib.util.spec_from_file_location("jointdyn_docs_conf", DOCS / "conf.py")
+    conf = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conf)
+    return conf
+
+
+def _public_classes() -> dict:
+    """Qualified name under which each public class is documented -> the class."""
+    conf = _docs_conf()
+    classes = {}
+    for q in sorted(set(conf._canonical(conf.public_modules()).values())):
+        modname, name = q.rsplit(".", 1)
+        obj = getattr(importlib.import_module(modname), name)
+        if inspect.isclass(obj):
+            classes[q] = obj
+    return classes
+
+
+def _public_members(cls) -> list[str]:
+    """The members a user calls or reads, defined by jointdyn (on ``cls`` or a
+    base): methods, properties, class and static methods, and the members of
+    a status enumeration. Fields of dataclasses are described in the class's
+    docstring instead."""
+    kinds = (property, functools.cached_property, classmethod, staticmethod)
+    names = []
+    for name in dir(cls):
+        owner = next((c for c in cls.__mro__ if name in c.__dict__), None)
+        if name.startswith("_") or owner is None or not owner.__module__.startswith("jointdyn"):
+            continue
+        raw = owner.__dict__[name]
+        if inspect.isfunction(raw) or isinstance(raw, kinds) or (issubclass(cls, enum.Enum)
+                                                                 and isinstance(raw, enum.Enum)):
+            names.append(name)
+    return names
+
+
+def _docstring(cls, name: str) -> str | None:
+    """The docstring autodoc shows for a member (its own, else a base's)."""
+    for c in cls.__mro__:
+        raw = c.__dict__.get(name)
+        if raw is None:
+            continue
+        raw = raw.__func__ if isinstance(raw, (classmethod, staticmethod)) else raw
+        raw = raw.func if isinstance(raw, functools.cached_property) else raw
+        if raw.__doc__:
+            return raw.__doc__
+    return None
+
+
+def test_every_public_member_has_an_api_entry():
+    """Fast check of what the site build shows (test_site_builds_strict_and_runs_the_gallery
+    checks the anchors themselves): class pages list members (the template
+    asks for them and no default switches them off, which once left every
+    class page without a method), and every method and property has a
+    docstring, without which autodoc leaves it out."""
+    conf = _docs_conf()
+    template = (DOCS / "_templates" / "autosummary" / "class.rst").read_text()
+    assert ":members:" in template and ":inherited-members:" in template
+    assert conf.autodoc_default_options.get("members", True) is not False
+    classes = _public_classes()
+    assert {"jointdyn.System", "jointdyn.LoopResult"} <= set(classes)
+    assert {"paper_damper", "last_cycle"} <= set(_public_members(classes["jointdyn.System"])) | set(
+        _public_members(classes["jointdyn.LoopResult"]))
+    undocumented = [f"{q}.{m}" for q, cls in classes.items() for m in _public_members(cls)
+                    if not isinstance(getattr(cls, m), enum.Enum) and not _docstring(cls, m)]
+    assert not undocumented, f"public members without a docstring (no API entry): {undocumented}"
 
 
 def _python_blocks(page: Path) -> str:
@@ -127,3 +207,18 @@ def test_relative_links_resolve(page):
         if not (base / file).exists():
             broken.append(target)
     assert not broken, f"{page}: links to missing files: {broken}"
+
+
+#: a reference to the project's internal issue tracker ("issue 9", "issue #9")
+_ISSUE = re.compile(r"\bissues? #?\d+\b", re.I)
+
+
+def test_user_pages_cite_no_internal_issue_numbers():
+    """README, the docs, the examples and the docstrings speak for themselves:
+    an internal issue number means nothing to a user."""
+    files = [ROOT / "README.md", ROOT / "CHANGELOG.md", *DOCS.glob("**/*.md"), *DOCS.glob("scripts/*.py"),
+             *(ROOT / "examples").glob("*.py"), *(ROOT / "src" / "jointdyn").glob("**/*.py")]
+    offenders = [f"{p.relative_to(ROOT)}:{no}: {line.strip()[:100]}"
+                 for p in files if not {"_build", "generated", "auto_examples"} & set(p.parts)
+                 for no, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) if _ISSUE.search(line)]
+    assert not offenders, "\n".join(offenders)

@@ -88,7 +88,7 @@ PEAK_SEARCH = 0.02
 PEAK_SCAN = 81
 #: absolute tolerance in gamma of the reference peak search
 PEAK_XTOL = 1e-7
-#: gamma STEP of the CLI's grid in issue 9 (``--gamma 0.6:1.8:0.01``), the second jointdyn row
+#: gamma STEP of the robustness grid's CLI runs (``--gamma 0.6:1.8:0.01``), the second jointdyn row
 CLI_STEP = 0.01
 JOINTDYN_STEP = f"jointdyn, max_step = {CLI_STEP:g}"
 CODES = ("jointdyn", JOINTDYN_STEP, "tmdsimpy", "pyHarm")

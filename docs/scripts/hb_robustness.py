@@ -1,4 +1,4 @@
-"""Robustness grid of harmonic balance with default settings (issue 9).
+"""Robustness grid of harmonic balance with default settings.
 
 Writes the table of docs/hb-robustness.md (between ``<!-- grid:start -->``
 and ``<!-- grid:end -->``), computed here:

@@ -1,4 +1,4 @@
-"""The bolted lap joint shipped with jointdyn: FE model, preload, reduction (issue 23).
+"""The bolted lap joint shipped with jointdyn: FE model, preload, reduction.
 
 Two steel plates, each 100 x 25 x 5 mm, overlap over 25 mm (a 25 x 25 mm
 patch) and are clamped at their far ends (a clamped-clamped beam of 175 mm

@@ -18,12 +18,38 @@ itself before compiling.
 
 from __future__ import annotations
 
+import os
+import sys
+
 import numba
 from numba.core import environment as _environment
 from numba.core.caching import FunctionCache
 from numba.core.runtime import nrt
 
-__all__ = ["jit", "specialize"]
+__all__ = ["jit", "specialize", "ANNOUNCE_ENV", "COMPILING_NOTE"]
+
+#: environment variable that asks the main process to say on stderr, once,
+#: that it compiles (set by the ``jointdyn`` process, :func:`jointdyn.cli.console`)
+ANNOUNCE_ENV = "JOINTDYN_ANNOUNCE_COMPILING"
+#: what it says
+COMPILING_NOTE = ("jointdyn: compiling, first run only (the compiled kernels are cached on disk for every later "
+                  "run; this can take minutes)")
+_ANNOUNCED: list = []
+
+
+def _note_compiling() -> None:
+    """A kernel was not in the disk cache (a cold cache: the first run after
+    installing or upgrading): say so on stderr, once per process, in the
+    main process of a ``jointdyn`` command (not in its sweep workers, not
+    for callers of the Python API, whose stderr is theirs)."""
+    if _ANNOUNCED or os.environ.get(ANNOUNCE_ENV) != "1":
+        return
+    import multiprocessing
+
+    if multiprocessing.parent_process() is not None:
+        return
+    _ANNOUNCED.append(True)
+    print(COMPILING_NOTE, file=sys.stderr, flush=True)
 
 
 class _LoadingCache(FunctionCache):
@@ -95,7 +121,10 @@ class _LazyCache:
         return self._made
 
     def load_overload(self, sig, target_context):
-        return self._cache().load_overload(sig, target_context)
+        got = self._cache().load_overload(sig, target_context)
+        if got is None:  # not cached: Numba compiles it next
+            _note_compiling()
+        return got
 
     def save_overload(self, sig, data):
         return self._cache().save_overload(sig, data)

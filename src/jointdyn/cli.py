@@ -133,6 +133,8 @@ def console() -> int:
     itself is collected first, so that its finalizers run as they would.
     In-process callers use :func:`main`, which leaves the collector alone.
     """
+    # a cold Numba cache (the first run after installing) compiles for minutes: say so once (jointdyn._jit)
+    os.environ.setdefault("JOINTDYN_ANNOUNCE_COMPILING", "1")
     gc.freeze()
     try:
         return main()

@@ -421,6 +421,9 @@ MODES_DS_MAX = 0.0625
 MODES_TOL = 1e-12
 #: Newton iterations of the first EPMC point (from the linear stuck mode)
 MODES_START_MAX_ITER = 30
+#: points of an EPMC backbone (spread over it, plus its largest damping) where
+#: harmonics="auto" / samples="auto" check the discretisation (jointdyn.modes._auto)
+MODES_AUTO_CHECK_POINTS = 12
 #: a DOF moves in a linear mode when |phi_dof| exceeds this fraction of max |phi|
 MODES_MIN_PARTICIPATION = 1e-8
 #: K (tangential contacts free) is positive definite for nonlinear modes when
@@ -454,6 +457,11 @@ SWEEP_SCHEDULER_TIMEOUT_S = 5.0
 #: local pool for sweep lines when no Dask client is given: "process" or
 #: "thread" (the compiled kernels release the GIL)
 SWEEP_POOL = "process"
+#: why a swept point is not-settled (``not_settled_reason``; index = code, 0
+#: for every other point): still converging at the period budget, stalled
+#: (quasi-periodic or chaotic), or repeating only after more than
+#: SS_MAX_MULTIPLE periods
+SWEEP_NOT_SETTLED_REASONS = ("none", "slowly-converging", "quasi-periodic-or-chaotic", "long-period")
 #: consecutive points of a line solved as one task and saved as one resume
 #: checkpoint (an interrupt stops a task after its current point, so this
 #: bounds what a killed run loses, not what an interrupted one loses)

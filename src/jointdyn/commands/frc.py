@@ -34,6 +34,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from .._io import jsonable as _jsonable
+from . import _frc_report as report
 from ._law_args import add_law_arguments, law_params, model_help
 from ._system_args import add_system_argument, load_system_file, refuse_paper_options
 from ..systems import PAPER
@@ -372,6 +373,10 @@ def _run_time(args, gammas):
             "gamma": _jsonable(one.gamma.values),
             **{v: _jsonable(one[v].values) for v in ("amplitude_q", "amplitude_m", "offset_m", "max_abs_m")},
             "status": [status_name(c) for c in one.status.values],
+            # a steady state that repeats every K periods: K (1: the forcing period; 0: not periodic)
+            "period_multiple": [int(p) for p in one.period_multiple.values],
+            "not_settled_reason": [report.reason_name(s, r) for s, r in zip(one.status.values,
+                                                                            one.not_settled_reason.values)],
             "negative_dissipation": [bool(v) for v in one.negative_dissipation.values],
         }
         if "contact" in one.dims or "dof" in one.dims:
@@ -389,8 +394,9 @@ def _run_time(args, gammas):
     return ds, result
 
 
-def _hb_branches(br) -> list:
-    """The segments of an HBBranch as JSON objects (per point: gamma, amplitudes, stability, status)."""
+def _hb_branches(br, dofs=()) -> list:
+    """The segments of an HBBranch as JSON objects (per point: gamma, amplitudes, stability, status;
+    ``dofs``: the amplitude and offset of each of these DOFs too, under ``dofs``)."""
     from ..hb.problem import contact_of
 
     law = contact_of(br.problem.system).law
@@ -402,6 +408,9 @@ def _hb_branches(br) -> list:
         one = {"gamma": gam[idx], "amplitude_q": law.kt * amp[idx] / law.fy, "amplitude_m": amp[idx],
                "offset_m": off[idx], "max_abs_m": mx[idx]}
         one = {k: _jsonable(v) for k, v in one.items()}
+        if len(dofs):
+            one["dofs"] = {str(d): {"amplitude_m": _jsonable(r[0][idx]), "offset_m": _jsonable(r[1][idx])}
+                           for d, r in ((int(d), br.response(int(d))) for d in dofs)}
         one["stable"] = [bool(s) for s in br.stable[idx]]
         one["point_status"] = [str(s) for s in br.point_status[idx]]
         one["folds"] = [int(i) for i in np.flatnonzero(br.fold[idx])]
@@ -439,7 +448,7 @@ def _run_hb(args, gammas):
     result["samples"] = br.problem.Ns
     result["discretisation"] = {k: (_jsonable([v])[0] if isinstance(v, float) else v)
                                 for k, v in discretisation_attrs(br).items()}
-    result["branches"] = _hb_branches(br)
+    result["branches"] = _hb_branches(br, () if args.system_file is None else args.system_file.dofs)
     result["peaks"] = _hb_peaks(br)
     result["status"] = br.status.value
     result["message"] = br.message
@@ -448,6 +457,10 @@ def _run_hb(args, gammas):
 
 
 def _plot_title(result) -> str:
+    return report.wrap(_title_text(result))
+
+
+def _title_text(result) -> str:
     if "system" in result:
         sysd = result["system"]
         return (f"{result['method']}: {sysd['title']} ({Path(sysd['file']).name}), DOF {sysd['response_dof']}, "
@@ -458,7 +471,7 @@ def _plot_title(result) -> str:
 
 
 def _plot(result, path: Path) -> None:
-    from ..figures import pyplot
+    from ..figures import pyplot, use_math_text
 
     plt = pyplot()
 
@@ -472,17 +485,24 @@ def _plot(result, path: Path) -> None:
             if d not in result["directions"]:
                 continue
             r = result["directions"][d]
-            amp = np.array([np.nan if v is None else v for v in r["amplitude_q"]], float)
             codes = [STATUS_CODES.get(s, NOT_COMPUTED) for s in r["status"]]
-            plot_frc_curve(ax, r["gamma"], amp, codes, color="C0" if d == "up" else "C3",
-                           linestyle=style, label=f"sweep {d}", rug_y=0.03 if d == "up" else 0.07)
+            plot_frc_curve(ax, r["gamma"], report.y_values(r, result), codes, color="C0" if d == "up" else "C3",
+                           linestyle=style, label=report.curve_label(result, f"sweep {d}"),
+                           rug_y=0.03 if d == "up" else 0.07)
+            for k, dof in enumerate(report.output_dofs(result)[1:]):  # the other [output] DOFs, thinner
+                y = report.dof_mm(r, result, dof)
+                if y is not None:
+                    ok = np.array(codes) == 0
+                    ax.plot(r["gamma"], np.where(ok, y, np.nan), style, color=f"C{k + 4}", lw=0.9,
+                            label=f"DOF {dof}, sweep {d}")
         mark_legend(ax, fontsize=8)
     else:
         _plot_hb(ax, result)
     ax.set_title(_plot_title(result), fontsize=9)
     ax.set_xlabel("gamma = w / w0")
-    ax.set_ylabel("amplitude of q = kt x / fy (half peak-to-peak)")
+    ax.set_ylabel(report.y_label(result))
     ax.grid(alpha=0.3)
+    use_math_text(fig)
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=120)
@@ -498,16 +518,18 @@ def _plot_hb(ax, result) -> None:
     first = {}
     for br in result["branches"]:
         g = np.array(br["gamma"], float)
-        a = np.array([np.nan if v is None else v for v in br["amplitude_q"]], float)
+        a = report.y_values(br, result)
         st = np.array(br["stable"], bool)
         cut = np.array([piece[0] for piece in branch_pieces(br["point_status"])], dtype=int)
         # a NaN row between two points that are not joined breaks the line there
         g, a, st = (np.insert(v, cut[cut > 0], f) for v, f in ((g, np.nan), (a, np.nan), (st, True)))
         for sel, style, c, name in ((st, "-", "C0", "stable"), (~st, "--", "C1", "unstable")):
-            ax.plot(g, np.where(sel, a, np.nan), style, color=c, label=name if name not in first else None)
-            first[name] = True
+            name = report.curve_label(result, name)
+            shown = bool(np.any(sel & np.isfinite(a)))  # no legend entry for a style never drawn
+            ax.plot(g, np.where(sel, a, np.nan), style, color=c, label=name if shown and name not in first else None)
+            first[name] = first.get(name) or shown
         gp = np.array(br["gamma"], float)
-        ap = np.array([np.nan if v is None else v for v in br["amplitude_q"]], float)
+        ap = report.y_values(br, result)
         marks = ((br["folds"], "ks", "fold"),
                  ([i for i, s in enumerate(br["point_status"]) if s == "stopped"], "rx", "stopped short"),
                  ([i for i, s in enumerate(br["point_status"]) if s == "after-jump"], "k|", "after a jump"))
@@ -515,11 +537,16 @@ def _plot_hb(ax, result) -> None:
             if len(idx):
                 ax.plot(gp[idx], ap[idx], fmt, ms=6, label=name if name not in first else None)
                 first[name] = True
+        for k, dof in enumerate(report.output_dofs(result)[1:]):  # the other [output] DOFs, thinner
+            y = report.dof_mm(br, result, dof)
+            if y is not None:
+                ax.plot(gp, y, "-", color=f"C{k + 4}", lw=0.9, label=f"DOF {dof}" if dof not in first else None)
+                first[dof] = True
     for pk in result.get("peaks", []):
-        if pk["amplitude_q"] is not None:
+        if report.peak_value(pk, result) is not None:
             # a peak where the branch could be followed only up to it: an open marker (a lower bound)
             name = "peak at a stop (at least)" if pk.get("at_stop") else "peak"
-            ax.plot([pk["gamma"]], [pk["amplitude_q"]], "^", color="C2", ms=5,
+            ax.plot([pk["gamma"]], [report.peak_value(pk, result)], "^", color="C2", ms=5,
                     mfc="none" if pk.get("at_stop") else "C2", label=name if name not in first else None)
             first[name] = True
     what = "no bounded response" if result["status"] == "unbounded" else "not computed"
@@ -529,6 +556,17 @@ def _plot_hb(ax, result) -> None:
         ax.text(0.01, 0.98, f"status: {result['status']}", transform=ax.transAxes, va="top", fontsize=8,
                 color="C3")
     ax.legend(fontsize=8)
+
+
+def _titled(ds, result):
+    """``ds`` with the --system file's ``title`` as its ``title`` attribute (frc.nc carries it as the JSON
+    and frc.png do); what the run computed, the title of a paper-damper run, moves to ``summary``."""
+    if "system" in result:
+        what = ds.attrs.get("title")
+        ds.attrs["title"] = result["system"]["title"]
+        if what and what != ds.attrs["title"]:
+            ds.attrs["summary"] = what
+    return ds
 
 
 def exit_status(result) -> int:
@@ -552,13 +590,13 @@ def run(args) -> int:
         if args.method == "time":
             from ..sweeps import write_outputs
 
-            write_outputs(ds, out)
+            write_outputs(_titled(ds, result), out)
         else:
             from .._io import write_dataset
             from ..hb import branch_dataset
 
             # frc.csv: one row per point (per-harmonic data in frc.nc)
-            write_dataset(branch_dataset(ds), out, "frc")
+            write_dataset(_titled(branch_dataset(ds), result), out, "frc")
         _plot(result, out / "frc.png")
     if args.json:
         print(json.dumps(result))
@@ -583,6 +621,11 @@ def _digits(values, least: int = 4) -> int:
 
 
 def _print_table(result) -> None:
+    if "system" in result:  # the output DOFs in mm: q of the first contact means nothing at a blade tip
+        gammas = (result["directions"][next(iter(result["directions"]))]["gamma"] if result["method"] == "time"
+                  else [g for br in result["branches"] for g in br["gamma"]])
+        report.print_system_table(result, _digits(gammas), _JOINED)
+        return
     if result["method"] == "time":
         dirs = list(result["directions"])
         g = result["directions"][dirs[0]]["gamma"]
@@ -595,8 +638,9 @@ def _print_table(result) -> None:
                 r = result["directions"][d]
                 a = r["amplitude_q"][i]
                 cells.append(f"{'-' if a is None or r['status'][i] != 'periodic' else f'{a:.5g}':>12s} "
-                             f"{r['status'][i]:>11s}")
+                             f"{report.status_cell(r, i):>11s}")
             print(f"{gi:<{w}.{p}g} " + "  ".join(cells))
+        report.print_notes(result, p)
     else:
         from ..hb.results import JOINED
 

@@ -162,7 +162,8 @@ def _validate_args(args):
 
 
 def _plot_png(res, title) -> bytes:
-    from ..figures import pyplot
+    from ..figures import pyplot, use_math_text
+    from ._frc_report import wrap
 
     plt = pyplot()
     import numpy as np
@@ -178,9 +179,10 @@ def _plot_png(res, title) -> bytes:
         ax.plot(res.x[sep] * 1e3, res.T[sep], "x", color="C3", ms=3, label="separation (N <= 0)")
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("T (N)")
-    ax.set_title(title, fontsize=9)
+    ax.set_title(wrap(title, 75), fontsize=9)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
+    use_math_text(fig)
     fig.tight_layout()
     buf = io.BytesIO()
     fig.savefig(buf, format="png")

@@ -5,7 +5,8 @@ The system is the paper's friction damper at its constant normal load
 forcing is not used, its normal loads must be autonomous). ``--method
 epmc`` (default) follows the extended periodic motion concept by harmonic
 balance (:func:`jointdyn.modes.epmc`, ``--harmonics``, ``--samples``,
-``--max-points``); ``--method qsma`` is the quasi-static estimate
+``--max-points``; harmonics and samples chosen automatically unless given,
+as ``frc --method hb`` does); ``--method qsma`` is the quasi-static estimate
 (:func:`jointdyn.modes.qsma`). The amplitude is the first-harmonic
 amplitude of the output DOF in metres (``--amplitude MIN:MAX``, stepped
 logarithmically).
@@ -55,9 +56,12 @@ def add_arguments(p) -> None:
     p.add_argument("--mode", type=int, default=1, help="linear stuck mode to start from, 1-based (default 1)")
     p.add_argument("--output-dof", type=int, default=None,
                    help="DOF whose amplitude is the modal amplitude (default: the system's output DOF)")
-    p.add_argument("--harmonics", type=int, default=None, help=f"epmc: harmonics (default {config.HB_HARMONICS})")
-    p.add_argument("--samples", type=int, default=None,
-                   help=f"epmc: AFT time samples per period (default {config.HB_SAMPLES})")
+    p.add_argument("--harmonics", default=None, metavar="H|auto",
+                   help=f"epmc: harmonics, or auto (default: from {config.HB_HARMONICS}, raised while the backbone "
+                        "changes with more, as frc --method hb does)")
+    p.add_argument("--samples", default=None, metavar="NS|auto",
+                   help=f"epmc: AFT time samples per period, or auto (default: from {config.HB_SAMPLES}, doubled "
+                        "while the backbone changes with more: where a contact separates)")
     p.add_argument("--max-points", type=int, default=None,
                    help=f"epmc: bound on the points of the backbone (default {config.CONT_MAX_POINTS})")
     p.add_argument("--out", default=None, metavar="DIR", help="write modes.nc, modes.csv, modes.png here")
@@ -95,22 +99,28 @@ def _validate(args):
         if args.model is not None or args.law_param or args.n is not None:
             raise ValueError("--model, --law-param and --n cannot be combined with --system: the system file "
                              "names the law of each contact")
-        system = load_system_file(args).system
+        sf = load_system_file(args)
+        system = sf.system
         label = Path(args.system).name
+        args.title = sf.title  # the file's title, in the JSON, modes.nc and modes.png
+        args.figure_label = f"{sf.title} ({label})"
     else:
         args.model = config.MODEL if args.model is None else V.choice("--model", args.model, law_names())
         args.law_params = law_params(args)
         system = System.paper_damper(eta=0.0, model=args.model, law_params=args.law_params)
         label = f"paper's damper, {args.model}"
+        args.title = args.figure_label = label
     check_free_vibration(system, args.method.upper(), springs=args.method == "epmc")
     amps = amplitude_range(system, None if args.amplitude is None else parse_amplitude(args.amplitude))
     args.output_dof = output_dof_of(system, args.output_dof)
     linear_stuck_mode(system, V.positive_int("--mode", args.mode, 1), args.output_dof)
     if args.method == "epmc":
-        args.harmonics = V.positive_int("--harmonics", config.HB_HARMONICS if args.harmonics is None
-                                        else args.harmonics, 1)
-        args.samples = V.positive_int("--samples", config.HB_SAMPLES if args.samples is None else args.samples,
-                                      2 * args.harmonics + 2)
+        from .frc import _count_or_auto
+
+        auto = config.HB_AUTO
+        args.harmonics = _count_or_auto("--harmonics", auto if args.harmonics is None else args.harmonics, 1)
+        h = config.HB_HARMONICS if args.harmonics == auto else args.harmonics
+        args.samples = _count_or_auto("--samples", auto if args.samples is None else args.samples, 2 * h + 2)
         args.max_points = V.positive_int("--max-points", config.CONT_MAX_POINTS if args.max_points is None
                                          else args.max_points, 2)
     if args.out is not None:
@@ -132,7 +142,7 @@ def _compute(args, system, amps):
 def _result(args, ds, label) -> dict:
     keys = ("amplitude_m", "amplitude_q", "omega_rad_s", "frequency_hz", "damping_ratio", "damping_ratio_contacts",
             "damping_ratio_viscous", "energy_contact_j")
-    return {"method": args.method, "system": label, "mode": int(ds.attrs["linear_mode"]),
+    return {"method": args.method, "system": label, "title": args.title, "mode": int(ds.attrs["linear_mode"]),
             "output_dof": int(ds.attrs["output_dof"]), "harmonics": int(ds.attrs["harmonics"]),
             "samples": int(ds.attrs["samples"]), "omega_linear_rad_s": float(ds.attrs["omega_linear_rad_s"]),
             "branches": [{k: _jsonable(ds[k].values) for k in keys}],
@@ -141,7 +151,8 @@ def _result(args, ds, label) -> dict:
 
 def _plot(ds, title: str, path: Path) -> None:
     from .._io import atomic_path
-    from ..figures import pyplot
+    from ..figures import pyplot, use_math_text
+    from ._frc_report import wrap
 
     plt = pyplot()
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(6.4, 6.0), sharex=True)
@@ -156,8 +167,9 @@ def _plot(ds, title: str, path: Path) -> None:
     for ax in (ax1, ax2):
         ax.set_xscale("log")
         ax.grid(alpha=0.3, which="both")
-    ax1.set_title(f"{ds.attrs['method'].upper()} backbone of mode {ds.attrs['linear_mode']} ({title}); "
-                  f"status {ds.attrs['status']}", fontsize=9)
+    ax1.set_title(wrap(f"{ds.attrs['method'].upper()} backbone of mode {ds.attrs['linear_mode']} ({title}); "
+                       f"status {ds.attrs['status']}"), fontsize=9)
+    use_math_text(fig)
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=120)
@@ -175,7 +187,8 @@ def run(args) -> int:
     system, amps, label = _validate(args)
     backbone, ds = _compute(args, system, amps)
     if args.out is not None:
-        _write(ds, Path(args.out), label)
+        ds.attrs["title"] = args.title
+        _write(ds, Path(args.out), args.figure_label)
     result = _result(args, ds, label)
     if args.json:
         print(json.dumps(result))

@@ -56,13 +56,15 @@ bordered systems, the compiled LU :func:`~jointdyn.continuation.linalg.lu_solve`
 :mod:`~jointdyn.continuation.newton` (the damped corrector),
 :mod:`~jointdyn.continuation.walk` (the predictor-corrector walk along a
 branch) and :mod:`~jointdyn.continuation.post` (turning points, maxima and
-their refinement on a computed branch).
+their refinement on a computed branch); :mod:`~jointdyn.continuation.progress`
+holds a progress bar over the parameter's range.
 """
 
 from .newton import newton
 from .options import ContinuationOptions, ContinuationResult, ContinuationStatus, make_options
 from .post import local_maxima, refine_maximum, turning_points
+from .progress import ParameterProgress
 from .walk import continuation
 
 __all__ = ["ContinuationOptions", "ContinuationStatus", "ContinuationResult", "continuation", "newton",
-           "turning_points", "make_options", "local_maxima", "refine_maximum"]
+           "turning_points", "make_options", "local_maxima", "refine_maximum", "ParameterProgress"]

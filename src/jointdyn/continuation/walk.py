@@ -436,7 +436,8 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
         accepted point; a tuple stops the branch with that status (a
         :class:`~jointdyn.status.Status`; the point is kept).
     progress : tqdm-like, optional
-        Its ``update(1)`` is called per accepted point.
+        Its ``update(1)`` is called per accepted point, and its
+        ``reached(lam)`` where it has one (:class:`ParameterProgress`).
     observe : callable, optional
         ``observe(y, lam) -> float``, the quantity a plot of the branch
         shows against lam (e.g. the logarithm of an amplitude, so that the
@@ -484,7 +485,10 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
         fold = bool(np.sign(t_new[n]) != np.sign(t[n]) and t[n] != 0.0) and not (st.gap or st.corner)
         pts.cnt["folds"] += fold
         if (v[n] - lam_stop) * sgn > 0 or (v[n] - lam0) * sgn < 0:
-            return pts.finish(*_range_end(walk, u, v, t, fold, pts, lam_stop, lam_name))
+            end = _range_end(walk, u, v, t, fold, pts, lam_stop, lam_name)
+            if hasattr(progress, "reached"):  # the point landed on the end of the range
+                progress.reached(float(pts.L[-1]))
+            return pts.finish(*end)
         u_prev, t_prev, u, t, g_u = u, t, v, t_new, st.g
         prev = None if (st.gap or st.corner) else (u_prev, t_prev)
         pts.add(v[:n].copy(), v[n], t[n], fold, st.it, st.gap, st.corner)
@@ -514,6 +518,8 @@ def _accepted(v, n, monitor, progress):
     """Progress and monitor at an accepted point: None or the monitor's (status, message)."""
     if progress is not None:
         progress.update(1)
+        if hasattr(progress, "reached"):  # a bar over the parameter's range (ParameterProgress)
+            progress.reached(float(v[n]))
     if monitor is not None:
         return monitor(v[:n], v[n])
     return None

@@ -14,6 +14,7 @@ data beside it.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -23,7 +24,7 @@ import pandas as pd
 from .._io import atomic_path
 
 __all__ = ["Figure", "register_figure", "figure_names", "make_figure", "FIGURES", "pyplot", "save_figure",
-           "model_label"]
+           "model_label", "math_text", "use_math_text"]
 
 def model_label(model: str) -> str:
     """Name of a contact law in a figure: its label registered with the law
@@ -34,6 +35,49 @@ def model_label(model: str) -> str:
 
     label = law_label(model) if model in law_names() else model
     return f"{label} ({model})" if label != model else str(model)
+
+
+#: Greek letters that titles, labels and legends spell out (eta, gamma, ...)
+_GREEK = ("alpha", "beta", "gamma", "delta", "zeta", "eta", "theta", "mu", "omega")
+#: a Greek word, the unit um, w0 and the w of "w / w0", each a whole word
+_MATH_WORD = re.compile(r"\b(?:" + "|".join(_GREEK) + r"|um|w0)\b|\bw(?= / )")
+#: a mathtext segment already in a text
+_MATH_SEGMENT = re.compile(r"(\$[^$]*\$)")
+
+
+def _math_word(match) -> str:
+    word = match.group(0)
+    if word == "um":
+        return r"$\mu$m"
+    if word == "w0":
+        return r"$\omega_0$"
+    if word == "w":
+        return r"$\omega$"
+    return rf"$\{word}$"
+
+
+def math_text(text: str) -> str:
+    """``text`` with its spelled-out Greek letters (``eta``, ``gamma``, ...),
+    the unit ``um`` and the ``w / w0`` of a frequency ratio in matplotlib's
+    mathtext (``$\\eta$``, ``$\\mu$m``, ``$\\omega / \\omega_0$``).
+
+    Only whole words change (``delta_deg``, ``beta1`` and ``maximum`` stay),
+    and mathtext already in the text is left as it is.
+    """
+    parts = _MATH_SEGMENT.split(text)
+    return "".join(p if i % 2 else _MATH_WORD.sub(_math_word, p) for i, p in enumerate(parts))
+
+
+def use_math_text(fig) -> None:
+    """Apply :func:`math_text` to every text of ``fig`` (titles, axis labels,
+    legends, annotations), so that pictures show eta as the letter."""
+    from matplotlib.text import Text
+
+    for text in fig.findobj(Text):
+        old = text.get_text()
+        new = math_text(old) if old else old
+        if new != old:
+            text.set_text(new)
 
 
 class _Registry(dict):
@@ -152,7 +196,9 @@ def pyplot():
 
 
 def save_figure(fig, out_dir, name: str, dpi: int = 130) -> list[Path]:
-    """Write ``fig`` as ``<name>.png`` (at ``dpi``) and ``<name>.svg``, atomically; close it."""
+    """Write ``fig`` as ``<name>.png`` (at ``dpi``) and ``<name>.svg``, atomically,
+    its texts in mathtext (:func:`use_math_text`); close it."""
+    use_math_text(fig)
     paths = []
     for ext in ("png", "svg"):
         path = Path(out_dir) / f"{name}.{ext}"

@@ -50,16 +50,23 @@ def plot_frc_curve(ax, gamma, amplitude, status, *, color=None, linestyle="-", l
     return color
 
 
+#: legend text per non-periodic status name
+_MARK_LABELS = {"unbounded": "unbounded (no steady state)", "not-settled": "not settled"}
+
+
 def mark_legend(ax, **kw):
-    """Legend entries for the rug markers (added to the existing handles)."""
+    """Legend entries for the rug markers that ``ax`` shows (added to the
+    existing handles): a status no point has gets no entry."""
     from matplotlib.lines import Line2D
 
+    drawn = {line.get_marker() for line in ax.lines if line.get_linestyle() in ("None", "none", "")}
     handles, labels = ax.get_legend_handles_labels()
-    handles += [
-        Line2D([], [], color="k", linestyle="none", marker="x", ms=4),
-        Line2D([], [], color="k", linestyle="none", marker="o", markerfacecolor="none", ms=4),
-    ]
-    labels += ["unbounded (no steady state)", "not settled"]
+    for name in ("unbounded", "not-settled"):
+        marker, face = _MARKS[name]
+        if marker in drawn:
+            handles.append(Line2D([], [], color="k", linestyle="none", marker=marker, ms=4,
+                                  markerfacecolor=face if face else "k"))
+            labels.append(_MARK_LABELS[name])
     ax.legend(handles, labels, **kw)
 
 

@@ -129,13 +129,17 @@ def _fig6_panel(ax, rug, df, betas):
     _linear_limits(ax)
 
 
-def _fig6_legend(fig, ax):
+def _fig6_legend(fig, ax, statuses):
+    """The betas, the two sweeps, and the rug markers of the ``statuses`` that occur."""
     from matplotlib.lines import Line2D
 
     h, lab = ax.get_legend_handles_labels()
-    h += [Line2D([], [], color="k", lw=4.0, alpha=0.35), Line2D([], [], color="k", lw=1.1),
-          Line2D([], [], color="k", marker="x", ls="none"), Line2D([], [], color="k", marker="o", mfc="none", ls="none")]
-    lab += ["sweep up (pale band)", "sweep down (thin line)", "unbounded (rug)", "not settled (rug)"]
+    h += [Line2D([], [], color="k", lw=4.0, alpha=0.35), Line2D([], [], color="k", lw=1.1)]
+    lab += ["sweep up (pale band)", "sweep down (thin line)"]
+    for name, (marker, face) in RUG_MARKERS.items():
+        if name in statuses:
+            h.append(Line2D([], [], color="k", marker=marker, mfc=face if face else "k", ls="none"))
+            lab.append(f"{name.replace('-', ' ')} (rug)")
     fig.legend(h, lab, loc="outside lower center", ncol=6, fontsize=8, frameon=False)
 
 
@@ -159,7 +163,7 @@ def _plot_fig6(tables, out_dir):
         rug.set_xlabel("gamma = w / w0")
         ax.set_ylabel("half peak-to-peak amplitude\nof q = kt x / fy")
         if k == 0:
-            _fig6_legend(fig, ax)
+            _fig6_legend(fig, ax, set(_status_names(df.status)))
     model = f"; {model_label(df['model'].iloc[0])}" if "model" in df else ""
     fig.suptitle("Paper Fig 6: steady response vs frequency ratio gamma; eta = N1/N0 varied by panel, "
                  f"beta = mu N0 / F1 by colour (delta = 0{model})", fontsize=10)
@@ -304,6 +308,24 @@ def _label_opening(ax, df, color):
                     fontweight="bold", ha="right")
 
 
+#: a force at A below this fraction of the loop's largest |T| is no jump: the contact opens unloaded
+DROP_CONTINUOUS = 0.01
+
+
+def _drop_text(force_N: float, travel: float, force_max_N: float) -> str:
+    """What the contact carries at A and over how much travel it loses it, in
+    words (``travel``: the displacement from A to the opening over the loop's
+    half peak-to-peak amplitude, below 0.5 % a jump; ``force_max_N``: the
+    loop's largest |T|, against which a force at A is nothing or a load)."""
+    if not math.isfinite(force_N):
+        return "the contact does not open"
+    if abs(force_N) < DROP_CONTINUOUS * force_max_N:
+        return f"T at A, where opening starts: {force_N:.3g} N, next to nothing: no force jump"
+    where = (f"within {100 * travel:.0f} % of the amplitude" if travel >= 0.005 else
+             "with no travel (a jump)")
+    return f"T at A, where opening starts: {force_N:.3g} N, lost {where}"
+
+
 @fig7.plotter
 def _plot_fig7(tables, out_dir):
     plt = pyplot()
@@ -316,8 +338,7 @@ def _plot_fig7(tables, out_dir):
         _path_arrows(ax, df["x"].to_numpy() * 1e6, df["T"].to_numpy(), "C0")
         _label_opening(ax, df, "C0")
         ax.set_title(f"({tag}) delta = {row.delta_deg:g} deg: {row.case.split(': ', 1)[-1]}\n"
-                     f"load when opening starts (A) = {row.drop_T_N:.3g} N, lost over "
-                     f"{row.drop_dx_over_amp:.2g} of the amplitude", fontsize=9)
+                     + _drop_text(row.drop_T_N, row.drop_dx_over_amp, float(df["T"].abs().max())), fontsize=9)
         ax.set_xlabel("tangential displacement x (um)")
         ax.set_ylabel("tangential force T (N)")
         ax.grid(alpha=0.3)
@@ -369,7 +390,6 @@ def _fig8_energy(ax, info, eta):
     ax.set_ylabel("energy dissipated per cycle (mJ)")
     ax.set_title(f"loop area vs delta, eta = {eta:g}\nlargest (star): " + ", ".join(largest), fontsize=9)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
 
 
 @fig8.plotter
@@ -393,8 +413,12 @@ def _plot_fig8(tables, out_dir):
             ax.set_ylabel("T (N)")
             ax.grid(alpha=0.3)
         _fig8_energy(axes[r, 2], info, eta)
+    # one legend below the panels (the energy panels' curves are everywhere in
+    # their axes, a legend inside would cover some): the phases, then the models
     h, lab = axes[0, 0].get_legend_handles_labels()
-    fig.legend(h, lab, loc="outside lower center", ncol=len(h), fontsize=8, frameon=False)
+    h2, lab2 = axes[0, 2].get_legend_handles_labels()
+    fig.legend(h + h2, lab + [f"energy (right): {t}" for t in lab2], loc="outside lower center",
+               ncol=len(h + h2), fontsize=8, frameon=False)
     fig.suptitle(f"Paper Fig 8: steady loops, phase delta of the normal load varied (beta = {FIG8_BETA:g}, "
                  f"gamma = {FIG8_GAMMA:g}; dots: separated)\nThe paper finds the largest loop near delta = 90 deg "
                  "and the smallest at 0 and 180 deg: compare the largest loop (star) of the exact model and of the "
@@ -446,8 +470,9 @@ def _plot_energy(tables, out_dir):
         ax.set_xticks(range(0, 181, 30))
         ax.grid(alpha=0.3, which="both")
     h, lab = axes[0, 0].get_legend_handles_labels()
-    h.append(Line2D([], [], color="k", marker="x", ls="none", ms=8, mew=1.6))
-    lab.append("no steady state (on the bottom edge)")
+    if (df.status != 0).any():  # the marker's entry only where one is drawn
+        h.append(Line2D([], [], color="k", marker="x", ls="none", ms=8, mew=1.6))
+        lab.append("no steady state (on the bottom edge)")
     fig.legend(h, lab, loc="outside lower center", ncol=4, fontsize=8, frameon=False)
     model = f"; {model_label(df['model'].iloc[0])}" if "model" in df else ""
     fig.suptitle("Beyond paper Fig 8: energy dissipated by the contact per cycle, phase delta of the normal load "

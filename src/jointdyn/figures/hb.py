@@ -91,7 +91,9 @@ def _hb_curve(ax, sub, color):
     ax.plot(g[f], a[f], "ks", ms=5, mfc="none")
 
 
-def _hb_legend(fig, betas, statuses):
+def _hb_legend(fig, betas, statuses, hb, td):
+    """The betas, then an entry for each line style and marker that is drawn
+    (unstable pieces, folds, time-domain points of either sweep)."""
     from matplotlib.lines import Line2D
 
     from .dynamics import BETA_COLORS
@@ -100,11 +102,16 @@ def _hb_legend(fig, betas, statuses):
     for ib, beta in enumerate(betas):
         h.append(Line2D([], [], color=BETA_COLORS[ib % len(BETA_COLORS)], lw=1.4))
         lab.append(f"beta = {beta:g}" + (" (HB stopped: unbounded)" if statuses.get(beta) == "unbounded" else ""))
-    h += [Line2D([], [], color="k", ls="--"), Line2D([], [], color="k", marker="s", mfc="none", ls="none"),
-          Line2D([], [], color="k", marker="^", mfc="none", ls="none"),
-          Line2D([], [], color="k", marker="v", mfc="none", ls="none")]
-    lab += ["HB unstable (Hill)", "HB fold", "time domain, sweep up (periodic points)",
-            "time domain, sweep down (periodic points)"]
+    drawn = [(not hb.stable.astype(bool).all(), Line2D([], [], color="k", ls="--"), "HB unstable (Hill)"),
+             (hb.fold.astype(bool).any(), Line2D([], [], color="k", marker="s", mfc="none", ls="none"), "HB fold")]
+    for d, mk in (("up", "^"), ("down", "v")):
+        shown = td is not None and ((td.direction == d) & (td.status_name == "periodic")).any()
+        drawn.append((shown, Line2D([], [], color="k", marker=mk, mfc="none", ls="none"),
+                      f"time domain, sweep {d} (periodic points)"))
+    for shown, handle, text in drawn:
+        if shown:
+            h.append(handle)
+            lab.append(text)
     fig.legend(h, lab, loc="outside lower center", ncol=4, fontsize=8, frameon=False)
 
 
@@ -138,7 +145,7 @@ def _plot_fig6_hb(tables, out_dir):
         ax.set_xlabel("gamma = w / w0")
     for ax in axes[:, 0]:
         ax.set_ylabel("half peak-to-peak amplitude\nof q = kt x / fy")
-    _hb_legend(fig, betas, statuses)
+    _hb_legend(fig, betas, statuses, hb, td)
     model = f"; {model_label(hb['model'].iloc[0])}" if "model" in hb else ""
     fig.suptitle("Paper Fig 6 cases by harmonic balance over time-domain steady states; eta varied by panel, "
                  f"beta by colour\n(H = 7, 128 samples per period, 512 for eta > 1; stability by Hill's method{model})",

@@ -202,7 +202,6 @@ def _plot_blade_damper(tables, out_dir):
     ax1.set_xlabel("gamma = w / w0")
     ax1.set_ylabel("tip amplitude, mm")
     ax1.set_title("Tip response, sweeps up (solid) and down (dashed); x at the axis: not periodic", fontsize=9)
-    ax1.legend(fontsize=7)
     ax1.grid(alpha=0.3)
     ax2.plot(design.preload_N, 1e3 * design.peak_m, "o-", color="C0",
              label="peak tip amplitude, either sweep (time domain)")
@@ -216,7 +215,10 @@ def _plot_blade_damper(tables, out_dir):
     ax2.set_xlabel("damper preload P, N")
     ax2.set_ylabel("peak tip amplitude, mm")
     ax2.set_title("Design chart", fontsize=9)
-    ax2.legend(fontsize=7)
+    # one legend below both panels: inside, it covered the limits' lines and curves
+    h1, l1 = ax1.get_legend_handles_labels()
+    h2, l2 = ax2.get_legend_handles_labels()
+    fig.legend(h1 + h2, l1 + l2, loc="outside lower center", ncol=5, fontsize=7, frameon=False)
     ax2.grid(alpha=0.3, which="both")
     fig.suptitle("Blade with a wedge damper whose normal load follows the platform's motion "
                  f"(theta = {BLADE['theta_deg']:g} deg, kn = {BLADE['kn']:g} N/m, tip force "

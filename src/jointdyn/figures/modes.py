@@ -119,7 +119,8 @@ def _plot_modes_backbones(tables, out_dir):
     for ax in (ax1, ax2):
         ax.set_xscale("log")
         ax.grid(alpha=0.3, which="both")
-    ax2.legend(fontsize=7, loc="lower right")
+    # below the panels: inside, the legend would cover curves (they fill both axes)
+    fig.legend(*ax2.get_legend_handles_labels(), loc="outside lower center", ncol=1, fontsize=7, frameon=False)
     fig.suptitle("Backbones of the paper's damper (H = 7): constant N0 = 100 N, and N following the motion",
                  fontsize=10)
     return save_figure(fig, out_dir, "modes_backbones")

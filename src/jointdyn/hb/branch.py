@@ -57,6 +57,7 @@ from ..continuation import (
     ContinuationOptions,
     ContinuationResult,
     ContinuationStatus,
+    ParameterProgress,
     continuation,
     local_maxima,
     make_options,
@@ -347,16 +348,15 @@ class _Tracker:
 _AMPLITUDE_CACHE = 8
 
 
-def _bar(total: int, desc: str, progress):
-    """A tqdm bar (shown on a TTY when ``progress`` is None), or a null context without one when it is
-    False (tqdm is not even imported: it takes a noticeable part of a short command's time)."""
+def _bar(start: float, stop: float, desc: str, progress, name: str, scale: float):
+    """A bar over the range [start, stop] of the (scaled) parameter (:class:`ParameterProgress`, shown on a
+    TTY when ``progress`` is None), or a null context without one when it is False (tqdm is not even
+    imported: it takes a noticeable part of a short command's time)."""
     if progress is False:
         import contextlib
 
         return contextlib.nullcontext(None)
-    from tqdm.auto import tqdm
-
-    return tqdm(total=total, desc=desc, disable=None if progress is None else not progress, leave=False)
+    return ParameterProgress(start, stop, desc, progress, name=name, scale=scale)
 
 
 def _forcing_problem(system: System, gamma: float, harmonics: int, samples: int, condense):
@@ -419,7 +419,7 @@ def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress, mon
     fails from it in gamma, from :func:`solve_point`); ``monitor`` defaults to the tracker's."""
     problem = tr.problem
     xs, _, ps = tr.scales
-    with _bar(opt.max_points, f"HB {problem.parameter.name}", progress) as bar:
+    with _bar(lam_a / ps, lam_b / ps, f"HB {problem.parameter.name}", progress, problem.parameter.name, ps) as bar:
         y0 = problem.linear_guess(lam_a) / xs
         if (problem.parameter is GAMMA
                 and not newton(tr.residual, y0, lam_a / ps, opt, max_iter=config.HB_START_MAX_ITER)[1]):
@@ -463,7 +463,7 @@ def _gap_fills(tr: _Tracker, parts, span: float, opt: ContinuationOptions, progr
             end = p.lam[i - 1] + math.copysign(min(opt.max_dlam, span), p.lam[i - 1] - p.lam[i])
             reach = abs(p.lam[i] - end)
             fopt = dataclasses.replace(opt, jump_fractions=tuple(f * span / reach for f in opt.jump_fractions))
-            with _bar(opt.max_points, f"HB {name} (gap)", progress) as bar:
+            with _bar(p.lam[i], end, f"HB {name} (gap)", progress, name, tr.scales[2]) as bar:
                 fill = tr.relabel(continuation(tr.residual, p.y[i], p.lam[i], end, fopt,
                                                monitor=_FillMonitor(tr, p.lam[i - 1], p.lam[i], p.y[i - 1]),
                                                progress=bar, observe=tr.observe_step, lam_name=name))

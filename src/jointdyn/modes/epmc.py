@@ -62,7 +62,8 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ..continuation import ContinuationOptions, ContinuationStatus, continuation, make_options, newton
+from ..continuation import (ContinuationOptions, ContinuationStatus, ParameterProgress, continuation, make_options,
+                            newton)
 from ..fourier import derivative_matrix
 from ..hb import HBProblem
 from ..kinematics import contact_kinematics, selection_matrix
@@ -283,7 +284,7 @@ def _reduce(system, n_modes: int, output_dof):
 
 
 def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None,
-         harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
+         harmonics: int | str = config.HB_HARMONICS, samples: int | str = config.HB_SAMPLES,
          options: ContinuationOptions | None = None, progress: bool | None = None, reduce: int | None = None,
          **overrides) -> Backbone:
     """Backbone of a nonlinear mode by the extended periodic motion concept.
@@ -302,10 +303,17 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         Linear stuck mode the backbone starts from (1-based).
     output_dof : int, optional
         DOF of the modal amplitude (default: the system's response DOF).
-    harmonics : int
-        Highest harmonic H (>= 1).
-    samples : int
-        AFT samples per period (>= 2H + 2).
+    harmonics : int or "auto"
+        Highest harmonic H (>= 1). ``"auto"``: from ``config.HB_HARMONICS``,
+        raised to 2H + 1 while the backbone's frequency or damping at its
+        check points changes by more than ``config.HB_AUTO_RTOL`` with it
+        (``jointdyn.modes._auto``; the levels tried and the last check are
+        in the message and counters), as ``frc_hb`` does for a branch.
+    samples : int or "auto"
+        AFT samples per period (>= 2H + 2). ``"auto"``: from
+        ``config.HB_SAMPLES``, doubled the same way (where a contact
+        separates, its force jumps and too few samples make the backbone
+        ripple).
     options : ContinuationOptions, optional
         Step control in the scaled unknowns (arc length in decades of
         amplitude); default ``ds = config.MODES_DS_START``,
@@ -333,8 +341,11 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         modes against the full model's; :meth:`Backbone.full_shape`: the
         harmonics of the mode shape on the full model's DOFs).
     """
-    from tqdm.auto import tqdm
+    if harmonics == config.HB_AUTO or samples == config.HB_AUTO:
+        from ._auto import auto_backbone
 
+        return auto_backbone(epmc, system, amplitude, harmonics=harmonics, samples=samples, mode=mode,
+                             output_dof=output_dof, options=options, progress=progress, reduce=reduce, **overrides)
     check_free_vibration(system, "EPMC")
     lo, hi = amplitude_range(system, amplitude)
     reduction = None
@@ -357,8 +368,8 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         if last is not None and last[0].tobytes() == X.tobytes():
             stash[X.tobytes()] = last[3]
 
-    with tqdm(total=opt.max_points, desc="EPMC", disable=None if progress is None else not progress,
-              leave=False) as bar:
+    # the bar fills over the range of log10(amplitude), not against max_points
+    with ParameterProgress(lam0, lam1, "EPMC", progress, name="log10(a / m)") as bar:
         res = continuation(problem.residual, v0, lam0, lam1, opt, monitor=keep, progress=bar)
     status = _STATUS.get(res.status, ModeStatus.FAILED if res.lam.size else ModeStatus.NO_START)
     message = res.message.replace("lam = ", "log10(amplitude / m) = ")

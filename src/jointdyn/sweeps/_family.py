@@ -108,6 +108,30 @@ class LineSpec:
         label = _SAFE.sub("_", self.label)[:_LABEL_CHARS]
         return f"{label}_{self.direction}_{h}"
 
+    @property
+    def folder(self) -> str:
+        """Folder name of the line's checkpoints: as :attr:`key`, but the hash
+        leaves out the gamma grid, so that a rerun on another grid (one more
+        point, a finer step) finds the points it can reuse (each checkpoint
+        records the gammas its points were reached through)."""
+        d = json.loads(self.to_json())
+        d.pop("gammas")
+        h = hashlib.sha1(json.dumps(d, sort_keys=True).encode()).hexdigest()[:12]
+        label = _SAFE.sub("_", self.label)[:_LABEL_CHARS]
+        return f"{label}_{self.direction}_{h}"
+
+    def resume_key(self) -> str:
+        """:meth:`checkpoint_key` without the gamma grid: the key a checkpoint
+        must carry to be reused on any grid (its points are reused where the
+        gammas that led to them match, see ``sweeps._checkpoint``)."""
+        from .. import __version__
+        from ..dynamics.version import SOLVER_VERSION
+
+        d = json.loads(self.to_json())
+        d.pop("gammas")
+        return json.dumps({"line": json.dumps(d, sort_keys=True), "solver_version": SOLVER_VERSION,
+                           "jointdyn": __version__}, sort_keys=True)
+
     def checkpoint_key(self) -> str:
         """The spec with the versions of the solver and of jointdyn: the
         resume key stored in (and compared with) each checkpoint."""

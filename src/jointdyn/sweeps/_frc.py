@@ -422,7 +422,7 @@ def _resume(runs, line_root) -> tuple:
         return 0, 0
     names = tuple(runs[0].arrays) if runs else ()
     for run in runs:
-        ck = load_line(line_root / run.spec.key, run.spec.checkpoint_key(), names, run.index, len(run.gammas))
+        ck = load_line(line_root / run.spec.folder, run.spec.resume_key(), names, run.index, run.gammas)
         for chunk in ck.chunks:
             run.accept(chunk)
         reused += ck.reused
@@ -455,7 +455,8 @@ def _run(runs, family, client, n_workers, out, progress, on_line) -> tuple:
 
     def on_chunk(run, chunk):
         if line_root is not None and chunk.done:
-            save_chunk(line_root / run.spec.key, run.spec.checkpoint_key(), chunk)
+            save_chunk(line_root / run.spec.folder, run.spec.resume_key(), chunk,
+                       run.gammas[:chunk.first + chunk.done])
         show()
         if run.finished and on_line is not None:
             on_line(run.spec, True)
@@ -491,6 +492,9 @@ def _assemble(family, runs, directions, g, dofs, spp, loop_outputs):
         dtype = np.int32 if name in INT_VARIABLES else np.float64
         data[name] = (dims, _stack(runs, family, directions, name, (m,), dtype, 0 if name in INT_VARIABLES
                                    else np.nan), {"units": unit, "long_name": desc})
+    reasons = config.SWEEP_NOT_SETTLED_REASONS
+    data["not_settled_reason"][2].update(flag_values=np.arange(len(reasons), dtype=np.int32),
+                                         flag_meanings=" ".join(reasons))
     data["status"] = (dims, _stack(runs, family, directions, "status", (m,), np.int8, _MISSING), {
         "legend": _LEGEND,
         "flag_values": np.array([s.code for s in SteadyStatus], dtype=np.int8),
@@ -540,6 +544,11 @@ def to_frame(ds):
             label = "_".join(_column_part(d, p) for d, p in zip(extra, parts))
             df[f"{name}_{label}"] = stacked.isel(_col=j).values.reshape(-1)
     df["status_name"] = [status_name(c) for c in df["status"]]
+    if "not_settled_reason" in df:
+        reasons = config.SWEEP_NOT_SETTLED_REASONS
+        unsettled = SteadyStatus.NOT_SETTLED.code
+        df["not_settled_reason_name"] = ["" if s != unsettled else reasons[int(r)] if 0 < int(r) < len(reasons) else ""
+                                         for s, r in zip(df["status"], df["not_settled_reason"])]
     return df
 
 

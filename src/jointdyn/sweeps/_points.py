@@ -61,6 +61,8 @@ VARIABLES = {
 INT_VARIABLES = {
     "periods": ("1", "forcing periods integrated for this point"),
     "period_multiple": ("1", "the steady response repeats after this many forcing periods (0 if none)"),
+    "not_settled_reason": ("1", "why a point is not-settled, a code: " + ", ".join(
+        f"{i} {name}" for i, name in enumerate(config.SWEEP_NOT_SETTLED_REASONS)) + " (0 for the other points)"),
     "negative_dissipation": ("1", "1 where the periodic state's contact dissipation is negative beyond its "
                                   "energy-balance residual (a contact created energy: SteadyState.energy_check)"),
 }
@@ -324,6 +326,17 @@ def empty_arrays(m: int, ndofs: int, nc: int, loop_outputs: bool) -> dict:
     return out
 
 
+def not_settled_reason(res) -> int:
+    """Code (``config.SWEEP_NOT_SETTLED_REASONS``) of why the steady state
+    ``res`` is not-settled, from its ``detail``; 0 when it is not."""
+    if res.status != "not-settled":
+        return 0
+    detail = str(getattr(res, "detail", ""))
+    name = "long-period" if detail.startswith("period-") else detail
+    reasons = config.SWEEP_NOT_SETTLED_REASONS
+    return reasons.index(name) if name in reasons else 0
+
+
 def _store(out: dict, k: int, res, system, task: ChunkTask) -> None:
     """Point k of the chunk from the steady state ``res``."""
     if res.status not in STATUS_CODES:
@@ -333,6 +346,7 @@ def _store(out: dict, k: int, res, system, task: ChunkTask) -> None:
         out[name][k] = float(getattr(res, name, math.nan))
     out["periods"][k] = int(res.periods)
     out["period_multiple"][k] = int(getattr(res, "period_multiple", 0) or 0)
+    out["not_settled_reason"][k] = not_settled_reason(res)
     out["negative_dissipation"][k] = int(getattr(res, "energy_check", None) == EnergyCheck.NEGATIVE_DISSIPATION)
     loop = getattr(res, "loop", None)
     if task.loop_outputs and loop is not None:

@@ -2,7 +2,7 @@
 
 Every case is one ``jointdyn frc --method hb`` run with the CLI's defaults
 (:func:`jointdyn.hb.frc_hb` with the gamma grid's STEP as the largest
-spacing), checked against what must hold (issue 9):
+spacing), checked against what must hold:
 
 * the branch covers the requested range (``complete``), or it is
   ``unbounded`` where friction cannot bound the resonance (Den Hartog:
@@ -40,7 +40,7 @@ from ..status import Status
 __all__ = ["GRID_MODELS", "GRID_ETAS", "GRID_BETAS", "GRID_GAMMA", "GridCase", "Verdict", "grid_case",
            "grid_cases", "grid_table", "hb_restart"]
 
-#: the grid of issue 9: models (default exact, closed form with full memory, the paper's rule, Jenkins),
+#: the robustness grid: models (default exact, closed form with full memory, the paper's rule, Jenkins),
 #: eta = N1 / N0, beta = mu N0 / F1, gamma START:STOP:STEP
 GRID_MODELS = (config.MODEL, "iwan-closed", "iwan-paper", "jenkins")
 GRID_ETAS = (0.01, 0.5, 1.5, 10.0)
