@@ -15,7 +15,7 @@ import xarray as xr
 from jointdyn import config
 from jointdyn.cli import main
 from jointdyn.dynamics import Restart
-from jointdyn.sweeps import _frc
+from jointdyn.sweeps import _frc, _points
 from jointdyn.sweeps._points import not_settled_reason
 from test_sweeps import _FakeSS
 
@@ -39,7 +39,7 @@ def _fake(system, gamma, *, start=None, keep_loop=True, **kw):
 
 @pytest.fixture
 def fake(monkeypatch):
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: _fake)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: _fake)
 
 
 def test_not_settled_reason_codes():

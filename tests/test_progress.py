@@ -38,10 +38,10 @@ def test_continuation_fills_the_bar_over_the_range():
 
 @pytest.fixture
 def recorded(monkeypatch):
-    """Every ParameterProgress made by hb.frc and modes.epmc."""
+    """Every ParameterProgress made by hb.branch and modes.epmc."""
     import importlib
 
-    frc = importlib.import_module("jointdyn.hb.frc")
+    frc = importlib.import_module("jointdyn.hb.branch")
     epmc = importlib.import_module("jointdyn.modes.epmc")
 
     bars = []

@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 import xarray as xr
 
-from jointdyn.sweeps import _frc, frc_sweep
+from jointdyn.sweeps import _frc, _points, frc_sweep
 from jointdyn.sweeps._family import LineSpec
 from test_sweeps import GAMMAS, _Fake, _results
 
@@ -17,7 +17,7 @@ def swap(monkeypatch):
     """``swap()``: a fresh recording solver double in place, returned."""
     def install():
         f = _Fake()
-        monkeypatch.setattr(_frc, "_steady_state_fn", lambda: f)
+        monkeypatch.setattr(_points, "_steady_state_fn", lambda: f)
         return f
 
     return install

@@ -624,7 +624,9 @@ def _print_table(result) -> None:
     if "system" in result:  # the output DOFs in mm: q of the first contact means nothing at a blade tip
         gammas = (result["directions"][next(iter(result["directions"]))]["gamma"] if result["method"] == "time"
                   else [g for br in result["branches"] for g in br["gamma"]])
-        report.print_system_table(result, _digits(gammas), _JOINED)
+        from ..hb.results import JOINED
+
+        report.print_system_table(result, _digits(gammas), JOINED)
         return
     if result["method"] == "time":
         dirs = list(result["directions"])

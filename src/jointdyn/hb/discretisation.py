@@ -33,7 +33,7 @@ def _fixed_branch(req: _Request, level, auto=(False, False), watch: bool = False
     return continued_branch(req, level, watch_for)
 
 
-def _first_level(harmonics, samples):
+def first_level(harmonics, samples):
     """((H, Ns) of the first branch, (harmonics auto, samples auto)); validates both."""
     auto_h, auto_s = harmonics == AUTO, samples == AUTO
     for name, v, auto in (("harmonics", harmonics, auto_h), ("samples", samples, auto_s)):
@@ -45,7 +45,7 @@ def _first_level(harmonics, samples):
     return (H, V.positive_int("samples", samples, 2 * H + 2)), (auto_h, auto_s)
 
 
-def _check_levels(level, auto):
+def check_levels(level, auto):
     """(H, Ns) of the harmonics check and of the samples check one level above ``level`` (None: not made)."""
     H, Ns = level
     h2 = 2 * H + 1
@@ -55,14 +55,14 @@ def _check_levels(level, auto):
     return by_h, ((H, 2 * Ns) if auto[1] else None)
 
 
-def _next_level(level, auto, bad_h: bool, bad_s: bool):
+def next_level(level, auto, bad_h: bool, bad_s: bool):
     """The level the checks ask for, within ``config.HB_AUTO_MAX_*`` (equal to ``level``: no refinement).
 
     The samples first: with too few, the sampling error of the contact
     force also moves the solution with more harmonics, so H is raised
     only once the samples pass their check.
     """
-    by_h, by_s = _check_levels(level, auto)
+    by_h, by_s = check_levels(level, auto)
     if bad_s and by_s is not None:
         return by_s if by_s[1] <= config.HB_AUTO_MAX_SAMPLES else level
     if bad_h and by_h is not None and by_h[0] <= config.HB_AUTO_MAX_HARMONICS:
@@ -114,7 +114,7 @@ def _peak_level(req: _Request, condensed: bool, pk: HBPeak, scale: float, level,
     """(level at which the peak converges (or the bound), (harmonics change, samples change) at ``level``).
 
     The peak is solved with more harmonics and with more samples
-    (:func:`_check_levels`); the changes are relative to ``scale`` (the
+    (:func:`check_levels`); the changes are relative to ``scale`` (the
     highest peak of the branch, so that a small secondary peak asks for no
     more than its share of the curve). Where a change exceeds
     ``config.HB_AUTO_RTOL`` the peak is solved at the refined level and
@@ -127,10 +127,10 @@ def _peak_levels(req: _Request, condensed: bool, pk, scale: float, level, auto):
     """:func:`_peak_level`, and whether the peak's check passed at the level returned (not at a bound)."""
     at, X, amp, first = level, pk.X, pk.amplitude_m, None
     while True:
-        solved = {lv: _solve_at(req, condensed, pk.lam, X, lv) for lv in _check_levels(at, auto) if lv}
-        ch = tuple(_change(solved[lv][0], amp, scale) if lv else math.nan for lv in _check_levels(at, auto))
+        solved = {lv: _solve_at(req, condensed, pk.lam, X, lv) for lv in check_levels(at, auto) if lv}
+        ch = tuple(_change(solved[lv][0], amp, scale) if lv else math.nan for lv in check_levels(at, auto))
         first = ch if first is None else first
-        nxt = _next_level(at, auto, ch[0] > config.HB_AUTO_RTOL, ch[1] > config.HB_AUTO_RTOL)
+        nxt = next_level(at, auto, ch[0] > config.HB_AUTO_RTOL, ch[1] > config.HB_AUTO_RTOL)
         if nxt == at:
             return at, first, not (ch[0] > config.HB_AUTO_RTOL or ch[1] > config.HB_AUTO_RTOL)
         amp, X = solved[nxt] if nxt in solved else _solve_at(req, condensed, pk.lam, X, nxt)
@@ -241,7 +241,7 @@ class _PeakWatch:
         xs, _, ps = tr.scales
         g, lam_s, y = self.points[i]
         condensed = tr.problem.condensed
-        by_h, by_s = _check_levels(self.level, self.auto)
+        by_h, by_s = check_levels(self.level, self.auto)
         first = by_s if by_s is not None else by_h  # the cheaper check (more samples are checked first)
         if first is None or i == 0:
             return None
@@ -332,7 +332,7 @@ def _adaptive_branch(req: _Request, level, auto, watch: bool = True) -> HBBranch
             break
         levels.append(target)
         br, level, _ = _watched_branch(req, target, auto, levels, br.status is not ContinuationStatus.FAILED, False)
-    by_h, by_s = _check_levels(level, auto)
+    by_h, by_s = check_levels(level, auto)
     ch_h, ch_s = _worst(c[1][0] for c in checks), _worst(c[1][1] for c in checks)
     converged = not (ch_h > config.HB_AUTO_RTOL or ch_s > config.HB_AUTO_RTOL)
     if stop is not None and not (converged and _confirmed(req, br.problem.condensed, stop, scale, auto)):

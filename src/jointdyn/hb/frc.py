@@ -21,7 +21,7 @@ from .. import config
 from ..continuation import ContinuationOptions, make_options
 from ..systems import System
 from .branch import _forcing_problem, _Request, solve_point
-from .discretisation import _adaptive_branch, _first_level
+from .discretisation import _adaptive_branch, first_level
 from .export import branch_dataset
 from .parameters import GAMMA, parameter_named
 from .problem import HBProblem, contact_of
@@ -117,7 +117,7 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         max_step = config.HB_MAX_GAMMA_STEP
     if max_step is not None:
         V.positive("max_step", max_step)
-    level, auto = _first_level(harmonics, samples)
+    level, auto = first_level(harmonics, samples)
     req = _Request(system=system, start=start, stop=stop, parameter=par, gamma=gamma, max_step=max_step, dof=dof,
                    options=opt, backward=backward_after_unbounded, progress=progress, condense=condense)
     return _adaptive_branch(req, level, auto)

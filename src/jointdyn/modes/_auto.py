@@ -24,7 +24,8 @@ import math
 import numpy as np
 
 from .. import config
-from ..hb.frc import AUTO, _check_levels, _first_level, _next_level
+from ..hb.discretisation import check_levels, first_level, next_level
+from ..hb.results import AUTO
 
 __all__ = ["AUTO", "auto_backbone", "check_points", "level_changes"]
 
@@ -53,17 +54,15 @@ def level_changes(backbone, level, auto, mode: int) -> tuple:
     failed): the largest over :func:`check_points` of the natural
     frequency's relative change and the damping ratio's change relative to
     the backbone's largest damping ratio."""
-    from .epmc import EPMCProblem
-
     b = backbone
     system, n = b.problem.system, b.problem.n
     zeta_scale = float(np.nanmax(np.abs(b.damping_ratio))) if b.points else 0.0
     changes = []
-    for check in _check_levels(level, auto):
+    for check in check_levels(level, auto):
         if check is None:
             changes.append(math.nan)
             continue
-        problem = EPMCProblem(system, mode=mode, output_dof=b.output_dof, harmonics=check[0], samples=check[1])
+        problem = type(b.problem)(system, mode=mode, output_dof=b.output_dof, harmonics=check[0], samples=check[1])
         worst = 0.0
         for i in check_points(b):
             w, zeta = b.omega_rad_s[i], b.damping_ratio[i]
@@ -85,7 +84,7 @@ def auto_backbone(fixed, system, amplitude, *, harmonics, samples, mode: int = 1
     """The backbone of ``fixed(system, amplitude, harmonics=H, samples=Ns, mode=mode, **kw)`` (the EPMC
     at one level) at the coarsest level whose check passes (see the module docstring); ``harmonics`` and
     ``samples`` are integers or ``"auto"``."""
-    level, auto = _first_level(harmonics, samples)
+    level, auto = first_level(harmonics, samples)
     levels = [level]
     while True:
         b = fixed(system, amplitude, harmonics=level[0], samples=level[1], mode=mode, **kw)
@@ -93,7 +92,7 @@ def auto_backbone(fixed, system, amplitude, *, harmonics, samples, mode: int = 1
             return b
         ch = level_changes(b, level, auto, mode)
         bad = tuple(c > config.HB_AUTO_RTOL for c in ch)  # NaN (no check) compares False
-        nxt = _next_level(level, auto, *bad)
+        nxt = next_level(level, auto, *bad)
         if nxt == level:
             break
         level = nxt

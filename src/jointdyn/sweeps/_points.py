@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import config
 from ..dynamics.status import EnergyCheck, SteadyStatus
 from ..laws import STATE_NAMES
 
