@@ -141,11 +141,13 @@ def _compute(args, system, amps):
 
 def _result(args, ds, label) -> dict:
     keys = ("amplitude_m", "amplitude_q", "omega_rad_s", "frequency_hz", "damping_ratio", "damping_ratio_contacts",
-            "damping_ratio_viscous", "energy_contact_j")
+            "damping_ratio_viscous", "energy_contact_J")
+    branch = {k: _jsonable(ds[k].values) for k in keys}
+    branch["energy_contact_j"] = branch["energy_contact_J"]  # deprecated alias: JSON keys are added, never renamed
     return {"method": args.method, "system": label, "title": args.title, "mode": int(ds.attrs["linear_mode"]),
             "output_dof": int(ds.attrs["output_dof"]), "harmonics": int(ds.attrs["harmonics"]),
             "samples": int(ds.attrs["samples"]), "omega_linear_rad_s": float(ds.attrs["omega_linear_rad_s"]),
-            "branches": [{k: _jsonable(ds[k].values) for k in keys}],
+            "branches": [branch],
             "status": str(ds.attrs["status"]), "message": str(ds.attrs["message"])}
 
 

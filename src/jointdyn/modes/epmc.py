@@ -245,9 +245,9 @@ def _points(problem: EPMCProblem, lam, V, stash):
     nc = len(problem.system.contacts)
     out = {k: np.empty(p) for k in ("amplitude_m", "omega_rad_s", "xi_rad_s", "damping_ratio",
                                       "damping_ratio_contacts", "damping_ratio_viscous", "modal_amplitude",
-                                      "energy_viscous_j")}
+                                      "energy_viscous_J")}
     out["X"] = np.empty((p, problem.size))
-    out["energy_contact_j"] = np.empty((p, nc))
+    out["energy_contact_J"] = np.empty((p, nc))
     for i in range(p):
         X, w, xi = problem.unpack(V[i], lam[i])
         ev = stash.get(X.tobytes())
@@ -261,8 +261,8 @@ def _points(problem: EPMCProblem, lam, V, stash):
         out["damping_ratio_contacts"][i] = float(np.sum(contact)) / (2.0 * w * kin)
         out["damping_ratio_viscous"][i] = visc / (2.0 * w * kin)
         out["modal_amplitude"][i] = problem.modal_amplitude(X)
-        out["energy_viscous_j"][i] = visc
-        out["energy_contact_j"][i] = contact
+        out["energy_viscous_J"][i] = visc
+        out["energy_contact_J"][i] = contact
         out["X"][i] = X
     return out
 
