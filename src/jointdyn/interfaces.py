@@ -25,26 +25,28 @@ their number)::
     interface_gather(pairs, x, u, g)
     interface_scatter(pairs, T, N, params, f)
 
-``params``  float64 (np, 4)     per pair: kt (N/m), kn (N/m), mu, P (N)
-``u``       float64 (np, 2)     relative tangential displacement, m
-``g``       float64 (np,)       normal approach, m
-``w_*``     float64 (np, 2)     committed (``w_old``, not written) and trial
-                                (``w_new``, written in full) slider, m
-``T``       float64 (np, 2)     tangential force, N (output)
-``N``       float64 (np,)       normal load, N (output)
-``code``    int8 or int64 (np,) STICK_SLIP (stuck), MACROSLIP (slipping) or
-                                SEPARATION (open), the codes of the laws
-``du``      float64 (np, 2, nd) derivatives of u along nd directions per pair
-                                (``dg`` (np, nd), ``dw_*`` (np, 2, nd),
-                                ``dT`` (np, 2, nd), ``dN`` (np, nd) alike)
-``J``       float64 (np, 3, 3)  d(T1, T2, N) / d(u1, u2, g) of every pair at
-                                fixed committed slider (output)
+with the arguments::
+
+    params      float64 (np, 4)     per pair: kt (N/m), kn (N/m), mu, P (N)
+    u           float64 (np, 2)     relative tangential displacement, m
+    g           float64 (np,)       normal approach, m
+    w_old/new   float64 (np, 2)     committed (w_old, not written) and trial
+                                    (w_new, written in full) slider, m
+    T           float64 (np, 2)     tangential force, N (output)
+    N           float64 (np,)       normal load, N (output)
+    code        int8 or int64 (np,) STICK_SLIP (stuck), MACROSLIP (slipping) or
+                                    SEPARATION (open), the codes of the laws
+    du          float64 (np, 2, nd) derivatives of u along nd directions per pair
+                                    (dg (np, nd), dw_old/new (np, 2, nd),
+                                    dT (np, 2, nd), dN (np, nd) alike)
+    J           float64 (np, 3, 3)  d(T1, T2, N) / d(u1, u2, g) of every pair at
+                                    fixed committed slider (output)
 
 The derivative of the slider carries the history (as ``step_jvp`` of the
-contact laws, :mod:`jointdyn.laws._base`): the chain rule through a march is
+contact laws, ``jointdyn.laws._base``): the chain rule through a march is
 exact away from the measure-zero instants where a pair changes state.
-``step_jvp`` and ``step_tangent`` return the primal outputs of ``step`` bit
-for bit.
+``interface_step_jvp`` and ``interface_step_tangent`` return the primal
+outputs of ``interface_step`` bit for bit.
 """
 
 from __future__ import annotations
