@@ -81,35 +81,40 @@ PARAM_NAMES = ("kt", "kn", "mu", "preload")
 
 
 @jit(inline="always")
-def _pair_step(params, i, u, g, w_old, w_new, T, N):  # pragma: no cover - compiled
-    """Step of pair i (docs/model.md section 10); returns its code and, for the derivatives,
-    the trial force (t1, t2), its norm r and the slip factor s = mu N / r (1 when stuck)."""
-    kt = params[i, 0]
-    n = params[i, 3] + params[i, 1] * g[i]
+def _pair(kt, kn, mu, P, u1, u2, g, w1, w2):  # pragma: no cover - compiled
+    """Step of one pair (docs/model.md section 10), scalars in and out. The arrays are read and
+    written in one place (:func:`_pair_step`): a first version that wrote them in every branch of
+    this helper's early returns measured 71 instead of 5.7 ns per pair and step.
+
+    Returns ``code, T1, T2, N, w1_new, w2_new`` and, for the derivatives, the trial force
+    ``(t1, t2)``, its norm ``r`` and the slip factor ``s = mu N / r`` (1 when stuck).
+    """
+    n = P + kn * g
     if not n > 0.0:
-        N[i] = 0.0
-        T[i, 0] = 0.0
-        T[i, 1] = 0.0
-        w_new[i, 0] = u[i, 0]
-        w_new[i, 1] = u[i, 1]
-        return SEPARATION, 0.0, 0.0, 0.0, 0.0
-    N[i] = n
-    t1 = kt * (u[i, 0] - w_old[i, 0])
-    t2 = kt * (u[i, 1] - w_old[i, 1])
+        return SEPARATION, 0.0, 0.0, 0.0, u1, u2, 0.0, 0.0, 0.0, 0.0
+    t1 = kt * (u1 - w1)
+    t2 = kt * (u2 - w2)
     r = math.sqrt(t1 * t1 + t2 * t2)
-    lim = params[i, 2] * n
+    lim = mu * n
     if r <= lim:
-        T[i, 0] = t1
-        T[i, 1] = t2
-        w_new[i, 0] = w_old[i, 0]
-        w_new[i, 1] = w_old[i, 1]
-        return STICK_SLIP, t1, t2, r, 1.0
+        return STICK_SLIP, t1, t2, n, w1, w2, t1, t2, r, 1.0
     s = lim / r
-    T[i, 0] = s * t1
-    T[i, 1] = s * t2
-    w_new[i, 0] = u[i, 0] - T[i, 0] / kt
-    w_new[i, 1] = u[i, 1] - T[i, 1] / kt
-    return MACROSLIP, t1, t2, r, s
+    T1 = s * t1
+    T2 = s * t2
+    return MACROSLIP, T1, T2, n, u1 - T1 / kt, u2 - T2 / kt, t1, t2, r, s
+
+
+@jit(inline="always")
+def _pair_step(params, i, u, g, w_old, w_new, T, N):  # pragma: no cover - compiled
+    """:func:`_pair` of pair i, its outputs written; returns code, t1, t2, r, s."""
+    c, T1, T2, n, v1, v2, t1, t2, r, s = _pair(params[i, 0], params[i, 1], params[i, 2], params[i, 3],
+                                               u[i, 0], u[i, 1], g[i], w_old[i, 0], w_old[i, 1])
+    T[i, 0] = T1
+    T[i, 1] = T2
+    N[i] = n
+    w_new[i, 0] = v1
+    w_new[i, 1] = v2
+    return c, t1, t2, r, s
 
 
 @jit
