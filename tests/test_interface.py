@@ -260,3 +260,45 @@ def test_dofs_beyond_the_structure_are_refused():
     it = Interface(kt=1e3, kn=1e3, mu=0.3, preload=1.0, pairs=[[0, 1, 7, -1, -1, -1]])
     with pytest.raises(ValueError, match=r"pairs\[0, 2\] \(a_n\) must be in \[-1, 5\]"):
         it.check_ndof(6)
+
+
+# --- the interface as seen by the structure --------------------------------------------------
+
+
+def test_tangent_of_the_structure_forces_equals_finite_differences():
+    """K = -df/dx of the generalised forces through stuck, slipping and open pairs, pairs sharing DOFs,
+    fixed sides; all stuck: the springs kt, kt, kn; all open: nothing."""
+    it = Interface(kt=[1e3, 2e3, 3e3], kn=[2e3, 1e3, 4e3], mu=[0.5, 0.2, 0.3], preload=[2.0, 1.0, 0.5],
+                   pairs=[[0, 1, 2, 3, 4, 5], [3, -1, 5, 6, 7, -1], [-1, 7, 8, 0, -1, 2]])
+    ndof = 9
+    rng = np.random.default_rng(5)
+    w = rng.normal(0.0, 1e-4, (3, 2))
+    # stuck everywhere (tiny motion around the sliders), and all open (large opening)
+    B = it.selection(ndof)
+    x_stuck = np.linalg.lstsq(B[[0, 1, 3, 4, 6, 7]], w.ravel(), rcond=None)[0]
+    f, K = it.tangent(x_stuck, w)
+    springs = B.T @ np.diag(np.repeat(np.stack([it.kt, it.kt, it.kn], 1), 1, 0).ravel()) @ B
+    np.testing.assert_allclose(K, springs, rtol=1e-14, atol=0)
+    x_open = np.zeros(ndof)
+    x_open[[5, 2, 8]] = -1.0, -2.0, -3.0  # g = -1 m for every pair
+    assert np.all(it.step(*it.relative(x_open), w)[2] == SEPARATION)
+    np.testing.assert_array_equal(it.tangent(x_open, w)[1], 0.0)
+    # a mix, against central differences of the forces at fixed sliders
+    seen = set()
+    for seed in range(20):
+        x = np.random.default_rng(seed).normal(0.0, 8e-4, ndof)
+        f, K = it.tangent(x, w)
+        codes = it.step(*it.relative(x), w)[2]
+        h = 1e-10
+        fd = np.empty((ndof, ndof))
+        for d in range(ndof):
+            e = np.zeros(ndof)
+            e[d] = h
+            cp, cm = it.step(*it.relative(x + e), w)[2], it.step(*it.relative(x - e), w)[2]
+            if not (np.array_equal(cp, codes) and np.array_equal(cm, codes)):
+                break
+            fd[:, d] = -(it.tangent(x + e, w)[0] - it.tangent(x - e, w)[0]) / (2 * h)
+        else:
+            np.testing.assert_allclose(K, fd, rtol=1e-5, atol=1e-5 * np.abs(K).max())
+            seen |= set(codes.tolist())
+    assert seen == {STICK_SLIP, MACROSLIP, SEPARATION}

@@ -402,6 +402,44 @@ class Interface:
                           np.ascontiguousarray(N, dtype=np.float64), self.params, f)
         return f
 
+    def selection(self, ndof: int) -> np.ndarray:
+        """Dense selection B (3 npairs, ndof): rows ``3 i, 3 i + 1, 3 i + 2`` give u1, u2 and g of pair i
+        (``(u1, u2, g) = B x``; the structure feels ``-B^T (T1, T2, N - P)``)."""
+        self.check_ndof(int(ndof))
+        B = np.zeros((3 * self.npairs, int(ndof)))
+        for k, (a, b) in enumerate(((0, 3), (1, 4), (2, 5))):
+            rows = 3 * np.arange(self.npairs) + k
+            for col, sign in ((a, 1.0), (b, -1.0)):
+                d = self.pairs[:, col]
+                live = d >= 0
+                np.add.at(B, (rows[live], d[live]), sign)
+        return B
+
+    def tangent(self, x, w) -> tuple[np.ndarray, np.ndarray]:
+        """Forces and exact stiffness of the interface at structure displacements ``x`` (m) from the
+        committed sliders ``w`` (npairs, 2), m.
+
+        Returns
+        -------
+        f : ndarray (ndof,)
+            Generalised forces the pairs exert on the structure, N (:meth:`forces`).
+        K : ndarray (ndof, ndof)
+            Their stiffness ``-df/dx = B^T J B`` (N/m) with the 3 x 3 blocks J of
+            :func:`interface_step_tangent` and B of :meth:`selection`: each pair couples only its
+            own DOFs. All pairs stuck: the springs kt, kt, kn between their DOFs; all open: 0.
+        """
+        u, g = self.relative(x)
+        n = u.shape[0]
+        w = self.check_state(w)
+        T, N, J = np.empty((n, 2)), np.empty(n), np.empty((n, 3, 3))
+        interface_step_tangent(self.params, u, g, w, np.empty((n, 2)), T, N, np.empty(n, dtype=np.int8), J)
+        ndof = np.asarray(x).size
+        B = self.selection(ndof)
+        Jd = np.zeros((3 * n, 3 * n))
+        for i in range(n):
+            Jd[3 * i : 3 * i + 3, 3 * i : 3 * i + 3] = J[i]
+        return self.forces(T, N, ndof), B.T @ Jd @ B
+
     def initial_state(self, u=None) -> np.ndarray:
         """Virgin sliders (npairs, 2), m: every pair unstretched at the relative displacements ``u``
         (default 0), so that a step there gives T = 0."""
