@@ -9,6 +9,10 @@ instant where ``P + kn g`` changes sign between two samples is inserted
 ``--period`` the history is cut into cycles and the metrics are those of
 the last full one; otherwise the whole history is one cycle.
 
+The JSON gives the metrics of the last full cycle: ``energy_per_cycle_J``
+(work of T over it), the fractions of it the pair sticks, slips and is
+open, the largest |T| and the range of N over its samples.
+
 ``--out DIR`` receives ``loop.csv`` (columns t, u1, u2, g, T1, T2, N, state,
 inserted) and ``loop.png`` (T1 against u1 and T2 against u2), each written
 atomically after everything is computed. Bad input: one line on stderr,
@@ -54,7 +58,10 @@ def _report(args, res) -> dict:
     from ..laws import STATE_NAMES
 
     last = res.code[-1, 0]
-    T = res.T[:, 0]
+    tol = 1e-9 * float(res.t[-1] - res.t[0])
+    cyc = (res.t >= res.t_start_s - tol) & (res.t <= res.t_end_s + tol)  # the samples of the last full cycle
+    T = res.T[cyc, 0]
+    N = res.N[cyc, 0]
     report = {
         "model": "pair",
         "parameters": {"kt_N_per_m": args.kt, "kn_N_per_m": args.kn, "mu": args.mu, "preload_N": args.preload,
@@ -69,8 +76,8 @@ def _report(args, res) -> dict:
         "slip_fraction": float(res.slip_fraction[0]),
         "open_fraction": float(res.open_fraction[0]),
         "force_max_N": float(np.max(np.hypot(T[:, 0], T[:, 1]))),
-        "normal_load_min_N": float(np.min(res.N[:, 0])),
-        "normal_load_max_N": float(np.max(res.N[:, 0])),
+        "normal_load_min_N": float(np.min(N)),
+        "normal_load_max_N": float(np.max(N)),
         "final_state": STATE_NAMES[int(last)],
         "n_inserted": res.n_inserted,
     }

@@ -253,7 +253,8 @@ def interface_loop(interface, t, u1, u2, g, *, period=None, state=None) -> Inter
         i1 = int(np.searchsorted(tr, bounds[k + 1] + tol, side="right")) - 1
         work, f_stick, f_slip, f_open = _window(tr, Ur, Tr, sep, contact, i0, i1)
         energies.append(float(np.sum(work)))
-    status = InterfaceLoopStatus.OPEN if np.all(f_open >= 1.0) else InterfaceLoopStatus.OK
+    closes = np.any(nr[i0 : i1 + 1] > 0.0)
+    status = InterfaceLoopStatus.OK if closes else InterfaceLoopStatus.OPEN
     return InterfaceLoopResult(
         t=t, u=U, g=g, T=T, N=N, code=code, inserted=inserted, period=None if period is None else float(period),
         cycle_energy_J=np.asarray(energies), pair_energy_J=work, stick_fraction=f_stick, slip_fraction=f_slip,
