@@ -154,7 +154,8 @@ def run(args) -> int:
         return 0
     print(f"jointdyn loop: pair, slip force mu P = {args.mu * args.preload:g} N, {res.n_cycles} cycle(s), "
           f"last [{res.t_start_s:g}, {res.t_end_s:g}] s")
-    print(f"  energy per cycle   {report['energy_per_cycle_J']:.6g} J")
+    what = "energy per cycle " if args.period is not None else "work of T (whole)"
+    print(f"  {what}  {report['energy_per_cycle_J']:.6g} J")
     print(f"  time fractions     stick {report['stick_fraction']:.4f}, slip {report['slip_fraction']:.4f}, "
           f"open {report['open_fraction']:.4f}")
     print(f"  max |T|            {report['force_max_N']:.6g} N; N in [{report['normal_load_min_N']:.6g}, "
