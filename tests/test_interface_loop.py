@@ -207,6 +207,10 @@ def test_per_pair_columns_and_bad_input():
         interface_loop(it, t[::-1], np.zeros(11), np.zeros(11), np.zeros(11))
     with pytest.raises(ValueError, match="period must be"):
         interface_loop(it, t, np.zeros(11), np.zeros(11), np.zeros(11), period=5.0)
+    with pytest.raises(ValueError, match="u2 must be an array of real numbers"):
+        interface_loop(it, t, np.zeros(11), ["a"] * 11, np.zeros(11))
+    with pytest.raises(ValueError, match="g must be finite"):
+        interface_loop(it, t, np.zeros(11), np.zeros(11), np.full(11, np.nan))
     with pytest.raises(ValueError, match="interface must be"):
         interface_loop(object(), t, np.zeros(11), np.zeros(11), np.zeros(11))
     assert STICK_SLIP == 0

@@ -116,8 +116,8 @@ def _histories(interface: Interface, t, u1, u2, g):
     V.increasing("t", t)
     out = []
     for name, a in (("u1", u1), ("u2", u2), ("g", g)):
-        a = np.asarray(a, dtype=np.float64) if not isinstance(a, np.ndarray) else a
-        arr = V.finite_array(name, a, a.ndim if a.ndim in (1, 2) else 1)
+        ndim = np.ndim(a) if np.ndim(a) in (1, 2) else 1
+        arr = V.finite_array(name, a, ndim)
         if arr.shape[0] != t.size:
             raise ValueError(f"{name} must have one row per sample of t ({t.size}), got {arr.shape[0]}")
         if arr.ndim == 1:
