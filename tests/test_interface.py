@@ -12,6 +12,8 @@ from reference_interface import PairRef, march_ref
 
 from jointdyn.interfaces import (
     Interface,
+    interface_march,
+    interface_march_jvp,
     interface_step,
     interface_step_jvp,
     interface_step_tangent,
@@ -221,6 +223,43 @@ def test_jvp_through_a_history_of_stick_slip_separation_and_recontact(a1, a2, g1
         scale = float(np.max(np.abs(dT[..., k]))) + 1.0
         np.testing.assert_allclose(dT[..., k], (Tp - Tm) / (2 * h[k]), rtol=0, atol=1e-5 * scale)
         np.testing.assert_allclose(dN[..., k], (Np - Nm) / (2 * h[k]), rtol=0, atol=1e-5 * (np.max(np.abs(dN)) + 1))
+
+
+def test_compiled_marches_equal_the_step_by_step_march():
+    """interface_march and interface_march_jvp: the same bits as the kernels called sample by sample,
+    derivatives of the starting sliders carried through."""
+    it = Interface(kt=[1e3, 2e3], kn=[2e3, 1e3], mu=[0.4, 0.2], preload=[2.0, 1.0],
+                   pairs=[[0, 1, 2, -1, -1, -1], [3, 4, 5, -1, -1, -1]])
+    U1, G1 = _history(2e-3, 1e-3, 2e-4, 2e-3)
+    U = np.ascontiguousarray(np.concatenate([U1, 0.5 * U1[:, :, ::-1]], axis=1))
+    G = np.ascontiguousarray(np.concatenate([G1, -0.7 * G1], axis=1))
+    rng = np.random.default_rng(2)
+    dU = rng.normal(size=U.shape + (4,))
+    dG = rng.normal(size=G.shape + (4,))
+    dU[0] = 0.0
+    T, N, code, dT, dN = _march_jvp(it, U, dU, G, dG)
+    nt, npairs = G.shape
+    T2, N2, c2 = np.empty_like(T), np.empty_like(N), np.empty_like(code)
+    wf = np.empty((npairs, 2))
+    interface_march(it.params, np.ascontiguousarray(U[0]), U, G, T2, N2, c2, wf)
+    assert np.array_equal(T, T2) and np.array_equal(N, N2) and np.array_equal(code, c2)
+    T3, N3, c3 = np.empty_like(T), np.empty_like(N), np.empty_like(code)
+    dT3, dN3 = np.empty_like(dT), np.empty_like(dN)
+    wf3, dwf3 = np.empty((npairs, 2)), np.empty((npairs, 2, 4))
+    interface_march_jvp(it.params, np.ascontiguousarray(U[0]), np.zeros((npairs, 2, 4)), U, dU, G, dG,
+                        T3, dT3, N3, dN3, c3, wf3, dwf3)
+    assert np.array_equal(T, T3) and np.array_equal(code, c3) and np.array_equal(wf, wf3)
+    assert np.array_equal(dT, dT3) and np.array_equal(dN, dN3)
+    # a derivative of the starting sliders reaches the forces until the pair slips or opens
+    dw0 = np.zeros((npairs, 2, 1))
+    dw0[0, 0, 0] = 1.0
+    dT4 = np.empty((nt, npairs, 2, 1))
+    interface_march_jvp(it.params, np.ascontiguousarray(U[0]), dw0, U, np.zeros((nt, npairs, 2, 1)), G,
+                        np.zeros((nt, npairs, 1)), T3, dT4, N3, np.empty((nt, npairs, 1)), c3, wf3,
+                        np.empty((npairs, 2, 1)))
+    first_change = int(np.argmax(code[:, 0] != STICK_SLIP))
+    assert first_change > 0
+    np.testing.assert_array_equal(dT4[:first_change, 0, 0, 0], -1e3)
 
 
 def test_jvp_history_covers_every_state():

@@ -22,6 +22,7 @@ their number)::
     interface_step_jvp(params, u, du, g, dg, w_old, dw_old, w_new, dw_new, T, dT, N, dN, code)
     interface_step_tangent(params, u, g, w_old, w_new, T, N, code, J)
     interface_march(params, w0, U, G, T, N, code, w_final)
+    interface_march_jvp(params, w0, dw0, U, dU, G, dG, T, dT, N, dN, code, w_final, dw_final)
     interface_gather(pairs, x, u, g)
     interface_scatter(pairs, T, N, params, f)
 
@@ -67,6 +68,7 @@ __all__ = [
     "interface_step_jvp",
     "interface_step_tangent",
     "interface_march",
+    "interface_march_jvp",
     "interface_gather",
     "interface_scatter",
 ]
@@ -230,6 +232,27 @@ def interface_march(params, w0, U, G, T, N, code, w_final):  # pragma: no cover 
     for i in range(a.shape[0]):
         w_final[i, 0] = a[i, 0]
         w_final[i, 1] = a[i, 1]
+
+
+@jit
+def interface_march_jvp(params, w0, dw0, U, dU, G, dG, T, dT, N, dN, code, w_final, dw_final):  # pragma: no cover
+    """:func:`interface_march` with forward-mode derivatives along ``dU.shape[3]`` directions per pair:
+    ``dU[j]`` (np, 2, nd), ``dG[j]`` (np, nd) the derivatives of the samples, ``dw0`` (np, 2, nd) that
+    of the starting sliders (not written); ``dT[j]``, ``dN[j]`` and ``dw_final`` are written. The
+    chain rule through the whole march is exact away from the instants where a pair changes state."""
+    a = w0.copy()
+    b = w0.copy()
+    da = dw0.copy()
+    db = dw0.copy()
+    for j in range(U.shape[0]):
+        interface_step_jvp(params, U[j], dU[j], G[j], dG[j], a, da, b, db, T[j], dT[j], N[j], dN[j], code[j])
+        a, b = b, a
+        da, db = db, da
+    for i in range(a.shape[0]):
+        for k in range(2):
+            w_final[i, k] = a[i, k]
+            for d in range(da.shape[2]):
+                dw_final[i, k, d] = da[i, k, d]
 
 
 @jit(inline="always")
