@@ -42,7 +42,8 @@ def _jvp_loop_template(params, w0, U, dU, G, dG, T, dT, N, dN, code):  # pragma:
     da = np.zeros(dU.shape[1:])
     db = np.zeros(dU.shape[1:])
     for j in range(U.shape[0]):
-        JVP(params, U[j], dU[j], G[j], dG[j], a, da, b, db, T, dT, N, dN, code)  # noqa: F821
+        k = j - 1 if j > 0 else 0
+        JVP(params, U[k], dU[k], G[k], dG[k], U[j], dU[j], G[j], dG[j], a, da, b, db, T, dT, N, dN, code)  # noqa: F821
         a, b = b, a
         da, db = db, da
 

@@ -21,7 +21,9 @@ class PairRef:
         self.w = [float(w[0]), float(w[1])]
 
     def step(self, u1, u2, g):
-        """Step to (u1, u2) m, g m; returns (T1 N, T2 N, N N, code) and commits."""
+        """Step to (u1, u2) m, g m; returns (T1 N, T2 N, N N, code) and commits. The step starts at
+        the point of the previous call (the first at the point itself); radial return of the end
+        point does not need it."""
         N = max(0.0, self.P + self.kn * g)
         if N == 0.0:
             self.w = [u1, u2]

@@ -48,7 +48,8 @@ def test_kernels_equal_the_reference_on_random_walks(seed, npairs):
     rT1, rT2, rN, rc = (np.array(a) for a in march_ref(refs, U1.tolist(), U2.tolist(), G.tolist()))
     w = np.stack([U1[0], U2[0]], axis=1)
     for j in range(nt):
-        T, N, code, w = it.step(np.stack([U1[j], U2[j]], axis=1), G[j], w)
+        k = max(j - 1, 0)
+        T, N, code, w = it.step(np.stack([U1[j], U2[j]], axis=1), G[j], w, np.stack([U1[k], U2[k]], axis=1), G[k])
         f = max(1.0, float(np.max(mu * P)))
         np.testing.assert_allclose(T[:, 0], rT1[j], rtol=0, atol=1e-12 * f)
         np.testing.assert_allclose(T[:, 1], rT2[j], rtol=0, atol=1e-12 * f)
@@ -101,7 +102,7 @@ def _step1(params, u, g, w):
     N = np.empty(1)
     code = np.empty(1, dtype=np.int8)
     w_new = np.empty((1, 2))
-    interface_step(params, u, g, w, w_new, T, N, code)
+    interface_step(params, u, g, u, g, w, w_new, T, N, code)
     return np.array([T[0, 0], T[0, 1], N[0]]), w_new[0].copy(), int(code[0])
 
 
@@ -132,7 +133,7 @@ def test_tangent_and_jvp_equal_finite_differences(u1, u2, g, w1, w2, dw):
     N = np.empty(1)
     code = np.empty(1, dtype=np.int8)
     w_new = np.empty((1, 2))
-    interface_step_tangent(p, u, gg, w, w_new, T, N, code, J)
+    interface_step_tangent(p, u, gg, u, gg, w, w_new, T, N, code, J)
     assert code[0] == c0 and np.array_equal(np.array([T[0, 0], T[0, 1], N[0]]), y0)
     h = 1e-9
     fd = np.empty((3, 3))
@@ -151,7 +152,7 @@ def test_tangent_and_jvp_equal_finite_differences(u1, u2, g, w1, w2, dw):
     dg = np.zeros((1, 3))
     dg[0, 2] = 1.0
     dT, dN, dwn = np.empty((1, 2, 3)), np.empty((1, 3)), np.empty((1, 2, 3))
-    interface_step_jvp(p, u, du, gg, dg, w, dW, w_new, dwn, T, dT, N, dN, code)
+    interface_step_jvp(p, u, du, gg, dg, u, du, gg, dg, w, dW, w_new, dwn, T, dT, N, dN, code)
     assert code[0] == c0 and np.array_equal(np.array([T[0, 0], T[0, 1], N[0]]), y0)
     for k in range(3):
         e = np.zeros(3)
@@ -179,7 +180,9 @@ def _march_jvp(it, U, dU, G, dG):
     for j in range(nt):
         w_new = np.empty_like(w)
         dw_new = np.empty_like(dw)
-        interface_step_jvp(p, U[j], dU[j], G[j], dG[j], w, dw, w_new, dw_new, T[j], dT[j], N[j], dN[j], code[j])
+        k = max(j - 1, 0)  # the step's start point: the previous sample
+        interface_step_jvp(p, U[k], dU[k], G[k], dG[k], U[j], dU[j], G[j], dG[j], w, dw, w_new, dw_new,
+                           T[j], dT[j], N[j], dN[j], code[j])
         w, dw = w_new, dw_new
     return T, N, code, dT, dN
 

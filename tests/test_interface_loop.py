@@ -155,7 +155,8 @@ def test_energy_balance_of_a_pair():
     diss = np.zeros(2)
     T_old = np.zeros((2, 2))
     for j in range(nt):
-        T, N, code, w_new = it.step(U[j], G[j], w)
+        k = max(j - 1, 0)
+        T, N, code, w_new = it.step(U[j], G[j], w, U[k], G[k])
         if j:
             du = U[j] - U[j - 1]
             work += np.sum(0.5 * (T + T_old) * du, axis=1)

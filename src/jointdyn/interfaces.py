@@ -18,9 +18,10 @@ outside it slips by radial return onto the circle. The structure feels
 Compiled kernels (allocation-free, a loop over the pairs, cost linear in
 their number)::
 
-    interface_step(params, u, g, w_old, w_new, T, N, code)
-    interface_step_jvp(params, u, du, g, dg, w_old, dw_old, w_new, dw_new, T, dT, N, dN, code)
-    interface_step_tangent(params, u, g, w_old, w_new, T, N, code, J)
+    interface_step(params, u0, g0, u, g, w_old, w_new, T, N, code)
+    interface_step_jvp(params, u0, du0, g0, dg0, u, du, g, dg, w_old, dw_old, w_new, dw_new,
+                       T, dT, N, dN, code)
+    interface_step_tangent(params, u0, g0, u, g, w_old, w_new, T, N, code, J)
     interface_march(params, w0, U, G, T, N, code, w_final)
     interface_march_jvp(params, w0, dw0, U, dU, G, dG, T, dT, N, dN, code, w_final, dw_final)
     interface_gather(pairs, x, u, g)
@@ -29,6 +30,8 @@ their number)::
 with the arguments::
 
     params      float64 (np, 4)     per pair: kt (N/m), kn (N/m), mu, P (N)
+    u0, g0      float64 (np, 2), (np,)  the step's start point: relative displacement
+                                    and normal approach at the committed state, m
     u           float64 (np, 2)     relative tangential displacement, m
     g           float64 (np,)       normal approach, m
     w_old/new   float64 (np, 2)     committed (w_old, not written) and trial
@@ -38,10 +41,11 @@ with the arguments::
     code        int8 or int64 (np,) STICK_SLIP (stuck), MACROSLIP (slipping) or
                                     SEPARATION (open), the codes of the laws
     du          float64 (np, 2, nd) derivatives of u along nd directions per pair
-                                    (dg (np, nd), dw_old/new (np, 2, nd),
+                                    (du0 (np, 2, nd), dg0, dg (np, nd), dw_old/new (np, 2, nd),
                                     dT (np, 2, nd), dN (np, nd) alike)
-    J           float64 (np, 3, 3)  d(T1, T2, N) / d(u1, u2, g) of every pair at
-                                    fixed committed slider (output)
+    J           float64 (np, 3, 3)  d(T1, T2, N) / d(u1, u2, g) of every pair at the
+                                    end point, start point and committed slider
+                                    fixed (output)
 
 The derivative of the slider carries the history (as ``step_jvp`` of the
 contact laws, ``jointdyn.laws._base``): the chain rule through a march is
@@ -107,7 +111,7 @@ def _pair(kt, kn, mu, P, u1, u2, g, w1, w2):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _pair_step(params, i, u, g, w_old, w_new, T, N):  # pragma: no cover - compiled
+def _pair_step(params, i, u0, g0, u, g, w_old, w_new, T, N):  # pragma: no cover - compiled
     """:func:`_pair` of pair i, its outputs written; returns code, t1, t2, r, s."""
     c, T1, T2, n, v1, v2, t1, t2, r, s = _pair(params[i, 0], params[i, 1], params[i, 2], params[i, 3],
                                                u[i, 0], u[i, 1], g[i], w_old[i, 0], w_old[i, 1])
@@ -120,13 +124,15 @@ def _pair_step(params, i, u, g, w_old, w_new, T, N):  # pragma: no cover - compi
 
 
 @jit
-def interface_step(params, u, g, w_old, w_new, T, N, code):  # pragma: no cover - compiled
+def interface_step(params, u0, g0, u, g, w_old, w_new, T, N, code):  # pragma: no cover - compiled
     """Trial step of every pair from the committed sliders (module docstring).
 
     Parameters
     ----------
     params : float64 (np, 4)
         kt (N/m), kn (N/m), mu, P (N) per pair.
+    u0, g0 : float64 (np, 2), (np,)
+        Start point of the step (the committed relative displacements and approaches), m.
     u : float64 (np, 2)
         Relative tangential displacements, m.
     g : float64 (np,)
@@ -137,11 +143,12 @@ def interface_step(params, u, g, w_old, w_new, T, N, code):  # pragma: no cover 
         Tangential force (np, 2) N, normal load (np,) N, motion state (np,).
     """
     for i in range(params.shape[0]):
-        code[i] = _pair_step(params, i, u, g, w_old, w_new, T, N)[0]
+        code[i] = _pair_step(params, i, u0, g0, u, g, w_old, w_new, T, N)[0]
 
 
 @jit
-def interface_step_jvp(params, u, du, g, dg, w_old, dw_old, w_new, dw_new, T, dT, N, dN, code):  # pragma: no cover
+def interface_step_jvp(params, u0, du0, g0, dg0, u, du, g, dg, w_old, dw_old, w_new, dw_new, T, dT, N, dN,
+                       code):  # pragma: no cover - compiled
     """:func:`interface_step` with forward-mode derivatives along ``du.shape[2]`` directions per pair.
 
     Open: dT = dN = 0, dw = du. Stuck: dT = kt (du - dw_old), dN = kn dg,
@@ -151,7 +158,7 @@ def interface_step_jvp(params, u, du, g, dg, w_old, dw_old, w_new, dw_new, T, dT
     """
     nd = du.shape[2]
     for i in range(params.shape[0]):
-        c, t1, t2, r, s = _pair_step(params, i, u, g, w_old, w_new, T, N)
+        c, t1, t2, r, s = _pair_step(params, i, u0, g0, u, g, w_old, w_new, T, N)
         code[i] = c
         kt = params[i, 0]
         kn = params[i, 1]
@@ -188,13 +195,13 @@ def interface_step_jvp(params, u, du, g, dg, w_old, dw_old, w_new, dw_new, T, dT
 
 
 @jit
-def interface_step_tangent(params, u, g, w_old, w_new, T, N, code, J):  # pragma: no cover - compiled
+def interface_step_tangent(params, u0, g0, u, g, w_old, w_new, T, N, code, J):  # pragma: no cover - compiled
     """:func:`interface_step` and the 3 x 3 block ``J[i] = d(T1, T2, N) / d(u1, u2, g)`` of every pair at
     fixed committed slider (N/m): stuck diag(kt, kt, kn); slipping
     ``(mu N kt / |T*|) (I - n n^T)`` in the tangential block, ``mu kn n`` in
     the column of g and kn in the corner; open zero."""
     for i in range(params.shape[0]):
-        c, t1, t2, r, s = _pair_step(params, i, u, g, w_old, w_new, T, N)
+        c, t1, t2, r, s = _pair_step(params, i, u0, g0, u, g, w_old, w_new, T, N)
         code[i] = c
         for a in range(3):
             for b in range(3):
@@ -223,11 +230,13 @@ def interface_step_tangent(params, u, g, w_old, w_new, T, N, code, J):  # pragma
 def interface_march(params, w0, U, G, T, N, code, w_final):  # pragma: no cover - compiled
     """March every pair over the samples ``U[j]`` (np, 2), ``G[j]`` (np,) from the committed sliders
     ``w0`` (not written), committing after each sample, into ``T[j]``, ``N[j]``, ``code[j]`` and the
-    final sliders ``w_final``."""
+    final sliders ``w_final``. The samples are the vertices of the path: step j runs from sample
+    j - 1 to sample j, the first from the first sample itself."""
     a = w0.copy()
     b = w0.copy()
     for j in range(U.shape[0]):
-        interface_step(params, U[j], G[j], a, b, T[j], N[j], code[j])
+        k = j - 1 if j > 0 else 0
+        interface_step(params, U[k], G[k], U[j], G[j], a, b, T[j], N[j], code[j])
         a, b = b, a
     for i in range(a.shape[0]):
         w_final[i, 0] = a[i, 0]
@@ -245,7 +254,9 @@ def interface_march_jvp(params, w0, dw0, U, dU, G, dG, T, dT, N, dN, code, w_fin
     da = dw0.copy()
     db = dw0.copy()
     for j in range(U.shape[0]):
-        interface_step_jvp(params, U[j], dU[j], G[j], dG[j], a, da, b, db, T[j], dT[j], N[j], dN[j], code[j])
+        k = j - 1 if j > 0 else 0
+        interface_step_jvp(params, U[k], dU[k], G[k], dG[k], U[j], dU[j], G[j], dG[j], a, da, b, db,
+                           T[j], dT[j], N[j], dN[j], code[j])
         a, b = b, a
         da, db = db, da
     for i in range(a.shape[0]):
@@ -438,9 +449,10 @@ class Interface:
                 np.add.at(B, (rows[live], d[live]), sign)
         return B
 
-    def tangent(self, x, w) -> tuple[np.ndarray, np.ndarray]:
+    def tangent(self, x, w, x0=None) -> tuple[np.ndarray, np.ndarray]:
         """Forces and exact stiffness of the interface at structure displacements ``x`` (m) from the
-        committed sliders ``w`` (npairs, 2), m.
+        committed sliders ``w`` (npairs, 2), m, the step starting from the structure displacements
+        ``x0`` (m; None: from ``x`` itself, as :meth:`step`).
 
         Returns
         -------
@@ -448,14 +460,16 @@ class Interface:
             Generalised forces the pairs exert on the structure, N (:meth:`forces`).
         K : ndarray (ndof, ndof)
             Their stiffness ``-df/dx = B^T J B`` (N/m) with the 3 x 3 blocks J of
-            :func:`interface_step_tangent` and B of :meth:`selection`: each pair couples only its
-            own DOFs. All pairs stuck: the springs kt, kt, kn between their DOFs; all open: 0.
+            :func:`interface_step_tangent` and B of :meth:`selection` (at fixed ``x0`` and ``w``):
+            each pair couples only its own DOFs. All pairs stuck: the springs kt, kt, kn between
+            their DOFs; all open: 0.
         """
         u, g = self.relative(x)
+        u0, g0 = (u, g) if x0 is None else self.relative(x0)
         n = u.shape[0]
         w = self.check_state(w)
         T, N, J = np.empty((n, 2)), np.empty(n), np.empty((n, 3, 3))
-        interface_step_tangent(self.params, u, g, w, np.empty((n, 2)), T, N, np.empty(n, dtype=np.int8), J)
+        interface_step_tangent(self.params, u0, g0, u, g, w, np.empty((n, 2)), T, N, np.empty(n, dtype=np.int8), J)
         ndof = np.asarray(x).size
         B = self.selection(ndof)
         Jd = np.zeros((3 * n, 3 * n))
@@ -482,9 +496,22 @@ class Interface:
             raise ValueError("state must be finite (the sliders, m)")
         return a
 
-    def step(self, u, g, w):
+    def step(self, u, g, w, u0=None, g0=None):
         """One step of every pair from the committed sliders ``w`` (Python convenience over
         :func:`interface_step`).
+
+        Parameters
+        ----------
+        u : array_like (npairs, 2)
+            Relative tangential displacements at the end of the step, m.
+        g : array_like (npairs,)
+            Normal approaches at the end of the step, m.
+        w : array_like (npairs, 2)
+            Committed sliders, m.
+        u0, g0 : array_like (npairs, 2), (npairs,), optional
+            The step's start point (where the sliders ``w`` were committed), m; the path of the
+            step is the straight line from (u0, g0) to (u, g). None (each separately): the step
+            starts at (u, g) itself, a step without motion.
 
         Returns
         -------
@@ -499,10 +526,12 @@ class Interface:
         """
         u = np.ascontiguousarray(u, dtype=np.float64).reshape(self.npairs, 2)
         g = np.ascontiguousarray(g, dtype=np.float64).reshape(self.npairs)
+        u0 = u if u0 is None else np.ascontiguousarray(u0, dtype=np.float64).reshape(self.npairs, 2)
+        g0 = g if g0 is None else np.ascontiguousarray(g0, dtype=np.float64).reshape(self.npairs)
         w = self.check_state(w)
         T = np.empty((self.npairs, 2))
         N = np.empty(self.npairs)
         code = np.empty(self.npairs, dtype=np.int8)
         w_new = np.empty((self.npairs, 2))
-        interface_step(self.params, u, g, w, w_new, T, N, code)
+        interface_step(self.params, u0, g0, u, g, w, w_new, T, N, code)
         return T, N, code, w_new
