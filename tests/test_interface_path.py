@@ -153,3 +153,40 @@ def test_dissipation_of_a_turning_slip_in_closed_form(alpha, s, theta, g):
         W += 0.5 * wk * (Tk[0] * v[0] + Tk[1] * v[1])
     assert D > 0.0
     np.testing.assert_allclose(W, D, rtol=1e-10, atol=1e-14 * MU * P * s)
+
+
+def test_structure_tangent_from_a_start_point_equals_finite_differences():
+    """Interface.tangent(x, w, x0): K = -df/dx with the step's start x0 and the sliders fixed, through
+    stuck, slipping (turning) and open pairs and a pair that re-closes inside the step, against
+    central differences of Interface.step from the same start."""
+    from jointdyn.interfaces import Interface
+
+    it = Interface(kt=[1e3, 2e3, 3e3, 1e3], kn=[2e3, 1e3, 4e3, 2e3], mu=[0.5, 0.2, 0.3, 0.4],
+                   preload=[2.0, 1.0, 0.5, 1.0],
+                   pairs=[[0, 1, 2, 3, 4, 5], [3, -1, 5, 6, 7, -1], [-1, 7, 8, 0, -1, 2], [9, 10, 11, -1, -1, -1]])
+    ndof = 12
+    seen = set()
+    for seed in range(30):
+        rng = np.random.default_rng(seed)
+        x0 = rng.normal(0.0, 4e-4, ndof)
+        x = x0 + rng.normal(0.0, 8e-4, ndof)
+        x0[11], x[11] = -1e-3, 1e-3  # pair 3 open at the start, closed at the end
+        u0, g0 = it.relative(x0)
+        w = u0 + rng.normal(0.0, 2e-4, (4, 2))
+        f, K = it.tangent(x, w, x0)
+        codes = it.step(*it.relative(x), w, u0, g0)[2]
+        h = 1e-10
+        fd = np.empty((ndof, ndof))
+        for d in range(ndof):
+            e = np.zeros(ndof)
+            e[d] = h
+            out = [it.step(*it.relative(x + sg * e), w, u0, g0) for sg in (1.0, -1.0)]
+            if not all(np.array_equal(o[2], codes) for o in out):
+                break
+            fp, fm = (it.forces(o[0], o[1], ndof) for o in out)
+            fd[:, d] = -(fp - fm) / (2 * h)
+        else:
+            np.testing.assert_allclose(K, fd, rtol=1e-5, atol=1e-5 * np.abs(K).max())
+            np.testing.assert_allclose(f, it.forces(*it.step(*it.relative(x), w, u0, g0)[:2], ndof), rtol=0, atol=0)
+            seen |= set(codes.tolist())
+    assert seen == {STICK_SLIP, MACROSLIP, SEPARATION}

@@ -7,10 +7,18 @@ B; -1 is a fixed side), and sees
     u_k = x[a_tk] - x[b_tk]  (k = 1, 2),   g = x[a_n] - x[b_n]  (positive closes),
     N = max(0, P + kn g),   T = kt (u - w),   |T| <= mu N,
 
-with the slider ``w`` (a 2-vector, m) its only memory. One step is a
-trial from the committed slider: open (N = 0) gives T = 0 and w = u; a
-trial force ``kt (u - w)`` inside the circle of radius ``mu N`` sticks;
-outside it slips by radial return onto the circle. The structure feels
+with the slider ``w`` (a 2-vector, m) its only memory. A step is
+integrated exactly along the straight path from its start point
+``(u0, g0)``, where the slider was committed, to its end ``(u, g)``
+(histories are piecewise linear between samples): open at the end
+(N = 0) gives T = 0 and w = u; a pair open at the start closes at the
+instant where ``P + kn g`` = 0 with T = 0 and w = u there; closed, it
+sticks while the trial force stays in the disc ``|T| <= mu N`` (the exit
+instant a root of a quadratic, ``_exit``) and slips from there to
+the end with the closed form of the turning angle (``_turn``). The
+radial return of the end point's trial force onto the circle is the
+special case without turning (1-D motion). A step that starts where it
+ends (a march's first sample) is that radial return. The structure feels
 ``-T`` on side A and ``+T`` on side B along t1, t2, and ``-(N - P)`` on
 ``a_n``, ``+(N - P)`` on ``b_n`` (the signs of the normal springs,
 :mod:`jointdyn.kinematics`).
@@ -47,8 +55,9 @@ with the arguments::
                                     end point, start point and committed slider
                                     fixed (output)
 
-The derivative of the slider carries the history (as ``step_jvp`` of the
-contact laws, ``jointdyn.laws._base``): the chain rule through a march is
+The derivatives are exact: forward mode through the closed form (``_dpair``), along directions
+of the start point (du0, dg0), the end point (du, dg) and the committed slider (dw_old). The
+derivative of the slider carries the history (as ``step_jvp`` of the contact laws, ``jointdyn.laws._base``): the chain rule through a march is
 exact away from the measure-zero instants where a pair changes state.
 ``interface_step_jvp`` and ``interface_step_tangent`` return the primal
 outputs of ``interface_step`` bit for bit.
@@ -112,10 +121,11 @@ def _closing(kt, mu, n0, n1, a1, a2, w1, w2):  # pragma: no cover - compiled
         return n1 / (n1 - n0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0
     t1 = kt * (a1 - w1)
     t2 = kt * (a2 - w2)
-    r = math.sqrt(t1 * t1 + t2 * t2)
+    r2 = t1 * t1 + t2 * t2
     lim = mu * n0
-    if r <= lim:
-        return 1.0, t1, t2, n0, t1, t2, r, 0.0, 0.0
+    if r2 <= lim * lim:  # (r0 is only needed to slide back)
+        return 1.0, t1, t2, n0, t1, t2, 0.0, 0.0, 0.0
+    r = math.sqrt(r2)
     f = lim / r
     return 1.0, f * t1, f * t2, n0, t1, t2, r, 0.0, 1.0
 
@@ -140,23 +150,24 @@ def _exit(kt, mu, v1, v2, s, nd, Ta1, Ta2, Na, proj):  # pragma: no cover - comp
 def _turn(kt, mu, v1, v2, s, nd, Ts1, Ts2, Ns, Ls, n1):  # pragma: no cover - compiled
     """Slip from the force Ts (on the circle, load Ns) over the rest Ls of the step: the direction e
     at the end, at the angle phi from v / |v| with tan(phi / 2) = F tan(phi_s / 2),
-    F = exp(-kt |v| l / mu), l = int dtau / N. Returns e1, e2, the half-angle (x, y) of phi_s,
-    F, l, dl / dnd and ``turned`` (0: no start direction, e = v / |v|)."""
+    F = exp(-kt |v| l / mu), l = int dtau / N. Returns e1, e2, the half-angle (x, y) of phi_s
+    (a vector along it, not of unit length), F, l, dl / dnd and ``turned`` (0: no start
+    direction, e = v / |v|)."""
     rs = math.sqrt(Ts1 * Ts1 + Ts2 * Ts2)
     if s == 0.0:  # no tangential motion: the force keeps its direction
         return Ts1 / rs, Ts2 / rs, 1.0, 0.0, 1.0, 0.0, 0.0, 1.0
-    p1 = v1 / s
-    p2 = v2 / s
+    inv = 1.0 / s
+    p1 = v1 * inv
+    p2 = v2 * inv
     x, y, F, ell, dl, turned = 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
     if rs > 0.0:
-        c = (p1 * Ts1 + p2 * Ts2) / rs
-        sn = (p1 * Ts2 - p2 * Ts1) / rs
+        inv = 1.0 / rs
+        c = (p1 * Ts1 + p2 * Ts2) * inv
+        sn = (p1 * Ts2 - p2 * Ts1) * inv
         if c >= 0.0:
             x, y = 1.0 + c, sn
         else:  # (1 + cos, sin) without the cancellation near phi_s = pi
             x, y = abs(sn), (1.0 - c if sn >= 0.0 else c - 1.0)
-        h = math.sqrt(x * x + y * y)
-        x, y = x / h, y / h
         q = Ls / Ns
         hz, dhz = _log1p_ratio(nd * q)
         ell = q * hz
@@ -165,7 +176,8 @@ def _turn(kt, mu, v1, v2, s, nd, Ts1, Ts2, Ns, Ls, n1):  # pragma: no cover - co
         turned = 1.0
     Fy = F * y
     D = x * x + Fy * Fy
-    cp, sp = ((x * x - Fy * Fy) / D, 2.0 * x * Fy / D) if D > 0.0 else (-1.0, 0.0)
+    inv = 1.0 / D if D > 0.0 else 0.0
+    cp, sp = ((x * x - Fy * Fy) * inv, 2.0 * x * Fy * inv) if D > 0.0 else (-1.0, 0.0)
     return cp * p1 - sp * p2, cp * p2 + sp * p1, x, y, F, ell, dl, turned
 
 
@@ -263,7 +275,7 @@ def _dpair(kt, kn, mu, aux, da1, da2, dg0, du1, du2, dg, dw1, dw2):  # pragma: n
             dNs = dNa + dnd * sig
             dell = dL / n1 - Ls / (Ns * n1) * dNs + dl * dnd
             dF = -F * kt / mu * ((v1 * dv1 + v2 * dv2) / s * ell + s * dell)
-            dth += (F * dphis + 2.0 * x * y * dF) / D
+            dth += (F * (x * x + y * y) * dphis + 2.0 * x * y * dF) / D
     dn1 = mu * kn * dg
     f = mu * n1 * dth
     d1 = dn1 * e1 - f * e2
