@@ -40,7 +40,8 @@ class Restart:
     x, v : ndarray
         Displacements (m) and velocities (m/s), one per DOF.
     states : ndarray
-        Committed law states, one row per contact.
+        Committed law states, one row per contact, then the sliders of the
+        interface pairs (two numbers per pair, row after row).
     """
 
     x: np.ndarray
@@ -100,8 +101,9 @@ def _start_vectors(model: Model, x0, v0, states):
         S = model.initial_states(x)
     else:
         S = np.array(states, dtype=np.float64, ndmin=2)
-        if S.shape != (model.nc, model.pack.slen):
-            raise ValueError(f"states must have shape {(model.nc, model.pack.slen)}, got {S.shape}")
+        shape = (model.pack.state_rows, model.pack.slen)
+        if S.shape != shape:
+            raise ValueError(f"states must have shape {shape}, got {S.shape}")
     return x, v, np.ascontiguousarray(S)
 
 
