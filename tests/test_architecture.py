@@ -30,6 +30,7 @@ MAX_FUNCTION_LINES = 100
 LAYERS = {
     "laws": 0,
     "systems": 1, "kinematics": 1, "interfaces": 1, "fourier": 1, "reduction": 1, "systemfile": 1, "files": 1,
+    "fe": 1,
     "continuation": 2, "drivers": 2,
     "dynamics": 3, "hb": 3, "modes": 3,
     "sweeps": 4,
