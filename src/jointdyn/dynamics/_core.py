@@ -91,8 +91,8 @@ The runner takes five grouped arguments (tuples of arrays):
             caps of (x, v)
 ``out``     ``(t, x, v, T, N, code, summary, z_end, pairs)``: recorded samples
             and the per-repetition summary (columns ``S_*``; ``S_OPEN``
-            counts the steps that end with a spring contact or a pair
-            open), end states and per pair (repetitions, np, 4) its work (J)
+            counts the steps that end with a spring contact open or in
+            which a pair opened or closed), end states and per pair (repetitions, np, 4) its work (J)
             and the fractions of the repetition it was stuck, slipping, open
 
 It returns ``(samples recorded, run status RUN_*, repetitions done)``
@@ -400,8 +400,11 @@ def _pairs_commit(pw, ia, pairs, y0, h, nopen, S, nc, psum, k, n, last, period):
     states (half to each when a pair's state changed inside the step:
     stick/slip fractions are exact to a step, openings and closings are
     step boundaries), the committed point moved to y0; ``nopen`` plus 1 if
-    a pair is open at the end. At the ``last`` step of repetition k, its
-    per-pair summary (:func:`_pair_summary`)."""
+    a pair opened or closed in the step (a pair open all along, e.g. one
+    without preload whose normal DOFs stay apart, does not count: the
+    refinement it triggers is for the ringing at re-contacts). At the
+    ``last`` step of repetition k, its per-pair summary
+    (:func:`_pair_summary`)."""
     code, code_c, times = pw[7], pw[8], pw[9]
     _pair_write_back(S, nc, pw[0][1 - ia])
     opened = 0
@@ -412,9 +415,9 @@ def _pairs_commit(pw, ia, pairs, y0, h, nopen, S, nc, psum, k, n, last, period):
         else:
             times[i, code_c[i]] += 0.5 * h
             times[i, c] += 0.5 * h
+            if (c == SEPARATION) != (code_c[i] == SEPARATION):
+                opened = 1
         code_c[i] = c
-        if c == SEPARATION:
-            opened = 1
     _pair_point(pairs, y0, pw[3], pw[4])
     if last:
         _pair_summary(psum, k, y0, n, times, period)
