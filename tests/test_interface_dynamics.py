@@ -90,9 +90,11 @@ def _reduction_systems(n, force_n):
 
 @pytest.mark.parametrize("force_n", [0.5, 3.0])  # the normal load varies; with 3.0 the patch opens
 def test_one_dimensional_patch_is_the_discrete_iwan_law_under_a_normal_spring(force_n):
-    """The same steps give the same response to rounding (measured: 3e-15 of the amplitude, 2e-15 of
-    the contact energy, with and without reversal and opening splits as long as the patch stays
-    closed). Once it opens, the steps must split at the openings and closings (events on): a pair
+    """The same steps give the same response to rounding (measured without event splits: 3e-15 of the
+    amplitude, 2e-15 of the contact energy). With them, while the patch stays closed, the only
+    difference is that the pairs do not split the step at a reversal where none of them slips (the
+    Iwan contact always does): measured 2e-10. Once it opens, the steps must split at the openings
+    and closings (events on): a pair
     re-closing inside a step restarts virgin at the instant it closes on the straight path, the
     Iwan law at the step's end. With events on, the Iwan contact's steps also split where all its
     elements start slipping (bisection on its state) and its load is snapped at the located
@@ -100,7 +102,7 @@ def test_one_dimensional_patch_is_the_discrete_iwan_law_under_a_normal_spring(fo
     8e-7 of the amplitude, 2e-5 of the energy per period)."""
     iwan, patch = _reduction_systems(8, force_n)
     opened = force_n == 3.0
-    for events, tol in ((True, 1e-5),) if opened else ((False, 1e-13), (True, 1e-13)):
+    for events, tol in ((True, 1e-5),) if opened else ((False, 1e-13), (True, 1e-8)):
         out = []
         for s in (iwan, patch):
             model = make_model(s, 40.0, 256, events=events)
