@@ -65,6 +65,10 @@ class Trajectory:
         Normal loads, N.
     code : ndarray of int8, shape (ns, ncontacts)
         Motion state per contact (STICK_SLIP, MACROSLIP, SEPARATION).
+        Interface pairs are not recorded here: their relative motion is
+        that of ``x`` (``Interface.relative``), their sliders are in
+        ``final.states`` and their per-period results in
+        :class:`~jointdyn.dynamics.SteadyState`.
     final : Restart
         Final state (x, v, law states), usable as a start for a further run.
     status : RunStatus
