@@ -353,7 +353,7 @@ def has_springs(kin: ContactKinematics) -> bool:
 
 
 @by_identity
-def contact_kinematics(system) -> ContactKinematics:
+def contact_kinematics(system, with_interfaces: bool = False) -> ContactKinematics:
     """Pack the contacts of ``system`` (a :class:`~jointdyn.System`), cached per object.
 
     Each contact gives its tangential selection from ``(dof, dof2)``
@@ -362,14 +362,16 @@ def contact_kinematics(system) -> ContactKinematics:
     load: constant and harmonic loads as ``(n0, n1, delta rad)``, sampled
     loads as ``(mean, m, 0)`` with their table row, normal springs as
     ``(preload, kn, 0)`` with their normal selection row. A System with
-    interfaces is refused (ValueError naming ``interfaces``): the solvers that
-    pack their contacts here do not march interfaces yet.
+    interfaces is refused (ValueError naming ``interfaces``) unless
+    ``with_interfaces`` (a solver that marches the interfaces itself: time
+    integration); the solvers that pack their contacts here otherwise do
+    not march interfaces yet.
     """
-    if getattr(system, "interfaces", ()):
-        # every dynamic solver packs its contacts here: none of them marches interfaces yet
-        raise ValueError(f"interfaces: the dynamic solvers (time integration, harmonic balance, nonlinear modes, "
-                         f"sweeps) do not take interfaces yet (the System has {len(system.interfaces)}); their "
-                         "quasi-static loops are jointdyn.drivers.interface_loop")
+    if getattr(system, "interfaces", ()) and not with_interfaces:
+        # the frequency-domain solvers pack their contacts here: none of them marches interfaces yet
+        raise ValueError(f"interfaces: harmonic balance and nonlinear modes do not take interfaces yet (the System "
+                         f"has {len(system.interfaces)}); time integration (integrate, steady_state, frc --system) "
+                         "and the quasi-static loops (jointdyn.drivers.interface_loop) do")
     cs = system.contacts
     nc = len(cs)
     tan_idx, tan_w = _pack_rows([_sparse_selection(c.dof, c.dof2, c.direction) for c in cs])

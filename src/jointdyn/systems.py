@@ -161,9 +161,10 @@ class System:
     interfaces : tuple of Interface
         Contact patches of node pairs with 2-D slip and normal loads from
         the motion (docs/model.md section 10). The quasi-static driver
-        (:func:`jointdyn.drivers.interface_loop`) marches them; the
-        dynamic solvers refuse a System with interfaces (they do not take
-        them yet).
+        (:func:`jointdyn.drivers.interface_loop`) and the time integration
+        (:func:`jointdyn.integrate`, :func:`jointdyn.steady_state`) march
+        them; harmonic balance and nonlinear modes refuse a System with
+        interfaces (they do not take them yet).
     """
 
     M: np.ndarray

@@ -31,6 +31,22 @@ A normal spring acts on the structure with ``Bn (N - P)`` (N = max(0,
 P + kn g)), the tangential law with ``Bt T``; the contact power counted as
 dissipation is that of T alone (the spring is conservative).
 
+Interface pairs (docs/model.md section 10) are marched alongside: every
+evaluation steps all pairs from their committed sliders along the straight
+path from the committed point (u0, g0) to the stage point
+(:func:`jointdyn.interfaces.interface_step`, bound as ``PAIR_STEP``), the
+accepted step's end is committed (sliders, point, codes). Each pair's
+velocity reversals of u1, u2 and its openings and closings (P + kn g
+changes sign on the Hermite interpolant of g) split the step as a
+contact's do, in one pass over the pairs (cost linear in their number);
+stick/slip changes inside a step are not located (the kernel is exact
+along the straight path). The power T . du of each pair is integrated with
+the RK4 weights (one entry of y per pair, after the four integrals), so
+that the per-pair dissipation adds up to the contacts' total; the time
+each pair spends stuck, slipping and open is booked at every commit. The
+sliders live in the rows of the law-state array after the contacts' rows
+(two numbers per pair, row after row).
+
 The runner is one loop around a single evaluation of the right-hand side
 (law trial steps included), so that the law kernel is compiled inline once;
 an *evaluation kind* (``EVAL_*``) says what the evaluation is for (the
@@ -49,17 +65,19 @@ hand-written one (both measured):
   the reference counts of its arguments, which Numba updates at every
   inlined call, are not optimised away (1.3 to 2x slower).
 
-The spring and phase work is compiled only for systems that have normal
-springs or forcing phases (global flags ``SPRINGS`` and ``PHASED`` bound
-with the kernel), so other systems run the loop they ran without it.
+The spring, phase and pair work is compiled only for systems that have
+normal springs, forcing phases or interfaces (global flags ``SPRINGS``,
+``PHASED`` and ``INTERFACES`` bound with the kernel), so other systems run
+the loop they ran without it.
 
 The runner takes five grouped arguments (tuples of arrays):
 
-``system``  ``(Minv, K, C, (f_sin, f_cos), kin, P)``: inverse mass matrix,
+``system``  ``(Minv, K, C, (f_sin, f_cos), kin, P, (pairs, pair_params))``: inverse mass matrix,
             stiffness and damping matrices, forcing amplitudes (mode
             LOADS_HARMONIC: F = f_sin sin(w t) + f_cos cos(w t)), the contact
             kinematics tuple (:mod:`jointdyn.kinematics`) and the law
-            parameter rows (:mod:`jointdyn.laws._dispatch`)
+            parameter rows (:mod:`jointdyn.laws._dispatch`), the interface
+            pairs' DOFs (np, 6) and parameters kt, kn, mu, P (np, 4)
 ``grid``    ``(t, N, F, (sin_mid, sin_end, cos_mid, cos_end), N_mid)``: step
             grid (s), prescribed normal loads (N) at its points, sampled
             forcing F (N; mode LOADS_SAMPLED), forcing sines and cosines at
@@ -69,10 +87,13 @@ The runner takes five grouped arguments (tuples of arrays):
             (``recontact``: the load committed at a spring's re-contact, as
             a fraction of its preload)
 ``io``      ``(x, v, S, cap)``: state in and out (S: committed law states,
-            one row per contact) and the blow-up caps of (x, v)
-``out``     ``(t, x, v, T, N, code, summary, z_end)``: recorded samples and
-            the per-repetition summary (columns ``S_*``; ``S_OPEN`` counts
-            the steps that end with a spring contact open) and end states
+            one row per contact, then the pairs' sliders) and the blow-up
+            caps of (x, v)
+``out``     ``(t, x, v, T, N, code, summary, z_end, pairs)``: recorded samples
+            and the per-repetition summary (columns ``S_*``; ``S_OPEN``
+            counts the steps that end with a spring contact open or in
+            which a pair opened or closed), end states and per pair (repetitions, np, 4) its work (J)
+            and the fractions of the repetition it was stuck, slipping, open
 
 It returns ``(samples recorded, run status RUN_*, repetitions done)``
 (samples: ``capacity + 1`` with RUN_OVERFLOW when the buffers were full).
@@ -99,7 +120,7 @@ from ..kinematics import (
     spring_load,
     tangential,
 )
-from ..laws._base import SEPARATION
+from ..laws._base import MACROSLIP, SEPARATION
 
 # columns of the per-period summary
 S_XMAX, S_XMIN, S_EC, S_EV, S_W, S_XMEAN, S_STEPS, S_OPEN = range(8)
@@ -215,21 +236,15 @@ def _reversal_fraction(tan_idx, tan_w, y0, y1, h, n):  # pragma: no cover - comp
 
 
 @jit(inline="always")
-def _spring_event(n_par, n_idx, n_w, c, y0, y1, h, n):  # pragma: no cover - compiled
-    """First sign change of P + kn g of spring contact c inside the step, on
-    the cubic Hermite interpolant of the normal approach g; returns (fraction
-    of the step, 2.0 when there is none; True at a re-contact).
+def _crossing(P, kn, g0, g1, dg0, dg1, h):  # pragma: no cover - compiled
+    """First sign change of P + kn g inside a step on the cubic Hermite
+    interpolant of g (values g0, g1, slopes dg0, dg1); returns (fraction of
+    the step, 2.0 when there is none; True at a re-contact).
 
     A sign change between the ends is bisected; without one, an extremum of
     g inside the step whose value has the other sign (the contact opens and
     closes again within the step) brackets the first crossing.
     """
-    P = n_par[c, 0]
-    kn = n_par[c, 1]
-    g0 = tangential(n_idx, n_w, c, y0, 0)
-    g1 = tangential(n_idx, n_w, c, y1, 0)
-    dg0 = tangential(n_idx, n_w, c, y0, n)
-    dg1 = tangential(n_idx, n_w, c, y1, n)
     closed0 = P + kn * g0 > 0.0
     lo = 0.0
     hi = 1.0
@@ -246,6 +261,17 @@ def _spring_event(n_par, n_idx, n_w, c, y0, y1, h, n):  # pragma: no cover - com
         else:
             hi = sm
     return 0.5 * (lo + hi), not closed0
+
+
+@jit(inline="always")
+def _spring_event(n_par, n_idx, n_w, c, y0, y1, h, n):  # pragma: no cover - compiled
+    """:func:`_crossing` of spring contact c inside the step (normal approach
+    g from the states y0, y1)."""
+    g0 = tangential(n_idx, n_w, c, y0, 0)
+    g1 = tangential(n_idx, n_w, c, y1, 0)
+    dg0 = tangential(n_idx, n_w, c, y0, n)
+    dg1 = tangential(n_idx, n_w, c, y1, n)
+    return _crossing(n_par[c, 0], n_par[c, 1], g0, g1, dg0, dg1, h)
 
 
 @jit
@@ -270,6 +296,162 @@ def _spring_split(n_kind, n_par, n_idx, n_w, y0, y1, h, n, recontact, sbest):  #
                 ev_c = c
                 ev_n = recontact * n_par[c, 0] if rising else 0.0
     return sbest, ev_c, ev_n
+
+
+# --- interface pairs (compiled into runners of systems with interfaces only) -------
+
+
+@jit(inline="always")
+def _rel(y, a, b, off):  # pragma: no cover - compiled
+    """y[off + a] - y[off + b] with -1 a fixed side (0): a relative coordinate of a pair."""
+    return (y[off + a] if a >= 0 else 0.0) - (y[off + b] if b >= 0 else 0.0)
+
+
+@jit
+def _pair_workspace(S, nc, x, pairs):  # pragma: no cover - compiled
+    """Buffers of the pairs of a run: ``(W, u, g, u0, g0, T, N, code, code_c, times)``.
+
+    W (2, np, 2): committed and trial sliders (m; W[ia] committed), read from
+    the rows of S after the nc contacts (flat, two numbers per pair); u, g
+    the pairs' relative displacements at an evaluation and u0, g0 at the
+    committed point (m, here those of x); T, N the forces (N); the trial and
+    committed codes (committed -1: unknown before the first step); times
+    (np, 3): seconds stuck, slipping, open in the current repetition.
+    """
+    m = pairs.shape[0]
+    W = np.zeros((2, m, 2))
+    L = S.shape[1]
+    u0 = np.zeros((m, 2))
+    g0 = np.zeros(m)
+    for i in range(m):
+        for k in range(2):
+            W[0, i, k] = S[nc + (2 * i + k) // L, (2 * i + k) % L]
+            u0[i, k] = _rel(x, pairs[i, k], pairs[i, 3 + k], 0)
+        g0[i] = _rel(x, pairs[i, 2], pairs[i, 5], 0)
+    return (W, np.zeros((m, 2)), np.zeros(m), u0, g0, np.zeros((m, 2)), np.zeros(m), np.zeros(m, dtype=np.int64),
+            np.full(m, -1, dtype=np.int64), np.zeros((m, 3)))  # fmt: skip
+
+
+@jit
+def _pair_point(pairs, ys, u, g):  # pragma: no cover - compiled
+    """u, g (m) of every pair at the stage state ys."""
+    for i in range(pairs.shape[0]):
+        u[i, 0] = _rel(ys, pairs[i, 0], pairs[i, 3], 0)
+        u[i, 1] = _rel(ys, pairs[i, 1], pairs[i, 4], 0)
+        g[i] = _rel(ys, pairs[i, 2], pairs[i, 5], 0)
+
+
+@jit
+def _pair_reactions(pairs, par, ys, n, T, N, work, kk, row):  # pragma: no cover - compiled
+    """work -= the pairs' reactions (-T on side A, +T on side B along t1, t2;
+    -(N - P) on a_n, +(N - P) on b_n; N); the power T . du of pair i (W) into
+    ``kk[row, 2 n + 4 + i]`` (its dissipation integral); returns their sum."""
+    tot = 0.0
+    for i in range(pairs.shape[0]):
+        dn = N[i] - par[i, 3]
+        p = 0.0
+        for k in range(3):
+            a = pairs[i, k]
+            b = pairs[i, 3 + k]
+            f = T[i, k] if k < 2 else dn
+            if a >= 0:
+                work[a] -= f
+            if b >= 0:
+                work[b] += f
+            if k < 2:
+                p += f * _rel(ys, a, b, n)
+        kk[row, 2 * n + 4 + i] = p
+        tot += p
+    return tot
+
+
+@jit
+def _pair_split(pairs, par, y0, y1, h, n, sbest, ev_c, pw):  # pragma: no cover - compiled
+    """Earliest pair event inside the step before ``sbest`` and away from the
+    ends: a velocity reversal of u1 or u2 (Hermite root) of a pair slipping
+    at the committed point or at the last stage (``pw``: its codes), or an
+    opening or closing (P + kn g changes sign on the Hermite interpolant of
+    g, as a normal spring's). Returns (fraction, ev_c: -1 when a pair event
+    comes first, since a pair's load needs no snapping). One pass over the
+    pairs: cost linear in their number.
+
+    A stuck pair's reversal does not split the step: its slider stays where
+    it is (a slip only at an extremum inside the step is missed, as between
+    the samples of any sampled history). On the lap joint the ringing of the
+    stiff interface DOFs made nearly every step split four times at the
+    reversals of stuck pairs (88700 steps per period against 18264 grid
+    steps; 36250 with this rule); on the 1-D patch it changed the response
+    by 2e-10 (tests/test_interface_dynamics.py)."""
+    for i in range(pairs.shape[0]):
+        for k in range(3):
+            a = pairs[i, k]
+            b = pairs[i, 3 + k]
+            u0 = _rel(y0, a, b, 0)
+            u1 = _rel(y1, a, b, 0)
+            du0 = _rel(y0, a, b, n)
+            du1 = _rel(y1, a, b, n)
+            sr = 2.0
+            if k == 2:
+                sr = _crossing(par[i, 3], par[i, 1], u0, u1, du0, du1, h)[0]
+            elif du0 * du1 < 0.0 and (pw[8][i] == MACROSLIP or pw[7][i] == MACROSLIP):
+                sr = _hermite_root(u0, u1, du0, du1, h)
+            if sr > _SPLIT_GUARD and sr < 1.0 - _SPLIT_GUARD and sr < sbest:
+                sbest = sr
+                ev_c = -1
+    return sbest, ev_c
+
+
+@jit
+def _pairs_commit(pw, ia, pairs, y0, h, nopen, S, nc, psum, k, n, last, period):  # pragma: no cover - compiled
+    """Accept the step for the pairs: the trial sliders become the committed
+    ones (returns their new index in W) and are written into S (rows after
+    the nc contacts), the step's time h (s) booked to the pairs' motion
+    states (half to each when a pair's state changed inside the step:
+    stick/slip fractions are exact to a step, openings and closings are
+    step boundaries), the committed point moved to y0; ``nopen`` plus 1 if
+    a pair opened or closed in the step (a pair open all along, e.g. one
+    without preload whose normal DOFs stay apart, does not count: the
+    refinement it triggers is for the ringing at re-contacts). At the
+    ``last`` step of repetition k, its per-pair summary
+    (:func:`_pair_summary`)."""
+    code, code_c, times = pw[7], pw[8], pw[9]
+    _pair_write_back(S, nc, pw[0][1 - ia])
+    opened = 0
+    for i in range(pairs.shape[0]):
+        c = code[i]
+        if code_c[i] < 0 or code_c[i] == c:
+            times[i, c] += h
+        else:
+            times[i, code_c[i]] += 0.5 * h
+            times[i, c] += 0.5 * h
+            if (c == SEPARATION) != (code_c[i] == SEPARATION):
+                opened = 1
+        code_c[i] = c
+    _pair_point(pairs, y0, pw[3], pw[4])
+    if last:
+        _pair_summary(psum, k, y0, n, times, period)
+    return 1 - ia, nopen + opened
+
+
+@jit
+def _pair_summary(psum, k, y0, n, times, period):  # pragma: no cover - compiled
+    """Per-pair row of repetition k: work of the pair's force (J: its
+    dissipation over a periodic repetition) and the fractions of the
+    repetition it was stuck, slipping, open; the times are reset."""
+    for i in range(psum.shape[1]):
+        psum[k, i, 0] = y0[2 * n + 4 + i]
+        for c in range(3):
+            psum[k, i, 1 + c] = times[i, c] / period
+            times[i, c] = 0.0
+
+
+@jit
+def _pair_write_back(S, nc, W):  # pragma: no cover - compiled
+    """The committed sliders W (np, 2) into the rows of S after the contacts."""
+    L = S.shape[1]
+    for i in range(W.shape[0]):
+        for k in range(2):
+            S[nc + (2 * i + k) // L, (2 * i + k) % L] = W[i, k]
 
 
 # --- loads at a time ---------------------------------------------------------------
@@ -480,16 +662,17 @@ def _period_summary(summ, zend, k, y0, n, xmax, xmin, nsteps, nopen, period):  #
 
 
 @jit(inline="always")
-def _workspace(x, v, nc):  # pragma: no cover - compiled
-    """Buffers of a run: y0 (start of the step, = (x, v, 0...)), y1, ys (stage
-    state), the stage table, forces and loads, trial and committed codes."""
+def _workspace(x, v, nc, m):  # pragma: no cover - compiled
+    """Buffers of a run: y0 (start of the step, = (x, v, 0...); m pair
+    energies after the four integrals), y1, ys (stage state), the stage
+    table, forces and loads, trial and committed codes."""
     n = x.shape[0]
-    y0 = np.zeros(2 * n + 4)
-    ys = np.zeros(2 * n + 4)  # = y0: the state of the initial evaluation
+    y0 = np.zeros(2 * n + 4 + m)
+    ys = np.zeros(2 * n + 4 + m)  # = y0: the state of the initial evaluation
     for i in range(n):
         y0[i] = ys[i] = x[i]
         y0[n + i] = ys[n + i] = v[i]
-    return (y0, np.zeros(2 * n + 4), ys, np.zeros((N_ROWS, 2 * n + 4)), np.zeros(n),
+    return (y0, np.zeros(2 * n + 4 + m), ys, np.zeros((N_ROWS, 2 * n + 4 + m)), np.zeros(n),
             np.zeros(n), np.zeros(nc), np.zeros(nc), np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64))
 
 
@@ -511,27 +694,28 @@ def _after_start(y0, kk, code_c, codes, n, record, out, t0, Tc, Nv):  # pragma: 
 
 
 @jit(inline="always")
-def _write_back(x_io, v_io, S_io, y0, Sa):  # pragma: no cover - compiled
-    """Final state into the caller's x, v and law states."""
+def _write_back(x_io, v_io, S_io, y0, Sa, nc):  # pragma: no cover - compiled
+    """Final state into the caller's x, v and law states (the nc contacts' rows; the pairs' sliders
+    are written at every commit)."""
     n = x_io.shape[0]
     for i in range(n):
         x_io[i] = y0[i]
         v_io[i] = y0[n + i]
-    for c in range(S_io.shape[0]):
+    for c in range(nc):
         for r in range(S_io.shape[1]):
             S_io[c, r] = Sa[c, r]
 
 
 def _run_template(system, grid, control, io, out):  # pragma: no cover - compiled
     """March ``control[1]`` repetitions of the step grid (see module docstring)."""
-    Minv, K, C, (fsin, fcos), (tan_idx, tan_w, n_kind, n_par, n_idx, n_w, n_tab), P = system
+    Minv, K, C, (fsin, fcos), (tan_idx, tan_w, n_kind, n_par, n_idx, n_w, n_tab), P, (ipairs, ipar) = system
     tgrid, Ngrid, Fgrid, (sin_mid, sin_end, cos_mid, cos_end), N_mid = grid
     mode, nper, phase0, w, rdof, max_split, record, recontact = control
     x_io, v_io, S_io, xcap = io
     summ, zend = out[6], out[7]
-    n, nc, J = x_io.shape[0], S_io.shape[0], tgrid.shape[0] - 1
-    Sa, Sb = S_io.copy(), S_io.copy()
-    y0, y1, ys, kk, work, Fv, Nv, Tc, codes, code_c = _workspace(x_io, v_io, nc)
+    n, nc, J = x_io.shape[0], P.shape[0], tgrid.shape[0] - 1  # S_io: the contacts' rows, then the pairs' sliders
+    Sa, Sb, pw, ia = S_io.copy(), S_io.copy(), _pair_workspace(S_io, nc, x_io, ipairs), 0
+    y0, y1, ys, kk, work, Fv, Nv, Tc, codes, code_c = _workspace(x_io, v_io, nc, ipairs.shape[0])
     blo, bhi, bit, sm, located, e, ev_c, ev_n = 0.0, 1.0, 0, 0.0, False, EVAL_START, -1, 0.0
     nrec, status, done, k, j, attempt, nsplit, nsteps, nopen = 0, RUN_OK, 0, 0, 0, 0, 0, 0, 0
     tc, t_end, end_idx, h, period = tgrid[0], tgrid[1], 1, tgrid[1] - tgrid[0], tgrid[J] - tgrid[0]
@@ -543,6 +727,8 @@ def _run_template(system, grid, control, io, out):  # pragma: no cover - compile
                 sbest = _reversal_fraction(tan_idx, tan_w, y0, y1, h, n)
                 if SPRINGS:  # noqa: F821 - bound by specialize
                     sbest, ev_c, ev_n = _spring_split(n_kind, n_par, n_idx, n_w, y0, y1, h, n, recontact, sbest)
+                if INTERFACES:  # noqa: F821 - bound by specialize
+                    sbest, ev_c = _pair_split(ipairs, ipar, y0, y1, h, n, sbest, ev_c, pw)
                 if sbest < 1.0:  # redo the step up to the velocity reversal or spring event
                     h, end_idx, attempt, e = sbest * h, -1, 1, EVAL_STAGE2
                     continue
@@ -555,7 +741,6 @@ def _run_template(system, grid, control, io, out):  # pragma: no cover - compile
             if e >= EVAL_STAGE2 and e < EVAL_END:  # RK stages (ys holds the start and the end already)
                 for r in range(ys.shape[0]):
                     ys[r] = y0[r] + a_ * kk[e, r]
-        # ---- loads at tau (tables: grid points, midpoints of unsplit harmonic steps)
         fresh = mode == LOADS_HARMONIC and e >= EVAL_STAGE2 and e <= EVAL_END and attempt == 0 and nsplit == 0
         if mode == LOADS_HARMONIC:
             sp = (sin_mid[j] if e < EVAL_STAGE4 else sin_end[j]) if fresh else math.sin(phase0 + w * tau)
@@ -574,44 +759,45 @@ def _run_template(system, grid, control, io, out):  # pragma: no cover - compile
         else:
             for c in range(nc):
                 Nv[c] = PRESCRIBED_LOAD(n_kind[c], n_par, n_tab, c, phase0 + w * tau)  # noqa: F821 - bound by specialize
-        # ---- right-hand side (the law kernel here: inside an inlined helper 3.5x slower)
-        _linear_forces(K, C, ys, Fv, n, work)
+        _linear_forces(K, C, ys, Fv, n, work)  # right-hand side (law kernels here: in a helper 3.5x slower)
         if SPRINGS:  # noqa: F821 - bound by specialize; spring loads from the state, and their reactions
             _springs(n_kind, n_par, n_idx, n_w, ys, Nv, ev_c if e == EVAL_END else -1, ev_n, work)
         pc = 0.0
+        row = e + 1 if (e >= EVAL_STAGE2 and e < EVAL_END) else (ROW_PROBE if e == EVAL_PROBE else ROW_END)
+        if INTERFACES:  # noqa: F821 - the pairs' trial forces along the straight path from the committed point
+            _pair_point(ipairs, ys, pw[1], pw[2])
+            PAIR_STEP(ipar, pw[3], pw[4], pw[1], pw[2], pw[0][ia], pw[0][1 - ia], pw[5], pw[6], pw[7])  # noqa: F821
+            pc += _pair_reactions(ipairs, ipar, ys, n, pw[5], pw[6], work, kk, row)
         for c in range(nc):
             u, du = tangential(tan_idx, tan_w, c, ys, 0), tangential(tan_idx, tan_w, c, ys, n)
             t_, k_, c_ = STEP(P[c], Sa[c], Sb[c], u, Nv[c])  # noqa: F821 - bound by specialize
             Tc[c], codes[c] = t_, c_
             apply_tangential_force(tan_idx, tan_w, c, t_, work)
             pc += t_ * du
-        row = e + 1 if (e >= EVAL_STAGE2 and e < EVAL_END) else (ROW_PROBE if e == EVAL_PROBE else ROW_END)
         _derivatives(Minv, C, ys, Fv, n, rdof, work, pc, kk, row)
-        # ---- after the evaluation -----------------------------------------
         if e < EVAL_END:  # the start, or RK stages 2, 3: on to the next stage (EVAL_START + 1 = EVAL_STAGE2)
             if e == EVAL_START:
                 nrec = _after_start(y0, kk, code_c, codes, n, record, out, tgrid[0], Tc, Nv)
             e += 1
             continue
-        # change of motion state inside an unsplit step (separation and
-        # re-contact are grid points or spring events): located by bisection
+        # a contact's change of motion state inside an unsplit step: located by bisection
         if e == EVAL_PROBE or (attempt == 0 and nsplit < max_split and not located
                                and _state_changed(codes, code_c, True)):  # fmt: skip
             blo, bhi, bit, e, h, end_idx, attempt, located = _bisection(e, codes, code_c, sm, blo, bhi, bit, h, end_idx,
                                                                         attempt)  # fmt: skip
             continue
-        located = False
-        Sa, Sb = Sb, Sa
+        located, Sa, Sb = False, Sb, Sa
         t_new = t_end if end_idx >= 0 else tc + h
         xmax, xmin = _extremum(y0, y1, h, rdof, n, xmax, xmin)
         status, nopen = _commit(y0, y1, kk, code_c, codes, xcap, n, n_kind, nopen)
+        if INTERFACES:  # noqa: F821 - bound by specialize (with the repetition's pair summary at its end)
+            ia, nopen = _pairs_commit(pw, ia, ipairs, y0, h, nopen, S_io, nc, out[8], k, n, end_idx == J, period)
         nsteps += 1
         if record:
             nrec, status = _record_step(out, nrec, k * period + t_new, y0, n, Tc, Nv, codes, status)
         if status != RUN_OK:
             break
-        # next attempt: rest of the grid step, or the next grid step
-        e, attempt, ev_c = EVAL_STAGE2, 0, -1
+        e, attempt, ev_c = EVAL_STAGE2, 0, -1  # next attempt: rest of the grid step, or the next grid step
         if end_idx < 0:
             nsplit, tc, h, end_idx = nsplit + 1, t_new, t_end - t_new, j + 1
             continue
@@ -620,7 +806,7 @@ def _run_template(system, grid, control, io, out):  # pragma: no cover - compile
         if k == nper:
             break
         nsplit, tc, t_end, end_idx, h = 0, tgrid[j], tgrid[j + 1], j + 1, tgrid[j + 1] - tgrid[j]
-    _write_back(x_io, v_io, S_io, y0, Sa)
+    _write_back(x_io, v_io, S_io, y0, Sa, nc)
     return nrec, status, done
 
 
@@ -656,15 +842,18 @@ def grid_trig(tgrid, w, phase0):  # pragma: no cover - compiled
     return sin_mid, sin_end, cos_mid, cos_end
 
 
-def compiled_runner(step, springs: bool = False, phased: bool = False):
+def compiled_runner(step, springs: bool = False, phased: bool = False, interfaces: bool = False):
     """The RK4 runner with ``step`` (a law kernel or a mixed-law dispatcher)
-    bound, compiled and cached; ``springs`` (a contact has a normal spring)
-    and ``phased`` (a forcing phase is not 0) are compile-time constants, so
-    that systems without them compile none of that work."""
+    bound, compiled and cached; ``springs`` (a contact has a normal spring),
+    ``phased`` (a forcing phase is not 0) and ``interfaces`` (the system has
+    interface pairs) are compile-time constants, so that systems without
+    them compile none of that work. The pairs' kernel is bound as
+    ``PAIR_STEP`` so that the runner's cache name follows its source."""
     from .._jit import specialize
+    from ..interfaces import interface_step
 
     return specialize(_run_template, STEP=step, PRESCRIBED_LOAD=prescribed_load, SPRINGS=bool(springs),
-                      PHASED=bool(phased))  # fmt: skip
+                      PHASED=bool(phased), INTERFACES=bool(interfaces), PAIR_STEP=interface_step)  # fmt: skip
 
 
 __all__ = [

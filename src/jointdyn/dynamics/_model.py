@@ -37,7 +37,7 @@ from ._core import LOADS_HARMONIC, N_SUMMARY, RUN_OVERFLOW, S_OPEN, compiled_run
 from .status import RunStatus, run_status
 
 __all__ = ["PackedSystem", "pack_system", "Model", "make_model", "refine_if_opened", "Grid", "RunResult", "run",
-           "recontact_load"]  # fmt: skip
+           "recontact_load", "pair_relative", "sliders", "set_sliders"]  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -71,8 +71,9 @@ class PackedSystem:
     step: object
     init: object
     runner: object
-    #: K with the normal springs closed (N/m); with every contact stuck too,
-    #: its highest and lowest natural frequencies (rad/s)
+    #: K with the normal springs closed and the interface pairs closed at rest
+    #: stuck (N/m); with every contact stuck and every pair stuck and closed
+    #: too (K_stuck), its highest and lowest natural frequencies (rad/s)
     K_closed: np.ndarray
     K_stuck: np.ndarray
     w_max: float
@@ -86,6 +87,22 @@ class PackedSystem:
     #: table of a harmonic grid (unused there)
     nobufs: tuple
     no_forcing_table: np.ndarray
+    #: the pairs of every interface, one after the other: DOFs (np, 6) and
+    #: parameters kt, kn, mu, P (np, 4); rows of the state array that hold
+    #: their sliders (after the contacts' rows; 0 without interfaces)
+    pairs: np.ndarray = None
+    pair_params: np.ndarray = None
+    slider_rows: int = 0
+
+    @property
+    def npairs(self) -> int:
+        """Number of interface pairs (all interfaces)."""
+        return self.pairs.shape[0]
+
+    @property
+    def state_rows(self) -> int:
+        """Rows of the state array: one per contact, then the pairs' sliders."""
+        return self.ncontacts + self.slider_rows
 
     @property
     def springs(self) -> bool:
@@ -103,7 +120,7 @@ def pack_system(system) -> PackedSystem:
     """
     n = system.ndof
     cs = system.contacts
-    kin = contact_kinematics(system)
+    kin = contact_kinematics(system, True)  # the runner marches the interfaces itself
     M = np.ascontiguousarray(system.M, dtype=np.float64)
     Minv = np.ascontiguousarray(np.linalg.inv(system.M))
     K = np.ascontiguousarray(system.K, dtype=np.float64)
@@ -125,21 +142,44 @@ def pack_system(system) -> PackedSystem:
     Kst = Kcl.copy()
     for i in range(len(cs)):
         Kst += kt[i] * np.outer(B[i], B[i])
+    pairs, ppar, Kp_start, Kp_stiff = _interface_arrays(system)
+    Kcl += Kp_start  # the pairs stuck and closed at rest: the linear start's structure
+    Kst += Kp_stiff  # every pair stuck and closed: the stiffest mode
+    slider_rows = -(-2 * pairs.shape[0] // slen)
     from scipy.linalg import eigh
 
     lam = eigh(0.5 * (Kst + Kst.T), system.M, eigvals_only=True)
     w_max = math.sqrt(max(lam[-1], 0.0))
     w_min = math.sqrt(max(lam[0], 0.0))
     fmax = float(np.max(np.abs(fvec)))
+    xlin = sum(c.law.fy / c.law.kt for c in cs) + float(np.sum(ppar[:, 2] * ppar[:, 3] / ppar[:, 0]))
     return PackedSystem(
         ndof=n, ncontacts=len(cs), M=M, Minv=Minv, K=K, C=C, fvec=fvec, fsin=fsin, fcos=fcos, kin=kin, B=B,
         Bn=Bn, kt=kt, P=P, slen=slen, laws=tuple(c.law for c in cs), step=step, init=init,
-        runner=compiled_runner(step, kin.springs.size > 0, bool(np.any(fcos != 0.0))), K_closed=np.ascontiguousarray(Kcl), K_stuck=np.ascontiguousarray(Kst),
-        w_max=w_max, w_min_stuck=w_min, xlin=sum(c.law.fy / c.law.kt for c in cs), fmax=fmax,
+        runner=compiled_runner(step, kin.springs.size > 0, bool(np.any(fcos != 0.0)), pairs.shape[0] > 0),
+        K_closed=np.ascontiguousarray(Kcl), K_stuck=np.ascontiguousarray(Kst),
+        w_max=w_max, w_min_stuck=w_min, xlin=xlin, fmax=fmax,
         kmin=max(w_min**2 * float(np.min(np.diag(system.M))), 1e-300),
-        arrays=(Minv, K, C, (fsin, fcos), kin.arrays, P), nobufs=_buffers(1, n, len(cs)),
-        no_forcing_table=np.zeros((1, n)),
+        arrays=(Minv, K, C, (fsin, fcos), kin.arrays, P, (pairs, ppar)), nobufs=_buffers(1, n, len(cs)),
+        no_forcing_table=np.zeros((1, n)), pairs=pairs, pair_params=ppar, slider_rows=slider_rows,
     )  # fmt: skip
+
+
+def _interface_arrays(system):
+    """The pairs of every interface of ``system`` (DOFs (np, 6), parameters (np, 4)) and two
+    stiffness matrices (N/m): the springs kt, kt, kn of the pairs closed at rest (preload > 0), and
+    those of every pair (stuck and closed: the stiffest the structure can be)."""
+    itfs = tuple(getattr(system, "interfaces", ()))
+    n = system.ndof
+    if not itfs:
+        return np.zeros((0, 6), dtype=np.int64), np.zeros((0, 4)), np.zeros((n, n)), np.zeros((n, n))
+    pairs = np.ascontiguousarray(np.concatenate([i.pairs for i in itfs]), dtype=np.int64)
+    par = np.ascontiguousarray(np.concatenate([i.params for i in itfs]))
+    B = np.concatenate([i.selection(n) for i in itfs])  # rows u1, u2, g of every pair
+    k = np.stack([par[:, 0], par[:, 0], par[:, 1]], axis=1).ravel()
+    k_all = B.T @ (k[:, None] * B)
+    k_rest = B.T @ ((k * np.repeat(par[:, 3] > 0.0, 3))[:, None] * B)
+    return pairs, par, k_rest, k_all
 
 
 def _buffers(cap, n, nc):
@@ -308,8 +348,10 @@ class Model:
         ``loads`` (N; default the loads at t = 0, event-snapped: a re-contact
         at t = 0 starts the virgin curve there); a spring contact's load
         comes from x."""
-        S = np.zeros((self.nc, self.pack.slen))
+        S = np.zeros((self.pack.state_rows, self.pack.slen))
         x = np.ascontiguousarray(x, dtype=np.float64)
+        if self.pack.npairs:  # virgin pairs: sliders at the relative displacements of x
+            set_sliders(self.pack, S, pair_relative(self.pack, x)[0])
         u = tangential_history(self.pack.kin.arrays, x[None, :])[0]
         n_x = normal_history(self.pack.kin.arrays, x[None, :], np.zeros(1), self.w)[0]
         for i, law in enumerate(self.pack.laws):
@@ -383,8 +425,10 @@ class RunResult:
 
     ``summary`` (done, N_SUMMARY) and ``z_end`` (done, 2 n) hold the
     per-repetition summary (columns ``S_*`` of ``_core.py``) and the state
-    at the end of each repetition; ``samples`` is ``(t, x, v, T, N, code)``
-    when recording, else None.
+    at the end of each repetition; ``pairs`` (done, npairs, 4) per
+    repetition and interface pair the work of its force (J) and the
+    fractions of the repetition it was stuck, slipping, open; ``samples``
+    is ``(t, x, v, T, N, code)`` when recording, else None.
     """
 
     summary: np.ndarray
@@ -392,6 +436,7 @@ class RunResult:
     status: RunStatus
     done: int
     samples: tuple | None
+    pairs: np.ndarray | None = None
 
 
 def run(model: Model, grid: Grid, mode: int, x, v, S, nper: int, *, rdof: int = 0, record: bool = False,
@@ -405,16 +450,39 @@ def run(model: Model, grid: Grid, mode: int, x, v, S, nper: int, *, rdof: int = 
     pack = model.pack
     summ = np.zeros((nper, N_SUMMARY))
     zend = np.zeros((nper, 2 * pack.ndof))
+    psum = np.zeros((nper, pack.npairs, 4))
     control = (mode, nper, 0.0, model.w, rdof, model.max_split, record, config.TI_RECONTACT_ALPHA)
     io = (x, v, S, model.cap(x, v))
     if record:
         x0, v0, S0 = x.copy(), v.copy(), S.copy()
     while True:
         bufs = _buffers(capacity, pack.ndof, pack.ncontacts) if record else pack.nobufs
-        nrec, status, done = pack.runner(pack.arrays, grid, control, io, (*bufs, summ, zend))
+        nrec, status, done = pack.runner(pack.arrays, grid, control, io, (*bufs, summ, zend, psum))
         if status != RUN_OVERFLOW:
             break
         capacity *= 2
         x[:], v[:], S[:] = x0, v0, S0
     samples = tuple(b[:nrec] for b in bufs) if record else None
-    return RunResult(summ[:done], zend[:done], run_status(status), done, samples)
+    return RunResult(summ[:done], zend[:done], run_status(status), done, samples, psum[:done])
+
+
+def pair_relative(pack: PackedSystem, x) -> tuple[np.ndarray, np.ndarray]:
+    """(u (np, 2), g (np,)) of every interface pair at displacements x (m)."""
+    x = np.asarray(x, dtype=np.float64)
+    xe = np.append(x, 0.0)  # index -1 (a fixed side) reads the appended 0
+    p = pack.pairs
+    return xe[p[:, :2]] - xe[p[:, 3:5]], xe[p[:, 2]] - xe[p[:, 5]]
+
+
+def sliders(pack: PackedSystem, S) -> np.ndarray:
+    """The interface pairs' committed sliders (np, 2), m, from a state array (rows after the contacts)."""
+    m = pack.npairs
+    return np.asarray(S)[pack.ncontacts:].ravel()[: 2 * m].reshape(m, 2).copy()
+
+
+def set_sliders(pack: PackedSystem, S, W) -> None:
+    """Write the sliders W (np, 2), m, into the state array S (rows after the contacts), in place."""
+    m = pack.npairs
+    flat = np.zeros(pack.slider_rows * pack.slen)
+    flat[: 2 * m] = np.asarray(W, dtype=np.float64).ravel()
+    S[pack.ncontacts:] = flat.reshape(pack.slider_rows, pack.slen)

@@ -156,7 +156,7 @@ def linear_start(model):
     f = pk.fsin + 1j * pk.fcos
     ns, th, sin_th, cos_th = _DF_GRID
     loads = load_table(pk.kin.arrays, th, 1.0).T.copy()
-    S = np.zeros((pk.ncontacts, pk.slen))
+    S = np.zeros((pk.state_rows, pk.slen))  # interface pairs: sliders at 0, stuck as K_closed has them
     X = np.zeros(pk.ndof, dtype=np.complex128)
     run = specialize(_df_template, INIT=pk.init, MARCH=law_marcher(pk.step))
     xmax = 1e3 * (pk.fmax / pk.kmin + pk.xlin)
@@ -200,6 +200,7 @@ def clean_states(model, x, v, S, rdof, count):
     _, X, _, _, N, _ = res.samples
     U = tangential_history(model.pack.kin.arrays, X)
     Snew = np.zeros_like(S)
+    Snew[model.nc:] = S[model.nc:]  # a pair's slider is its whole memory: kept
     for i, law in enumerate(model.pack.laws):
         uu = np.concatenate([U[:, i], U[1:, i]])
         NN = np.concatenate([N[:, i], N[1:, i]])

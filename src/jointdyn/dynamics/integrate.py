@@ -40,7 +40,8 @@ class Restart:
     x, v : ndarray
         Displacements (m) and velocities (m/s), one per DOF.
     states : ndarray
-        Committed law states, one row per contact.
+        Committed law states, one row per contact, then the sliders of the
+        interface pairs (two numbers per pair, row after row).
     """
 
     x: np.ndarray
@@ -64,6 +65,10 @@ class Trajectory:
         Normal loads, N.
     code : ndarray of int8, shape (ns, ncontacts)
         Motion state per contact (STICK_SLIP, MACROSLIP, SEPARATION).
+        Interface pairs are not recorded here: their relative motion is
+        that of ``x`` (``Interface.relative``), their sliders are in
+        ``final.states`` and their per-period results in
+        :class:`~jointdyn.dynamics.SteadyState`.
     final : Restart
         Final state (x, v, law states), usable as a start for a further run.
     status : RunStatus
@@ -105,8 +110,9 @@ def _start_vectors(model: Model, x0, v0, states):
         S = model.initial_states(x)
     else:
         S = np.array(states, dtype=np.float64, ndmin=2)
-        if S.shape != (model.nc, model.pack.slen):
-            raise ValueError(f"states must have shape {(model.nc, model.pack.slen)}, got {S.shape}")
+        shape = (model.pack.state_rows, model.pack.slen)
+        if S.shape != shape:
+            raise ValueError(f"states must have shape {shape}, got {S.shape}")
     return x, v, np.ascontiguousarray(S)
 
 

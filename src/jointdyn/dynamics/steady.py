@@ -90,6 +90,16 @@ class SteadyState:
         x, v and law states at the final period boundary (warm start).
     loop : Trajectory or None
         The final p periods, sampled at every step (if ``keep_loop``).
+    pair_energy_J : ndarray (npairs,)
+        Per interface pair (the pairs of ``system.interfaces`` one after
+        the other), the energy it dissipates per forcing period (J, the work
+        of its tangential force over the final p periods, averaged); NaN
+        unless periodic. Their sum is part of ``energy_contact_J``.
+    pair_stick, pair_slip, pair_open : ndarray (npairs,)
+        Fractions of the period each pair is stuck, slipping, open (they
+        add up to 1; openings and closings are step boundaries, a change
+        between stick and slip inside a step counts half a step to each);
+        NaN unless periodic.
     """
 
     status: SteadyStatus
@@ -112,6 +122,10 @@ class SteadyState:
     last_amplitude_m: float
     restart: Restart = field(repr=False)
     loop: Trajectory | None = field(default=None, repr=False)
+    pair_energy_J: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    pair_stick: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    pair_slip: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    pair_open: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
 
     @property
     def ok(self) -> bool:
@@ -144,11 +158,14 @@ class _History:
         z0 = np.array(z0, dtype=float)
         self.Z = z0[None, :]
         self.summ = np.empty((0, N_SUMMARY))
+        self.pairs = []  # per-period (npairs, 4) summaries of the interface pairs
         self.shot_checked = False
 
-    def add(self, summ, zend):
+    def add(self, summ, zend, pairs=None):
         self.summ = np.concatenate([self.summ, summ])
         self.Z = np.concatenate([self.Z, zend])
+        if pairs is not None:
+            self.pairs.extend(pairs)
 
     @property
     def size(self):
@@ -489,7 +506,7 @@ def _unpack_start(start, model):
     x = np.array(start.x, dtype=float)
     v = np.array(start.v, dtype=float)
     S = np.array(start.states, dtype=float, ndmin=2)
-    if x.shape != (model.n,) or v.shape != (model.n,) or S.shape != (model.nc, model.pack.slen):
+    if x.shape != (model.n,) or v.shape != (model.n,) or S.shape != (model.pack.state_rows, model.pack.slen):
         raise ValueError("start does not belong to this system (shapes of x, v or law states differ)")
     if not (np.all(np.isfinite(x)) and np.all(np.isfinite(v))):
         raise ValueError("start must be finite (NaN/inf in its x or v)")
@@ -565,7 +582,7 @@ def _settle(model, st: _March, K, maxp, amp_rtol, energy_rtol, rdof, shooting):
             return None, "", 0, model
         res = model.run_periods(st.x, st.v, st.S, nrun, rdof=rdof)
         _booker(st.counters)(res)
-        st.hist.add(res.summary, res.z_end)
+        st.hist.add(res.summary, res.z_end, res.pairs)
         if not res.status.ok:
             return SteadyStatus.UNBOUNDED, "blow-up", 0, model
         finer = refine_if_opened(model, res.summary)
@@ -601,10 +618,11 @@ def _periodic_values(model, st: _March, p, rdof, keep_loop):
         res = model.run_periods(st.x, st.v, st.S, p, rec=True, rdof=rdof)
         _booker(st.counters)(res)
         loop = _trajectory(res, st.x, st.v, st.S)
-        summ = res.summary
+        summ, pairs = res.summary, res.pairs
     else:
         loop = None
         summ = np.asarray(st.hist.summ[-p:])
+        pairs = np.asarray(st.hist.pairs[-p:]) if model.pack.npairs else np.zeros((p, 0, 4))
     A = 0.5 * (summ[:, S_XMAX].max() - summ[:, S_XMIN].min())
     vals = {"amplitude_m": float(A), "amplitude_q": math.nan}
     if model.pack.laws:
@@ -615,6 +633,8 @@ def _periodic_values(model, st: _March, p, rdof, keep_loop):
     vals["energy_contact_J"] = float(summ[:, S_EC].mean())
     vals["energy_viscous_J"] = float(summ[:, S_EV].mean())
     vals["work_force_J"] = float(summ[:, S_W].mean())
+    for col, key in enumerate(("pair_energy_J", "pair_stick", "pair_slip", "pair_open")):
+        vals[key] = pairs[:, :, col].mean(axis=0)
     return vals, loop
 
 
@@ -702,6 +722,8 @@ def steady_state(
     nan = math.nan
     vals = dict(amplitude_q=nan, amplitude_m=nan, offset_m=nan, max_abs_m=nan,
                 energy_contact_J=nan, energy_viscous_J=nan, work_force_J=nan)  # fmt: skip
+    for key in ("pair_energy_J", "pair_stick", "pair_slip", "pair_open"):
+        vals[key] = np.full(model.pack.npairs, nan)
     loop, check = None, EnergyCheck.NOT_CHECKED
     if status.ok:
         vals, loop = _periodic_values(model, st, p_found, rdof, keep_loop)
