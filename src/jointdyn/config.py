@@ -186,6 +186,18 @@ SYSTEM_RIGID_MODE_RTOL = 1e-10
 #: float64 copy takes 8 n^2 bytes: 800 MB at the bound)
 FILES_MAX_DOF = 10_000
 
+# --- memory bounds (jointdyn._validate.memory_budget) ------------------------------------
+#: bound on the memory one computation may allocate, bytes; None: MEMORY_FRACTION of the
+#: memory available when it is checked (MemAvailable of /proc/meminfo, else the physical memory).
+#: Sizes given as options or parameters (harmonics, samples, steps per period, law state sizes) are
+#: refused before computing when their estimated arrays exceed it
+MEMORY_LIMIT_BYTES = None
+#: share of the available memory a computation may take when MEMORY_LIMIT_BYTES is None
+MEMORY_FRACTION = 0.5
+#: copies of a contact law's state a solver holds at once (trial and committed states, their
+#: forward-mode derivatives): a law whose state times this exceeds the bound is refused
+LAW_STATE_COPIES = 16
+
 # --- harmonic balance: discretisation and AFT ------------------------------------------
 #: harmonics 0..H of the unknowns
 HB_HARMONICS = 7

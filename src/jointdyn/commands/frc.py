@@ -34,6 +34,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ._law_args import add_law_arguments, law_params, model_help
+from ._sizes import check_hb_sizes
 from ._system_args import add_system_argument, load_system_file, refuse_paper_options
 from ..systems import PAPER
 
@@ -235,10 +236,32 @@ def _validate(args):
         _check_system_derived(args.system_file.system, gammas)
     else:
         _validate_paper(args, gammas)
+    if args.method == "time":
+        _check_time_steps(args, gammas)
+    else:
+        check_hb_sizes(_system(args), args.harmonics, args.samples, given_samples=True)
     if args.out is not None:
         subdirs = ("lines",) if args.method == "time" else ()
         V.output_dir("--out", args.out, files=("frc.nc", "frc.csv", "frc.png"), subdirs=subdirs)
     return gammas
+
+
+def _check_time_steps(args, gammas) -> None:
+    """The steps of a forcing period at the lowest gamma (the most) fit the memory bound, for the
+    lines run at once: refused before computing, naming --steps-per-period when it sets the step,
+    else the structure's stiffest mode."""
+    from ..dynamics._model import pack_system, period_steps
+
+    system = _system(args)
+    pack = pack_system(system)
+    spp = config.TI_STEPS_PER_PERIOD if args.steps_per_period is None else args.steps_per_period
+    lines = 1 if args.sweep != "both" or args.workers == 1 else 2
+    try:
+        period_steps(pack, float(gammas[0]) * system.w0, spp, refined=pack.springs, lines=lines,
+                     name="--steps-per-period")
+    except ValueError as exc:
+        msg = str(exc)
+        raise ValueError(msg if msg.startswith("--") else f"--method time: {msg}; --method hb has no time step") from None
 
 
 def _connect(address):

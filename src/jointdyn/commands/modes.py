@@ -30,6 +30,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ._law_args import add_law_arguments, law_params, model_help
+from ._sizes import check_hb_sizes
 from ._system_args import load_system_file
 
 NAME = "modes"
@@ -110,8 +111,13 @@ def _validate(args):
     if args.method == "epmc":
         args.harmonics = V.positive_int("--harmonics", config.HB_HARMONICS if args.harmonics is None
                                         else args.harmonics, 1)
-        args.samples = V.positive_int("--samples", config.HB_SAMPLES if args.samples is None else args.samples,
+        check_hb_sizes(system, args.harmonics, None, given_samples=False)
+        given = args.samples is not None
+        # the default samples follow --harmonics (at least the 2H + 2 the AFT needs)
+        args.samples = V.positive_int("--samples", args.samples if given else max(config.HB_SAMPLES,
+                                                                                   2 * args.harmonics + 2),
                                       2 * args.harmonics + 2)
+        check_hb_sizes(system, args.harmonics, args.samples, given_samples=given)
         args.max_points = V.positive_int("--max-points", config.CONT_MAX_POINTS if args.max_points is None
                                          else args.max_points, 2)
     if args.out is not None:
