@@ -21,6 +21,7 @@ __all__ = [
     "in_range",
     "derived",
     "count_at_most",
+    "short_repr",
     "memory_budget",
     "memory_fits",
     "output_dir",
@@ -28,7 +29,7 @@ __all__ = [
 ]
 
 
-def _short(value) -> str:
+def short_repr(value) -> str:
     """``repr(value)``, an integer of many digits shortened to its digit count."""
     if isinstance(value, int) and not isinstance(value, bool) and abs(value).bit_length() > 200:
         return f"an integer of {len(str(abs(value))) if abs(value).bit_length() < 13000 else 'over 4000'} digits"
@@ -39,7 +40,7 @@ def _num(name: str, value) -> float:
     try:
         v = float(value)
     except OverflowError:
-        raise ValueError(f"{name} must be finite, got {_short(value)}") from None
+        raise ValueError(f"{name} must be finite, got {short_repr(value)}") from None
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a real number, got {value!r}") from None
     if not math.isfinite(v):
@@ -87,7 +88,7 @@ def positive_int(name: str, value, minimum: int = 1) -> int:
     try:
         f = float(value)
     except (TypeError, ValueError, OverflowError):
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {_short(value)}") from None
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {short_repr(value)}") from None
     if not math.isfinite(f) or f != int(f) or int(f) < minimum:
         raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
     return int(f)

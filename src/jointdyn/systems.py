@@ -232,15 +232,19 @@ class System:
         (M, :attr:`K_reference`): normal springs in place, tangential contacts
         free, rigid-body modes (eigenvalues below
         ``config.SYSTEM_RIGID_MODE_RTOL`` times the largest) skipped; 0 when
-        every mode is rigid. For the single-DOF damper w0 = sqrt(k/m), the
-        paper's reference.
+        every mode is rigid; inf when the frequencies overflow (K / M beyond
+        the floating-point range). For the single-DOF damper w0 = sqrt(k/m),
+        the paper's reference.
         """
         if self.w0_rad_s is not None:
             return self.w0_rad_s
         # numpy's LAPACK (already loaded): scipy.linalg would add a third of a second to the CLI's start
         L = np.linalg.cholesky(self.M)
-        A = np.linalg.solve(L, np.linalg.solve(L, self.K_reference).T)
-        lam = np.linalg.eigvalsh(0.5 * (A + A.T))
+        with np.errstate(over="ignore", invalid="ignore"):
+            A = np.linalg.solve(L, np.linalg.solve(L, self.K_reference).T)
+            if not np.all(np.isfinite(A)):
+                return math.inf  # K / M beyond the floating-point range
+            lam = np.linalg.eigvalsh(0.5 * A + 0.5 * A.T)
         elastic = lam[lam > config.SYSTEM_RIGID_MODE_RTOL * lam[-1]]
         return math.sqrt(elastic[0]) if elastic.size and lam[-1] > 0.0 else 0.0
 

@@ -240,6 +240,7 @@ def _validate(args):
         _check_time_steps(args, gammas)
     else:
         check_hb_sizes(_system(args), args.harmonics, args.samples, given_samples=True)
+        _check_hb_static(_system(args))
     if args.out is not None:
         subdirs = ("lines",) if args.method == "time" else ()
         V.output_dir("--out", args.out, files=("frc.nc", "frc.csv", "frc.png"), subdirs=subdirs)
@@ -262,6 +263,26 @@ def _check_time_steps(args, gammas) -> None:
     except ValueError as exc:
         msg = str(exc)
         raise ValueError(msg if msg.startswith("--") else f"--method time: {msg}; --method hb has no time step") from None
+
+
+def _check_hb_static(system) -> None:
+    """Harmonic balance starts from the static stiffness with every contact stuck and every normal
+    spring closed: a DOF that this holds by nothing (a rigid-body mode) has no unique mean position,
+    and the structure is refused naming it (the time domain takes it)."""
+    from ..kinematics import contact_kinematics, selection_matrix
+
+    K = system.K_reference.copy()
+    if system.contacts:
+        B = selection_matrix(contact_kinematics(system), system.ndof)
+        K += (B.T * [c.law.kt for c in system.contacts]) @ B
+    lam, vec = np.linalg.eigh(0.5 * K + 0.5 * K.T)
+    if lam[0] > config.SYSTEM_RIGID_MODE_RTOL * abs(lam[-1]):
+        return
+    dof = int(np.argmax(np.abs(vec[:, 0])))
+    raise ValueError(f"--method hb: the structure has a rigid-body mode even with every contact stuck and every "
+                     f"normal spring closed (mostly DOF {dof}: held by nothing, K + kt + kn is singular), so its "
+                     "mean position is not unique; harmonic balance needs one: give that DOF a stiffness in K, "
+                     "or use --method time")
 
 
 def _connect(address):

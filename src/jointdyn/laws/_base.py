@@ -189,12 +189,13 @@ class LawParameter:
             if value not in self.choices:
                 raise ValueError(f"{self.name} must be {self.allowed()}; got {value!r}")
             return value
-        bad = ValueError(f"{self.name} must be {self.allowed()}, got {value!r}")
+        shown = V.short_repr(value)
+        bad = ValueError(f"{self.name} must be {self.allowed()}, got {shown}")
         if isinstance(value, bool):
             raise bad
         try:
             v = float(value)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise bad from None
         if not (math.isfinite(v) and self.low <= v <= self.high):
             raise bad
