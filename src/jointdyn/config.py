@@ -180,6 +180,14 @@ SWEEP_PARENT_POLL_S = 0.5
 #: eigenvalues of (M, K_reference) below this fraction of the largest are
 #: rigid-body modes (zero up to rounding), skipped by the default w0
 SYSTEM_RIGID_MODE_RTOL = 1e-10
+#: structures of up to this many DOFs are checked (M positive definite, K and C positive
+#: semi-definite) and get their w0 from dense eigen-decompositions; larger ones from a
+#: Cholesky factorisation (shifted by the semi-definiteness tolerance) and Lanczos iterations
+#: for the extreme eigenvalues (scipy.sparse.linalg.eigsh), which scale to config.FILES_MAX_DOF
+SYSTEM_DENSE_CHECK_MAX_DOF = 1000
+#: a matrix is positive semi-definite when its smallest eigenvalue is at least -this times
+#: its largest (rounding of an assembled singular matrix)
+SYSTEM_SEMIDEFINITE_RTOL = 1e-10
 
 # --- system files (jointdyn.files) ------------------------------------------------------
 #: most degrees of freedom of a matrix read from a system file (its dense

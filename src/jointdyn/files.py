@@ -401,10 +401,11 @@ def _matrix_value(where: _Where, key: str, value, folder: Path) -> np.ndarray:
 
 
 def _symmetric(where: _Where, key: str, A: np.ndarray) -> None:
+    from .systems import asymmetry
+
     scale = float(np.max(np.abs(A)))
-    d = np.abs(A - A.T)
-    if d.max() > 1e-10 * scale:
-        i, j = np.unravel_index(int(np.argmax(d)), A.shape)
+    diff, i, j = asymmetry(A)
+    if diff > 1e-10 * scale:
         raise where.error(key, f"must be symmetric ({key}[{i},{j}] = {float(A[i, j])!r} but {key}[{j},{i}] = "
                                f"{float(A[j, i])!r})")
 
@@ -463,6 +464,16 @@ def _check_matrices(where: _Where, mats: dict) -> None:
             what = "square" if name == "M" else f"{n} x {n} like M"
             raise where.error(key, f"must be {what}, got shape {A.shape[0]} x {A.shape[1]}")
         _symmetric(where, key, A)
+    if n > config.SYSTEM_DENSE_CHECK_MAX_DOF:  # a factorisation and Lanczos iterations, no eigen-decomposition
+        from .systems import definiteness_failure
+
+        for name in _MATRICES:
+            if name in mats:
+                lam = definiteness_failure(mats[name], semi=name != "M")
+                if lam is not None:
+                    what = "definite" if name == "M" else "semi-definite"
+                    raise where.error(f"structure.{name}", f"must be positive {what} (smallest eigenvalue {lam:.6g})")
+        return
     try:
         np.linalg.cholesky(M)
     except np.linalg.LinAlgError:

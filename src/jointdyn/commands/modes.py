@@ -170,9 +170,14 @@ def _plot(ds, title: str, path: Path) -> None:
     ax2.plot(a, ds.damping_ratio.values, "-", color="C3")
     ax2.set_ylabel("modal damping ratio")
     ax2.set_xlabel("first-harmonic amplitude of DOF %d, m" % ds.attrs["output_dof"])
+    points = bool(np.any(np.isfinite(a) & (a > 0.0)))  # a backbone that never started has none
     for ax in (ax1, ax2):
-        ax.set_xscale("log")
+        if points:
+            ax.set_xscale("log")
         ax.grid(alpha=0.3, which="both")
+    if not points:
+        ax2.text(0.5, 0.5, f"no point: {ds.attrs['message']}", transform=ax2.transAxes, ha="center",
+                 va="center", fontsize=8, color="C3", wrap=True)
     ax1.set_title(f"{ds.attrs['method'].upper()} backbone of mode {ds.attrs['linear_mode']} ({title}); "
                   f"status {ds.attrs['status']}", fontsize=9)
     fig.tight_layout()
@@ -202,7 +207,12 @@ def run(args) -> int:
         print(json.dumps(result))
     else:
         _print_table(result)
-    return 0 if backbone.status.ok else EXIT_PARTIAL
+    if backbone.status.ok:
+        return 0
+    import sys
+
+    print(f"jointdyn modes: incomplete: {result['status']}: {result['message']}", file=sys.stderr)
+    return EXIT_PARTIAL
 
 
 def _print_table(result) -> None:
