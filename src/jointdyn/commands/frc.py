@@ -367,6 +367,8 @@ def _sweep(args, gammas, directions, client):
     if args.system_file is not None:
         try:
             ds = frc_sweep(args.system_file.system, gammas, dofs=args.system_file.dofs, **common)
+        except np.linalg.LinAlgError:
+            raise  # a failed solve, not a refusal (the command line says so)
         except ValueError as exc:
             # the options are checked already: what is left is the time integrator's refusal of the structure
             raise ValueError(f"--method time: {exc}") from None
@@ -484,6 +486,8 @@ def _run_hb(args, gammas):
     try:
         br = continue_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics,
                          samples=args.samples, max_step=step, progress=None if not args.json else False)
+    except np.linalg.LinAlgError:
+        raise  # a failed solve, not a refusal (the command line says so)
     except ValueError as exc:
         # what the harmonic-balance solver refuses (a kind of normal load, mixed laws) is said as its own
         raise ValueError(f"--method hb: {exc}") from None

@@ -387,13 +387,17 @@ def period_steps(pack: PackedSystem, w: float, steps_per_period: int, *, refined
             need = float(np.ceil(np.float64(2 * math.pi) * pack.w_max / (np.float64(w) * wh)))
         J = max(J, need)
     words = _STEP_WORDS + _STEP_WORDS_PER_DOF * pack.ndof + _STEP_WORDS_PER_CONTACT * pack.ncontacts
+    per_step = 8.0 * words * max(int(lines), 1)
+    top = max(int(V.memory_budget() // per_step) - 1, 0)
     if J > steps_per_period:
         label = (f"the time step of the stiffest mode (w_max = {pack.w_max:.6g} rad/s with every contact stuck "
                  f"and every normal spring closed; w_max h <= {wh:g}: {J:.6g} steps per forcing period at "
                  f"w = {w:.6g} rad/s)")
+        hint = f"at most {top} steps fit"
     else:
         label = f"{name} {int(steps_per_period)}"
-    V.memory_fits(label, 8.0 * (J + 1.0) * words * max(int(lines), 1))
+        hint = f"{name} must be at most {top} here"
+    V.memory_fits(label, (J + 1.0) * per_step, hint=hint)
     return int(J)
 
 
