@@ -641,3 +641,20 @@ def test_asymmetry_matches_the_full_difference():
         d = np.abs(A - A.T)
         i, j = np.unravel_index(int(np.argmax(d)), A.shape)
         assert asymmetry(A) == (float(d[i, j]), i, j)
+
+
+# --- gamma grids of tiny or huge values ---------------------------------------------------------------
+def test_gamma_grid_keeps_tiny_and_huge_values():
+    """The grid's 12-decimal cleaning is kept where it cleans float noise and not applied where it would
+    change a value (1e-300 rounded to 0 crashed the derived checks with a ZeroDivisionError)."""
+    from jointdyn.commands.frc import parse_gamma
+
+    np.testing.assert_array_equal(parse_gamma("0.6:1.8:0.01"), np.round(0.6 + 0.01 * np.arange(121), 12))
+    tiny = parse_gamma("1e-300:1e-299:1e-300")
+    assert tiny[0] == 1e-300 and np.all(tiny > 0) and np.all(np.diff(tiny) > 0)
+    assert parse_gamma("1e300:1e300:1").tolist() == [1e300]
+
+
+def test_tiny_gamma_passes_validation(no_compute, capsys):
+    with pytest.raises(_Reached):
+        main(["frc", "--method", "hb", "--gamma", "1e-300:1e-299:1e-300"])

@@ -114,7 +114,11 @@ def parse_gamma(text: str) -> np.ndarray:
     V.count_at_most("--gamma START:STOP:STEP", (stop - start) / step + 1.0,
                     config.SWEEP_MAX_GAMMA_POINTS, "points")
     count = int(math.floor((stop - start) / step + 1e-9)) + 1
-    return np.round(start + step * np.arange(count), 12)
+    grid = start + step * np.arange(count)
+    with np.errstate(over="ignore", invalid="ignore"):
+        # 12 decimals clean the float noise of a grid; not where they would change a value (tiny or huge gammas)
+        rounded = np.round(grid, 12)
+    return np.where(np.abs(rounded - grid) <= 1e-9 * grid, rounded, grid)
 
 
 def _count_or_auto(name: str, value, minimum: int):
@@ -182,7 +186,8 @@ def _check_derived(args, gammas) -> None:
         V.derived("F1 = --mu x --n0 / --beta", fy / args.beta, positive=True)
     V.derived("--eta x --n0 (normal-load amplitude, N)", args.eta * args.n0)
     w0 = V.derived("w0 = sqrt(--k / --m)", math.sqrt(args.k / args.m), positive=True)
-    V.derived("--gamma STOP x w0 (highest forcing frequency, rad/s)", float(gammas[-1]) * w0)
+    w_top = V.derived("--gamma STOP x w0 (highest forcing frequency, rad/s)", float(gammas[-1]) * w0)
+    V.derived("(--gamma STOP x w0)^2 (the inertia scale w^2 of the solvers, rad^2/s^2)", w_top * w_top)
     V.derived("2 pi / (--gamma START x w0) (longest forcing period, s)", 2.0 * math.pi / (float(gammas[0]) * w0))
     V.derived("--zeta x 2 sqrt(--k x --m) (viscous coefficient)", 2.0 * args.zeta * math.sqrt(args.k) * math.sqrt(args.m))
     V.derived("--kt / fy (normalised contact stiffness)", args.kt / fy)
@@ -191,7 +196,8 @@ def _check_derived(args, gammas) -> None:
 def _check_system_derived(system, gammas) -> None:
     """The grid in rad/s stays finite for the system file's reference frequency."""
     w0 = V.derived("w0 of --system (reference frequency, rad/s)", system.w0, positive=True)
-    V.derived("--gamma STOP x w0 (highest forcing frequency, rad/s)", float(gammas[-1]) * w0)
+    w_top = V.derived("--gamma STOP x w0 (highest forcing frequency, rad/s)", float(gammas[-1]) * w0)
+    V.derived("(--gamma STOP x w0)^2 (the inertia scale w^2 of the solvers, rad^2/s^2)", w_top * w_top)
     V.derived("2 pi / (--gamma START x w0) (longest forcing period, s)", 2.0 * math.pi / (float(gammas[0]) * w0))
 
 
