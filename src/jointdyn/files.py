@@ -171,22 +171,21 @@ def _dense(where: _Where, key: str, value) -> np.ndarray:
     if np.iscomplexobj(a):
         raise where.error(key, "must be real, got complex entries")
     try:
-        a = a.astype(np.float64)
+        a = np.ascontiguousarray(a, dtype=np.float64)  # no copy of a float64 array read from a file
     except (TypeError, ValueError):
         raise where.error(key, f"must be a matrix of numbers, got entries of type {a.dtype}") from None
     if a.ndim != 2:
         raise where.error(key, f"must be a 2-D matrix, got shape {a.shape}")
     if a.size == 0:
         raise where.error(key, "must not be empty")
-    if not np.all(np.isfinite(a)):
-        i, j = np.argwhere(~np.isfinite(a))[0]
-        raise where.error(key, f"must be finite everywhere (NaN/inf at [{i},{j}])")
-    big = np.abs(a) > _MAX_ENTRY
-    if np.any(big):
-        i, j = np.argwhere(big)[0]
+    if not float(np.max(np.abs(a))) <= _MAX_ENTRY:  # one pass: NaN, inf and too large entries
+        if not np.all(np.isfinite(a)):
+            i, j = np.argwhere(~np.isfinite(a))[0]
+            raise where.error(key, f"must be finite everywhere (NaN/inf at [{i},{j}])")
+        i, j = np.argwhere(np.abs(a) > _MAX_ENTRY)[0]
         raise where.error(key, f"entries must be at most {_MAX_ENTRY:.4g} in magnitude (the solvers add and scale "
                                f"them), got {float(a[i, j])!r} at [{i},{j}]")
-    return np.ascontiguousarray(a)
+    return a
 
 
 class _FileError(ValueError):
