@@ -21,14 +21,26 @@ __all__ = [
     "in_range",
     "derived",
     "count_at_most",
+    "short_repr",
+    "memory_budget",
+    "memory_fits",
     "output_dir",
     "input_file",
 ]
 
 
+def short_repr(value) -> str:
+    """``repr(value)``, an integer of many digits shortened to its digit count."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value).bit_length() > 200:
+        return f"an integer of {len(str(abs(value))) if abs(value).bit_length() < 13000 else 'over 4000'} digits"
+    return f"{value!r:.80}"
+
+
 def _num(name: str, value) -> float:
     try:
         v = float(value)
+    except OverflowError:
+        raise ValueError(f"{name} must be finite, got {short_repr(value)}") from None
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a real number, got {value!r}") from None
     if not math.isfinite(v):
@@ -75,8 +87,8 @@ def positive_int(name: str, value, minimum: int = 1) -> int:
         raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
     try:
         f = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {short_repr(value)}") from None
     if not math.isfinite(f) or f != int(f) or int(f) < minimum:
         raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
     return int(f)
@@ -148,6 +160,53 @@ def count_at_most(label: str, count: float, limit: int, unit: str) -> int:
     if not c <= limit:  # also catches NaN and inf
         raise ValueError(f"{label} must be at most {limit} {unit}, got {c:.4g}")
     return int(c)
+
+
+def _available_bytes() -> int:
+    """Memory available to a new allocation, bytes: MemAvailable of
+    /proc/meminfo, else the physical memory (os.sysconf), else 4 GiB."""
+    try:
+        with open("/proc/meminfo", "rb") as fh:
+            for line in fh:
+                if line.startswith(b"MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+    except (AttributeError, OSError, ValueError):
+        return 4 << 30
+
+
+def memory_budget() -> int:
+    """Bytes one computation may allocate: ``config.MEMORY_LIMIT_BYTES``, or
+    ``config.MEMORY_FRACTION`` of the memory available now."""
+    from . import config
+
+    if config.MEMORY_LIMIT_BYTES is not None:
+        return int(config.MEMORY_LIMIT_BYTES)
+    return int(config.MEMORY_FRACTION * _available_bytes())
+
+
+def _gib(nbytes: float) -> str:
+    return f"{nbytes / 2**30:.3g} GiB" if nbytes >= 2**30 else f"{nbytes / 2**20:.3g} MiB"
+
+
+def memory_fits(label: str, nbytes: float, *, hint: str = "") -> None:
+    """ValueError naming ``label`` (the option or parameter that sets the
+    size) when an estimate of ``nbytes`` (a float: it may be huge or inf)
+    exceeds :func:`memory_budget`; checked before anything is allocated."""
+    from . import config
+
+    budget = memory_budget()
+    b = float(nbytes)
+    if b <= budget:
+        return
+    where = ("config.MEMORY_LIMIT_BYTES" if config.MEMORY_LIMIT_BYTES is not None
+             else f"{config.MEMORY_FRACTION:g} of the available memory, config.MEMORY_FRACTION")
+    size = _gib(b) if math.isfinite(b) and b < 1e30 else f"{b:.3g} bytes"
+    raise ValueError(f"{label} needs about {size} of memory, more than the bound of {_gib(budget)} ({where})"
+                     + (f"; {hint}" if hint else ""))
 
 
 def _probe_writable(directory: str) -> bool:

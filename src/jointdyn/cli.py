@@ -10,14 +10,18 @@ Exit status (:mod:`jointdyn._exit`)
 ------------------------------------
 - 0: success.
 - 2: bad input (a ``ValueError`` from validation, or an argparse usage
-  error): one line on stderr naming the parameter, no file written.
+  error): one line on stderr naming the parameter, no file written (the
+  warnings of the arithmetic that found it, such as an overflow, are not
+  printed; after any other end they are).
 - 1: an operating-system error during the run, after validation (e.g. a
   full disk while writing the results): one line on stderr.
 - 3: incomplete result: the computation ran, but its answer does not
   cover what was asked (``jointdyn frc --method hb``: a branch that failed,
   turned back or stopped at its point bound short of the gamma range).
   The output and the files are still written, with a per-point status;
-  one line on stderr names where and why it stopped.
+  one line on stderr names where and why it stopped. Also a computation
+  that failed outright (a linear solve met a singular system): one line
+  saying so, no file.
 - 130: interrupted (Ctrl-C).
 - 141 (128 + SIGPIPE): the reader of stdout went away (``jointdyn ... |
   head``); the command stops quietly, as Unix tools do, and the shell's
@@ -32,6 +36,7 @@ import importlib
 import os
 import pkgutil
 import sys
+import warnings
 
 # the exit statuses live below the commands (jointdyn._exit); re-exported here for callers of main()
 from ._exit import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INCOMPLETE, EXIT_INTERRUPTED, EXIT_OS_ERROR
@@ -91,24 +96,48 @@ def _dispatch(argv) -> int:
         sys.stdout.flush()  # --help, --version: a closed pipe shows here, not at exit
         raise
     prog = f"jointdyn {args.command}"
+    from numpy.linalg import LinAlgError
+
+    held = []
     try:
-        rc = args._run(args)
+        # warnings are held back: bad input drops them (its one line says what was wrong, e.g. the
+        # overflow that an arithmetic warning would only hint at); any other end issues them again
+        with warnings.catch_warnings(record=True) as held:
+            rc = args._run(args)
         sys.stdout.flush()
     except BrokenPipeError:
         raise
+    except LinAlgError as exc:  # a ValueError, but a solver's failure (a singular system), not bad input
+        _reissue(held)
+        msg = " ".join(str(exc).split())
+        print(f"{prog}: failed: a linear solve of the computation failed ({msg}); no result", file=sys.stderr)
+        return EXIT_INCOMPLETE
     except ValueError as exc:
         msg = " ".join(str(exc).split())
         print(f"{prog}: error: {msg}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except MemoryError:
+        _reissue(held)
+        print(f"{prog}: error: out of memory during the run (see config.MEMORY_LIMIT_BYTES)", file=sys.stderr)
+        return EXIT_OS_ERROR
     except OSError as exc:  # after validation: the environment failed during the run
+        _reissue(held)
         where = f": {exc.filename!r}" if getattr(exc, "filename", None) else ""
         msg = " ".join(str(exc.strerror or exc).split())
         print(f"{prog}: error: {msg}{where}", file=sys.stderr)
         return EXIT_OS_ERROR
     except KeyboardInterrupt:
+        _reissue(held)
         print(f"{prog}: interrupted (finished results are kept)", file=sys.stderr)
         return EXIT_INTERRUPTED
+    _reissue(held)
     return int(rc or 0)
+
+
+def _reissue(held) -> None:
+    """Issue again the warnings held back during a command (through the filters in force)."""
+    for w in held:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
 def main(argv=None) -> int:

@@ -33,11 +33,31 @@ IWAN_CLOSED_WIPE_TOL = 1e-9
 #: eigenvalues of (M, K_reference) below this fraction of the largest are
 #: rigid-body modes (zero up to rounding), skipped by the default w0
 SYSTEM_RIGID_MODE_RTOL = 1e-10
+#: structures of up to this many DOFs are checked (M positive definite, K and C positive
+#: semi-definite) and get their w0 from dense eigen-decompositions; larger ones from a
+#: Cholesky factorisation (shifted by the semi-definiteness tolerance) and Lanczos iterations
+#: for the extreme eigenvalues (scipy.sparse.linalg.eigsh), which scale to config.FILES_MAX_DOF
+SYSTEM_DENSE_CHECK_MAX_DOF = 1000
+#: a matrix is positive semi-definite when its smallest eigenvalue is at least -this times
+#: its largest (rounding of an assembled singular matrix)
+SYSTEM_SEMIDEFINITE_RTOL = 1e-10
 
 # --- system files (jointdyn.files) ------------------------------------------------------
 #: most degrees of freedom of a matrix read from a system file (its dense
 #: float64 copy takes 8 n^2 bytes: 800 MB at the bound)
 FILES_MAX_DOF = 10_000
+
+# --- memory bounds (jointdyn._validate.memory_budget) ------------------------------------
+#: bound on the memory one computation may allocate, bytes; None: MEMORY_FRACTION of the
+#: memory available when it is checked (MemAvailable of /proc/meminfo, else the physical memory).
+#: Sizes given as options or parameters (harmonics, samples, steps per period, law state sizes) are
+#: refused before computing when their estimated arrays exceed it
+MEMORY_LIMIT_BYTES = None
+#: share of the available memory a computation may take when MEMORY_LIMIT_BYTES is None
+MEMORY_FRACTION = 0.5
+#: copies of a contact law's state a solver holds at once (trial and committed states, their
+#: forward-mode derivatives): a law whose state times this exceeds the bound is refused
+LAW_STATE_COPIES = 16
 
 # --- FE interfaces and reduction (jointdyn.fe, jointdyn.reduction) ---------------------
 #: two mesh nodes are the same point (a node pair) when their distance is

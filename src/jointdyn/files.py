@@ -19,11 +19,13 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from . import _validate as V
 from . import config
 
 __all__ = ["SystemFile", "read_system", "read_system_file", "read_matrices"]
@@ -46,6 +48,9 @@ _MATRICES = ("M", "K", "C")
 #: file suffixes holding one matrix per file, and several named ones
 _SINGLE_SUFFIXES = (".mtx", ".npy")
 _NAMED_SUFFIXES = (".npz", ".mat")
+#: largest magnitude of a matrix entry: the largest double over a headroom for the sums and
+#: products of the solvers (K + kt, w^2 M, their scaled copies)
+_MAX_ENTRY = sys.float_info.max / 2.0**20
 #: first bytes of a .npy file
 _NPY_MAGIC = b"\x93NUMPY"
 
@@ -114,7 +119,10 @@ def _number(where: _Where, key: str, value, *, low=-math.inf, low_open=False) ->
     """A finite TOML number (integer or float, not a string or boolean) above ``low``."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise where.error(key, f"must be a number, got {type(value).__name__} {value!r:.60}")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:
+        raise where.error(key, f"must be finite, got {V.short_repr(value)}") from None
     if not math.isfinite(v):
         raise where.error(key, f"must be finite, got {v!r}")
     if (v <= low) if low_open else (v < low):
@@ -130,7 +138,8 @@ def _dof(where: _Where, key: str, value, n: int, *, ground: bool = False) -> int
     lo = -1 if ground else 0
     if not lo <= value < n:
         extra = " (or -1 for ground)" if ground else ""
-        raise where.error(key, f"must be in [0, {n - 1}]{extra}, got {value}")
+        got = value if abs(value) < 10**20 else V.short_repr(value)
+        raise where.error(key, f"must be in [0, {n - 1}]{extra}, got {got}")
     return value
 
 
@@ -164,66 +173,169 @@ def _dense(where: _Where, key: str, value) -> np.ndarray:
     if np.iscomplexobj(a):
         raise where.error(key, "must be real, got complex entries")
     try:
-        a = a.astype(np.float64)
+        a = np.ascontiguousarray(a, dtype=np.float64)  # no copy of a float64 array read from a file
     except (TypeError, ValueError):
         raise where.error(key, f"must be a matrix of numbers, got entries of type {a.dtype}") from None
     if a.ndim != 2:
         raise where.error(key, f"must be a 2-D matrix, got shape {a.shape}")
     if a.size == 0:
         raise where.error(key, "must not be empty")
-    if not np.all(np.isfinite(a)):
-        i, j = np.argwhere(~np.isfinite(a))[0]
-        raise where.error(key, f"must be finite everywhere (NaN/inf at [{i},{j}])")
-    return np.ascontiguousarray(a)
+    if not float(np.max(np.abs(a))) <= _MAX_ENTRY:  # one pass: NaN, inf and too large entries
+        if not np.all(np.isfinite(a)):
+            i, j = np.argwhere(~np.isfinite(a))[0]
+            raise where.error(key, f"must be finite everywhere (NaN/inf at [{i},{j}])")
+        i, j = np.argwhere(np.abs(a) > _MAX_ENTRY)[0]
+        raise where.error(key, f"entries must be at most {_MAX_ENTRY:.4g} in magnitude (the solvers add and scale "
+                               f"them), got {float(a[i, j])!r} at [{i},{j}]")
+    return a
 
 
-def _load_named(path: Path) -> dict:
-    """Arrays of a ``.npz`` or ``.mat`` file by name (a ``scipy.sparse.save_npz``
-    file is one matrix, named ``""``)."""
-    if path.suffix.lower() == ".mat":
-        import scipy.io
+class _FileError(ValueError):
+    """What a matrix file's own check found (said after the file's name)."""
 
-        try:
-            data = scipy.io.loadmat(str(path))
-        except NotImplementedError:
-            raise ValueError("is a MATLAB v7.3 (HDF5) file; save it with -v7 (scipy.io reads v4 to v7)") from None
-        return {k: v for k, v in data.items() if not k.startswith("__")}
+
+def _bound_header(what: str, shape, dtype=None) -> None:
+    """A declared array (from a file's header, nothing read yet) within
+    ``config.FILES_MAX_DOF``: ValueError naming ``what`` (a member or
+    variable followed by a space, or "" for the file itself) otherwise."""
+    shape = tuple(int(d) for d in shape)
+    top = config.FILES_MAX_DOF
+    if dtype is not None and np.dtype(dtype).hasobject:
+        raise _FileError(f"{what}holds Python objects (a pickled array): save numbers (float64)")
+    if len(shape) == 2 and max(shape) > top:
+        raise _FileError(f"{what}declares shape {shape} in its header: a matrix must have at most {top} rows and "
+                         "columns (config.FILES_MAX_DOF); nothing was read")
+    if math.prod(shape) > top * top:
+        raise _FileError(f"{what}declares shape {shape} in its header: more than {top} x {top} entries "
+                         "(config.FILES_MAX_DOF); nothing was read")
+
+
+def _npy_header(fh):
+    """(shape, dtype) from the header of a .npy stream (nothing else read)."""
+    fmt = np.lib.format
+    version = fmt.read_magic(fh)
+    if version == (1, 0):
+        shape, _, dtype = fmt.read_array_header_1_0(fh)
+    elif version == (2, 0):
+        shape, _, dtype = fmt.read_array_header_2_0(fh)
+    else:
+        shape, _, dtype = fmt._read_array_header(fh, version)
+    return shape, dtype
+
+
+def _load_npz(path: Path, wanted) -> dict:
+    """Arrays of a ``.npz`` file by name: the ``wanted`` ones read (their
+    headers bounded first), the others listed as None; a
+    ``scipy.sparse.save_npz`` file is one matrix, named ``""``."""
     import zipfile
+    import zlib
 
     if not zipfile.is_zipfile(path):
-        raise ValueError("is not a .npz archive (numpy.savez writes one)")
-    with np.load(str(path), allow_pickle=False) as z:
-        names = set(z.files)
-        if {"format", "shape", "data"} <= names:
-            import scipy.sparse as sp
+        raise _FileError("is not a .npz archive (numpy.savez writes one)")
+    with zipfile.ZipFile(path) as z:
+        members = {i.filename[:-4]: i.filename for i in z.infolist() if i.filename.endswith(".npy")}
+        sparse = {"format", "shape", "data"} <= set(members)
+        read = list(members) if sparse else [k for k in wanted if k in members]
+        out = {k: None for k in members}
+        for key in read:
+            member = members[key]
+            try:
+                with z.open(member) as fh:
+                    shape, dtype = _npy_header(fh)
+                _bound_header(f"member {member!r} ", shape, dtype)
+                with z.open(member) as fh:
+                    out[key] = np.lib.format.read_array(fh, allow_pickle=False)
+            except _FileError:
+                raise
+            except (zipfile.BadZipFile, zlib.error, OSError, EOFError, RuntimeError, ValueError) as exc:
+                raise _FileError(f"member {member!r} cannot be read: {exc}") from None
+    if sparse:
+        return {"": _sparse_npz(out)}
+    return out
 
-            return {"": sp.load_npz(str(path))}
-        return {k: z[k] for k in z.files}
+
+def _sparse_npz(arrays: dict):
+    """The matrix of a ``scipy.sparse.save_npz`` file from its arrays."""
+    import scipy.sparse as sp
+
+    fmt = str(arrays["format"].item() if arrays["format"].ndim == 0 else arrays["format"])
+    fmt = fmt.strip("b'")
+    shape = tuple(int(d) for d in np.asarray(arrays["shape"]).ravel())
+    _bound_header("its sparse matrix ", shape)
+    if fmt in ("csr", "csc", "bsr"):
+        cls = {"csr": sp.csr_matrix, "csc": sp.csc_matrix, "bsr": sp.bsr_matrix}[fmt]
+        return cls((arrays["data"], arrays["indices"], arrays["indptr"]), shape=shape)
+    if fmt == "coo":
+        return sp.coo_matrix((arrays["data"], (arrays["row"], arrays["col"])), shape=shape)
+    if fmt == "dia":
+        return sp.dia_matrix((arrays["data"], arrays["offsets"]), shape=shape)
+    raise _FileError(f"is a sparse matrix of unknown format {fmt!r}")
+
+
+def _load_mat(path: Path, wanted) -> dict:
+    """Variables of a MATLAB file by name: the ``wanted`` ones read (their
+    declared shapes bounded first), the others listed as None."""
+    import scipy.io
+
+    try:
+        listed = scipy.io.whosmat(str(path))
+    except NotImplementedError:
+        raise _FileError("is a MATLAB v7.3 (HDF5) file; save it with -v7 (scipy.io reads v4 to v7)") from None
+    names = {name: shape for name, shape, _ in listed if not name.startswith("__")}
+    read = [k for k in wanted if k in names]
+    for k in read:
+        _bound_header(f"variable {k!r} ", names[k])
+    data = scipy.io.loadmat(str(path), variable_names=read) if read else {}
+    return {k: data.get(k) for k in names}
+
+
+def _load_named(path: Path, wanted=_MATRICES) -> dict:
+    """Arrays of a ``.npz`` or ``.mat`` file by name (``wanted`` read, the
+    others listed as None; a ``scipy.sparse.save_npz`` file is one matrix,
+    named ``""``)."""
+    if path.suffix.lower() == ".mat":
+        return _load_mat(path, wanted)
+    return _load_npz(path, wanted)
 
 
 def _load_single(path: Path):
-    """The matrix of a ``.mtx`` or ``.npy`` file."""
+    """The matrix of a ``.mtx`` or ``.npy`` file (its declared size bounded first)."""
     if path.suffix.lower() == ".mtx":
         import scipy.io
 
+        rows, cols, entries, *_ = scipy.io.mminfo(str(path))
+        _bound_header("", (rows, cols))
+        if int(entries) > int(rows) * int(cols):
+            raise _FileError(f"declares {entries} entries in a {rows} x {cols} matrix")
         return scipy.io.mmread(str(path))
     with open(path, "rb") as fh:
         if fh.read(len(_NPY_MAGIC)) != _NPY_MAGIC:
-            raise ValueError("is not a .npy file (numpy.save writes one)")
-    return np.load(str(path), allow_pickle=False)
+            raise _FileError("is not a .npy file (numpy.save writes one)")
+        fh.seek(0)
+        shape, dtype = _npy_header(fh)
+        _bound_header("", shape, dtype)
+        fh.seek(0)
+        return np.lib.format.read_array(fh, allow_pickle=False)
 
 
 def _read_file(where: _Where, key: str, path: Path, loader):
-    """``loader(path)`` with every failure as one line naming ``key`` and the file."""
+    """``loader(path)`` with every failure as one line naming ``key`` and the file.
+
+    The readers of the formats (zipfile, numpy, scipy.io) raise many kinds of
+    exception on a corrupt or truncated file; each is said as a file that
+    cannot be read, never a traceback."""
     if not path.is_file():
         what = "a directory" if path.is_dir() else "no such file"
         raise where.error(key, f"names {str(path)!r}: {what}")
     try:
         return loader(path)
-    except ValueError as exc:
+    except _FileError as exc:
         raise where.error(key, f"{str(path)!r} {exc}") from None
-    except (OSError, EOFError, KeyError, TypeError) as exc:
-        raise where.error(key, f"{str(path)!r} cannot be read as a {path.suffix} matrix file: {exc}") from None
+    except MemoryError:
+        raise where.error(key, f"{str(path)!r} is too large to read into memory") from None
+    except Exception as exc:  # noqa: BLE001 - a foreign reader's failure on a corrupt file, said in one line
+        raise where.error(key, f"{str(path)!r} cannot be read as a {path.suffix} matrix file: "
+                               f"{type(exc).__name__}: {exc}") from None
 
 
 def read_matrices(path) -> dict:
@@ -272,8 +384,8 @@ def _matrix_value(where: _Where, key: str, value, folder: Path) -> np.ndarray:
         if suffix in _SINGLE_SUFFIXES:
             return _dense(where, key, _read_file(where, key, p, _load_single))
         if suffix in _NAMED_SUFFIXES:
-            data = _read_file(where, key, p, _load_named)
             name = key.rsplit(".", 1)[-1]
+            data = _read_file(where, key, p, lambda q: _load_named(q, (name,)))
             pick = data.get(name, data.get("") if len(data) == 1 else None)
             if pick is None:
                 raise where.error(key, f"names {str(p)!r}, which holds no variable {name!r} "
@@ -290,10 +402,11 @@ def _matrix_value(where: _Where, key: str, value, folder: Path) -> np.ndarray:
 
 
 def _symmetric(where: _Where, key: str, A: np.ndarray) -> None:
+    from .systems import asymmetry
+
     scale = float(np.max(np.abs(A)))
-    d = np.abs(A - A.T)
-    if d.max() > 1e-10 * scale:
-        i, j = np.unravel_index(int(np.argmax(d)), A.shape)
+    diff, i, j = asymmetry(A)
+    if diff > 1e-10 * scale:
         raise where.error(key, f"must be symmetric ({key}[{i},{j}] = {float(A[i, j])!r} but {key}[{j},{i}] = "
                                f"{float(A[j, i])!r})")
 
@@ -352,6 +465,16 @@ def _check_matrices(where: _Where, mats: dict) -> None:
             what = "square" if name == "M" else f"{n} x {n} like M"
             raise where.error(key, f"must be {what}, got shape {A.shape[0]} x {A.shape[1]}")
         _symmetric(where, key, A)
+    if n > config.SYSTEM_DENSE_CHECK_MAX_DOF:  # a factorisation and Lanczos iterations, no eigen-decomposition
+        from .systems import definiteness_failure
+
+        for name in _MATRICES:
+            if name in mats:
+                lam = definiteness_failure(mats[name], semi=name != "M")
+                if lam is not None:
+                    what = "definite" if name == "M" else "semi-definite"
+                    raise where.error(f"structure.{name}", f"must be positive {what} (smallest eigenvalue {lam:.6g})")
+        return
     try:
         np.linalg.cholesky(M)
     except np.linalg.LinAlgError:
@@ -394,7 +517,10 @@ def _selection(where: _Where, key: str, t: dict, n: int) -> dict:
         for k in ("dof", "dof2"):
             if k in t:
                 raise where.error(f"{key}.{k}", "cannot be combined with direction (a selection vector); give one")
-        return {"direction": _vector(where, f"{key}.direction", t["direction"], n)}
+        direction = _vector(where, f"{key}.direction", t["direction"], n)
+        if not np.any(direction != 0.0):
+            raise where.error(f"{key}.direction", "must have a non-zero entry (it selects the relative motion)")
+        return {"direction": direction}
     if "dof" not in t:
         raise where.error(f"{key}.dof", "is missing (or give direction, a selection vector)")
     d = _dof(where, f"{key}.dof", t["dof"], n)
@@ -419,6 +545,9 @@ def _normal(where: _Where, key: str, t, n: int):
     elif "values" in t:
         t = _table(where, key, t, _SAMPLED_KEYS)
         values = _vector(where, f"{key}.values", t["values"])
+        if not np.any(values > 0.0):
+            raise where.error(f"{key}.values", f"must have a positive (compressive) entry: the contact is never "
+                                               f"loaded, got {t['values']!r:.60}")
         make, fields = (lambda: SampledLoad(values)), _SAMPLED_KEYS
     elif "n0" in t:
         t = _table(where, key, t, _HARMONIC_KEYS)
@@ -460,7 +589,14 @@ def _contact(where: _Where, i: int, c, n: int):
     normal, n_static = _normal(where, f"{key}.normal", c["normal"], n)
     kt = _number(where, f"{key}.kt", c["kt"])
     mu = _number(where, f"{key}.mu", c["mu"])
-    n_ref = _number(where, f"{key}.n_ref", c["n_ref"]) if "n_ref" in c else n_static
+    if "n_ref" in c:
+        n_ref = _number(where, f"{key}.n_ref", c["n_ref"])
+    elif not n_static > 0.0:
+        raise where.error(f"{key}.normal.values", f"have the mean {n_static:.6g} N, the static load the law's "
+                                                  "n_ref defaults to, which must be > 0: give n_ref (N), or "
+                                                  "values with a positive mean")
+    else:
+        n_ref = n_static
     given = {p: c[p] for p in params if p in c}
     for p, v in given.items():
         if isinstance(v, (bool, list, dict)):
@@ -565,6 +701,18 @@ def _output(where: _Where, o, n: int):
     return dof, dofs
 
 
+def _not_utf8(p: Path, exc: UnicodeDecodeError) -> str:
+    """Where a file stops being UTF-8 (line and byte), as TOML requires it."""
+    try:
+        with open(p, "rb") as fh:
+            head = fh.read(exc.start)
+    except OSError:
+        head = b""
+    line = head.count(b"\n") + 1
+    bad = exc.object[exc.start:exc.start + 1].hex() if isinstance(exc.object, bytes) else "?"
+    return f"line {line}: byte 0x{bad} is not UTF-8 (a TOML file is UTF-8 text)"
+
+
 def read_system_file(path) -> SystemFile:
     """Read a TOML system file (``docs/system-files.md``) with its output options.
 
@@ -597,6 +745,13 @@ def read_system_file(path) -> SystemFile:
             doc = tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(" ".join(f"{p}: not valid TOML: {exc}".split())) from None
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{p}: not valid TOML: {_not_utf8(p, exc)}") from None
+    except ValueError as exc:  # what the parser does not convert (an integer beyond Python's digit limit)
+        msg = str(exc)
+        if "integer string conversion" in msg:
+            msg = f"an integer has more than {sys.get_int_max_str_digits()} digits (Python reads no longer ones)"
+        raise ValueError(" ".join(f"{p}: not valid TOML: {msg}".split())) from None
     except OSError as exc:
         raise ValueError(f"{p}: cannot be read: {exc.strerror or exc}") from None
     _table(where, "", doc, _TOP_KEYS, required=("structure",))
@@ -624,6 +779,9 @@ def read_system_file(path) -> SystemFile:
             system = System(M, modal_damping(M, system.K_reference, st["zeta"]), K, **kw)
     except ValueError as exc:
         raise ValueError(" ".join(f"{p}: {exc}".split())) from None
+    if st["w0"] is None and not math.isfinite(system.w0):
+        raise where.error("structure.K", "and structure.M give natural frequencies beyond the floating-point range "
+                          "(K / M overflows): give them in consistent units")
     if st["w0"] is None and not system.w0 > 0.0:
         raise where.error("structure.w0", "is needed: every natural frequency of (M, K) with the normal springs "
                           "in place and the tangential contacts free is 0 (nothing but the tangential contacts holds "

@@ -111,10 +111,27 @@ def _square(name: str, A, n: int) -> np.ndarray:
     return A
 
 
+#: rows compared at once by :func:`asymmetry` (a block of A against the same columns of A: cache-friendly)
+_SYMMETRY_BLOCK = 256
+
+
+def asymmetry(A: np.ndarray) -> tuple[float, int, int]:
+    """(max |A - A^T|, i, j where it is reached) of a square matrix, by blocks of rows
+    (no n x n temporary; the transposed reads stay in cache)."""
+    n = A.shape[0]
+    best, where = 0.0, (0, 0)
+    for r in range(0, n, _SYMMETRY_BLOCK):
+        d = np.abs(A[r:r + _SYMMETRY_BLOCK, :] - A[:, r:r + _SYMMETRY_BLOCK].T)
+        k = int(np.argmax(d)) if d.size else 0
+        if d.size and d.flat[k] > best:
+            best, where = float(d.flat[k]), (r + k // n, k % n)
+    return best, where[0], where[1]
+
+
 def _symmetric(name: str, A: np.ndarray) -> None:
     scale = float(np.max(np.abs(A))) if A.size else 0.0
-    if np.max(np.abs(A - A.T), initial=0.0) > 1e-10 * scale:
-        i, j = np.unravel_index(int(np.argmax(np.abs(A - A.T))), A.shape)
+    diff, i, j = asymmetry(A) if A.ndim == 2 and A.shape[0] == A.shape[1] else (0.0, 0, 0)
+    if diff > 1e-10 * scale:
         raise ValueError(f"{name} must be symmetric ({name}[{i},{j}] = {A[i, j]!r} but "
                          f"{name}[{j},{i}] = {A[j, i]!r})")
 
@@ -183,7 +200,8 @@ class System:
         if M.shape != (n, n):
             raise ValueError(f"M must be square, got shape {M.shape}")
         _symmetric("M", M)
-        if np.any(np.linalg.eigvalsh(M) <= 0):
+        if (np.any(np.linalg.eigvalsh(M) <= 0) if n <= config.SYSTEM_DENSE_CHECK_MAX_DOF
+                else definiteness_failure(M, semi=False) is not None):  # fmt: skip
             raise ValueError("M must be symmetric positive definite (eigenvalues in (0, inf))")
         K = _square("K", self.K, n)
         _symmetric("K", K)
@@ -265,15 +283,23 @@ class System:
         (M, :attr:`K_reference`): normal springs in place, tangential contacts
         free, rigid-body modes (eigenvalues below
         ``config.SYSTEM_RIGID_MODE_RTOL`` times the largest) skipped; 0 when
-        every mode is rigid. For the single-DOF damper w0 = sqrt(k/m), the
-        paper's reference.
+        every mode is rigid; inf when the frequencies overflow (K / M beyond
+        the floating-point range). For the single-DOF damper w0 = sqrt(k/m),
+        the paper's reference.
         """
         if self.w0_rad_s is not None:
             return self.w0_rad_s
+        if self.ndof > config.SYSTEM_DENSE_CHECK_MAX_DOF:
+            w0 = _lowest_elastic_large(self.M, self.K_reference)
+            if w0 is not None:
+                return w0
         # numpy's LAPACK (already loaded): scipy.linalg would add a third of a second to the CLI's start
         L = np.linalg.cholesky(self.M)
-        A = np.linalg.solve(L, np.linalg.solve(L, self.K_reference).T)
-        lam = np.linalg.eigvalsh(0.5 * (A + A.T))
+        with np.errstate(over="ignore", invalid="ignore"):
+            A = np.linalg.solve(L, np.linalg.solve(L, self.K_reference).T)
+            if not np.all(np.isfinite(A)):
+                return math.inf  # K / M beyond the floating-point range
+            lam = np.linalg.eigvalsh(0.5 * A + 0.5 * A.T)
         elastic = lam[lam > config.SYSTEM_RIGID_MODE_RTOL * lam[-1]]
         return math.sqrt(elastic[0]) if elastic.size and lam[-1] > 0.0 else 0.0
 
@@ -449,6 +475,112 @@ def _coupled_damper(cls, p, law, *, f1, zeta, eta, delta_deg, m_n, zeta_n) -> Sy
     return cls(M=np.diag([m, m_n]), C=np.diag([2.0 * zeta * math.sqrt(k * m), c_n]), K=np.diag([k, 0.0]),
                contacts=(Contact(law=law, dof=0, normal=spring),), force=[f1, eta * n0],
                force_phase_deg=[0.0, delta_deg], w0_rad_s=math.sqrt(k / m), output_dof=0)  # fmt: skip
+
+
+#: a matrix with at most this fraction of non-zero entries is factorised and multiplied as a
+#: sparse one by the checks of large structures (assembled finite-element matrices are)
+_SPARSE_FRACTION = 0.05
+
+
+def _operator(A: np.ndarray):
+    """``A`` as a scipy.sparse CSC matrix when it is sparse enough, else itself."""
+    import scipy.sparse as sp
+
+    if np.count_nonzero(A) <= _SPARSE_FRACTION * A.size:
+        return sp.csc_matrix(A)
+    return A
+
+
+def _largest_eigenvalue(A, M=None) -> float:
+    """Largest eigenvalue of A (or of the pencil (A, M)) by Lanczos iterations (eigsh), to 1e-3: a scale
+    for the tolerances of the semi-definite and rigid-mode tests."""
+    from scipy.sparse.linalg import eigsh
+
+    return float(eigsh(A, k=1, M=M, which="LA", return_eigenvectors=False, tol=1e-3)[0])
+
+
+def _positive_definite(A) -> bool:
+    """Whether the symmetric ``A`` (dense, or scipy.sparse) is positive definite: a dense Cholesky
+    factorisation, or a sparse symmetric LDL^T one (SuperLU, diagonal pivots: the signs of the pivots are
+    the signs of the eigenvalues, Sylvester's law of inertia)."""
+    import scipy.sparse as sp
+
+    if not sp.issparse(A):
+        import scipy.linalg as sl
+
+        try:
+            sl.cholesky(A, lower=True, overwrite_a=True, check_finite=False)
+            return True
+        except np.linalg.LinAlgError:
+            return False
+    from scipy.sparse.linalg import splu
+
+    try:
+        lu = splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                  options=dict(SymmetricMode=True))
+    except RuntimeError:  # an exactly singular pivot
+        return False
+    return bool(np.all(lu.perm_r == lu.perm_c)) and bool(np.all(lu.U.diagonal() > 0.0))
+
+
+def definiteness_failure(A: np.ndarray, *, semi: bool) -> float | None:
+    """None when the symmetric ``A`` is positive definite (``semi``: positive
+    semi-definite, its smallest eigenvalue at least -``config.SYSTEM_SEMIDEFINITE_RTOL``
+    times its largest); else its smallest eigenvalue.
+
+    Scales to large matrices: a Cholesky factorisation (of A shifted by the
+    tolerance when ``semi``, the largest eigenvalue by Lanczos iterations)
+    decides, no eigen-decomposition; the smallest eigenvalue is computed
+    only for the message of a matrix that fails.
+    """
+    import scipy.sparse as sp
+
+    n = A.shape[0]
+    op = _operator(A)
+    shift = 0.0
+    if semi:
+        shift = config.SYSTEM_SEMIDEFINITE_RTOL * max(abs(_largest_eigenvalue(op)) if n > 2 else
+                                                       float(np.max(np.abs(np.linalg.eigvalsh(A)))), 1e-300)
+    if sp.issparse(op):
+        B = op + shift * sp.identity(n, format="csc")
+    else:
+        B = np.array(A, dtype=np.float64, order="F")
+        B[np.diag_indices(n)] += shift
+    if _positive_definite(B):
+        return None
+    del B
+    from scipy.sparse.linalg import ArpackError, eigsh
+
+    try:
+        return float(eigsh(op, k=1, which="SA", return_eigenvectors=False)[0])
+    except (ArpackError, ValueError):
+        return float(np.linalg.eigvalsh(A)[0])
+
+
+def _lowest_elastic_large(M: np.ndarray, K: np.ndarray) -> float | None:
+    """Lowest elastic natural frequency (rad/s) of (M, K) by shift-invert Lanczos
+    iterations: the few lowest eigenvalues, more until one is elastic (above
+    ``SYSTEM_RIGID_MODE_RTOL`` of the largest); 0 when every mode is rigid;
+    None when the iterations fail (the caller decomposes densely)."""
+    from scipy.sparse.linalg import ArpackError, eigsh
+
+    n = M.shape[0]
+    K, M = _operator(K), _operator(M)
+    try:
+        top = _largest_eigenvalue(K, M)
+        if not top > 0.0:
+            return 0.0
+        k = 6
+        while k < n - 1:
+            lam = np.sort(eigsh(K, k=k, M=M, sigma=-config.SYSTEM_RIGID_MODE_RTOL * top, which="LM",
+                                return_eigenvectors=False))
+            elastic = lam[lam > config.SYSTEM_RIGID_MODE_RTOL * top]
+            if elastic.size:
+                return math.sqrt(elastic[0])
+            k *= 4
+    except (ArpackError, ValueError, np.linalg.LinAlgError):
+        return None
+    return None
 
 
 def _dense(dof: int, dof2: int, direction, n: int) -> np.ndarray:

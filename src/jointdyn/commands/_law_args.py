@@ -42,7 +42,7 @@ def law_params(args) -> dict:
         without a parameter ``n``, an unknown parameter (the message lists
         the model's parameters) or a value out of range.
     """
-    from ..laws import canonical_law_params, law_names, law_parameters
+    from ..laws import canonical_law_params, law_names, law_parameters, make_law
 
     given = {}
     for item in args.law_param or ():
@@ -67,6 +67,14 @@ def law_params(args) -> dict:
         except ValueError:
             raise ValueError(f"--n must be {params['n'].allowed()}, got {args.n!r}") from None
     try:
-        return dict(canonical_law_params(args.model, given))
+        out = dict(canonical_law_params(args.model, given))
     except ValueError as exc:
         raise ValueError(f"--law-param {exc}") from None
+    try:  # the sizes the parameters set (a law's state) are bounded by the memory, before computing
+        make_law(args.model, kt=1.0, mu=1.0, n_ref=1.0, **out)
+    except ValueError as exc:
+        msg = str(exc)
+        if args.n is not None and msg.startswith("n "):
+            raise ValueError(f"--n{msg[1:]}") from None
+        raise ValueError(f"--law-param {msg}") from None
+    return out

@@ -36,6 +36,7 @@ from .. import config
 from .._io import jsonable as _jsonable
 from . import _frc_report as report
 from ._law_args import add_law_arguments, law_params, model_help
+from ._sizes import check_hb_sizes
 from ._system_args import add_system_argument, load_system_file, refuse_paper_options
 from ..systems import PAPER
 
@@ -115,7 +116,11 @@ def parse_gamma(text: str) -> np.ndarray:
     V.count_at_most("--gamma START:STOP:STEP", (stop - start) / step + 1.0,
                     config.SWEEP_MAX_GAMMA_POINTS, "points")
     count = int(math.floor((stop - start) / step + 1e-9)) + 1
-    return np.round(start + step * np.arange(count), 12)
+    grid = start + step * np.arange(count)
+    with np.errstate(over="ignore", invalid="ignore"):
+        # 12 decimals clean the float noise of a grid; not where they would change a value (tiny or huge gammas)
+        rounded = np.round(grid, 12)
+    return np.where(np.abs(rounded - grid) <= 1e-9 * grid, rounded, grid)
 
 
 def _count_or_auto(name: str, value, minimum: int):
@@ -173,7 +178,8 @@ def _check_derived(args, gammas) -> None:
         V.derived("F1 = --mu x --n0 / --beta", fy / args.beta, positive=True)
     V.derived("--eta x --n0 (normal-load amplitude, N)", args.eta * args.n0)
     w0 = V.derived("w0 = sqrt(--k / --m)", math.sqrt(args.k / args.m), positive=True)
-    V.derived("--gamma STOP x w0 (highest forcing frequency, rad/s)", float(gammas[-1]) * w0)
+    w_top = V.derived("--gamma STOP x w0 (highest forcing frequency, rad/s)", float(gammas[-1]) * w0)
+    V.derived("(--gamma STOP x w0)^2 (the inertia scale w^2 of the solvers, rad^2/s^2)", w_top * w_top)
     V.derived("2 pi / (--gamma START x w0) (longest forcing period, s)", 2.0 * math.pi / (float(gammas[0]) * w0))
     V.derived("--zeta x 2 sqrt(--k x --m) (viscous coefficient)", 2.0 * args.zeta * math.sqrt(args.k) * math.sqrt(args.m))
     V.derived("--kt / fy (normalised contact stiffness)", args.kt / fy)
@@ -182,7 +188,8 @@ def _check_derived(args, gammas) -> None:
 def _check_system_derived(system, gammas) -> None:
     """The grid in rad/s stays finite for the system file's reference frequency."""
     w0 = V.derived("w0 of --system (reference frequency, rad/s)", system.w0, positive=True)
-    V.derived("--gamma STOP x w0 (highest forcing frequency, rad/s)", float(gammas[-1]) * w0)
+    w_top = V.derived("--gamma STOP x w0 (highest forcing frequency, rad/s)", float(gammas[-1]) * w0)
+    V.derived("(--gamma STOP x w0)^2 (the inertia scale w^2 of the solvers, rad^2/s^2)", w_top * w_top)
     V.derived("2 pi / (--gamma START x w0) (longest forcing period, s)", 2.0 * math.pi / (float(gammas[0]) * w0))
 
 
@@ -227,10 +234,53 @@ def _validate(args):
         _check_system_derived(args.system_file.system, gammas)
     else:
         _validate_paper(args, gammas)
+    if args.method == "time":
+        _check_time_steps(args, gammas)
+    else:
+        check_hb_sizes(_system(args), args.harmonics, args.samples, given_samples=True)
+        _check_hb_static(_system(args))
     if args.out is not None:
         subdirs = ("lines",) if args.method == "time" else ()
         V.output_dir("--out", args.out, files=("frc.nc", "frc.csv", "frc.png"), subdirs=subdirs)
     return gammas
+
+
+def _check_time_steps(args, gammas) -> None:
+    """The steps of a forcing period at the lowest gamma (the most) fit the memory bound, for the
+    lines run at once: refused before computing, naming --steps-per-period when it sets the step,
+    else the structure's stiffest mode."""
+    from ..dynamics._model import pack_system, period_steps
+
+    system = _system(args)
+    pack = pack_system(system)
+    spp = config.TI_STEPS_PER_PERIOD if args.steps_per_period is None else args.steps_per_period
+    lines = 1 if args.sweep != "both" or args.workers == 1 else 2
+    try:
+        period_steps(pack, float(gammas[0]) * system.w0, spp, refined=pack.springs, lines=lines,
+                     name="--steps-per-period")
+    except ValueError as exc:
+        msg = str(exc)
+        raise ValueError(msg if msg.startswith("--") else f"--method time: {msg}; --method hb has no time step") from None
+
+
+def _check_hb_static(system) -> None:
+    """Harmonic balance starts from the static stiffness with every contact stuck and every normal
+    spring closed: a DOF that this holds by nothing (a rigid-body mode) has no unique mean position,
+    and the structure is refused naming it (the time domain takes it)."""
+    from ..kinematics import contact_kinematics, selection_matrix
+
+    K = system.K_reference.copy()
+    if system.contacts:
+        B = selection_matrix(contact_kinematics(system), system.ndof)
+        K += (B.T * [c.law.kt for c in system.contacts]) @ B
+    lam, vec = np.linalg.eigh(0.5 * K + 0.5 * K.T)
+    if lam[0] > config.SYSTEM_RIGID_MODE_RTOL * abs(lam[-1]):
+        return
+    dof = int(np.argmax(np.abs(vec[:, 0])))
+    raise ValueError(f"--method hb: the structure has a rigid-body mode even with every contact stuck and every "
+                     f"normal spring closed (mostly DOF {dof}: held by nothing, K + kt + kn is singular), so its "
+                     "mean position is not unique; harmonic balance needs one: give that DOF a stiffness in K, "
+                     "or use --method time")
 
 
 def _connect(address):
@@ -315,6 +365,8 @@ def _sweep(args, gammas, directions, client):
     if args.system_file is not None:
         try:
             ds = frc_sweep(args.system_file.system, gammas, dofs=args.system_file.dofs, **common)
+        except np.linalg.LinAlgError:
+            raise  # a failed solve, not a refusal (the command line says so)
         except ValueError as exc:
             # the options are checked already: what is left is the time integrator's refusal of the structure
             raise ValueError(f"--method time: {exc}") from None
@@ -440,6 +492,8 @@ def _run_hb(args, gammas):
     try:
         br = continue_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics,
                          samples=args.samples, max_step=step, progress=None if not args.json else False)
+    except np.linalg.LinAlgError:
+        raise  # a failed solve, not a refusal (the command line says so)
     except ValueError as exc:
         # what the harmonic-balance solver refuses (a kind of normal load, mixed laws) is said as its own
         raise ValueError(f"--method hb: {exc}") from None

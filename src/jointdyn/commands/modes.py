@@ -25,11 +25,14 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
+
 from .. import _validate as V
 from .. import config
 from .._exit import EXIT_INCOMPLETE
 from .._io import jsonable as _jsonable
 from ._law_args import add_law_arguments, law_params, model_help
+from ._sizes import check_hb_sizes
 from ._system_args import load_system_file
 
 NAME = "modes"
@@ -118,9 +121,12 @@ def _validate(args):
         from .frc import _count_or_auto
 
         auto = config.HB_AUTO
+        given = args.samples is not None
         args.harmonics = _count_or_auto("--harmonics", auto if args.harmonics is None else args.harmonics, 1)
+        check_hb_sizes(system, args.harmonics, None, given_samples=False)
         h = config.HB_HARMONICS if args.harmonics == auto else args.harmonics
         args.samples = _count_or_auto("--samples", auto if args.samples is None else args.samples, 2 * h + 2)
+        check_hb_sizes(system, args.harmonics, args.samples, given_samples=given)
         args.max_points = V.positive_int("--max-points", config.CONT_MAX_POINTS if args.max_points is None
                                          else args.max_points, 2)
     if args.out is not None:
@@ -166,9 +172,14 @@ def _plot(ds, title: str, path: Path) -> None:
     ax2.plot(a, ds.damping_ratio.values, "-", color="C3")
     ax2.set_ylabel("modal damping ratio")
     ax2.set_xlabel("first-harmonic amplitude of DOF %d, m" % ds.attrs["output_dof"])
+    points = bool(np.any(np.isfinite(a) & (a > 0.0)))  # a backbone that never started has none
     for ax in (ax1, ax2):
-        ax.set_xscale("log")
+        if points:
+            ax.set_xscale("log")
         ax.grid(alpha=0.3, which="both")
+    if not points:
+        ax2.text(0.5, 0.5, f"no point: {ds.attrs['message']}", transform=ax2.transAxes, ha="center",
+                 va="center", fontsize=8, color="C3", wrap=True)
     ax1.set_title(wrap(f"{ds.attrs['method'].upper()} backbone of mode {ds.attrs['linear_mode']} ({title}); "
                        f"status {ds.attrs['status']}"), fontsize=9)
     use_math_text(fig)
@@ -196,7 +207,12 @@ def run(args) -> int:
         print(json.dumps(result))
     else:
         _print_table(result)
-    return 0 if backbone.status.ok else EXIT_INCOMPLETE
+    if backbone.status.ok:
+        return 0
+    import sys
+
+    print(f"jointdyn modes: incomplete: {result['status']}: {result['message']}", file=sys.stderr)
+    return EXIT_INCOMPLETE
 
 
 def _print_table(result) -> None:

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import _validate as V
 from .. import config
 from .._cache import by_identity
 from ..kinematics import (
@@ -391,11 +392,8 @@ def make_model(system, w: float, steps_per_period: int, *, events: bool = True,
     """
     pack = pack_system(system)
     w = float(w)
-    J = int(steps_per_period)
     refined = bool(refined) and pack.springs
-    if w > 0:
-        wh = config.TI_SPRING_OMEGA_H if refined else config.TI_MAX_OMEGA_H
-        J = max(J, int(math.ceil(2 * math.pi * pack.w_max / (w * wh))))
+    J = period_steps(pack, w, steps_per_period, refined=refined)
     fs = pack.fmax if force_scale is None else force_scale
     xcap0 = config.TI_BLOWUP_FACTOR * (fs / pack.kmin + pack.xlin + 1e-12)
     xcap = np.empty(2 * pack.ndof)
@@ -408,6 +406,41 @@ def make_model(system, w: float, steps_per_period: int, *, events: bool = True,
     return Model(pack=pack, system=system, w=w, events=bool(events),
                  max_split=config.TI_MAX_SPLITS if events else 0, J=J, xcap0=xcap0, xcap=xcap,
                  grid=grid, period=period, steps_per_period=int(steps_per_period), refined=refined)  # fmt: skip
+
+
+#: float64 words per step of a period held by a run (the grid, its loads and trigonometric tables,
+#: their copies while events are inserted) beside those per DOF and per contact
+_STEP_WORDS = 12
+_STEP_WORDS_PER_DOF = 4
+_STEP_WORDS_PER_CONTACT = 8
+
+
+def period_steps(pack: PackedSystem, w: float, steps_per_period: int, *, refined: bool = False,
+                 lines: int = 1, name: str = "steps_per_period") -> int:  # fmt: skip
+    """Steps of one forcing period at ``w`` (rad/s): ``steps_per_period``,
+    raised so that w_max h <= ``TI_MAX_OMEGA_H`` (``TI_SPRING_OMEGA_H`` when
+    ``refined``), checked against the memory bound for ``lines`` runs at once
+    before anything is allocated (ValueError saying which of the two sets it,
+    ``name`` for the first)."""
+    J = float(steps_per_period)
+    if w > 0:
+        wh = config.TI_SPRING_OMEGA_H if refined else config.TI_MAX_OMEGA_H
+        with np.errstate(over="ignore", divide="ignore"):
+            need = float(np.ceil(np.float64(2 * math.pi) * pack.w_max / (np.float64(w) * wh)))
+        J = max(J, need)
+    words = _STEP_WORDS + _STEP_WORDS_PER_DOF * pack.ndof + _STEP_WORDS_PER_CONTACT * pack.ncontacts
+    per_step = 8.0 * words * max(int(lines), 1)
+    top = max(int(V.memory_budget() // per_step) - 1, 0)
+    if J > steps_per_period:
+        label = (f"the time step of the stiffest mode (w_max = {pack.w_max:.6g} rad/s with every contact stuck "
+                 f"and every normal spring closed; w_max h <= {wh:g}: {J:.6g} steps per forcing period at "
+                 f"w = {w:.6g} rad/s)")
+        hint = f"at most {top} steps fit"
+    else:
+        label = f"{name} {int(steps_per_period)}"
+        hint = f"{name} must be at most {top} here"
+    V.memory_fits(label, (J + 1.0) * per_step, hint=hint)
+    return int(J)
 
 
 def refine_if_opened(model: Model, summary) -> Model | None:

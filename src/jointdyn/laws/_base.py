@@ -106,6 +106,7 @@ from typing import ClassVar
 import numpy as np
 
 from .. import _validate as V
+from .. import config
 
 __all__ = [
     "STICK_SLIP",
@@ -189,12 +190,13 @@ class LawParameter:
             if value not in self.choices:
                 raise ValueError(f"{self.name} must be {self.allowed()}; got {value!r}")
             return value
-        bad = ValueError(f"{self.name} must be {self.allowed()}, got {value!r}")
+        shown = V.short_repr(value)
+        bad = ValueError(f"{self.name} must be {self.allowed()}, got {shown}")
         if isinstance(value, bool):
             raise bad
         try:
             v = float(value)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise bad from None
         if not (math.isfinite(v) and self.low <= v <= self.high):
             raise bad
@@ -287,7 +289,24 @@ class ContactLaw:
         object.__setattr__(self, "n_ref", V.positive("n_ref", self.n_ref))
         for p in _declared_parameters(type(self)):
             object.__setattr__(self, p.name, p.check(getattr(self, p.name)))
+        self._check_state_size()
         self._check_scales()
+
+    def _check_state_size(self) -> None:
+        """The state, in the copies the solvers hold (``config.LAW_STATE_COPIES``),
+        fits the memory bound: ValueError naming the integer law parameter that
+        sets its size (with the largest value that fits) otherwise."""
+        nbytes = 8.0 * self.state_size * config.LAW_STATE_COPIES
+        budget = V.memory_budget()
+        if nbytes <= budget:
+            return
+        for p in _declared_parameters(type(self)):
+            if p.kind == "int":
+                v = getattr(self, p.name)
+                hi = max(int(p.low), int(v * budget // nbytes))
+                V.memory_fits(f"{p.name} = {v}", nbytes, hint=f"{p.name} must be at most {hi} "
+                              f"(a state of {self.state_size} numbers, {config.LAW_STATE_COPIES} copies)")
+        V.memory_fits(f"the state of {type(self).__name__} ({self.state_size} numbers)", nbytes)
 
     def _check_scales(self) -> None:
         """The derived scales are finite (with headroom): ValueError naming
