@@ -28,7 +28,7 @@ from jointdyn import _validate as V
 from jointdyn import config
 from jointdyn.cli import main
 from jointdyn.files import read_matrices, read_system
-from jointdyn.sweeps import _frc
+from jointdyn.sweeps import _points
 
 SRC = str(Path(__file__).resolve().parents[1] / "src")
 #: a hang guard for subprocesses, not a speed requirement
@@ -57,7 +57,7 @@ def no_compute(monkeypatch, tmp_path):
     monkeypatch.setattr(frc_cmd, "_run_hb", _boom)
     monkeypatch.setattr(jointdyn.modes, "epmc", _boom)
     monkeypatch.setattr(jointdyn.modes, "qsma", _boom)
-    monkeypatch.setattr(_frc, "_steady_state_fn", lambda: _boom)
+    monkeypatch.setattr(_points, "_steady_state_fn", lambda: _boom)
     work = tmp_path / "work"
     work.mkdir()
     monkeypatch.chdir(work)
@@ -512,7 +512,10 @@ def test_modes_harmonics_raise_the_default_samples(monkeypatch, capsys):
     monkeypatch.setattr(jointdyn.modes, "epmc", fake)
     with pytest.raises(_Reached):
         main(["modes", "--harmonics", "100"])
-    assert seen["harmonics"] == 100 and seen["samples"] == 202
+    assert seen["harmonics"] == 100 and seen["samples"] == config.HB_AUTO  # chosen automatically, from 2H + 2
+    from jointdyn.hb.discretisation import first_level
+
+    assert first_level(seen["harmonics"], seen["samples"])[0] == (100, 202)
 
 
 def test_the_stiffest_mode_sets_the_step_and_is_named(no_compute, capsys, tmp_path):
