@@ -673,3 +673,17 @@ def test_rigid_mode_dof_large_path_agrees(sparse, monkeypatch):
     assert expected[0] is None and (not sparse or expected[1] == 7)
     monkeypatch.setattr(config, "SYSTEM_DENSE_CHECK_MAX_DOF", 10)
     assert (rigid_mode_dof(K), rigid_mode_dof(Kr)) == expected
+
+
+@pytest.mark.parametrize("fmt", ["csr", "csc", "coo", "bsr", "dia"])
+def test_every_save_npz_format_reads_back(fmt, tmp_path):
+    """A scipy.sparse.save_npz file of any format: its members bounded from their headers, then the matrix."""
+    import scipy.sparse as sp
+
+    A = np.array([[2.0, 1.0, 0.0, 0.0], [1.0, 2.0, 0.0, 0.0], [0.0, 0.0, 3.0, 1.0], [0.0, 0.0, 1.0, 3.0]])
+    sp.save_npz(tmp_path / "a.npz", getattr(sp, f"{fmt}_matrix")(A))
+    toml = _toml(tmp_path, structure='M = "a.npz"\nK = "a.npz"', tangential="{ dof = 0 }",
+                 normal="{ n0 = 100.0 }")
+    s = read_system(toml)
+    np.testing.assert_array_equal(s.M, A)
+    np.testing.assert_array_equal(s.K, A)
