@@ -661,3 +661,32 @@ def test_gamma_grid_keeps_tiny_and_huge_values():
 def test_tiny_gamma_passes_validation(no_compute, capsys):
     with pytest.raises(_Reached):
         main(["frc", "--method", "hb", "--gamma", "1e-300:1e-299:1e-300"])
+
+
+@pytest.mark.parametrize("sparse", [True, False], ids=["sparse", "dense"])
+def test_rigid_mode_dof_large_path_agrees(sparse, monkeypatch):
+    from jointdyn.systems import rigid_mode_dof
+
+    rng = np.random.default_rng(11)
+    _, K = _chain(40, rng, sparse=sparse)
+    Kr = K.copy()
+    Kr[:, 7] = 0.0
+    Kr[7, :] = 0.0  # DOF 7 held by nothing
+    expected = (rigid_mode_dof(K), rigid_mode_dof(Kr))
+    assert expected[0] is None and (not sparse or expected[1] == 7)
+    monkeypatch.setattr(config, "SYSTEM_DENSE_CHECK_MAX_DOF", 10)
+    assert (rigid_mode_dof(K), rigid_mode_dof(Kr)) == expected
+
+
+@pytest.mark.parametrize("fmt", ["csr", "csc", "coo", "bsr", "dia"])
+def test_every_save_npz_format_reads_back(fmt, tmp_path):
+    """A scipy.sparse.save_npz file of any format: its members bounded from their headers, then the matrix."""
+    import scipy.sparse as sp
+
+    A = np.array([[2.0, 1.0, 0.0, 0.0], [1.0, 2.0, 0.0, 0.0], [0.0, 0.0, 3.0, 1.0], [0.0, 0.0, 1.0, 3.0]])
+    sp.save_npz(tmp_path / "a.npz", getattr(sp, f"{fmt}_matrix")(A))
+    toml = _toml(tmp_path, structure='M = "a.npz"\nK = "a.npz"', tangential="{ dof = 0 }",
+                 normal="{ n0 = 100.0 }")
+    s = read_system(toml)
+    np.testing.assert_array_equal(s.M, A)
+    np.testing.assert_array_equal(s.K, A)

@@ -258,8 +258,8 @@ def _sparse_npz(arrays: dict):
     """The matrix of a ``scipy.sparse.save_npz`` file from its arrays."""
     import scipy.sparse as sp
 
-    fmt = str(arrays["format"].item() if arrays["format"].ndim == 0 else arrays["format"])
-    fmt = fmt.strip("b'")
+    fmt = np.asarray(arrays["format"]).ravel()[0].item() if np.asarray(arrays["format"]).size else ""
+    fmt = fmt.decode("ascii", "replace") if isinstance(fmt, bytes) else str(fmt)
     shape = tuple(int(d) for d in np.asarray(arrays["shape"]).ravel())
     _bound_header("its sparse matrix ", shape)
     if fmt in ("csr", "csc", "bsr"):

@@ -557,6 +557,26 @@ def definiteness_failure(A: np.ndarray, *, semi: bool) -> float | None:
         return float(np.linalg.eigvalsh(A)[0])
 
 
+def rigid_mode_dof(K: np.ndarray) -> int | None:
+    """None when the symmetric positive semi-definite ``K`` has no mode with an eigenvalue at most
+    ``config.SYSTEM_RIGID_MODE_RTOL`` times its largest (no rigid-body mode); else the DOF that takes
+    the largest part of such a mode. Dense eigen-decomposition up to
+    ``config.SYSTEM_DENSE_CHECK_MAX_DOF`` DOFs, else a shifted Cholesky factorisation and Lanczos
+    iterations (the mode only for a matrix that has one)."""
+    n = K.shape[0]
+    if n <= config.SYSTEM_DENSE_CHECK_MAX_DOF:
+        lam, vec = np.linalg.eigh(0.5 * K + 0.5 * K.T)
+        return None if lam[0] > config.SYSTEM_RIGID_MODE_RTOL * abs(lam[-1]) else int(np.argmax(np.abs(vec[:, 0])))
+    op = _operator(K)
+    shift = config.SYSTEM_RIGID_MODE_RTOL * abs(_largest_eigenvalue(op))
+    if definiteness_failure(K - shift * np.eye(n), semi=False) is None:
+        return None
+    from scipy.sparse.linalg import eigsh
+
+    _, vec = eigsh(op, k=1, sigma=-shift, which="LM")
+    return int(np.argmax(np.abs(vec[:, 0])))
+
+
 def _lowest_elastic_large(M: np.ndarray, K: np.ndarray) -> float | None:
     """Lowest elastic natural frequency (rad/s) of (M, K) by shift-invert Lanczos
     iterations: the few lowest eigenvalues, more until one is elastic (above

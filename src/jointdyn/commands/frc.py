@@ -268,15 +268,15 @@ def _check_hb_static(system) -> None:
     spring closed: a DOF that this holds by nothing (a rigid-body mode) has no unique mean position,
     and the structure is refused naming it (the time domain takes it)."""
     from ..kinematics import contact_kinematics, selection_matrix
+    from ..systems import rigid_mode_dof
 
     K = system.K_reference.copy()
     if system.contacts:
         B = selection_matrix(contact_kinematics(system), system.ndof)
         K += (B.T * [c.law.kt for c in system.contacts]) @ B
-    lam, vec = np.linalg.eigh(0.5 * K + 0.5 * K.T)
-    if lam[0] > config.SYSTEM_RIGID_MODE_RTOL * abs(lam[-1]):
+    dof = rigid_mode_dof(K)
+    if dof is None:
         return
-    dof = int(np.argmax(np.abs(vec[:, 0])))
     raise ValueError(f"--method hb: the structure has a rigid-body mode even with every contact stuck and every "
                      f"normal spring closed (mostly DOF {dof}: held by nothing, K + kt + kn is singular), so its "
                      "mean position is not unique; harmonic balance needs one: give that DOF a stiffness in K, "
