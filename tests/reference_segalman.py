@@ -79,7 +79,7 @@ def describing_function(m, k, kt, fy, chi, beta, a):
         return f(a) - 2.0 * f(0.5 * a * (1.0 - math.cos(t)))
 
     pts = [math.acos(1.0 - 2.0 * xk / a) for xk in kinks if 2.0 * xk / a < 2.0]
-    opts = dict(points=pts or None, limit=400, epsabs=1e-14 * abs(f(a)), epsrel=1e-13)
+    opts = dict(points=pts or None, limit=400, epsabs=1e-14 * abs(f(a)), epsrel=1e-12)
     c = 2.0 / math.pi * quad(lambda t: force(t) * math.cos(t), 0.0, math.pi, **opts)[0]
     s = 2.0 / math.pi * quad(lambda t: force(t) * math.sin(t), 0.0, math.pi, **opts)[0]
     w2 = (k + c / a) / m
