@@ -202,3 +202,40 @@ def test_discrete_elements_jvp_equals_finite_differences():
 def test_discrete_elements_bad_arrays(k, f, word):
     with pytest.raises(ValueError, match=word):
         DiscreteElements.from_elements(k, f, NREF)
+
+
+def test_system_file_and_sweep_take_the_law_by_name(tmp_path):
+    """``law = "segalman"`` with ``chi`` and ``beta`` in a system file, and a sweep of the
+    paper damper with ``model="segalman"`` (time integration to the steady state)."""
+    path = tmp_path / "joint.toml"
+    path.write_text('''
+[structure]
+M = [[2.0]]
+K = [[3.0e5]]
+
+[[force]]
+dof = 0
+amplitude = 20.0
+
+[[contact]]
+law = "segalman"
+kt = 2.0e5
+mu = 0.3
+chi = -0.6
+beta = 0.25
+tangential = { dof = 0 }
+normal = { n0 = 100.0 }
+''')
+    law = jd.read_system(path).contacts[0].law
+    assert (law.name, law.chi, law.beta, law.kt, law.fy) == ("segalman", -0.6, 0.25, 2.0e5, 30.0)
+    # the sweep's linear stuck limit (eta = 0, beta = 1e4, F1 = 0.005 N: the joint hardly
+    # slips; the microslip of chi = -0.5 grows as the square root of the amplitude, so
+    # further from the limit than the uniform law's at beta = 1000 in tests/test_sweeps.py)
+    g = [0.8, 1.6]
+    ds = jd.frc_sweep(g, etas=[0.0], betas=[1e4], model="segalman", law_params={"chi": -0.5, "beta": 0.2},
+                      directions=("up",), n_workers=1, progress=False)
+    q = ds.amplitude_q.sel(eta=0.0, beta=1e4, delta=0.0, direction="up").values
+    assert (ds.status.values == 0).all()
+    k, m, kt, fy = 3.9e5, 10.0, 3e5, 50.0
+    w = np.asarray(g) * math.sqrt(k / m)
+    np.testing.assert_allclose(q, kt / fy * 0.005 / np.abs(k + kt - m * w**2), rtol=0.01)

@@ -377,6 +377,7 @@ def _segalman_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
     m = 0
     total = 0.0  # weighted integral of P over [0, u_max]
     stuck = 0.0  # weighted measure of the stuck elements
+    tot_a = tot_b = 0.0
     pa = pb = np.nan
     lo = 0.0
     pleft = 0.0  # left^(chi + 1) of the next segment
@@ -406,9 +407,15 @@ def _segalman_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
                                b, alpha)
                 pright = _right_power(end, right, chi, ph_old, pl_old)
                 s_new[base + m - 1] = pright
-                total += _wint(left, right, pleft, pright, a2, b2, chi)
-                if kind == _STUCK:
-                    stuck += right - left if chi == 0.0 else (pright - pleft) / (chi + 1.0)
+                if chi == 0.0:  # the uniform law's operations
+                    total += _integral(left, right, a2, b2)
+                    if kind == _STUCK:
+                        stuck += right - left
+                else:  # the moments' numerators; divided once after the loop
+                    tot_a += a2 * (pright - pleft)
+                    tot_b += b2 * (right * pright - left * pleft)
+                    if kind == _STUCK:
+                        stuck += pright - pleft
                 pa = a2
                 pb = b2
                 left = right
@@ -416,6 +423,9 @@ def _segalman_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
         lo = hi
         pl_old = ph_old
         k_lo = k_hi
+    if chi != 0.0:
+        total = tot_a / (chi + 1.0) + tot_b / (chi + 2.0)
+        stuck = stuck / (chi + 1.0)
     written = m
     if m > cap:
         if chi == 0.0:  # weight 1: the uniform law's merges (and its bits when beta = 0)
