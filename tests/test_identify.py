@@ -173,3 +173,19 @@ def test_fit_backbone_bad_input(kw, word):
     args.update(kw)
     with pytest.raises(ValueError, match=word):
         fit_backbone(args.pop("amplitude_m"), args.pop("omega_rad_s"), args.pop("damping_ratio"), **args)
+
+
+def test_epmc_refinement_with_several_harmonics():
+    """A backbone made by EPMC with 5 harmonics of a Jenkins joint (the contact force is far
+    from harmonic): the describing-function fit is biased; refined by EPMC with 5 harmonics it
+    recovers the parameters within 0.5 %, closer than without."""
+    zeta = 0.002
+    m, k, law, b = _epmc_backbone("jenkins", {}, zeta, harmonics=5)
+    true = {"k": k, "kt": KT, "fy_N": FY}
+    df = fit_backbone(b.amplitude_m, b.omega_rad_s, b.damping_ratio, mass=m, model="jenkins")
+    ref = fit_backbone(b.amplitude_m, b.omega_rad_s, b.damping_ratio, mass=m, model="jenkins", refine_harmonics=5,
+                       refine_samples=2048)
+    assert ref.status.ok, ref.message
+    err_df = max(abs(df.parameters[n] / v - 1.0) for n, v in true.items())
+    err_ref = max(abs(ref.parameters[n] / v - 1.0) for n, v in true.items())
+    assert err_ref <= 0.005 and err_ref < err_df, (err_df, err_ref)

@@ -483,3 +483,7 @@ FIT_BETA_START = 0.1
 #: backbone fits: Gauss-Legendre nodes per smooth piece of the Masing loop in the
 #: first-harmonic quadrature
 FIT_QUAD_NODES = 64
+#: backbone fits refined by EPMC: most EPMC backbones (defect corrections), and the relative
+#: change of every parameter below which the refinement stops
+FIT_REFINE_ITERATIONS = 4
+FIT_REFINE_RTOL = 1e-4

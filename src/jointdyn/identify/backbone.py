@@ -29,7 +29,7 @@ from .. import config
 from ..laws import law_parameters, make_law
 from ..laws.segalman import CHI_MAX, CHI_MIN, segalman_constants
 from ._lsq import Param, solve, status_of
-from .result import FitResult
+from .result import FitResult, FitStatus
 
 __all__ = ["fit_backbone", "describing_function", "BACKBONE_MODELS"]
 
@@ -161,8 +161,51 @@ def _start(model, A, w, D, m):
     return start
 
 
+def _epmc_defect(law, k, zeta, m, A, harmonics, samples):
+    """(omega, D) of EPMC with ``harmonics`` harmonics minus those of the describing
+    function at the amplitudes A; None when EPMC does not cover the range."""
+    from ..modes import ModeStatus, epmc
+    from ..systems import System
+
+    c = 2.0 * zeta * math.sqrt((k + law.kt) * m)
+    b = epmc(System.sdof(m=m, k=k, law=law, c=c), (float(A.min()), float(A.max())), harmonics=harmonics,
+             samples=samples, progress=False)
+    if b.status is not ModeStatus.COMPLETE or b.points < 2:
+        return None
+    # the defect at EPMC's own amplitudes (small and smooth), interpolated in log amplitude
+    wD, DD = _model(law, k, zeta, m, b.amplitude_m)
+    la = np.log(b.amplitude_m)
+    return (np.interp(np.log(A), la, b.omega_rad_s - wD), np.interp(np.log(A), la, b.damping_ratio - DD))
+
+
+def _refine(sol, params, fun, law_of, m, A, harmonics, samples):
+    """Defect correction by EPMC (see fit_backbone): the solution refitted with the
+    describing function plus the EPMC defect at the last parameters, until the parameters
+    change by less than ``config.FIT_REFINE_RTOL``. Returns (solution, True) or
+    (the describing-function solution, False) when an EPMC backbone fails, and the last
+    defect (zeros when none was computed)."""
+    from dataclasses import replace
+
+    defect = (np.zeros(A.size), np.zeros(A.size))
+    for _ in range(config.FIT_REFINE_ITERATIONS):
+        v = sol.values
+        d = _epmc_defect(law_of(v), v["k"], v["zeta"], m, A, harmonics, samples)
+        if d is None:
+            return sol, False, defect
+        defect = d
+        # restart from the last values (a scale at 0, a zeta on its bound, keeps its old unit)
+        start = [replace(p, value=v[p.name]) if (not p.positive or v[p.name] > 0.0) else p for p in params]
+        new = solve(lambda u, d=defect: fun(u, *d), start)
+        change = max(abs(new.values[k] - v[k]) / max(abs(v[k]), 1e-300) for k in v)
+        sol = new
+        if change <= config.FIT_REFINE_RTOL:
+            break
+    return sol, True, defect
+
+
 def fit_backbone(amplitude_m, omega_rad_s, damping_ratio, *, mass: float, model: str = config.MODEL,
-                 law_params: dict | None = None, start: dict | None = None) -> FitResult:
+                 law_params: dict | None = None, start: dict | None = None, refine_harmonics: int | None = None,
+                 refine_samples: int = config.HB_SAMPLES) -> FitResult:
     """Fit a modal Iwan model to a measured backbone by the one-harmonic describing function.
 
     Parameters
@@ -181,6 +224,14 @@ def fit_backbone(amplitude_m, omega_rad_s, damping_ratio, *, mass: float, model:
         Law parameters held during the fit (``n`` of ``discrete``).
     start : dict, optional
         Start values by name (``k``, ``kt``, ``fy``, ``zeta``, ``chi``, ``beta``).
+    refine_harmonics : int, optional
+        Refine the fit with EPMC of this many harmonics (>= 1): the difference between
+        EPMC's backbone of the fitted model and its describing function is subtracted
+        from the data and the describing-function fit repeated (a defect correction, at
+        most ``config.FIT_REFINE_ITERATIONS`` EPMC backbones), so that the parameters are
+        those whose EPMC backbone fits the data.
+    refine_samples : int
+        AFT samples per period of the refining EPMC.
 
     Returns
     -------
@@ -217,17 +268,24 @@ def fit_backbone(amplitude_m, omega_rad_s, damping_ratio, *, mass: float, model:
         shape = {k: v[k] for k in ("chi", "beta") if k in v}
         return make_law(model, kt=v["kt"], mu=v["fy"], n_ref=1.0, **fixed, **shape)
 
-    def fun(v):
+    def fun(v, dw=0.0, dD=0.0):
         wf, Df = _model(law_of(v), v["k"], v["zeta"], m, A)
-        return np.concatenate(((wf - w) / w, (Df - D) / dscale))
+        return np.concatenate(((wf + dw - w) / w, (Df + dD - D) / dscale))
 
     sol = solve(fun, params)
+    refined, defect = None, (0.0, 0.0)
+    if refine_harmonics is not None:
+        V.positive_int("refine_harmonics", refine_harmonics)
+        sol, refined, defect = _refine(sol, params, fun, law_of, m, A, refine_harmonics, refine_samples)
     reasons = {k: "the backbone depends too weakly on it (its standard error exceeds the limit): measure more "
                   "amplitudes, into macroslip for fy and kt, in microslip for chi" for k in sol.weak}
     held = {**sol.values, **{k: s0[k] for k in sol.weak}}
     law = law_of(held)
     wf, Df = _model(law, held["k"], held["zeta"], m, A)
+    wf, Df = wf + defect[0], Df + defect[1]  # EPMC's values when refined
     status, message = status_of(sol, reasons)
+    if refined is False:
+        status, message = FitStatus.REFINE_FAILED, FitStatus.REFINE_FAILED.message
     values = {k: (None if k in reasons else v) for k, v in sol.values.items()}
     errors = dict(sol.errors)
     values["fy_N"], errors["fy_N"] = values.pop("fy"), errors.pop("fy")

@@ -19,6 +19,8 @@ class FitStatus(Status):
     PARTLY_IDENTIFIED = ("partly-identified", "least squares converged but the data do not determine some "
                          "parameters (see not_identifiable)")
     NOT_CONVERGED = "not-converged", "least squares stopped at its evaluation limit before converging"
+    REFINE_FAILED = ("refine-failed", "an EPMC backbone of the refinement did not cover the amplitudes: the "
+                     "parameters are those of the describing function")
 
 
 @dataclass(frozen=True)
