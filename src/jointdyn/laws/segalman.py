@@ -38,7 +38,8 @@ vertex's derivative keeps the weighted integral (exact, merges included).
 
 Kernel layouts
 --------------
-``params = [kt, fy, N_ref, K, kt / fy, 1 / N_ref, chi, u_max, c_R, c_S, u_max^(chi+1)]``.
+``params = [kt, fy, N_ref, K, kt / fy, 1 / N_ref, chi, u_max, c_R, c_S, u_max^(chi+1),
+1 / (chi+1), 1 / (chi+2)]``.
 
 ``state = [x_prev, m, (hi_k, a_k, b_k) for k < 3 K, hp_k for k < 3 K]``: the
 pieces as in :mod:`jointdyn.laws.exact` (last breakpoint at u_max), then a
@@ -95,7 +96,7 @@ CHI_MIN = -0.95
 #: largest microslip exponent (a density that grows as phi^4 towards phi_max)
 CHI_MAX = 4.0
 # params rows beyond the uniform law's
-_P_CHI, _P_UMAX, _P_CR, _P_CS, _P_UMAXP = 6, 7, 8, 9, 10
+_P_CHI, _P_UMAX, _P_CR, _P_CS, _P_UMAXP, _P_INV1, _P_INV2 = 6, 7, 8, 9, 10, 11, 12
 
 
 def segalman_constants(chi: float, beta: float) -> tuple:
@@ -248,9 +249,9 @@ def _wmerge_jvp(s, ds, j, uw, pw, hw, clamp, lines, alpha, ia, dN, chi):
         ds[r + 5, k] = dbl2
 
 
-# not inlined: merges of the weighted law are rare (above the capacity only), and this
-# code inlined into the step's loop slowed every step by about 40 % (measured)
-@jit
+# inlined (as _ucapacity): a call of a function that is not inlined, even on the rare
+# path of the merges, cost about 40 ns in every step of the caller's loop (measured)
+@jit(inline="always")
 def _wcapacity(s, ds, m, cap, alpha, ia, dN, chi):
     """Merge three adjacent pieces into two until at most ``cap`` pieces remain: the
     triple the uniform law would merge (:func:`jointdyn.laws.exact._least_triple`,
@@ -296,11 +297,10 @@ def _wcapacity(s, ds, m, cap, alpha, ia, dN, chi):
     return m
 
 
-@jit
+@jit(inline="always")
 def _ucapacity(s, ds, m, cap, alpha, total, stuck, ia, dN):
     """chi = 0: the uniform law's merges (:func:`jointdyn.laws.exact._enforce_capacity`,
-    the same operations and bits), not inlined as :func:`_wcapacity`; the power cache
-    (u^1) follows."""
+    the same operations and bits); the power cache (u^1) follows."""
     m, total, stuck = _enforce_capacity(s, ds, m, cap, alpha, total, stuck, ia, dN)
     base = _HEAD + 9 * cap
     for k in range(m):
@@ -377,7 +377,8 @@ def _segalman_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
     m = 0
     total = 0.0  # weighted integral of P over [0, u_max]
     stuck = 0.0  # weighted measure of the stuck elements
-    tot_a = tot_b = 0.0
+    tot_a = tot_b = st_a = 0.0
+    end_stuck = 0.0
     pa = pb = np.nan
     lo = 0.0
     pleft = 0.0  # left^(chi + 1) of the next segment
@@ -411,11 +412,14 @@ def _segalman_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
                     total += _integral(left, right, a2, b2)
                     if kind == _STUCK:
                         stuck += right - left
-                else:  # the moments' numerators; divided once after the loop
+                else:  # the moments' numerators; multiplied by 1/(chi+1), 1/(chi+2) after the loop
                     tot_a += a2 * (pright - pleft)
                     tot_b += b2 * (right * pright - left * pleft)
                     if kind == _STUCK:
-                        stuck += pright - pleft
+                        st_a += pright - pleft
+                end_stuck = 0.0  # whether the last segment (the element at u_max) is stuck
+                if kind == _STUCK:
+                    end_stuck = 1.0
                 pa = a2
                 pb = b2
                 left = right
@@ -423,9 +427,10 @@ def _segalman_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
         lo = hi
         pl_old = ph_old
         k_lo = k_hi
-    if chi != 0.0:
-        total = tot_a / (chi + 1.0) + tot_b / (chi + 2.0)
-        stuck = stuck / (chi + 1.0)
+    # unconditionally (a conditional reassignment here cost about 20 ns per step); the
+    # numerators are 0 when chi = 0, and x + 0.0 is x
+    total = total + (tot_a * params[_P_INV1] + tot_b * params[_P_INV2])
+    stuck = stuck + st_a * params[_P_INV1]
     written = m
     if m > cap:
         if chi == 0.0:  # weight 1: the uniform law's merges (and its bits when beta = 0)
@@ -433,6 +438,9 @@ def _segalman_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
         else:
             m = _wcapacity(s_new, ds_new, m, cap, alpha, params[_P_INV_NREF], dN, chi)
             total, stuck = _totals(s_new, m, alpha, chi, base)
+        # a merge may put the last piece on a clip line or take it off
+        re_ = _HEAD + 3 * (m - 1)
+        end_stuck = _stuck_part(0.0, 1.0, s_new[re_ + 1], s_new[re_ + 2], alpha)
     umax = params[_P_UMAX]
     if not contact:
         _write(s_new, 0, umax, 0.0, 0.0)
@@ -458,11 +466,13 @@ def _segalman_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
         for j in range(dx.shape[0]):
             ds_new[_X, j] = dx[j]
             ds_new[_M, j] = 0.0
-    # the delta at u_max: the end value of the last piece, stuck unless it lies on a clip line
+    # the delta at u_max: the end value of the last piece (stuck unless it lies on a clip
+    # line: end_stuck, from the segments written; computed here from the state, as a
+    # conditional expression with a call, it cost about 40 ns per step); a stuck last piece
+    # has a positive measure, so stuck > 0 says whether any element sticks
     rl = _HEAD + 3 * (m - 1)
     p_end = s_new[rl + 1] + s_new[rl + 2] * umax
-    end_stuck = 1.0 if contact and _stuck_part(0.0, 1.0, s_new[rl + 1], s_new[rl + 2], alpha) > 0.0 else 0.0
-    code = STICK_SLIP if stuck > 0.0 or end_stuck > 0.0 else MACROSLIP
+    code = STICK_SLIP if stuck > 0.0 else MACROSLIP
     if alpha <= 0.0:
         code = SEPARATION
     c_r = params[_P_CR]
@@ -598,7 +608,8 @@ class Segalman(ContactLaw):
         qs = self.kt / self.fy if self.fy > 0.0 else 0.0
         umax, c_r, c_s = self.constants
         return np.array([self.kt, self.fy, self.n_ref, float(self.capacity), qs, 1.0 / self.n_ref,
-                         self.chi, umax, c_r, c_s, umax ** (self.chi + 1.0)])
+                         self.chi, umax, c_r, c_s, umax ** (self.chi + 1.0), 1.0 / (self.chi + 1.0),
+                         1.0 / (self.chi + 2.0)])
 
     @property
     def state_size(self) -> int:
