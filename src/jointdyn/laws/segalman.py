@@ -309,6 +309,20 @@ def _ucapacity(s, ds, m, cap, alpha, total, stuck, ia, dN):
 
 
 @jit(inline="always")
+def _merges(s, ds, m, cap, alpha, total, stuck, params, dN, chi, base):
+    """Merges down to ``cap`` pieces (the uniform law's when chi = 0, with its bits when
+    beta = 0; else :func:`_wcapacity`): the piece count, the force integrals and whether
+    the last piece is stuck (a merge may put it on a clip line or take it off)."""
+    if chi == 0.0:
+        m, total, stuck = _ucapacity(s, ds, m, cap, alpha, total, stuck, params[_P_INV_NREF], dN)
+    else:
+        m = _wcapacity(s, ds, m, cap, alpha, params[_P_INV_NREF], dN, chi)
+        total, stuck = _totals(s, m, alpha, chi, base)
+    r = _HEAD + 3 * (m - 1)
+    return m, total, stuck, _stuck_part(0.0, 1.0, s[r + 1], s[r + 2], alpha)
+
+
+@jit(inline="always")
 def _totals(s, m, alpha, chi, base):
     """Weighted integral of P and weighted stuck measure of the ``m`` pieces of ``s``."""
     total = 0.0
@@ -420,27 +434,17 @@ def _segalman_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
                 end_stuck = 0.0  # whether the last segment (the element at u_max) is stuck
                 if kind == _STUCK:
                     end_stuck = 1.0
-                pa = a2
-                pb = b2
-                left = right
-                pleft = pright
+                pa, pb = a2, b2
+                left, pleft = right, pright
         lo = hi
         pl_old = ph_old
         k_lo = k_hi
-    # unconditionally (a conditional reassignment here cost about 20 ns per step); the
-    # numerators are 0 when chi = 0, and x + 0.0 is x
+    # unconditional (a conditional reassignment cost 20 ns a step); 0 numerators when chi = 0
     total = total + (tot_a * params[_P_INV1] + tot_b * params[_P_INV2])
     stuck = stuck + st_a * params[_P_INV1]
     written = m
     if m > cap:
-        if chi == 0.0:  # weight 1: the uniform law's merges (and its bits when beta = 0)
-            m, total, stuck = _ucapacity(s_new, ds_new, m, cap, alpha, total, stuck, params[_P_INV_NREF], dN)
-        else:
-            m = _wcapacity(s_new, ds_new, m, cap, alpha, params[_P_INV_NREF], dN, chi)
-            total, stuck = _totals(s_new, m, alpha, chi, base)
-        # a merge may put the last piece on a clip line or take it off
-        re_ = _HEAD + 3 * (m - 1)
-        end_stuck = _stuck_part(0.0, 1.0, s_new[re_ + 1], s_new[re_ + 2], alpha)
+        m, total, stuck, end_stuck = _merges(s_new, ds_new, m, cap, alpha, total, stuck, params, dN, chi, base)
     umax = params[_P_UMAX]
     if not contact:
         _write(s_new, 0, umax, 0.0, 0.0)
@@ -466,10 +470,8 @@ def _segalman_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
         for j in range(dx.shape[0]):
             ds_new[_X, j] = dx[j]
             ds_new[_M, j] = 0.0
-    # the delta at u_max: the end value of the last piece (stuck unless it lies on a clip
-    # line: end_stuck, from the segments written; computed here from the state, as a
-    # conditional expression with a call, it cost about 40 ns per step); a stuck last piece
-    # has a positive measure, so stuck > 0 says whether any element sticks
+    # the delta at u_max: the last piece's end value (end_stuck tracked while writing: from
+    # the state here it cost 40 ns a step); a stuck last piece makes stuck > 0
     rl = _HEAD + 3 * (m - 1)
     p_end = s_new[rl + 1] + s_new[rl + 2] * umax
     code = STICK_SLIP if stuck > 0.0 else MACROSLIP
