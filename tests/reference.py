@@ -19,6 +19,7 @@ comparable with ``jointdyn.march(law, x, N)``.
 from __future__ import annotations
 
 from reference_exact import ExactIwanRef
+from reference_segalman import SegalmanRef
 
 STICK_SLIP, MACROSLIP, SEPARATION = 0, 1, 2
 
@@ -281,6 +282,7 @@ REFERENCES = {
     "iwan-paper": lambda law, x0, n0: IwanPaperRef(law.kt, law.mu, law.n_ref, x0, n0),
     "discrete": lambda law, x0, n0: DiscreteIwanRef(law.kt, law.mu, law.n_ref, law.n, x0, n0),
     "jenkins": lambda law, x0, n0: DiscreteIwanRef(law.kt, law.mu, law.n_ref, 1, x0, n0),
+    "segalman": lambda law, x0, n0: SegalmanRef(law.kt, law.mu, law.n_ref, law.chi, law.beta, law.capacity, x0, n0),
 }
 
 

@@ -35,7 +35,7 @@ LAYERS = {
     "laws": 0,
     "systems": 1, "kinematics": 1, "interfaces": 1, "fourier": 1, "reduction": 1, "files": 1, "fe": 1,
     "continuation": 2, "drivers": 2,
-    "dynamics": 3, "hb": 3, "modes": 3,
+    "dynamics": 3, "hb": 3, "modes": 3, "identify": 3,
     "sweeps": 4, "validation": 4,
     "cli": 5, "commands": 5, "figures": 5, "__main__": 5,
 }

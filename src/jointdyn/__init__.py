@@ -61,6 +61,9 @@ _LAZY = {
     "craig_bampton": "reduction",
     "reduce_system": "reduction",
     "CraigBampton": "reduction",
+    "fit_loops": "identify",
+    "fit_backbone": "identify",
+    "FitResult": "identify",
 }
 
 

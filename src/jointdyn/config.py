@@ -28,6 +28,11 @@ IWAN_CLOSED_MAX_DEPTH = 64
 #: reversal point (normalised displacement kt x / fy) has reached it (Masing
 #: rejoin); the force error is of the same order in units of fy
 IWAN_CLOSED_WIPE_TOL = 1e-9
+#: microslip exponent chi of Segalman's four-parameter Iwan law (``segalman``)
+#: when none is given: the slip-displacement density grows as phi^chi
+SEGALMAN_CHI = -0.5
+#: weight beta of the final delta of the ``segalman`` density when none is given
+SEGALMAN_BETA = 0.0
 
 # --- systems (jointdyn.systems) ---------------------------------------------------------
 #: eigenvalues of (M, K_reference) below this fraction of the largest are
@@ -466,6 +471,35 @@ QSMA_MAX_ITER = 50
 #: single-nonlinear-mode synthesis: the resonance peak is located on the
 #: backbone to this relative tolerance in amplitude
 SYNTHESIS_PEAK_RTOL = 1e-10
+
+# --- identification (jointdyn.identify) -------------------------------------------
+#: most evaluations of the model (marches, describing functions) of one least-squares fit
+FIT_MAX_NFEV = 400
+#: tolerances of scipy.optimize.least_squares on the cost, the parameters and the gradient
+FIT_FTOL = 1e-12
+FIT_XTOL = 1e-10
+FIT_GTOL = 1e-12
+#: a stiffness, force or friction coefficient whose standard error exceeds this fraction
+#: of its value is reported as not identifiable
+FIT_MAX_RELATIVE_SE = 0.5
+#: a shape parameter (chi, beta) whose standard error exceeds this is reported as not identifiable
+FIT_MAX_SHAPE_SE = 0.5
+#: loop fits: the displacement window after a reversal over which the initial slope (start
+#: of kt) is measured, as a fraction of the peak-to-peak displacement
+FIT_SLOPE_WINDOW = 0.03
+#: loop fits: quantile of |T| / N over the samples in contact taken as the start of mu
+FIT_MU_QUANTILE = 0.99
+#: largest beta of a Segalman fit (the law's own range is unbounded)
+FIT_BETA_MAX = 100.0
+#: start of beta in a Segalman fit
+FIT_BETA_START = 0.1
+#: backbone fits: Gauss-Legendre nodes per smooth piece of the Masing loop in the
+#: first-harmonic quadrature
+FIT_QUAD_NODES = 64
+#: backbone fits refined by EPMC: most EPMC backbones (defect corrections), and the relative
+#: change of every parameter below which the refinement stops
+FIT_REFINE_ITERATIONS = 4
+FIT_REFINE_RTOL = 1e-4
 
 # --- sweeps --------------------------------------------------------------------------
 #: gamma grid START:STOP:STEP (the paper's Fig 6 range)

@@ -13,11 +13,12 @@ from typing import ClassVar
 import numpy as np
 
 from .. import config
+from .. import _validate as V
 from .._jit import jit
 from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, law_param, register
 
 __all__ = ["DiscreteIwan", "Jenkins", "discrete_step", "discrete_step_jvp", "discrete_init", "discrete_init_jvp",
-           "jenkins_step", "jenkins_step_jvp"]
+           "jenkins_step", "jenkins_step_jvp", "DiscreteElements", "elements_step", "elements_step_jvp"]
 
 # params layout: [kt, fy, n_ref, n, f_1 ... f_n]  (f_i: total slip force of
 # element i at the reference load, i.e. element limit = alpha * f_i / n)
@@ -311,6 +312,163 @@ class Jenkins(DiscreteIwan):
             raise ValueError(f"n must be 1 for a Jenkins element (allowed range [1, 1]), got {self.n!r}")
         object.__setattr__(self, "n", 1)
         super().__post_init__()
+
+
+# --- any density: element stiffnesses and slip forces given ------------------------------
+# params layout: [kt, fy, n_ref, n, g_1 ... g_n, k_1 ... k_n]  (g_i: slip force of element i at
+# the reference load, N; k_i: its stiffness, N/m); state layout as DiscreteIwan's
+
+
+@jit
+def _elements_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
+    # DiscreteIwan's element loop with a stiffness and a slip force per element
+    n_ref = params[2]
+    n = int(params[3])
+    alpha = N / n_ref
+    nd = _start(s_new, x, alpha, n, ds_new, dx, dT)
+    if alpha <= 0.0:
+        return 0.0, 0.0, SEPARATION
+    dxs = x - s_old[0]
+    kstick = 0.0
+    nstick = 0
+    for i in range(n):
+        ke = params[_P_HEAD + n + i]
+        lim = alpha * params[_P_HEAD + i]
+        p = s_old[_S_HEAD + i] + ke * dxs
+        pc = min(max(p, -lim), lim)
+        s_new[_S_HEAD + i] = pc
+        stuck = pc == p
+        nstick += stuck
+        kstick += ke if stuck else 0.0
+    T = _lane_sum(s_new, _S_HEAD, _S_HEAD + n)
+    if ds_new is not None:
+        for i in range(n):
+            r = _S_HEAD + i
+            ke = params[_P_HEAD + n + i]
+            p = s_new[r]
+            if p == s_old[r] + ke * dxs:  # stuck: same test as above, same bits
+                for j in range(nd):
+                    dp = ds_old[r, j] + ke * (dx[j] - ds_old[0, j])
+                    ds_new[r, j] = dp
+                    dT[j] += dp
+            else:
+                c = (1.0 if p > 0.0 else -1.0) * params[_P_HEAD + i] / n_ref
+                for j in range(nd):
+                    dp = c * dN[j]
+                    ds_new[r, j] = dp
+                    dT[j] += dp
+    code = MACROSLIP if nstick == 0 else STICK_SLIP
+    return T, kstick, code
+
+
+@jit
+def elements_step(params, s_old, s_new, x, N):
+    """Trial step of n Jenkins elements with given stiffnesses k_i (N/m) and slip
+    forces alpha g_i (N): :func:`discrete_step` with any density.
+
+    ``params = [kt, fy, N_ref, n, g_1..g_n, k_1..k_n]``; state and returns as
+    :func:`discrete_step` (kT: sum of the stiffnesses of the stuck elements).
+    """
+    return _elements_core(params, s_old, s_new, x, N, None, None, None, None, None)
+
+
+@jit
+def elements_step_jvp(params, s_old, ds_old, s_new, ds_new, x, dx, N, dN, dT):
+    """:func:`elements_step` with forward-mode derivatives along ``dx.size`` directions."""
+    return _elements_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT)
+
+
+def _element_array(name, values):
+    """``values`` as a 1-D float64 array of finite positive numbers; ValueError naming ``name``."""
+    try:
+        a = np.array(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a 1-D array of positive numbers, got {type(values).__name__}") from None
+    if a.ndim != 1 or a.size == 0:
+        raise ValueError(f"{name} must be a non-empty 1-D array of positive numbers, got shape {a.shape}")
+    bad = ~(np.isfinite(a) & (a > 0.0))
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{name} must hold finite numbers in (0, inf); entry {i} is {float(a[i])!r}")
+    return a
+
+
+@dataclass(frozen=True)
+class DiscreteElements(ContactLaw):
+    """Jenkins elements in parallel with given stiffnesses and slip forces (any density).
+
+    Element i has stiffness ``stiffnesses[i]`` (N/m) and slip force
+    ``alpha(t) slip_forces[i]`` (N, given at N_ref): a measured pressure
+    distribution or a fitted slip-force density used directly. kt is the sum
+    of the stiffnesses and mu = (sum of the slip forces) / n_ref. Build it
+    with :meth:`from_elements`; not registered by name (its parameters are
+    arrays). Exact for any history, as :class:`DiscreteIwan`.
+    """
+
+    stiffnesses: tuple = ()
+    slip_forces: tuple = ()
+    name: ClassVar[str] = "discrete-elements"
+
+    @classmethod
+    def from_elements(cls, stiffnesses, slip_forces, n_ref: float) -> "DiscreteElements":
+        """The law of elements with stiffnesses ``stiffnesses`` (N/m, > 0) and slip forces
+        ``slip_forces`` (N at ``n_ref``, > 0), arrays of the same length.
+
+        Raises
+        ------
+        ValueError
+            Naming the argument: not a 1-D array of finite positive numbers, or
+            lengths that differ.
+        """
+        k = _element_array("stiffnesses", stiffnesses)
+        f = _element_array("slip_forces", slip_forces)
+        if k.size != f.size:
+            raise ValueError(f"slip_forces must have the length of stiffnesses ({k.size}), got {f.size}")
+        n_ref = V.positive("n_ref", n_ref)
+        return cls(kt=float(k.sum()), mu=float(f.sum()) / n_ref, n_ref=n_ref,
+                   stiffnesses=tuple(k.tolist()), slip_forces=tuple(f.tolist()))
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if len(self.stiffnesses) == 0 or len(self.stiffnesses) != len(self.slip_forces):
+            raise ValueError("stiffnesses and slip_forces must be non-empty and of one length "
+                             "(build the law with DiscreteElements.from_elements)")
+        _element_array("stiffnesses", self.stiffnesses)
+        _element_array("slip_forces", self.slip_forces)
+
+    @property
+    def n(self) -> int:
+        """Number of elements."""
+        return len(self.stiffnesses)
+
+    @property
+    def step(self):
+        return elements_step
+
+    @property
+    def step_jvp(self):
+        return elements_step_jvp
+
+    @property
+    def params(self) -> np.ndarray:
+        return np.concatenate(([self.kt, self.fy, self.n_ref, float(self.n)], self.slip_forces, self.stiffnesses))
+
+    @property
+    def state_size(self) -> int:
+        return _S_HEAD + self.n
+
+    @property
+    def init(self):
+        return discrete_init
+
+    @property
+    def init_jvp(self):
+        return discrete_init_jvp
+
+    @property
+    def x_slip(self) -> float:
+        """Largest slip displacement of an element, max(g_i / k_i) (m)."""
+        return float(np.max(np.divide(self.slip_forces, self.stiffnesses)))
 
 
 register("discrete", DiscreteIwan, summary="n Jenkins elements in parallel, the exact discrete Iwan model and ground truth",

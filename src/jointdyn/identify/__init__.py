@@ -1,0 +1,19 @@
+"""Identification: joint-model parameters from measurements (docs/guide/identify.md).
+
+* :func:`fit_loops`: a contact law (kt, mu; chi, beta of Segalman's law) from
+  measured hysteresis loops t, x, N, T, by least squares of the law's force;
+* :func:`fit_backbone`: a modal Iwan model (linear stiffness, joint law,
+  linear damping ratio) from a measured backbone (amplitude, frequency,
+  damping ratio against amplitude) by the one-harmonic describing function.
+
+Both return a :class:`FitResult` with standard errors, the correlation matrix,
+the rms residual and a :class:`FitStatus`; parameters the data do not
+determine are reported as not identifiable, with the reason.
+"""
+
+from .backbone import BACKBONE_MODELS, describing_function, fit_backbone
+from .loops import LOOP_MODELS, fit_loops
+from .result import FitResult, FitStatus
+
+__all__ = ["fit_loops", "fit_backbone", "describing_function", "FitResult", "FitStatus", "LOOP_MODELS",
+           "BACKBONE_MODELS"]

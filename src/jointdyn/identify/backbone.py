@@ -1,0 +1,299 @@
+"""Fit a modal Iwan model to a measured backbone (amplitude, frequency, damping ratio).
+
+The model of one mode with modal mass m (docs/model.md, "Identification")::
+
+    m q'' + c q' + k q + F_J(q) = 0,   c = 2 zeta m omega_0,  omega_0 = sqrt((k + kt) / m)
+
+with F_J a joint law at constant normal load. One harmonic, q = A cos(theta)
+(the describing function): with T1c, T1s the first Fourier coefficients of
+the steady Masing loop of amplitude A,
+
+    omega^2 = (k + K1(A)) / m,   K1 = T1c / A,
+    D = E(A) / (2 pi m omega^2 A^2) + zeta omega_0 / omega,   E = -pi A T1s.
+
+K1 and E come from the law's virgin curve F by quadrature of the Masing
+loop T(theta) = F(A) - 2 F(A (1 - cos theta) / 2) (Gauss-Legendre on the
+smooth pieces between the kinks), not from the secant approximation. The
+linear part is viscous with the damping ratio zeta at the stuck frequency
+omega_0 (what a modal dashpot gives, and what EPMC computes).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import _validate as V
+from .. import config
+from ..laws import law_parameters, make_law
+from ..laws.segalman import CHI_MAX, CHI_MIN, segalman_constants
+from ._lsq import Param, solve, status_of
+from .result import FitResult, FitStatus
+
+__all__ = ["fit_backbone", "describing_function", "BACKBONE_MODELS"]
+
+#: laws a backbone fit accepts (at constant load: iwan-closed is iwan)
+BACKBONE_MODELS = ("jenkins", "iwan", "segalman", "iwan-closed", "discrete")
+
+
+def _virgin_curve(law):
+    """(F(u) vectorised for u >= 0 in m -> N, kink displacements m) of a law at N = n_ref."""
+    kt, fy = law.kt, law.fy
+    name = law.name
+    if name == "jenkins":
+        return (lambda u: np.minimum(kt * u, fy)), [fy / kt]
+    if name in ("iwan", "iwan-closed"):
+        xs = 2.0 * fy / kt
+        return (lambda u: np.where(u < xs, kt * u - kt * kt * u * u / (4.0 * fy), fy)), [xs]
+    if name == "segalman":
+        chi, beta = law.chi, law.beta
+        umax, _, _ = segalman_constants(chi, beta)
+        pm = umax * fy / kt
+        d = beta + (chi + 1.0) / (chi + 2.0)
+        R = fy * (chi + 1.0) / (pm ** (chi + 2.0) * d)
+
+        def f(u):
+            v = np.minimum(u, pm)
+            return np.where(u < pm, kt * v - R * v ** (chi + 2.0) / ((chi + 1.0) * (chi + 2.0)), fy)
+
+        return f, [pm]
+    if name == "discrete":
+        n = law.n
+        slip = 2.0 * fy * (np.arange(n) + 0.5) / (n * kt)  # slip displacement of each element
+        return (lambda u: (kt / n) * np.minimum(np.asarray(u)[..., None], slip).sum(axis=-1)), [float(slip[-1])]
+    raise ValueError(f"model must be one of {', '.join(BACKBONE_MODELS)}; got {name!r}")
+
+
+def _nodes(q):
+    x, w = np.polynomial.legendre.leggauss(q)
+    return 0.5 * (x + 1.0), 0.5 * w
+
+
+def describing_function(law, amplitude) -> tuple:
+    """First-harmonic stiffness and loop energy of a law at constant load N = n_ref.
+
+    Parameters
+    ----------
+    law : ContactLaw
+        One of :data:`BACKBONE_MODELS` (its virgin curve gives the Masing loop).
+    amplitude : array_like
+        Displacement amplitudes A > 0, m.
+
+    Returns
+    -------
+    k1 : ndarray
+        T1c / A, N/m: the first-harmonic (in-phase) stiffness of the steady loop.
+    energy : ndarray
+        Energy dissipated per cycle, -pi A T1s, J.
+    """
+    A = np.atleast_1d(np.asarray(amplitude, dtype=float))
+    F, kinks = _virgin_curve(law)
+    t, w = _nodes(config.FIT_QUAD_NODES)
+    k1 = np.empty(A.size)
+    en = np.empty(A.size)
+    for i, a in enumerate(A):
+        cuts = [0.0] + sorted(math.acos(1.0 - 2.0 * xk / a) for xk in kinks if 2.0 * xk / a < 2.0) + [math.pi]
+        th = np.concatenate([lo + (hi - lo) * t for lo, hi in zip(cuts[:-1], cuts[1:]) if hi > lo])
+        ww = np.concatenate([(hi - lo) * w for lo, hi in zip(cuts[:-1], cuts[1:]) if hi > lo])
+        T = F(np.array(a)) - 2.0 * F(0.5 * a * (1.0 - np.cos(th)))
+        t1c = 2.0 / math.pi * float(np.sum(ww * T * np.cos(th)))
+        t1s = 2.0 / math.pi * float(np.sum(ww * T * np.sin(th)))
+        k1[i] = t1c / a
+        en[i] = -math.pi * a * t1s
+    return k1, en
+
+
+def _model(law, k, zeta, m, A):
+    """(omega rad/s, damping ratio) of the modal model at amplitudes A."""
+    k1, en = describing_function(law, A)
+    w2 = (k + k1) / m
+    w = np.sqrt(np.maximum(w2, 1e-300))
+    w0 = math.sqrt((k + law.kt) / m)
+    return w, en / (2.0 * math.pi * m * w2 * A * A) + zeta * w0 / w
+
+
+def _check(A, w, D, mass):
+    out = []
+    for name, v in (("amplitude_m", A), ("omega_rad_s", w), ("damping_ratio", D)):
+        try:
+            a = np.asarray(v, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be a 1-D array of finite numbers") from None
+        if a.ndim != 1 or not np.all(np.isfinite(a)):
+            raise ValueError(f"{name} must be a 1-D array of finite numbers, got shape {a.shape}")
+        out.append(a)
+    A, w, D = out
+    if not (A.size == w.size == D.size):
+        raise ValueError(f"amplitude_m, omega_rad_s and damping_ratio must have one length, "
+                         f"got {A.size}, {w.size}, {D.size}")
+    if A.size < 4:
+        raise ValueError(f"amplitude_m must have at least 4 points, got {A.size}")
+    if not (np.all(A > 0.0) and np.all(w > 0.0)):
+        raise ValueError("amplitude_m and omega_rad_s must be > 0 (allowed range (0, inf))")
+    if not np.all(D >= 0.0):
+        raise ValueError("damping_ratio must be >= 0 (allowed range [0, inf))")
+    return A, w, D, V.positive("mass", mass)
+
+
+def _start(model, A, w, D, m):
+    """Start values from the data (see fit_backbone)."""
+    order = np.argsort(A)
+    A, w, D = A[order], w[order], D[order]
+    zeta0 = 0.5 * float(D[0])
+    en = 2.0 * math.pi * m * w * w * A * A * np.maximum(D - zeta0, 0.0)
+    fy0 = max(float(np.max(en / (4.0 * A))), 1e-12 * m * w[0] ** 2 * A[0])
+    kstuck, kslip = m * w.max() ** 2, m * w.min() ** 2
+    kt0 = max(1.1 * (kstuck - kslip), 1e-3 * kstuck)
+    k0 = max(1.01 * kstuck - kt0, 0.05 * kstuck)
+    start = {"k": k0, "kt": kt0, "fy": fy0, "zeta": max(zeta0, 1e-6)}
+    names = {p.name for p in law_parameters(model)}
+    if "chi" in names:
+        low = slice(0, max(2, A.size // 2))
+        ok = en[low] > 0.0
+        chi0 = config.SEGALMAN_CHI
+        if np.count_nonzero(ok) >= 2 and A[low][ok].max() > 1.2 * A[low][ok].min():
+            chi0 = float(np.clip(np.polyfit(np.log(A[low][ok]), np.log(en[low][ok]), 1)[0] - 3.0,
+                                 CHI_MIN + 0.01, 1.0))
+        start["chi"] = chi0
+    if "beta" in names:
+        start["beta"] = config.FIT_BETA_START
+    return start
+
+
+def _epmc_defect(law, k, zeta, m, A, harmonics, samples):
+    """(omega, D) of EPMC with ``harmonics`` harmonics minus those of the describing
+    function at the amplitudes A; None when EPMC does not cover the range."""
+    from ..modes import ModeStatus, epmc
+    from ..systems import System
+
+    c = 2.0 * zeta * math.sqrt((k + law.kt) * m)
+    b = epmc(System.sdof(m=m, k=k, law=law, c=c), (float(A.min()), float(A.max())), harmonics=harmonics,
+             samples=samples, progress=False)
+    if b.status is not ModeStatus.COMPLETE or b.points < 2:
+        return None
+    # the defect at EPMC's own amplitudes (small and smooth), interpolated in log amplitude
+    wD, DD = _model(law, k, zeta, m, b.amplitude_m)
+    la = np.log(b.amplitude_m)
+    return (np.interp(np.log(A), la, b.omega_rad_s - wD), np.interp(np.log(A), la, b.damping_ratio - DD))
+
+
+def _refine(sol, params, fun, law_of, m, A, harmonics, samples):
+    """Defect correction by EPMC (see fit_backbone): the solution refitted with the
+    describing function plus the EPMC defect at the last parameters, until the parameters
+    change by less than ``config.FIT_REFINE_RTOL``. Returns (solution, True) or
+    (the describing-function solution, False) when an EPMC backbone fails, and the last
+    defect (zeros when none was computed)."""
+    from dataclasses import replace
+
+    defect = (np.zeros(A.size), np.zeros(A.size))
+    for _ in range(config.FIT_REFINE_ITERATIONS):
+        v = sol.values
+        d = _epmc_defect(law_of(v), v["k"], v["zeta"], m, A, harmonics, samples)
+        if d is None:
+            return sol, False, defect
+        defect = d
+        # restart from the last values (a scale at 0, a zeta on its bound, keeps its old unit)
+        start = [replace(p, value=v[p.name]) if (not p.positive or v[p.name] > 0.0) else p for p in params]
+        new = solve(lambda u, d=defect: fun(u, *d), start)
+        change = max(abs(new.values[k] - v[k]) / max(abs(v[k]), 1e-300) for k in v)
+        sol = new
+        if change <= config.FIT_REFINE_RTOL:
+            break
+    return sol, True, defect
+
+
+def fit_backbone(amplitude_m, omega_rad_s, damping_ratio, *, mass: float, model: str = config.MODEL,
+                 law_params: dict | None = None, start: dict | None = None, refine_harmonics: int | None = None,
+                 refine_samples: int = config.HB_SAMPLES) -> FitResult:
+    """Fit a modal Iwan model to a measured backbone by the one-harmonic describing function.
+
+    Parameters
+    ----------
+    amplitude_m : array_like
+        Modal amplitudes A (first-harmonic amplitude of the measured coordinate), m.
+    omega_rad_s : array_like
+        Natural frequency at each amplitude, rad/s.
+    damping_ratio : array_like
+        Damping ratio at each amplitude (-).
+    mass : float
+        Modal mass m, kg (for the measured coordinate).
+    model : str
+        Joint law, one of :data:`BACKBONE_MODELS`.
+    law_params : dict, optional
+        Law parameters held during the fit (``n`` of ``discrete``).
+    start : dict, optional
+        Start values by name (``k``, ``kt``, ``fy``, ``zeta``, ``chi``, ``beta``).
+    refine_harmonics : int, optional
+        Refine the fit with EPMC of this many harmonics (>= 1): the difference between
+        EPMC's backbone of the fitted model and its describing function is subtracted
+        from the data and the describing-function fit repeated (a defect correction, at
+        most ``config.FIT_REFINE_ITERATIONS`` EPMC backbones), so that the parameters are
+        those whose EPMC backbone fits the data.
+    refine_samples : int
+        AFT samples per period of the refining EPMC.
+
+    Returns
+    -------
+    FitResult
+        ``parameters`` k (N/m), kt (N/m), fy_N (N), zeta (-), and chi, beta for
+        ``segalman``; ``rms_residual`` of the residuals (omega - measured) / measured and
+        (D - measured) / max(measured D).
+
+    Raises
+    ------
+    ValueError
+        Bad arrays or mass, an unknown model or parameter.
+    """
+    V.choice("model", model, BACKBONE_MODELS)
+    A, w, D, m = _check(amplitude_m, omega_rad_s, damping_ratio, mass)
+    fixed = dict(law_params or {})
+    make_law(model, kt=1.0, mu=1.0, n_ref=1.0, **fixed)
+    s0 = _start(model, A, w, D, m)
+    for k, v in (start or {}).items():
+        if k not in s0:
+            raise ValueError(f"start has {k!r}, which model {model} does not fit (it fits {', '.join(s0)})")
+        s0[k] = float(v)
+    params = [Param("k", s0["k"], True, 1e-6 * s0["k"], 1e3 * s0["k"]),
+              Param("kt", s0["kt"], True, 1e-4 * s0["kt"], 1e3 * s0["kt"]),
+              Param("fy", s0["fy"], True, 1e-4 * s0["fy"], 1e4 * s0["fy"]),
+              Param("zeta", s0["zeta"], True, 0.0, 1.0 / s0["zeta"])]
+    if "chi" in s0:
+        params.append(Param("chi", s0["chi"], False, CHI_MIN, CHI_MAX))
+    if "beta" in s0:
+        params.append(Param("beta", s0["beta"], False, 0.0, config.FIT_BETA_MAX))
+    dscale = float(np.max(D)) if np.max(D) > 0.0 else 1.0
+
+    def law_of(v):
+        shape = {k: v[k] for k in ("chi", "beta") if k in v}
+        return make_law(model, kt=v["kt"], mu=v["fy"], n_ref=1.0, **fixed, **shape)
+
+    def fun(v, dw=0.0, dD=0.0):
+        wf, Df = _model(law_of(v), v["k"], v["zeta"], m, A)
+        return np.concatenate(((wf + dw - w) / w, (Df + dD - D) / dscale))
+
+    sol = solve(fun, params)
+    refined, defect = None, (0.0, 0.0)
+    if refine_harmonics is not None:
+        V.positive_int("refine_harmonics", refine_harmonics)
+        sol, refined, defect = _refine(sol, params, fun, law_of, m, A, refine_harmonics, refine_samples)
+    reasons = {k: "the backbone depends too weakly on it (its standard error exceeds the limit): measure more "
+                  "amplitudes, into macroslip for fy and kt, in microslip for chi" for k in sol.weak}
+    held = {**sol.values, **{k: s0[k] for k in sol.weak}}
+    law = law_of(held)
+    wf, Df = _model(law, held["k"], held["zeta"], m, A)
+    wf, Df = wf + defect[0], Df + defect[1]  # EPMC's values when refined
+    status, message = status_of(sol, reasons)
+    if refined is False:
+        status, message = FitStatus.REFINE_FAILED, FitStatus.REFINE_FAILED.message
+    values = {k: (None if k in reasons else v) for k, v in sol.values.items()}
+    errors = dict(sol.errors)
+    values["fy_N"], errors["fy_N"] = values.pop("fy"), errors.pop("fy")
+    r = sol.residual
+    return FitResult(kind="backbone", model=model, status=status, message=message, parameters=values,
+                     standard_errors=errors, names=tuple("fy_N" if p.name == "fy" else p.name for p in params),
+                     correlation=sol.correlation, not_identifiable={("fy_N" if k == "fy" else k): v
+                                                                    for k, v in reasons.items()},
+                     rms_residual=math.sqrt(float(np.mean(r * r))), law=law,
+                     measured={"amplitude_m": A, "omega_rad_s": w, "damping_ratio": D},
+                     fitted={"omega_rad_s": wf, "damping_ratio": Df}, evaluations=sol.evaluations)

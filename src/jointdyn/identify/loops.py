@@ -1,0 +1,237 @@
+"""Fit a contact law to measured hysteresis loops (t, x, N, T).
+
+Least squares of the law's force, marched under the measured displacement
+x(t) and normal load N(t) from the virgin state at the first sample, against
+the measured force T (docs/model.md, "Identification"). The normal load is
+measured, so the friction coefficient mu is fitted (not only fy at one load).
+Start values come from the data: kt from the initial slope after the
+reversals (all elements stick there), mu from the macroslip plateau of
+|T| / N, chi (Segalman) from the slope of log(energy per cycle) against
+log(amplitude) (chi + 3 in microslip).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import _validate as V
+from .. import config
+from ..drivers import march
+from ..laws import MACROSLIP, law_parameters, make_law
+from ..laws.segalman import CHI_MAX, CHI_MIN
+from ._lsq import Param, solve, status_of
+from .result import FitResult
+
+__all__ = ["fit_loops", "LOOP_MODELS"]
+
+#: laws a loop fit accepts
+LOOP_MODELS = ("jenkins", "iwan", "segalman", "iwan-closed", "discrete")
+#: law parameters fitted when the law has them (the others are held at their given values)
+SHAPE_PARAMS = ("chi", "beta")
+
+
+def _array(name, v):
+    try:
+        a = np.asarray(v, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a 1-D array of finite numbers") from None
+    if a.ndim != 1 or not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be a 1-D array of finite numbers, got shape {a.shape}")
+    return a
+
+
+def _check(x, N, T):
+    x, N, T = _array("x", x), _array("N", N), _array("T", T)
+    if not (x.size == N.size == T.size):
+        raise ValueError(f"x, N and T must have one length, got {x.size}, {N.size}, {T.size}")
+    if x.size < 10:
+        raise ValueError(f"x must have at least 10 samples, got {x.size}")
+    if not np.any(N > 0.0):
+        raise ValueError("N must be positive (in contact) at some samples: no sample has N > 0")
+    if not np.ptp(x) > 0.0:
+        raise ValueError("x must move: every sample is the same")
+    if not np.any(T != 0.0):
+        raise ValueError("T must not be zero at every sample")
+    return x, N, T
+
+
+def _reversals(x):
+    """Indices of the samples where the direction of x changes (and 0)."""
+    d = np.sign(np.diff(x))
+    nz = np.flatnonzero(d)
+    if nz.size == 0:
+        return np.array([0])
+    dd = d[nz]
+    turns = nz[1:][dd[1:] != dd[:-1]]  # first move in the new direction starts at turns; reversal sample = turns
+    return np.concatenate(([0], turns))
+
+
+def _start_kt(x, T, rev):
+    """Median slope of T against x just after each reversal (all elements stick)."""
+    w = config.FIT_SLOPE_WINDOW * np.ptp(x)
+    slopes = []
+    ends = np.concatenate((rev[1:], [x.size - 1]))
+    for r, e in zip(rev, ends):
+        seg = slice(r, e + 1)
+        near = np.abs(x[seg] - x[r]) <= w
+        if np.count_nonzero(near) >= 3:
+            xs, ts = x[seg][near], T[seg][near]
+            if np.ptp(xs) > 0.0:
+                slopes.append(np.polyfit(xs, ts, 1)[0])
+    slopes = [s for s in slopes if s > 0.0]
+    if not slopes:  # too few samples near the reversals: the secant of the whole record
+        return max(np.ptp(T) / np.ptp(x), 1e-300)
+    return float(np.median(slopes))
+
+
+def _cycle_energies(x, T, rev):
+    """(amplitude m, energy J) of each closed cycle between every other reversal."""
+    out = []
+    for i in range(rev.size - 2):
+        a, b = rev[i], rev[i + 2]
+        if i == 0 and a == 0:
+            continue  # the virgin start is not a cycle
+        amp = 0.5 * abs(x[rev[i + 1]] - x[a])
+        e = abs(float(np.sum(0.5 * (T[a + 1 : b + 1] + T[a:b]) * np.diff(x[a : b + 1]))))
+        if amp > 0.0 and e > 0.0:
+            out.append((amp, e))
+    return out
+
+
+def _start_chi(x, T, rev, x_slip):
+    """chi from the log-log slope of energy against amplitude (chi + 3) of the cycles in
+    microslip; the default when fewer than two distinct amplitudes are there."""
+    cyc = [(a, e) for a, e in _cycle_energies(x, T, rev) if a < 0.7 * x_slip]
+    if len(cyc) >= 2:
+        amps = np.array([c[0] for c in cyc])
+        if amps.max() > 1.2 * amps.min():
+            slope = np.polyfit(np.log(amps), np.log([c[1] for c in cyc]), 1)[0]
+            return float(np.clip(slope - 3.0, CHI_MIN + 0.01, 1.0))
+    return config.SEGALMAN_CHI
+
+
+def _start(model, x, N, T, n_ref):
+    """Start values (dict) from the data (module docstring)."""
+    rev = _reversals(x)
+    kt0 = _start_kt(x, T, rev)
+    on = N > 0.0
+    mu0 = float(np.quantile(np.abs(T[on]) / N[on], config.FIT_MU_QUANTILE))
+    mu0 = max(mu0, 1e-12)
+    start = {"kt": kt0, "mu": mu0}
+    names = {p.name for p in law_parameters(model)}
+    if "chi" in names:
+        start["chi"] = _start_chi(x, T, rev, 2.0 * mu0 * n_ref / kt0)
+    if "beta" in names:
+        start["beta"] = config.FIT_BETA_START
+    return start
+
+
+def _params(model, start) -> list:
+    out = [Param("kt", start["kt"], True, 1e-3 * start["kt"], 1e3 * start["kt"]),
+           Param("mu", start["mu"], True, 1e-3 * start["mu"], 1e3 * start["mu"])]
+    if "chi" in start:
+        out.append(Param("chi", start["chi"], False, CHI_MIN, CHI_MAX))
+    if "beta" in start:
+        out.append(Param("beta", start["beta"], False, 0.0, config.FIT_BETA_MAX))
+    return out
+
+
+def _reasons(weak, law, x, N, T, T_fit):
+    """Why each weak parameter is not determined, from the fitted model's motion states."""
+    code = march(law, x, N)[2]
+    on = N > 0.0
+    use = float(np.max(np.abs(T_fit[on]) / (law.mu * N[on]))) if law.mu > 0.0 else 0.0
+    macro = int(np.count_nonzero(code == MACROSLIP))
+    # samples between stick and macroslip: the measured force clearly below the fitted plateau mu N
+    micro = int(np.count_nonzero(on & (np.abs(T) < 0.9 * law.mu * np.maximum(N, 0.0)) & (code != MACROSLIP)))
+    out = {}
+    for name in weak:
+        if name == "mu" and macro == 0:
+            out[name] = (f"the loops never slip (|T| reaches at most {100 * use:.3g} % of mu N): the force does "
+                         f"not determine the friction coefficient")
+        elif name in SHAPE_PARAMS and micro < 0.05 * x.size:
+            out[name] = (f"almost no microslip in the data ({micro} of {x.size} samples, the rest stuck or in "
+                         f"macroslip): the shape of the slip-force density is not seen")
+        else:
+            out[name] = "the force depends too weakly on it for these data (its standard error exceeds the limit)"
+    return out
+
+
+def fit_loops(x, N, T, model: str = config.MODEL, *, t=None, n_ref: float | None = None,
+              law_params: dict | None = None, start: dict | None = None) -> FitResult:
+    """Fit a contact law to measured loops: least squares of its force under the measured x, N.
+
+    Parameters
+    ----------
+    x : array_like
+        Tangential displacement samples, m (the first sample is the virgin state).
+    N : array_like
+        Normal-load samples, N (N <= 0: separation).
+    T : array_like
+        Measured tangential force, N.
+    model : str
+        One of :data:`LOOP_MODELS`: ``jenkins``, ``iwan``, ``segalman``, ``iwan-closed``,
+        ``discrete``.
+    t : array_like, optional
+        Time samples, s (kept with the data; the laws are rate independent).
+    n_ref : float, optional
+        Reference normal load, N (default the mean of N over the samples in contact);
+        fy_N = mu n_ref.
+    law_params : dict, optional
+        Law parameters held during the fit (e.g. ``n`` of ``discrete``, ``capacity``).
+    start : dict, optional
+        Start values by name (``kt``, ``mu``, ``chi``, ``beta``) replacing those from the data.
+
+    Returns
+    -------
+    FitResult
+        ``parameters`` kt (N/m), mu, fy_N (N), and chi, beta for ``segalman``.
+
+    Raises
+    ------
+    ValueError
+        Bad arrays (not 1-D, not finite, different lengths, fewer than 10 samples, no
+        contact, no motion) or an unknown model or parameter.
+    """
+    V.choice("model", model, LOOP_MODELS)
+    x, N, T = _check(x, N, T)
+    fixed = dict(law_params or {})
+    for k in fixed:
+        if k in SHAPE_PARAMS:
+            raise ValueError(f"law_params must not hold the fitted parameter {k}")
+    make_law(model, kt=1.0, mu=1.0, n_ref=1.0, **fixed)  # validates the held law parameters
+    n_ref = float(np.mean(N[N > 0.0])) if n_ref is None else V.positive("n_ref", n_ref)
+    s0 = _start(model, x, N, T, n_ref)
+    for k, v in (start or {}).items():
+        if k not in s0:
+            raise ValueError(f"start has {k!r}, which model {model} does not fit (it fits {', '.join(s0)})")
+        s0[k] = float(v)
+    params = _params(model, s0)
+    scale = float(np.max(np.abs(T)))
+
+    def law_of(v):
+        shape = {k: v[k] for k in SHAPE_PARAMS if k in v}
+        return make_law(model, kt=v["kt"], mu=v["mu"], n_ref=n_ref, **fixed, **shape)
+
+    def fun(v):
+        return (march(law_of(v), x, N)[0] - T) / scale
+
+    sol = solve(fun, params)
+    law = law_of({**sol.values, **{k: s0[k] for k in sol.weak}})
+    T_fit = march(law, x, N)[0]
+    reasons = _reasons(sol.weak, law, x, N, T, T_fit)
+    status, message = status_of(sol, reasons)
+    values = {k: (None if k in reasons else v) for k, v in sol.values.items()}
+    errors = dict(sol.errors)
+    values["fy_N"] = None if values["mu"] is None else values["mu"] * n_ref
+    errors["fy_N"] = None if errors["mu"] is None else errors["mu"] * n_ref
+    r = T_fit - T
+    measured = {"x": x, "N": N, "T": T}
+    if t is not None:
+        measured["t"] = _array("t", t)
+    return FitResult(kind="loops", model=model, status=status, message=message, parameters=values,
+                     standard_errors=errors, names=tuple(p.name for p in params), correlation=sol.correlation,
+                     not_identifiable=reasons, rms_residual=math.sqrt(float(np.mean(r * r))), n_ref=n_ref,
+                     law=law, measured=measured, fitted={"T": T_fit}, evaluations=sol.evaluations)
