@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import config
+from .._exit import EXIT_INCOMPLETE
 from ._law_args import add_law_arguments, law_params
 
 NAME = "fit"
@@ -42,8 +43,6 @@ HELP = "identify a joint model (kt, mu, chi, beta, ...) from measured loops (t, 
 LOOP_COLUMNS = ("t", "x", "N", "T")
 BACKBONE_COLUMNS = ("amplitude_m", "omega_rad_s", "damping_ratio")
 _FILES = ("fit.json", "fit.csv", "fit.png")
-#: exit status of a fit that is not ok (jointdyn.cli.EXIT_INCOMPLETE)
-EXIT_INCOMPLETE = 3
 
 
 def add_arguments(p) -> None:
