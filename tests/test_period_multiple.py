@@ -22,7 +22,7 @@ from test_sweeps import _FakeSS
 
 @dataclasses.dataclass
 class _SS(_FakeSS):
-    detail: str = ""
+    message: str = ""
 
 
 def _fake(system, gamma, *, start=None, keep_loop=True, **kw):
@@ -30,11 +30,11 @@ def _fake(system, gamma, *, start=None, keep_loop=True, **kw):
     restart = Restart(np.array([1.0]), np.array([gamma]), np.zeros((1, 1)))
     nan = math.nan
     if gamma < 0.95:
-        return _SS("periodic", gamma, 2.0, 2e-4, 0.0, 2e-4, 1.0, 0.0, 1.0, 3, 1, restart, detail="integration")
+        return _SS("periodic", gamma, 2.0, 2e-4, 0.0, 2e-4, 1.0, 0.0, 1.0, 3, 1, restart, message="integration")
     if gamma < 1.05:
-        return _SS("periodic", gamma, 3.0, 3e-4, 0.0, 3e-4, 1.0, 0.0, 1.0, 12, 4, restart, detail="integration")
+        return _SS("periodic", gamma, 3.0, 3e-4, 0.0, 3e-4, 1.0, 0.0, 1.0, 12, 4, restart, message="integration")
     detail = "slowly-converging" if gamma < 1.15 else "period-7"
-    return _SS("not-settled", gamma, nan, nan, nan, nan, nan, nan, nan, 50, 0, restart, detail=detail)
+    return _SS("not-settled", gamma, nan, nan, nan, nan, nan, nan, nan, 50, 0, restart, message=detail)
 
 
 @pytest.fixture
@@ -47,7 +47,7 @@ def test_not_settled_reason_codes():
     ss = _fake(None, 1.1)
     assert reasons[not_settled_reason(ss)] == "slowly-converging"
     assert reasons[not_settled_reason(_fake(None, 1.2))] == "long-period"
-    assert reasons[not_settled_reason(dataclasses.replace(ss, detail="quasi-periodic-or-chaotic"))] == \
+    assert reasons[not_settled_reason(dataclasses.replace(ss, message="quasi-periodic-or-chaotic"))] == \
         "quasi-periodic-or-chaotic"
     assert not_settled_reason(_fake(None, 1.0)) == 0
 

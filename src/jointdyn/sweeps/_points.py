@@ -329,11 +329,11 @@ def empty_arrays(m: int, ndofs: int, nc: int, loop_outputs: bool) -> dict:
 
 def not_settled_reason(res) -> int:
     """Code (``config.SWEEP_NOT_SETTLED_REASONS``) of why the steady state
-    ``res`` is not-settled, from its ``detail``; 0 when it is not."""
+    ``res`` is not-settled, from its ``message``; 0 when it is not."""
     if res.status != "not-settled":
         return 0
-    detail = str(getattr(res, "detail", ""))
-    name = "long-period" if detail.startswith("period-") else detail
+    message = str(getattr(res, "message", ""))
+    name = "long-period" if message.startswith("period-") else message
     reasons = config.SWEEP_NOT_SETTLED_REASONS
     return reasons.index(name) if name in reasons else 0
 
