@@ -6,7 +6,9 @@ Public API (everything else is private):
   :class:`IwanClosedForm` (the paper's closed forms), :class:`DiscreteIwan`,
   :class:`Jenkins`, :func:`make_law` (:func:`law_names`,
   :func:`law_parameters`), normal loads;
-- drivers: :func:`march`, :func:`quasistatic`, :func:`harmonic_loop`;
+- drivers: :func:`march`, :func:`quasistatic`, :func:`harmonic_loop`,
+  :func:`interface_loop` (quasi-static loops of an :class:`Interface`, a
+  contact patch of node pairs);
 - systems: :class:`System`, :class:`Contact`, :func:`read_system` (TOML
   system files), :func:`read_matrices`;
 - time integration: :func:`integrate`, :func:`steady_state`;
@@ -35,6 +37,8 @@ from .laws import (
     make_law,
 )
 from .drivers import LoopResult, harmonic_history, harmonic_loop, march, quasistatic, read_history_csv
+from .drivers import InterfaceLoopResult, interface_loop
+from .interfaces import Interface
 from .kinematics import ConstantLoad, HarmonicLoad, NormalSpring, SampledLoad
 from .systems import PAPER, Contact, System, modal_damping
 from .files import read_matrices, read_system
@@ -104,6 +108,9 @@ __all__ = [
     "harmonic_history",
     "read_history_csv",
     "LoopResult",
+    "Interface",
+    "interface_loop",
+    "InterfaceLoopResult",
     "System",
     "Contact",
     "PAPER",

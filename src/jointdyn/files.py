@@ -2,7 +2,7 @@
 
 :func:`read_system` reads the description documented in
 ``docs/system-files.md`` (tables ``[structure]``, ``[[force]]``,
-``[[contact]]``, ``[output]``) and returns a :class:`~jointdyn.System`;
+``[[contact]]``, ``[[interface]]``, ``[output]``) and returns a :class:`~jointdyn.System`;
 :func:`read_matrices` reads M, K (and C) from a ``.npz`` or MATLAB ``.mat``
 file; a single matrix may also come from a Matrix Market ``.mtx`` or a
 NumPy ``.npy`` file. Sparse matrices are converted to dense arrays (the
@@ -29,7 +29,7 @@ from . import config
 __all__ = ["SystemFile", "read_system", "read_system_file", "read_matrices"]
 
 #: top-level keys of a system file
-_TOP_KEYS = ("title", "structure", "force", "contact", "output")
+_TOP_KEYS = ("title", "structure", "force", "contact", "interface", "output")
 _STRUCTURE_KEYS = ("M", "K", "C", "zeta", "file", "w0")
 _FORCE_KEYS = ("dof", "amplitude", "phase_deg")
 #: keys of a contact beside its law's own parameters
@@ -39,6 +39,8 @@ _SPRING_KEYS = ("kn", "preload", *_SELECTION_KEYS)
 _HARMONIC_KEYS = ("n0", "n1", "phase_deg")
 _SAMPLED_KEYS = ("values",)
 _OUTPUT_KEYS = ("dof", "dofs")
+#: keys of an ``[[interface]]`` (docs/model.md section 10)
+_INTERFACE_KEYS = ("kt", "kn", "mu", "preload", "pairs")
 #: matrices a structure holds, in the order they are read
 _MATRICES = ("M", "K", "C")
 #: file suffixes holding one matrix per file, and several named ones
@@ -470,6 +472,85 @@ def _contact(where: _Where, i: int, c, n: int):
     return Contact(made, normal=normal, **tan)
 
 
+def _pair_value(where: _Where, key: str, value):
+    """A per-pair parameter: a number, or a non-empty list of numbers (one per pair)."""
+    if isinstance(value, list):
+        return _vector(where, key, value)
+    return _number(where, key, value)
+
+
+def _pairs_csv(where: _Where, key: str, path: Path) -> np.ndarray:
+    """The pair table of a CSV file: a header naming the six columns a_t1, a_t2, a_n, b_t1, b_t2, b_n
+    (any order, ``,`` separated; lines starting with ``#`` and blank lines skipped), then one row of
+    integers per pair."""
+    import csv
+
+    from .interfaces import PAIR_COLUMNS
+
+    if not path.is_file():
+        raise where.error(key, f"names {str(path)!r}: {'a directory' if path.is_dir() else 'no such file'}")
+    cols = ", ".join(PAIR_COLUMNS)
+    rows, header = [], None
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as fh:
+            for lineno, fields in enumerate(csv.reader(fh), start=1):
+                if not fields or not "".join(fields).strip() or fields[0].lstrip().startswith("#"):
+                    continue
+                fields = [f.strip() for f in fields]
+                if header is None:
+                    missing = [c for c in PAIR_COLUMNS if c not in fields]
+                    if missing or len(set(fields)) != len(fields):
+                        raise where.error(key, f"{str(path)!r} line {lineno}: the header must name the columns "
+                                               f"{cols} once each, got {', '.join(fields)!r:.80}")
+                    header = [fields.index(c) for c in PAIR_COLUMNS]
+                    width = len(fields)
+                    continue
+                if len(fields) != width:
+                    raise where.error(key, f"{str(path)!r} line {lineno}: expected {width} fields, got {len(fields)}")
+                try:
+                    rows.append([int(fields[i]) for i in header])
+                except ValueError:
+                    raise where.error(key, f"{str(path)!r} line {lineno}: the six DOF columns must be integers "
+                                           f"(-1 = fixed), got {', '.join(fields[i] for i in header)!r:.80}") from None
+                if len(rows) > config.FILES_MAX_DOF:
+                    raise where.error(key, f"{str(path)!r} must have at most {config.FILES_MAX_DOF} pairs "
+                                           "(config.FILES_MAX_DOF)")
+    except UnicodeDecodeError:
+        raise where.error(key, f"{str(path)!r} is not UTF-8 text") from None
+    except OSError as exc:
+        raise where.error(key, f"{str(path)!r} cannot be read: {exc.strerror or exc}") from None
+    if header is None or not rows:
+        raise where.error(key, f"{str(path)!r} holds no pairs: expected a header {cols}, then one row per pair")
+    return np.array(rows, dtype=np.int64)
+
+
+def _interface(where: _Where, i: int, t, n: int, folder: Path):
+    """One ``[[interface]]`` entry as an Interface (its pairs inline or from a CSV file)."""
+    from .interfaces import Interface
+
+    key = f"interface[{i}]"
+    t = _table(where, key, t, _INTERFACE_KEYS, required=_INTERFACE_KEYS)
+    params = {k: _pair_value(where, f"{key}.{k}", t[k]) for k in ("kt", "kn", "mu", "preload")}
+    pairs = t["pairs"]
+    if isinstance(pairs, str):
+        p = Path(pairs) if Path(pairs).is_absolute() else folder / pairs
+        pairs = _pairs_csv(where, f"{key}.pairs", p)
+    elif not (isinstance(pairs, list) and pairs and all(isinstance(r, list) for r in pairs)):
+        raise where.error(f"{key}.pairs", f"must be a list of rows of 6 DOF indices or the path of a CSV file, "
+                                          f"got {pairs!r:.60}")
+    else:
+        for j, row in enumerate(pairs):
+            if len(row) != 6 or any(isinstance(v, bool) or not isinstance(v, int) for v in row):
+                raise where.error(f"{key}.pairs[{j}]", f"must be 6 integer DOF indices (a_t1, a_t2, a_n, b_t1, "
+                                                       f"b_t2, b_n; -1 = fixed), got {row!r:.60}")
+    try:
+        made = Interface(pairs=pairs, **params)
+        made.check_ndof(n, "")
+    except ValueError as exc:
+        raise where.wrap(key, exc, _INTERFACE_KEYS) from None
+    return made
+
+
 def _output(where: _Where, o, n: int):
     """(output DOF or None, reported DOFs or None) of ``[output]``."""
     o = _table(where, "output", o, _OUTPUT_KEYS)
@@ -530,8 +611,13 @@ def read_system_file(path) -> SystemFile:
     if not isinstance(entries, list):
         raise where.error("contact", "must be an array of tables ([[contact]] entries)")
     contacts = tuple(_contact(where, i, c, n) for i, c in enumerate(entries))
+    entries = doc.get("interface", [])
+    if not isinstance(entries, list):
+        raise where.error("interface", "must be an array of tables ([[interface]] entries)")
+    interfaces = tuple(_interface(where, i, c, n, p.parent) for i, c in enumerate(entries))
     out_dof, dofs = _output(where, doc.get("output", {}), n)
-    kw = dict(contacts=contacts, force=force, force_phase_deg=phase, w0_rad_s=st["w0"], output_dof=out_dof)
+    kw = dict(contacts=contacts, force=force, force_phase_deg=phase, w0_rad_s=st["w0"], output_dof=out_dof,
+              interfaces=interfaces)
     try:
         system = System(M, st["mats"].get("C"), K, **kw)
         if st["zeta"] is not None:

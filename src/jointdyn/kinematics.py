@@ -361,8 +361,15 @@ def contact_kinematics(system) -> ContactKinematics:
     selection vector ``direction`` (the non-zero entries), and its normal
     load: constant and harmonic loads as ``(n0, n1, delta rad)``, sampled
     loads as ``(mean, m, 0)`` with their table row, normal springs as
-    ``(preload, kn, 0)`` with their normal selection row.
+    ``(preload, kn, 0)`` with their normal selection row. A System with
+    interfaces is refused (ValueError naming ``interfaces``): the solvers that
+    pack their contacts here do not march interfaces yet.
     """
+    if getattr(system, "interfaces", ()):
+        # every dynamic solver packs its contacts here: none of them marches interfaces yet
+        raise ValueError(f"interfaces: the dynamic solvers (time integration, harmonic balance, nonlinear modes, "
+                         f"sweeps) do not take interfaces yet (the System has {len(system.interfaces)}); their "
+                         "quasi-static loops are jointdyn.drivers.interface_loop")
     cs = system.contacts
     nc = len(cs)
     tan_idx, tan_w = _pack_rows([_sparse_selection(c.dof, c.dof2, c.direction) for c in cs])

@@ -272,6 +272,7 @@ def reduce_system(system: System, n_modes: int, boundary_dofs=None) -> tuple[Sys
     """
     if not isinstance(system, System):
         raise ValueError(f"system must be a System, got {type(system).__name__}")
+    system.require_no_interfaces("reduce_system")
     b = default_boundary(system) if boundary_dofs is None else boundary_dofs
     cb = craig_bampton(system.M, system.K, b, n_modes, C=system.C, K_modes=system.K_reference)
     out = int(system.response_dof)

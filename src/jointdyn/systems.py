@@ -25,6 +25,7 @@ import numpy as np
 
 from . import _validate as V
 from . import config
+from .interfaces import Interface
 from .kinematics import ConstantLoad, HarmonicLoad, NormalLoad, NormalSpring, _selection
 from .laws import ContactLaw, make_law
 
@@ -157,6 +158,12 @@ class System:
         Reference frequency of gamma = w / w0, rad/s (default: see :attr:`w0`).
     output_dof : int, optional
         DOF whose response is reported (default: :attr:`response_dof`).
+    interfaces : tuple of Interface
+        Contact patches of node pairs with 2-D slip and normal loads from
+        the motion (docs/model.md section 10). The quasi-static driver
+        (:func:`jointdyn.drivers.interface_loop`) marches them; the
+        dynamic solvers refuse a System with interfaces (they do not take
+        them yet).
     """
 
     M: np.ndarray
@@ -167,6 +174,7 @@ class System:
     force_phase_deg: np.ndarray = None
     w0_rad_s: float | None = None
     output_dof: int | None = None
+    interfaces: tuple = field(default_factory=tuple)
 
     def __post_init__(self) -> None:
         M = V.finite_array("M", np.atleast_2d(self.M), 2)
@@ -186,6 +194,12 @@ class System:
             _check_selection(f"contact {i} tangential", c.dof, c.dof2, c.direction, n)
             if isinstance(c.normal, NormalSpring):
                 _check_selection(f"contact {i} normal", c.normal.dof, c.normal.dof2, c.normal.direction, n)
+        interfaces = tuple(self.interfaces)
+        for i, itf in enumerate(interfaces):
+            if not isinstance(itf, Interface):
+                raise ValueError(f"interfaces must be Interface instances (interface {i} is a {type(itf).__name__})")
+            itf.check_ndof(n, f"interface {i}")
+        object.__setattr__(self, "interfaces", interfaces)
         for name, value in (("M", M), ("C", C), ("K", K), ("contacts", contacts),
                             ("force", _vector("force", self.force, n, 0.0)),
                             ("force_phase_deg", _vector("force_phase_deg", self.force_phase_deg, n, 0.0))):
@@ -216,13 +230,31 @@ class System:
 
     @property
     def K_reference(self) -> np.ndarray:
-        """K with the normal springs in place (closed) and the tangential contacts free, N/m."""
+        """K with the normal springs in place (closed) and the tangential contacts free, N/m.
+
+        The normal stiffness kn of every interface pair that is closed at
+        rest (preload > 0) is in place between its normal DOFs."""
         K = self.K.copy()
         for c in self.contacts:
             if isinstance(c.normal, NormalSpring):
                 b = _dense(c.normal.dof, c.normal.dof2, c.normal.direction, self.ndof)
                 K += c.normal.kn * np.outer(b, b)
+        for itf in self.interfaces:
+            for (a, b), kn, P in zip(itf.pairs[:, [2, 5]], itf.kn, itf.preload):
+                if P > 0.0:  # g = x[a_n] - x[b_n]: the spring kn g^2 / 2
+                    v = np.zeros(self.ndof)
+                    if a >= 0:
+                        v[a] += 1.0
+                    if b >= 0:
+                        v[b] -= 1.0
+                    K += kn * np.outer(v, v)
         return K
+
+    def require_no_interfaces(self, solver: str) -> None:
+        """ValueError naming ``interfaces`` if the System has any (for solvers that do not take them)."""
+        if self.interfaces:
+            raise ValueError(f"interfaces: {solver} does not take interfaces yet (the System has "
+                             f"{len(self.interfaces)}); their quasi-static loops are jointdyn.drivers.interface_loop")
 
     @functools.cached_property
     def w0(self) -> float:

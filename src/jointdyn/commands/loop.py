@@ -20,6 +20,11 @@ that does not divide the history leaves a remainder that is not analysed
 (``remainder_s``); a reported cycle in which the contact never closes gets
 a warning on stderr and in ``warnings``.
 
+``--model pair`` is one interface node pair with 2-D slip (docs/model.md
+section 10) under a relative history from ``--input`` (columns t, u1, u2,
+g), with ``--kt``, ``--kn``, ``--mu`` and ``--preload``: see
+:mod:`jointdyn.commands._pair_loop`.
+
 Everything is validated, computed and serialised first; ``--out DIR`` then
 receives ``loop.csv`` (columns t, x, N, T, state, inserted) and ``loop.png``
 (T against x, separated samples marked), each written atomically. Bad input
@@ -44,6 +49,8 @@ from ._law_args import add_law_arguments, law_params, model_help
 NAME = "loop"
 HELP = "quasi-static hysteresis loop of a contact law under prescribed tangential motion and normal load"
 
+#: default of --n-ref, N (a contact law's reference load; refused with --model pair)
+_N_REF = 100.0
 #: defaults of the harmonic shorthand (refused with --input)
 _HARMONIC = {
     "amplitude": 0.5e-3,
@@ -58,15 +65,21 @@ _HARMONIC = {
 def add_arguments(p) -> None:
     from ..laws import law_names
 
-    p.add_argument("--model", default=config.MODEL, choices=law_names(), help=model_help(config.MODEL))
+    p.add_argument("--model", default=config.MODEL, choices=[*law_names(), "pair"],
+                   help=model_help(config.MODEL) + "; pair: one interface node pair with 2-D slip and the normal "
+                        "load max(0, P + kn g) (docs/model.md section 10), driven by --input with columns "
+                        "t, u1, u2, g and needing --kn and --preload")
     add_law_arguments(p)
     p.add_argument("--kt", type=float, default=1e5, help="total tangential stiffness kt, N/m (default 1e5)")
     p.add_argument("--mu", type=float, default=0.1, help="friction coefficient mu (default 0.1)")
-    p.add_argument("--n-ref", type=float, default=100.0, dest="n_ref",
-                   help="reference normal load N_ref = N0, N (default 100); fy = mu N_ref")
+    p.add_argument("--n-ref", type=float, default=None, dest="n_ref",
+                   help=f"reference normal load N_ref = N0, N (default {_N_REF:g}); fy = mu N_ref")
+    p.add_argument("--preload", type=float, default=None,
+                   help="with --model pair: the pair's normal load at rest P, N (N = max(0, P + kn g))")
     p.add_argument("--kn", type=float, default=None,
                    help="normal stiffness, N/m: N = max(0, N_ref + kn v) with prescribed normal motion "
-                        "v = (eta N_ref / kn) sin(2 pi f t + delta) (default: N prescribed directly)")
+                        "v = (eta N_ref / kn) sin(2 pi f t + delta) (default: N prescribed directly); "
+                        "with --model pair the pair's normal stiffness (required)")
     p.add_argument("--amplitude", type=float, default=None,
                    help=f"tangential amplitude A, m (default {_HARMONIC['amplitude']:g})")
     p.add_argument("--frequency", type=float, default=None,
@@ -289,6 +302,14 @@ def run(args) -> int:
     from ..drivers import quasistatic
     from ..laws import make_law
 
+    if args.model == "pair":
+        from ._pair_loop import run as run_pair
+
+        return run_pair(args)
+    if args.preload is not None:
+        raise ValueError("--preload applies to --model pair only (a contact law's reference load is --n-ref)")
+    if args.n_ref is None:
+        args.n_ref = _N_REF
     _validate_args(args)
     lp = law_params(args)
     law = make_law(args.model, kt=args.kt, mu=args.mu, n_ref=args.n_ref, **lp)

@@ -1,4 +1,4 @@
-"""Read a prescribed history ``t, x, N`` from a CSV file (measurement exports).
+"""Read a prescribed history ``t, x, N`` (or a node pair's ``t, u1, u2, g``) from a CSV file (measurement exports).
 
 Accepted layout
 ---------------
@@ -35,24 +35,42 @@ import numpy as np
 
 from .. import _validate as V
 
-__all__ = ["read_history_csv"]
+__all__ = ["read_history_csv", "read_pair_history_csv"]
 
-#: the columns read, in the order returned, with their SI unit
-_COLUMNS = ("t", "x", "N")
-_SI_UNIT = {"t": "s", "x": "m", "N": "N"}
-#: names accepted in any case (besides the exact column name)
-_ALIASES = {
-    "t": ("time",),
-    "x": ("x", "displacement"),
-    "N": ("n", "normal load", "normal force", "normal_load", "normal_force"),
-}
+@dataclass(frozen=True)
+class _Spec:
+    """The columns a reader returns, in order, with their SI units, the other names each accepts in
+    any case, and how error messages describe the expected layout."""
+
+    columns: tuple
+    units: dict
+    aliases: dict
+    expected: str
+
+
+#: a contact's history: time, tangential displacement, normal load
+_HISTORY = _Spec(
+    columns=("t", "x", "N"),
+    units={"t": "s", "x": "m", "N": "N"},
+    aliases={
+        "t": ("time",),
+        "x": ("x", "displacement"),
+        "N": ("n", "normal load", "normal force", "normal_load", "normal_force"),
+    },
+    expected="expected a header row naming the columns t, x, N in SI units (s, m, N), "
+             "e.g. 't,x,N' or 't [s];x [m];N [N]', then one row of numbers per sample",
+)
+#: a node pair's relative history: time, tangential displacements along t1 and t2, normal approach
+_PAIR = _Spec(
+    columns=("t", "u1", "u2", "g"),
+    units={"t": "s", "u1": "m", "u2": "m", "g": "m"},
+    aliases={"t": ("time",), "u1": ("u1",), "u2": ("u2",), "g": ("g",)},
+    expected="expected a header row naming the columns t, u1, u2, g in SI units (s, m, m, m), "
+             "e.g. 't,u1,u2,g' or 't [s];u1 [m];u2 [m];g [m]', then one row of numbers per sample",
+)
 _UNIT = re.compile(r"^(.*?)\s*[\[(]\s*([^\])]*?)\s*[\])]$")
 #: one header field of a space-separated file: a word with an optional unit
 _SPACED_FIELD = re.compile(r"[^\s\[(]+(?:\s*[\[(][^\])]*[\])])?")
-_EXPECTED = (
-    "expected a header row naming the columns t, x, N in SI units (s, m, N), "
-    "e.g. 't,x,N' or 't [s];x [m];N [N]', then one row of numbers per sample"
-)
 #: longest header line read, bytes (a longer one is not a CSV header)
 _MAX_LINE = 1 << 20
 #: bytes per block when counting separators
@@ -69,7 +87,8 @@ class _Layout:
     data_offset: int  # byte offset of the first line after the header
     data_line: int  # its 1-based line number
     names: tuple  # header fields as written
-    use: tuple  # column indices of t, x, N
+    use: tuple  # column indices of the spec's columns
+    spec: _Spec = _HISTORY
 
 
 class _Refused(ValueError):
@@ -121,15 +140,15 @@ def _name_unit(field: str):
     return f, ""
 
 
-def _match_columns(fields, where) -> tuple:
-    """Indices of t, x, N among the header fields (units checked)."""
+def _match_columns(fields, where, spec: _Spec = _HISTORY) -> tuple:
+    """Indices of the spec's columns among the header fields (units checked)."""
     parsed = [_name_unit(f) for f in fields]
     use = []
     missing = []
-    for key in _COLUMNS:
+    for key in spec.columns:
         hits = [i for i, (b, _) in enumerate(parsed) if b == key]
         if not hits:
-            hits = [i for i, (b, _) in enumerate(parsed) if b.lower() in _ALIASES[key] and b != "T"]
+            hits = [i for i, (b, _) in enumerate(parsed) if b.lower() in spec.aliases[key] and b != "T"]
         if len(hits) > 1:
             both = ", ".join(repr(fields[i].strip()) for i in hits)
             raise _Refused(f"{where}: columns {both} all name {key}; keep one")
@@ -137,15 +156,16 @@ def _match_columns(fields, where) -> tuple:
             missing.append(key)
             continue
         unit = parsed[hits[0]][1]
-        if unit and unit != _SI_UNIT[key]:
+        if unit and unit != spec.units[key]:
+            si = ", ".join(f"{k} in {spec.units[k]}" for k in spec.columns)
             raise _Refused(
-                f"{where}: column {fields[hits[0]].strip()!r} has unit {unit!r}; expected {_SI_UNIT[key]} "
-                "(SI units: t in s, x in m, N in N; convert the file)"
+                f"{where}: column {fields[hits[0]].strip()!r} has unit {unit!r}; expected {spec.units[key]} "
+                f"(SI units: {si}; convert the file)"
             )
         use.append(hits[0])
     if missing:
         found = ", ".join(repr(f.strip()) for f in fields) or "none"
-        raise _Refused(f"{where}: missing column {', '.join(missing)} (found {found}); {_EXPECTED}")
+        raise _Refused(f"{where}: missing column {', '.join(missing)} (found {found}); {spec.expected}")
     return tuple(use)
 
 
@@ -163,7 +183,7 @@ def _decode(raw: bytes, where: str, first: bool, hint: str = "") -> str:
         raise _Refused(f"{where}: not UTF-8 text{hint}") from None
 
 
-def _layout(path: Path, name: str) -> _Layout:
+def _layout(path: Path, name: str, spec: _Spec = _HISTORY) -> _Layout:
     """Find the header, the separator and the decimal mark."""
     comment = None
     with open(path, "rb") as fh:
@@ -171,11 +191,11 @@ def _layout(path: Path, name: str) -> _Layout:
         while True:
             raw = fh.readline(_MAX_LINE)
             if not raw:
-                raise _Refused(f"{_where(name, path)} has no data; {_EXPECTED}")
+                raise _Refused(f"{_where(name, path)} has no data; {spec.expected}")
             lineno += 1
             if len(raw) == _MAX_LINE and not raw.endswith(b"\n"):
-                raise _Refused(f"{_where(name, path, lineno)} is longer than {_MAX_LINE} bytes; {_EXPECTED}")
-            text = _decode(raw, _where(name, path, lineno), lineno == 1, f"; {_EXPECTED}").strip()
+                raise _Refused(f"{_where(name, path, lineno)} is longer than {_MAX_LINE} bytes; {spec.expected}")
+            text = _decode(raw, _where(name, path, lineno), lineno == 1, f"; {spec.expected}").strip()
             if not text:
                 continue
             if text.startswith("#"):
@@ -185,12 +205,12 @@ def _layout(path: Path, name: str) -> _Layout:
                 header, header_line, offset, data_line = text, lineno, fh.tell(), lineno + 1
                 break
             if comment is None or not comment[1] or _is_numeric_row(comment[1]):
-                raise _Refused(f"{_where(name, path, lineno)} holds numbers but no header row came before it; {_EXPECTED}")
+                raise _Refused(f"{_where(name, path, lineno)} holds numbers but no header row came before it; {spec.expected}")
             header, header_line, offset, data_line = comment[1], comment[0], comment[2], comment[0] + 1
             break
         sep = _separator(header)
         fields = _header_fields(header, sep)
-        use = _match_columns(fields, _where(name, path, header_line))
+        use = _match_columns(fields, _where(name, path, header_line), spec)
         decimal = "."
         if sep == ";":
             fh.seek(offset)
@@ -199,7 +219,7 @@ def _layout(path: Path, name: str) -> _Layout:
                 if first:
                     decimal = "," if "," in first else "."
                     break
-    return _Layout(sep, decimal, header_line, offset, data_line, tuple(fields), use)
+    return _Layout(sep, decimal, header_line, offset, data_line, tuple(fields), use, spec)
 
 
 def _scan(path: Path, lay: _Layout, name: str, upto_row: int | None = None):
@@ -222,7 +242,7 @@ def _scan(path: Path, lay: _Layout, name: str, upto_row: int | None = None):
             if len(fields) != ncols:
                 cols = ", ".join(f.strip() for f in lay.names)
                 return lineno, f"expected {ncols} fields ({cols}), got {len(fields)}"
-            for key, i in zip(_COLUMNS, lay.use):
+            for key, i in zip(lay.spec.columns, lay.use):
                 v = _number(fields[i], lay.decimal)
                 if v is None:
                     shown = fields[i].strip()
@@ -308,17 +328,45 @@ def read_history_csv(path, *, name: str = "path"):
         non-numeric or non-finite value, fewer than 2 samples, or t not
         strictly increasing. The message names the file and the line.
     """
+    return tuple(_read_columns(path, name, _HISTORY))
+
+
+def read_pair_history_csv(path, *, name: str = "path"):
+    """Read a node pair's relative history ``t, u1, u2, g`` (SI units: s, m, m, m) from a CSV file.
+
+    The layouts of :func:`read_history_csv` with the columns ``t`` (or
+    ``time``), ``u1``, ``u2`` (relative tangential displacements along t1
+    and t2) and ``g`` (normal approach, positive closes); other columns
+    (such as the ``T1, T2, N`` of ``jointdyn loop --model pair --out``) are
+    ignored.
+
+    Returns
+    -------
+    t, u1, u2, g : ndarray
+        Float64 arrays of equal length (>= 2), finite, t strictly increasing.
+
+    Raises
+    ------
+    ValueError
+        As :func:`read_history_csv`, naming the file and the line.
+    """
+    return tuple(_read_columns(path, name, _PAIR))
+
+
+def _read_columns(path, name: str, spec: _Spec) -> list:
+    """The spec's columns of a CSV file, validated (see :func:`read_history_csv`)."""
     path = V.input_file(name, path)
     try:
-        lay = _layout(path, name)
+        lay = _layout(path, name, spec)
         fast = _fast_columns(path, lay)
         if fast is None or not fast[1] or not all(np.isfinite(c).all() for c in fast[0]):
             bad = _scan(path, lay, name)
             if bad is not None:
                 raise _Refused(f"{_where(name, path, bad[0])}: {bad[1]}")
             if fast is None or not all(np.isfinite(c).all() for c in fast[0]):
-                raise _Refused(f"{_where(name, path)} cannot be parsed as CSV; {_EXPECTED}")
-        t, x, N = fast[0]
+                raise _Refused(f"{_where(name, path)} cannot be parsed as CSV; {spec.expected}")
+        cols = fast[0]
+        t = cols[0]
         if t.size < 2:
             raise _Refused(f"{_where(name, path)} must have at least 2 samples (data rows), got {t.size}")
         steps = np.diff(t)
@@ -332,4 +380,4 @@ def read_history_csv(path, *, name: str = "path"):
             )
     except OSError as exc:
         raise ValueError(f"{_where(name, path)} cannot be read: {exc.strerror or exc}") from None
-    return t, x, N
+    return cols
