@@ -138,3 +138,107 @@ def test_systems_without_interfaces_evaluate_no_pairs():
     q = HBProblem(_system(None), harmonics=1, samples=8)
     assert not q.has_interfaces
     assert q.evaluate(np.zeros(q.size), 1.0).pair_T is None
+
+
+# --- branches, stability, nonlinear modes and the command line ---------------------------------------
+
+
+def _energy_balance(q, X, p, ev):
+    """(input, viscous, pairs' dissipation, normal work by quadrature) per cycle, J, at a solution."""
+    from jointdyn.fourier import derivative_matrix
+
+    w = q.omega(p)
+    Xm = X.reshape(q.nh, q.n)
+    DX = derivative_matrix(q.H) @ Xm
+    f = q.parameter.forcing(q, p)[0]
+    e_in = np.pi * float(f * q.phase_sin @ Xm[2] - f * q.phase_cos @ Xm[1])
+    e_visc = w * np.pi * float(np.einsum("ri,ij,rj->", DX, q.system.C, DX))
+    pairs = q.pair_results(X, ev)
+    dg = q.E @ DX
+    g = np.stack([sum(s * dg[:, q.pair_positions[i, c]] for c, s in ((2, 1.0), (5, -1.0))
+                      if q.pair_positions[i, c] >= 0) for i in range(q.pair_positions.shape[0])])
+    e_n = float(np.sum((ev.pair_N - q.pair_params[:, 3:4]) * g)) * 2.0 * np.pi / q.Ns
+    return e_in, e_visc, float(np.sum(pairs["energy_j"])), e_n, pairs
+
+
+def test_branch_with_interfaces_balances_energy_and_condenses_exactly():
+    s = _system(_patch(), force=(0.5, 0.25, 0.0, 0.0))
+    from jointdyn.hb import continue_hb
+
+    br = continue_hb(s, 0.6, 1.6, harmonics=3, samples=64, condense=False)
+    assert br.status == "complete" and br.lam.size >= 10
+    assert np.all(np.isfinite(br.growth)) and np.all(br.stable)
+    q = br.problem
+    i = int(np.argmax(br.response()[0]))  # near the resonance
+    X, p = br.X[i], br.lam[i]
+    ev = q.evaluate(X, p)
+    e_in, e_visc, e_pairs, e_n, pairs = _energy_balance(q, X, p, ev)
+    assert e_pairs > 0.01 * e_in  # the pairs slip
+    assert abs(e_in - e_visc - e_pairs - e_n) <= 1e-8 * e_in
+    np.testing.assert_allclose(pairs["stick"] + pairs["slip"] + pairs["open"], 1.0, rtol=0, atol=1e-12)
+    # the problem condensed onto the pairs' DOFs (and the response DOF) has the same solution
+    from jointdyn.hb.condense import make_problem
+
+    qc = make_problem(s, condense=True, harmonics=3, samples=64, response_dofs=(br.response_dof,))
+    assert qc.condensed and set(np.unique(_patch().pairs[_patch().pairs >= 0])) <= set(qc.dofs.tolist())
+    Xc = _newton(qc, p, qc.full_coefficients(X, p).reshape(q.nh, q.n)[:, qc.dofs].ravel())
+    np.testing.assert_allclose(qc.full_coefficients(Xc, p), X, rtol=0, atol=1e-9 * np.max(np.abs(X)))
+
+
+def test_epmc_backbone_with_interfaces_balances_energy():
+    from jointdyn.modes import epmc
+
+    s = jd.System(M=M4, C=0.05 * M4, K=K4, interfaces=(_patch(),))  # C = c M: xi M cancels it exactly
+    bb = epmc(s, harmonics=3, samples=64)
+    assert bb.status.ok and bb.points >= 20
+    np.testing.assert_allclose(bb.damping_ratio, bb.damping_ratio_contacts + bb.damping_ratio_viscous,
+                               rtol=1e-6, atol=0)
+    assert bb.energy_pair_j.shape == (bb.points, 2) and np.max(bb.energy_pair_j[-1]) > 0.0
+    # small amplitude: the linear stuck mode with the pairs' springs
+    assert bb.omega_rad_s[0] == pytest.approx(bb.linear.omega_rad_s, rel=1e-9)
+    from jointdyn.modes.backbone import backbone_dataset
+
+    assert backbone_dataset(bb)["energy_pair_j"].dims == ("point", "pair")
+
+
+SYSTEM = """\
+[structure]
+M = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 2.0]]
+K = [[1e3, 0.0, 0.0, -200.0], [0.0, 1.2e3, 0.0, 0.0], [0.0, 0.0, 2e3, 0.0], [-200.0, 0.0, 0.0, 4e3]]
+C = [[10.0, 0.0, 0.0, -2.0], [0.0, 12.0, 0.0, 0.0], [0.0, 0.0, 20.0, 0.0], [-2.0, 0.0, 0.0, 40.0]]
+
+[[force]]
+dof = 0
+amplitude = 0.2
+
+[[contact]]
+law = "jenkins"
+kt = 1e3
+mu = 0.3
+tangential = { dof = 3 }
+normal = { n0 = 1.0 }
+
+[[interface]]
+kt = [1.5e3, 800.0]
+kn = [1.5e3, 3e3]
+mu = 0.5
+preload = [0.5, 0.2]
+pairs = [[0, 1, 2, -1, -1, -1], [3, -1, 2, 0, -1, -1]]
+"""
+
+
+def test_command_line_hb_and_modes_take_interfaces(tmp_path, capsys):
+    import json
+
+    from jointdyn.cli import main
+
+    p = tmp_path / "sys.toml"
+    p.write_text(SYSTEM)
+    rc = main(["frc", "--method", "hb", "--system", str(p), "--gamma", "0.8:1.2:0.1", "--harmonics", "3",
+               "--samples", "32", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert rc == 0 and out["status"] == "complete"
+    rc = main(["modes", "--system", str(p), "--harmonics", "3", "--samples", "32", "--amplitude", "1e-6:1e-4",
+               "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert rc == 0 and out["status"] == "complete"

@@ -122,13 +122,11 @@ def test_system_validates_its_interfaces():
 
 def test_solvers_refuse_interfaces_they_do_not_march(tmp_path, capsys):
     s = jd.read_system(_write(tmp_path, BASE))
-    from jointdyn.modes import epmc, qsma
+    from jointdyn.modes import qsma
 
     calls = [
         lambda: jd.integrate(s, gamma=1.0, periods=2),
         lambda: jd.steady_state(s, 1.0),
-        lambda: jd.harmonic_balance(s, 1.0),
-        lambda: epmc(s, [1e-4, 1e-3]),
         lambda: qsma(s, [1e-4, 1e-3]),
         lambda: jd.reduce_system(s, 1),
     ]
@@ -136,9 +134,7 @@ def test_solvers_refuse_interfaces_they_do_not_march(tmp_path, capsys):
         with pytest.raises(ValueError, match="^interfaces: .* do(es)? not take interfaces yet"):
             call()
     p = str(tmp_path / "sys.toml")
-    for argv in (["frc", "--system", p, "--gamma", "0.9:1.1:0.1", "--json"],
-                 ["frc", "--method", "hb", "--system", p, "--gamma", "0.9:1.1:0.1", "--json"],
-                 ["modes", "--system", p, "--json"]):
+    for argv in (["frc", "--system", p, "--gamma", "0.9:1.1:0.1", "--json"],):
         try:
             rc = main(argv)
         except SystemExit as exc:

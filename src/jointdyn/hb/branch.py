@@ -70,7 +70,7 @@ from ..systems import System
 from ._aft import INFO_ERROR, INFO_PASSES, INFO_PERIOD
 from .condense import make_problem
 from .parameters import F1, GAMMA
-from .problem import HBProblem, contact_of
+from .problem import HBProblem, reference_scales
 from .results import HBBranch, HBPeak, PointStatus
 
 __all__ = ["continued_branch", "solve_point"]
@@ -218,9 +218,9 @@ def _confirmed_stability(problem: HBProblem, X, lam, growth):
 
 def _scales(problem: HBProblem, start: float):
     """(xs, fs, ps): units of the unknowns (fy/kt, m), of the residual (max(F1, fy), N) and of the parameter."""
-    c = contact_of(problem.system)
-    xs = c.law.fy / c.law.kt if c.law.fy > 0 else 1.0
-    fs = max(problem.f1_ref, c.law.fy, 1e-300)
+    kt, fy = reference_scales(problem.system)
+    xs = fy / kt if fy > 0 else 1.0
+    fs = max(problem.f1_ref, fy, 1e-300)
     return xs, fs, problem.parameter.scale(problem, start)
 
 
@@ -264,8 +264,7 @@ class _Tracker:
         self.problem = problem
         self.scales = scales
         self.dof = dof
-        law = contact_of(problem.system).law
-        self.kt, self.fy = law.kt, law.fy
+        self.kt, self.fy = reference_scales(problem.system)
         self.last = None
         #: parameter value -> (X, evaluation, amplitudes of the response DOF) at accepted points
         self.evaluations = {}

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from .problem import contact_of
+from .problem import reference_scales
 from .results import HBBranch, PointStatus
 
 __all__ = ["branch_dataset", "discretisation_attrs"]
@@ -51,14 +51,14 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
     dof = branch.response_dof if response_dof is None else response_dof
     if not 0 <= dof < p.system.ndof:
         raise ValueError(f"response_dof must be in [0, {p.system.ndof - 1}], got {dof!r}")
-    law = contact_of(p.system).law
+    kt, fy = reference_scales(p.system)
     amp, off, mx = branch.response(dof)
     Xd = p.dof_coefficients(branch.X, dof, branch.lam) if branch.X.size else np.empty((0, p.nh))
     harm = np.empty((Xd.shape[0], p.H + 1))
     harm[:, 0] = np.abs(Xd[:, 0])
     for k in range(1, p.H + 1):
         harm[:, k] = np.hypot(Xd[:, 2 * k - 1], Xd[:, 2 * k])
-    qs = law.kt / law.fy if law.fy > 0 else np.nan
+    qs = kt / fy if fy > 0 else np.nan
     data = {
         "gamma": ("point", branch.gamma()),
         "amplitude_q": ("point", qs * amp),

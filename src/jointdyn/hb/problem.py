@@ -39,9 +39,10 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from .._cache import by_identity, by_value
-from ..fourier import STARTS, STOPS, extrema, fourier_matrices, phases, separation_grid
+from ..fourier import STARTS, STOPS, derivative_matrix, extrema, fourier_matrices, phases, separation_grid
 from ..kinematics import NORMAL_SPRING, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
 from ..laws import law_dispatch
+from ..laws._base import MACROSLIP, SEPARATION, STICK_SLIP
 from ..systems import Contact, System
 from ._aft import NO_EVENT, eval_kernel, recontact_events
 from ._aft_pairs import pair_directions, pairs_aft
@@ -513,6 +514,28 @@ class HBProblem:
         c = self.dof_coefficients(X, dof, p)
         return math.hypot(c[1], c[2])
 
+    def pair_results(self, X, ev: _Eval) -> dict | None:
+        """Per node pair of the interfaces (stacked over them) at coefficients X (m) and their evaluation
+        ``ev``: ``energy_j`` the energy dissipated per cycle, ``oint T . du`` (J, the sum over the AFT samples,
+        the quadrature of the Galerkin projection, so that the energy balance holds to the residual), and the
+        fractions of the period ``stick``, ``slip`` and ``open`` (over the samples, their sum 1): the data
+        of a slip map. None without interfaces."""
+        if not self.has_interfaces:
+            return None
+        npairs = self.pair_positions.shape[0]
+        Xm = np.asarray(X, dtype=np.float64).reshape(self.nh, self.n)
+        Y = np.zeros((self.nh, npairs, 2))
+        for k in range(2):
+            for col, sign in ((k, 1.0), (k + 3, -1.0)):
+                pos = self.pair_positions[:, col]
+                live = pos >= 0
+                Y[:, live, k] += sign * Xm[:, pos[live]]
+        du = np.einsum("jh,hpk->pjk", self.E @ derivative_matrix(self.H), Y)  # du/dtau at the samples, m
+        code = ev.pair_code
+        return {"energy_j": np.einsum("pjk,pjk->p", ev.pair_T, du) * (2.0 * math.pi / self.Ns),
+                "stick": np.mean(code == STICK_SLIP, axis=1), "slip": np.mean(code == MACROSLIP, axis=1),
+                "open": np.mean(code == SEPARATION, axis=1)}
+
     # --- stability ----------------------------------------------------------
     def hill_growth(self, JXs, ws):
         """max Re(s) / w of the Floquet exponents (Hill's method) at many points (:func:`~jointdyn.hb.stability.hill_growth`)."""
@@ -535,6 +558,19 @@ def contacts_only(system: System) -> System:
 @by_identity
 def _stripped(system: System) -> System:
     return dataclasses.replace(system, interfaces=(), w0_rad_s=system.w0)
+
+
+def reference_scales(system: System) -> tuple[float, float]:
+    """(kt N/m, fy N) that normalise amplitudes (q = kt x / fy): the first contact's law, else the
+    interfaces' patch as a whole along one tangential direction (kt the sum of the pairs' kt, fy the sum
+    of their slip forces at rest, mu P); ValueError naming ``system`` when it has neither."""
+    if system.contacts:
+        law = system.contacts[0].law
+        return float(law.kt), float(law.fy)
+    if system.interfaces:
+        kt = sum(float(np.sum(itf.kt)) for itf in system.interfaces)
+        return kt, sum(float(np.sum(itf.mu * itf.preload)) for itf in system.interfaces)
+    raise ValueError("system must have at least one contact or interface")
 
 
 def contact_of(system: System) -> Contact:
