@@ -97,72 +97,77 @@ def test_forces_on_the_structure_follow_the_normal_spring_signs():
 # --- exact derivatives -------------------------------------------------------------------
 
 
-def _step1(params, u, g, w):
+def _step1(params, x, w):
+    """One pair's step from the start x[:3] = (u1, u2, g) to the end x[3:] from the slider w:
+    ((T1, T2, N), w_new, code)."""
     T = np.empty((1, 2))
     N = np.empty(1)
     code = np.empty(1, dtype=np.int8)
     w_new = np.empty((1, 2))
-    interface_step(params, u, g, u, g, w, w_new, T, N, code)
+    interface_step(params, x[None, 0:2], x[2:3], x[None, 3:5], x[5:6], w[None], w_new, T, N, code)
     return np.array([T[0, 0], T[0, 1], N[0]]), w_new[0].copy(), int(code[0])
 
 
-@settings(max_examples=200, deadline=None)
-@given(
-    u1=st.floats(-3e-3, 3e-3, **finite), u2=st.floats(-3e-3, 3e-3, **finite),
-    g=st.floats(-2e-3, 2e-3, **finite), w1=st.floats(-3e-3, 3e-3, **finite), w2=st.floats(-3e-3, 3e-3, **finite),
-    dw=st.lists(st.floats(-1.0, 1.0, **finite), min_size=6, max_size=6),
-)
-def test_tangent_and_jvp_equal_finite_differences(u1, u2, g, w1, w2, dw):
+def _steps_of_every_kind():
+    """Start (u1, u2, g), end and slider of one pair (kt 1e3, kn 2e3, mu 0.4, P 2: slip force 0.8 N,
+    opening at g = -1e-3 m) such that every state change happens inside a step: stuck, slipping,
+    leaving the disc inside the step, opening, re-closing, N rising and falling, a start outside the
+    disc."""
+    mm = st.floats(-2e-3, 2e-3, **finite)
+    return st.tuples(mm, mm, st.floats(-1.6e-3, 1.5e-3, **finite), mm, mm, st.floats(-1.6e-3, 1.5e-3, **finite),
+                     st.floats(-1.5e-3, 1.5e-3, **finite), st.floats(-1.5e-3, 1.5e-3, **finite))
+
+
+@settings(max_examples=300, deadline=None)
+@given(case=_steps_of_every_kind(), dirs=st.lists(st.floats(-1.0, 1.0, **finite), min_size=16, max_size=16))
+def test_tangent_and_jvp_equal_finite_differences(case, dirs):
+    """The exact derivatives of the straight-path step with respect to its start, end and committed
+    slider (interface_step_jvp) and to its end (interface_step_tangent) against central differences,
+    through stick, slip, opening and re-closing inside the step (away from the instants where a state
+    change reaches an end of the step)."""
     it = _pair()
     p = it.params
     kt, kn, mu, P = p[0]
-    n = P + kn * g
-    r = kt * math.hypot(u1 - w1, u2 - w2)
-    # away from the transitions (open / closed, stick / slip) and from r = 0 in slip
-    assume(abs(n) > 1e-3 * P)
-    assume(n <= 0 or abs(r - mu * n) > 1e-3 * mu * P)
-    assume(n <= 0 or r > 1e-3 * mu * P)
-    u = np.array([[u1, u2]])
-    gg = np.array([g])
-    w = np.array([[w1, w2]])
-    y0, wn0, c0 = _step1(p, u, gg, w)
-    event(f"state {c0}")
-    # tangent at fixed slider against central differences
-    J = np.empty((1, 3, 3))
-    T = np.empty((1, 2))
-    N = np.empty(1)
-    code = np.empty(1, dtype=np.int8)
-    w_new = np.empty((1, 2))
-    interface_step_tangent(p, u, gg, u, gg, w, w_new, T, N, code, J)
-    assert code[0] == c0 and np.array_equal(np.array([T[0, 0], T[0, 1], N[0]]), y0)
+    a1, a2, g0, u1, u2, g, w1, w2 = case
+    x = np.array([a1 * 0.5, a2 * 0.5, g0, u1, u2, g])
+    w = np.array([a1 * 0.5 + w1 * 0.5, a2 * 0.5 + w2 * 0.5])
+    assume(math.hypot(u1 - x[0], u2 - x[1]) > 1e-6)  # the slip direction of v / |v|
+    y0, wn0, c0 = _step1(p, x, w)
+    n0, n1 = P + kn * g0, P + kn * g
+    assume(abs(n1) > 1e-3 * P and abs(n0) > 1e-3 * P)
+    event(f"state {c0}" + (", re-closing" if n0 < 0 < n1 else "") + (", N falls" if n1 < n0 else ""))
+    # the 8 inputs (start, end, slider) one by one and two random mixtures of them
+    D = np.concatenate([np.eye(8), np.array(dirs).reshape(8, 2)], axis=1)  # (8 inputs, 10 directions)
     h = 1e-9
-    fd = np.empty((3, 3))
-    for k in range(3):
-        e = np.zeros(3)
-        e[k] = h
-        yp = _step1(p, u + e[:2], gg + e[2], w)
-        ym = _step1(p, u - e[:2], gg - e[2], w)
-        assert yp[2] == ym[2] == c0
-        fd[:, k] = (yp[0] - ym[0]) / (2 * h)
-    np.testing.assert_allclose(J[0], fd, rtol=1e-5, atol=1e-6 * kt)
-    # jvp: three input directions plus a derivative of the committed slider (the history)
-    dW = np.array(dw).reshape(1, 2, 3) * 1e-0
-    du = np.zeros((1, 2, 3))
-    du[0, 0, 0] = du[0, 1, 1] = 1.0
-    dg = np.zeros((1, 3))
-    dg[0, 2] = 1.0
-    dT, dN, dwn = np.empty((1, 2, 3)), np.empty((1, 3)), np.empty((1, 2, 3))
-    interface_step_jvp(p, u, du, gg, dg, u, du, gg, dg, w, dW, w_new, dwn, T, dT, N, dN, code)
+    fd = np.empty((5, D.shape[1]))
+    for k in range(D.shape[1]):
+        d = D[:, k] * h
+        yp, wp, cp = _step1(p, x + d[:6], w + d[6:])
+        ym, wm, cm = _step1(p, x - d[:6], w - d[6:])
+        assume(cp == cm == c0)
+        fd[:3, k] = (yp - ym) / (2 * h)
+        fd[3:, k] = (wp - wm) / (2 * h)
+    nd = D.shape[1]
+    du0 = np.ascontiguousarray(D[None, 0:2]).reshape(1, 2, nd)
+    dg0 = np.ascontiguousarray(D[None, 2])
+    du = np.ascontiguousarray(D[None, 3:5]).reshape(1, 2, nd)
+    dg = np.ascontiguousarray(D[None, 5])
+    dw = np.ascontiguousarray(D[None, 6:8]).reshape(1, 2, nd)
+    T, N, code, w_new = np.empty((1, 2)), np.empty(1), np.empty(1, dtype=np.int8), np.empty((1, 2))
+    dT, dN, dwn = np.empty((1, 2, nd)), np.empty((1, nd)), np.empty((1, 2, nd))
+    interface_step_jvp(p, x[None, 0:2], du0, x[2:3], dg0, x[None, 3:5], du, x[5:6], dg, w[None], dw, w_new, dwn,
+                       T, dT, N, dN, code)
     assert code[0] == c0 and np.array_equal(np.array([T[0, 0], T[0, 1], N[0]]), y0)
-    for k in range(3):
-        e = np.zeros(3)
-        e[k] = h
-        dwk = dW[0, :, k] * h
-        yp, wp, _ = _step1(p, u + e[:2], gg + e[2], w + dwk)
-        ym, wm, _ = _step1(p, u - e[:2], gg - e[2], w - dwk)
-        np.testing.assert_allclose([dT[0, 0, k], dT[0, 1, k], dN[0, k]], (yp - ym) / (2 * h), rtol=1e-5,
-                                   atol=1e-6 * kt)
-        np.testing.assert_allclose(dwn[0, :, k], (wp - wm) / (2 * h), rtol=1e-5, atol=1e-6)
+    assert np.array_equal(w_new[0], wn0)
+    an = np.concatenate([dT[0], dN, dwn[0]], axis=0)
+    scale = np.abs(fd).max(axis=0) + kt * 1e-3
+    np.testing.assert_allclose(an[:3], fd[:3], rtol=0, atol=2e-5 * scale.max())
+    np.testing.assert_allclose(an[3:], fd[3:], rtol=0, atol=2e-5 * (np.abs(fd[3:]).max() + 1e-3))
+    # the tangent: the columns of the end point with the start and the slider fixed
+    J = np.empty((1, 3, 3))
+    interface_step_tangent(p, x[None, 0:2], x[2:3], x[None, 3:5], x[5:6], w[None], w_new, T, N, code, J)
+    assert code[0] == c0 and np.array_equal(np.array([T[0, 0], T[0, 1], N[0]]), y0)
+    np.testing.assert_allclose(J[0], an[:3, 3:6], rtol=1e-13, atol=1e-13 * kt)
 
 
 def _march_jvp(it, U, dU, G, dG):

@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 
 from jointdyn import DiscreteIwan, Jenkins, march, quasistatic
 from jointdyn.drivers import interface_loop
+from jointdyn.drivers.interface_loop import _insert_crossings
 from jointdyn.interfaces import Interface, interface_march
 from jointdyn.laws import MACROSLIP, SEPARATION, STICK_SLIP
 
@@ -27,16 +28,21 @@ def _circle(n, a, cycles=3):
     return t, a * np.cos(2 * np.pi * t), a * np.sin(2 * np.pi * t)
 
 
+#: samples per cycle of the polygon that meets the circular orbit's energy to 1e-6 (measured error
+#: -6.5e-7 at 4096, -2.6e-6 at 2048: second order, the inscribed polygon and the trapezoidal work)
+CIRCLE_SAMPLES = 4096
+
+
 def test_circular_orbit_dissipates_2_pi_mu_N_rho():
-    """Steady circular orbit at constant load: E = 2 pi mu N sqrt(a^2 - (mu N / kt)^2). The radial
-    return converges at first order in the step; the extrapolation of two step sizes meets the
-    closed form to 1e-6."""
+    """Steady circular orbit at constant load: E = 2 pi mu N sqrt(a^2 - (mu N / kt)^2). The element is
+    exact along each side of the inscribed polygon, so the error is the polygon's and the trapezoidal
+    work's, second order in the step: 1e-6 with CIRCLE_SAMPLES samples per cycle."""
     r = MU * P / KT
     a = 2.0 * r
     exact = 2 * math.pi * MU * P * math.sqrt(a * a - r * r)
     it = _one_pair()
-    E = []
-    for n in (4096, 8192):
+    err = []
+    for n in (CIRCLE_SAMPLES // 2, CIRCLE_SAMPLES):
         t, u1, u2 = _circle(n, a)
         res = interface_loop(it, t, u1, u2, np.zeros_like(t), period=1.0)
         assert res.n_cycles == 3 and res.status == "ok" and res.status.ok
@@ -44,10 +50,9 @@ def test_circular_orbit_dissipates_2_pi_mu_N_rho():
         # |T| = mu N at every sample of the last cycle
         sl = res.t >= res.t_start_s
         np.testing.assert_allclose(np.hypot(*res.T[sl, 0].T), MU * P, rtol=1e-12)
-        E.append(res.energy_per_cycle_J)
-    err = [e / exact - 1.0 for e in E]
-    assert abs(err[0]) < 1e-3 and 1.9 < err[0] / err[1] < 2.1  # first order
-    assert abs((2 * E[1] - E[0]) / exact - 1.0) < 1e-6
+        err.append(res.energy_per_cycle_J / exact - 1.0)
+    assert abs(err[1]) < 1e-6
+    assert 3.9 < err[0] / err[1] < 4.1  # second order
 
 
 def test_circular_orbit_inside_the_friction_circle_sticks():
@@ -103,9 +108,13 @@ def _reduction_history(nt=1201, g1=1.5 * P / KN):
 def test_one_direction_patch_is_the_discrete_iwan_model(n):
     """P_i = P f_i, kn_i = kn f_i, common normal approach, motion along t1: the patch's force is the
     discrete Iwan model's with slip forces mu P f_i under N = max(0, P + kn g), sample by sample
-    (kernels), separation and re-contact included."""
+    (kernels), separation and re-contact included. The opening and closing instants are samples (as
+    the drivers insert them): the pair re-closes at its exact instant inside a step, the contact
+    laws at the sample."""
     it, law = _patch(n)
     t, x, g = _reduction_history()
+    t, (x, g), inserted = _insert_crossings(t, [x, g], (P + KN * g)[:, None])
+    assert inserted.any()
     nt = t.size
     U = np.zeros((nt, n, 2))
     U[:, :, 0] = x[:, None]
@@ -118,7 +127,7 @@ def test_one_direction_patch_is_the_discrete_iwan_model(n):
     Td, _, code_d, _ = march(law, x, Nd, state=law.initial_state(x[0], Nd[0]))
     np.testing.assert_allclose(T[:, :, 0].sum(axis=1), Td, rtol=0, atol=1e-12 * MU * P)
     np.testing.assert_allclose(T[:, :, 1], 0.0, atol=0)
-    np.testing.assert_allclose(N.sum(axis=1), Nd, rtol=1e-13)
+    np.testing.assert_allclose(N.sum(axis=1), Nd, rtol=1e-13, atol=1e-13 * P)  # the crossings: N ~ 0
     assert np.any(code_d == SEPARATION) and np.any(code_d == MACROSLIP)
     np.testing.assert_array_equal(code[:, 0] == SEPARATION, code_d == SEPARATION)
 

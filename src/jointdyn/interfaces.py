@@ -7,10 +7,18 @@ B; -1 is a fixed side), and sees
     u_k = x[a_tk] - x[b_tk]  (k = 1, 2),   g = x[a_n] - x[b_n]  (positive closes),
     N = max(0, P + kn g),   T = kt (u - w),   |T| <= mu N,
 
-with the slider ``w`` (a 2-vector, m) its only memory. One step is a
-trial from the committed slider: open (N = 0) gives T = 0 and w = u; a
-trial force ``kt (u - w)`` inside the circle of radius ``mu N`` sticks;
-outside it slips by radial return onto the circle. The structure feels
+with the slider ``w`` (a 2-vector, m) its only memory. A step is
+integrated exactly along the straight path from its start point
+``(u0, g0)``, where the slider was committed, to its end ``(u, g)``
+(histories are piecewise linear between samples): open at the end
+(N = 0) gives T = 0 and w = u; a pair open at the start closes at the
+instant where ``P + kn g`` = 0 with T = 0 and w = u there; closed, it
+sticks while the trial force stays in the disc ``|T| <= mu N`` (the exit
+instant a root of a quadratic, ``_exit``) and slips from there to
+the end with the closed form of the turning angle (``_turn``). The
+radial return of the end point's trial force onto the circle is the
+special case without turning (1-D motion). A step that starts where it
+ends (a march's first sample) is that radial return. The structure feels
 ``-T`` on side A and ``+T`` on side B along t1, t2, and ``-(N - P)`` on
 ``a_n``, ``+(N - P)`` on ``b_n`` (the signs of the normal springs,
 :mod:`jointdyn.kinematics`).
@@ -47,8 +55,9 @@ with the arguments::
                                     end point, start point and committed slider
                                     fixed (output)
 
-The derivative of the slider carries the history (as ``step_jvp`` of the
-contact laws, ``jointdyn.laws._base``): the chain rule through a march is
+The derivatives are exact: forward mode through the closed form (``_dpair``), along directions
+of the start point (du0, dg0), the end point (du, dg) and the committed slider (dw_old). The
+derivative of the slider carries the history (as ``step_jvp`` of the contact laws, ``jointdyn.laws._base``): the chain rule through a march is
 exact away from the measure-zero instants where a pair changes state.
 ``interface_step_jvp`` and ``interface_step_tangent`` return the primal
 outputs of ``interface_step`` bit for bit.
@@ -86,46 +95,213 @@ PARAM_NAMES = ("kt", "kn", "mu", "preload")
 # --- compiled kernels ----------------------------------------------------------------
 
 
-@jit(inline="always")
-def _pair(kt, kn, mu, P, u1, u2, g, w1, w2):  # pragma: no cover - compiled
-    """Step of one pair (docs/model.md section 10), scalars in and out. The arrays are read and
-    written in one place (:func:`_pair_step`): a first version that wrote them in every branch of
-    this helper's early returns measured 71 instead of 5.7 ns per pair and step.
+#: the intermediates of an open pair (:func:`_pair`)
+_NO_AUX = (0.0,) * 27
 
-    Returns ``code, T1, T2, N, w1_new, w2_new`` and, for the derivatives, the trial force
-    ``(t1, t2)``, its norm ``r`` and the slip factor ``s = mu N / r`` (1 when stuck).
+
+@jit(inline="always")
+def _log1p_ratio(z):  # pragma: no cover - compiled
+    """``h(z) = log(1 + z) / z`` and ``h'(z)`` (z > -1), by their series near 0 where the quotients
+    cancel (|z| < 1e-3: truncation below 1e-18, the quotients' rounding below 3e-13 beyond)."""
+    if abs(z) < 1e-3:
+        h = 1.0 + z * (-1.0 / 2 + z * (1.0 / 3 + z * (-1.0 / 4 + z * (1.0 / 5 + z * (-1.0 / 6 + z / 7)))))
+        dh = -1.0 / 2 + z * (2.0 / 3 + z * (-3.0 / 4 + z * (4.0 / 5 + z * (-5.0 / 6 + z * 6.0 / 7))))
+        return h, dh
+    lg = math.log1p(z)
+    return lg / z, (z / (1.0 + z) - lg) / (z * z)
+
+
+@jit(inline="always")
+def _closing(kt, mu, n0, n1, a1, a2, w1, w2):  # pragma: no cover - compiled
+    """Start of the closed part of a step: its length L (in units of the step), force Ta and load Na
+    there, the committed trial force T0 = kt (u0 - w_old) and its norm r0, and the flags
+    ``reclose`` (open at the start: closes at tau = n0 / (n0 - n1) with T = 0 and no memory) and
+    ``proj`` (a start outside the disc |T| <= mu N, slid back onto it radially first)."""
+    if not n0 > 0.0:
+        return n1 / (n1 - n0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0
+    t1 = kt * (a1 - w1)
+    t2 = kt * (a2 - w2)
+    r2 = t1 * t1 + t2 * t2
+    lim = mu * n0
+    if r2 <= lim * lim:  # (r0 is only needed to slide back)
+        return 1.0, t1, t2, n0, t1, t2, 0.0, 0.0, 0.0
+    r = math.sqrt(r2)
+    f = lim / r
+    return 1.0, f * t1, f * t2, n0, t1, t2, r, 0.0, 1.0
+
+
+@jit(inline="always")
+def _exit(kt, mu, v1, v2, s, nd, Ta1, Ta2, Na, proj):  # pragma: no cover - compiled
+    """First sigma >= 0 where the stuck trial ``Ta + kt v sigma`` leaves the disc of radius
+    ``mu (Na + nd sigma)``: the root of ``a sigma^2 + 2 b sigma + c`` where it rises through 0, in
+    the forms free of cancellation; inf when it never leaves."""
+    a = (kt * s) ** 2 - (mu * nd) ** 2
+    b = kt * (Ta1 * v1 + Ta2 * v2) - mu * mu * Na * nd
+    c = 0.0 if proj > 0.0 else min(Ta1 * Ta1 + Ta2 * Ta2 - (mu * Na) ** 2, 0.0)
+    if b > 0.0:
+        q2 = b * b - a * c
+        return -c / (b + math.sqrt(q2)) if q2 >= 0.0 else math.inf
+    if a > 0.0:
+        return (math.sqrt(b * b - a * c) - b) / a
+    return math.inf
+
+
+@jit(inline="always")
+def _turn(kt, mu, v1, v2, s, nd, Ts1, Ts2, Ns, Ls, n1):  # pragma: no cover - compiled
+    """Slip from the force Ts (on the circle, load Ns) over the rest Ls of the step: the direction e
+    at the end, at the angle phi from v / |v| with tan(phi / 2) = F tan(phi_s / 2),
+    F = exp(-kt |v| l / mu), l = int dtau / N. Returns e1, e2, the half-angle (x, y) of phi_s
+    (a vector along it, not of unit length), F, l, dl / dnd and ``turned`` (0: no start
+    direction, e = v / |v|)."""
+    rs = math.sqrt(Ts1 * Ts1 + Ts2 * Ts2)
+    if s == 0.0:  # no tangential motion: the force keeps its direction
+        return Ts1 / rs, Ts2 / rs, 1.0, 0.0, 1.0, 0.0, 0.0, 1.0
+    inv = 1.0 / s
+    p1 = v1 * inv
+    p2 = v2 * inv
+    x, y, F, ell, dl, turned = 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    if rs > 0.0:
+        inv = 1.0 / rs
+        c = (p1 * Ts1 + p2 * Ts2) * inv
+        sn = (p1 * Ts2 - p2 * Ts1) * inv
+        if c >= 0.0:
+            x, y = 1.0 + c, sn
+        else:  # (1 + cos, sin) without the cancellation near phi_s = pi
+            x, y = abs(sn), (1.0 - c if sn >= 0.0 else c - 1.0)
+        q = Ls / Ns
+        hz, dhz = _log1p_ratio(nd * q)
+        ell = q * hz
+        dl = q * q * dhz
+        F = math.exp(-kt * s * ell / mu)
+        turned = 1.0
+    Fy = F * y
+    D = x * x + Fy * Fy
+    inv = 1.0 / D if D > 0.0 else 0.0
+    cp, sp = ((x * x - Fy * Fy) * inv, 2.0 * x * Fy * inv) if D > 0.0 else (-1.0, 0.0)
+    return cp * p1 - sp * p2, cp * p2 + sp * p1, x, y, F, ell, dl, turned
+
+
+@jit(inline="always")
+def _pair(kt, kn, mu, P, a1, a2, g0, u1, u2, g, w1, w2):  # pragma: no cover - compiled
+    """Step of one pair along the straight path from (a, g0) to (u, g) (docs/model.md section 10),
+    scalars in and out: open at the end; else closed from the start (or from re-closing), stuck
+    until the trial leaves the disc (:func:`_exit`), slipping from there to the end (:func:`_turn`).
+
+    Returns ``code, T1, T2, N, w1_new, w2_new`` and the tuple of intermediates :func:`_dpair` takes.
     """
-    n = P + kn * g
-    if not n > 0.0:
-        return SEPARATION, 0.0, 0.0, 0.0, u1, u2, 0.0, 0.0, 0.0, 0.0
-    t1 = kt * (u1 - w1)
-    t2 = kt * (u2 - w2)
-    r = math.sqrt(t1 * t1 + t2 * t2)
-    lim = mu * n
-    if r <= lim:
-        return STICK_SLIP, t1, t2, n, w1, w2, t1, t2, r, 1.0
-    s = lim / r
-    T1 = s * t1
-    T2 = s * t2
-    return MACROSLIP, T1, T2, n, u1 - T1 / kt, u2 - T2 / kt, t1, t2, r, s
+    n1 = P + kn * g
+    if not n1 > 0.0:
+        return SEPARATION, 0.0, 0.0, 0.0, u1, u2, _NO_AUX
+    n0 = P + kn * g0
+    L, Ta1, Ta2, Na, T01, T02, r0, reclose, proj = _closing(kt, mu, n0, n1, a1, a2, w1, w2)
+    v1 = u1 - a1
+    v2 = u2 - a2
+    s = math.sqrt(v1 * v1 + v2 * v2)
+    nd = n1 - n0
+    sig = _exit(kt, mu, v1, v2, s, nd, Ta1, Ta2, Na, proj)
+    if not sig < L:  # stuck to the end
+        if reclose > 0.0:
+            T1, T2, wn1, wn2 = kt * v1 * L, kt * v2 * L, u1 - v1 * L, u2 - v2 * L
+        elif proj > 0.0:
+            T1, T2 = Ta1 + kt * v1, Ta2 + kt * v2
+            wn1, wn2 = u1 - T1 / kt, u2 - T2 / kt
+        else:
+            T1, T2, wn1, wn2 = kt * (u1 - w1), kt * (u2 - w2), w1, w2
+        aux = (1.0, L, n0, n1, v1, v2, s, Ta1, Ta2, T01, T02, r0, reclose, proj, sig,
+               0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        # the state at the end: stuck inside the disc; a start slid back onto the circle reports slip
+        # when the step does not carry the force off it (as the radial return of a step without motion)
+        slid = proj > 0.0 and ((s == 0.0 and nd == 0.0) or not T1 * T1 + T2 * T2 < (mu * n1) ** 2)
+        return (MACROSLIP if slid else STICK_SLIP), T1, T2, n1, wn1, wn2, aux
+    Ts1 = Ta1 + kt * v1 * sig
+    Ts2 = Ta2 + kt * v2 * sig
+    Ns = Na + nd * sig
+    Ls = L - sig
+    e1, e2, x, y, F, ell, dl, turned = _turn(kt, mu, v1, v2, s, nd, Ts1, Ts2, Ns, Ls, n1)
+    T1 = mu * n1 * e1
+    T2 = mu * n1 * e2
+    aux = (2.0, L, n0, n1, v1, v2, s, Ta1, Ta2, T01, T02, r0, reclose, proj, sig,
+           Ls, Ts1, Ts2, Ns, x, y, F, ell, dl, e1, e2, turned)
+    return MACROSLIP, T1, T2, n1, u1 - T1 / kt, u2 - T2 / kt, aux
+
+
+@jit(inline="always")
+def _dstart(kt, kn, mu, aux, da1, da2, dg0, dg, dw1, dw2):  # pragma: no cover - compiled
+    """Derivatives of the closed part's start (:func:`_closing`) along one direction: dL, dTa, dNa."""
+    L, n0, n1, T01, T02, r0, reclose, proj = aux[1], aux[2], aux[3], aux[9], aux[10], aux[11], aux[12], aux[13]
+    if reclose > 0.0:
+        nd = n1 - n0
+        return kn * (n1 * dg0 - n0 * dg) / (nd * nd), 0.0, 0.0, 0.0
+    d1 = kt * (da1 - dw1)
+    d2 = kt * (da2 - dw2)
+    if proj > 0.0:  # radial return of the start
+        q1 = T01 / r0
+        q2 = T02 / r0
+        along = q1 * d1 + q2 * d2
+        f = mu * n0 / r0
+        dn0 = mu * kn * dg0
+        d1, d2 = dn0 * q1 + f * (d1 - q1 * along), dn0 * q2 + f * (d2 - q2 * along)
+    return 0.0, d1, d2, kn * dg0
+
+
+@jit(inline="always")
+def _dpair(kt, kn, mu, aux, da1, da2, dg0, du1, du2, dg, dw1, dw2):  # pragma: no cover - compiled
+    """Forward-mode derivative of a closed pair's step (:func:`_pair`, its ``aux``) along one direction
+    of the start (da, dg0), end (du, dg) and committed slider (dw): returns dT1, dT2, dw1_new, dw2_new.
+    The exit instant needs no derivative: the force turns at the same rate stuck or slipping when on
+    the circle, so the end force does not depend on where along the path the slip starts."""
+    kind, L, n0, n1, v1, v2, s, sig = aux[0], aux[1], aux[2], aux[3], aux[4], aux[5], aux[6], aux[14]
+    if kind == 1.0 and aux[12] == 0.0 and aux[13] == 0.0:  # plain stick: T = kt (u - w_old)
+        return kt * (du1 - dw1), kt * (du2 - dw2), dw1, dw2
+    dL, dTa1, dTa2, dNa = _dstart(kt, kn, mu, aux, da1, da2, dg0, dg, dw1, dw2)
+    dv1 = du1 - da1
+    dv2 = du2 - da2
+    if kind == 1.0:
+        d1 = dTa1 + kt * (dv1 * L + v1 * dL)
+        d2 = dTa2 + kt * (dv2 * L + v2 * dL)
+        return d1, d2, du1 - d1 / kt, du2 - d2 / kt
+    Ls, Ts1, Ts2, Ns, x, y, F, ell, dl, e1, e2, turned = aux[15:27]
+    dnd = kn * (dg - dg0)
+    dTs1 = dTa1 + kt * dv1 * sig
+    dTs2 = dTa2 + kt * dv2 * sig
+    if s == 0.0:
+        dth = (Ts1 * dTs2 - Ts2 * dTs1) / (Ts1 * Ts1 + Ts2 * Ts2)
+    else:
+        dth = (v1 * dv2 - v2 * dv1) / (s * s)  # turn of v
+        Fy = F * y
+        D = x * x + Fy * Fy
+        if turned > 0.0 and D > 0.0:
+            dphis = (Ts1 * dTs2 - Ts2 * dTs1) / (Ts1 * Ts1 + Ts2 * Ts2) - dth
+            dNs = dNa + dnd * sig
+            dell = dL / n1 - Ls / (Ns * n1) * dNs + dl * dnd
+            dF = -F * kt / mu * ((v1 * dv1 + v2 * dv2) / s * ell + s * dell)
+            dth += (F * (x * x + y * y) * dphis + 2.0 * x * y * dF) / D
+    dn1 = mu * kn * dg
+    f = mu * n1 * dth
+    d1 = dn1 * e1 - f * e2
+    d2 = dn1 * e2 + f * e1
+    return d1, d2, du1 - d1 / kt, du2 - d2 / kt
 
 
 @jit(inline="always")
 def _pair_step(params, i, u0, g0, u, g, w_old, w_new, T, N):  # pragma: no cover - compiled
-    """:func:`_pair` of pair i, its outputs written; returns code, t1, t2, r, s."""
-    c, T1, T2, n, v1, v2, t1, t2, r, s = _pair(params[i, 0], params[i, 1], params[i, 2], params[i, 3],
-                                               u[i, 0], u[i, 1], g[i], w_old[i, 0], w_old[i, 1])
+    """:func:`_pair` of pair i, its outputs written (the arrays read and written in one place: a first
+    radial-return version that wrote them in every branch measured 71 instead of 5.7 ns per pair and
+    step); returns code and the intermediates."""
+    c, T1, T2, n, v1, v2, aux = _pair(params[i, 0], params[i, 1], params[i, 2], params[i, 3],
+                                      u0[i, 0], u0[i, 1], g0[i], u[i, 0], u[i, 1], g[i], w_old[i, 0], w_old[i, 1])
     T[i, 0] = T1
     T[i, 1] = T2
     N[i] = n
     w_new[i, 0] = v1
     w_new[i, 1] = v2
-    return c, t1, t2, r, s
+    return c, aux
 
 
 @jit
 def interface_step(params, u0, g0, u, g, w_old, w_new, T, N, code):  # pragma: no cover - compiled
-    """Trial step of every pair from the committed sliders (module docstring).
+    """Step of every pair along the straight path from its start point to (u, g), from the committed
+    sliders (module docstring).
 
     Parameters
     ----------
@@ -149,59 +325,44 @@ def interface_step(params, u0, g0, u, g, w_old, w_new, T, N, code):  # pragma: n
 @jit
 def interface_step_jvp(params, u0, du0, g0, dg0, u, du, g, dg, w_old, dw_old, w_new, dw_new, T, dT, N, dN,
                        code):  # pragma: no cover - compiled
-    """:func:`interface_step` with forward-mode derivatives along ``du.shape[2]`` directions per pair.
+    """:func:`interface_step` with forward-mode derivatives along ``du.shape[2]`` directions per pair
+    of the start point (du0, dg0), the end point (du, dg) and the committed slider (dw_old).
 
-    Open: dT = dN = 0, dw = du. Stuck: dT = kt (du - dw_old), dN = kn dg,
-    dw = dw_old. Slipping (n = T* / |T*|, T* = kt (u - w_old)):
-    dT = mu dN n + (mu N / |T*|) (I - n n^T) dT*, dN = kn dg,
-    dw = du - dT / kt.
+    Open at the end: dT = dN = 0, dw = du. Closed: dN = kn dg and dT from the closed form
+    (:func:`_dpair`), dw = du - dT / kt (stuck from a consistent start: dw = dw_old).
     """
     nd = du.shape[2]
     for i in range(params.shape[0]):
-        c, t1, t2, r, s = _pair_step(params, i, u0, g0, u, g, w_old, w_new, T, N)
+        c, aux = _pair_step(params, i, u0, g0, u, g, w_old, w_new, T, N)
         code[i] = c
         kt = params[i, 0]
         kn = params[i, 1]
-        if c == SEPARATION:
-            for j in range(nd):
+        mu = params[i, 2]
+        for j in range(nd):
+            if c == SEPARATION:
                 dN[i, j] = 0.0
                 dT[i, 0, j] = 0.0
                 dT[i, 1, j] = 0.0
                 dw_new[i, 0, j] = du[i, 0, j]
                 dw_new[i, 1, j] = du[i, 1, j]
-        elif c == STICK_SLIP:
-            for j in range(nd):
-                dN[i, j] = kn * dg[i, j]
-                dT[i, 0, j] = kt * (du[i, 0, j] - dw_old[i, 0, j])
-                dT[i, 1, j] = kt * (du[i, 1, j] - dw_old[i, 1, j])
-                dw_new[i, 0, j] = dw_old[i, 0, j]
-                dw_new[i, 1, j] = dw_old[i, 1, j]
-        else:
-            mu = params[i, 2]
-            n1 = t1 / r
-            n2 = t2 / r
-            for j in range(nd):
-                dn = kn * dg[i, j]
-                dN[i, j] = dn
-                a1 = kt * (du[i, 0, j] - dw_old[i, 0, j])
-                a2 = kt * (du[i, 1, j] - dw_old[i, 1, j])
-                along = n1 * a1 + n2 * a2
-                d1 = mu * dn * n1 + s * (a1 - n1 * along)
-                d2 = mu * dn * n2 + s * (a2 - n2 * along)
-                dT[i, 0, j] = d1
-                dT[i, 1, j] = d2
-                dw_new[i, 0, j] = du[i, 0, j] - d1 / kt
-                dw_new[i, 1, j] = du[i, 1, j] - d2 / kt
+                continue
+            d1, d2, e1, e2 = _dpair(kt, kn, mu, aux, du0[i, 0, j], du0[i, 1, j], dg0[i, j], du[i, 0, j],
+                                    du[i, 1, j], dg[i, j], dw_old[i, 0, j], dw_old[i, 1, j])
+            dN[i, j] = kn * dg[i, j]
+            dT[i, 0, j] = d1
+            dT[i, 1, j] = d2
+            dw_new[i, 0, j] = e1
+            dw_new[i, 1, j] = e2
 
 
 @jit
 def interface_step_tangent(params, u0, g0, u, g, w_old, w_new, T, N, code, J):  # pragma: no cover - compiled
     """:func:`interface_step` and the 3 x 3 block ``J[i] = d(T1, T2, N) / d(u1, u2, g)`` of every pair at
-    fixed committed slider (N/m): stuck diag(kt, kt, kn); slipping
-    ``(mu N kt / |T*|) (I - n n^T)`` in the tangential block, ``mu kn n`` in
-    the column of g and kn in the corner; open zero."""
+    the end point, the start point and the committed slider fixed (N/m): open zero; stuck from a
+    consistent start diag(kt, kt, kn); slipping the derivative of the closed form (:func:`_dpair`)
+    and kn in the corner."""
     for i in range(params.shape[0]):
-        c, t1, t2, r, s = _pair_step(params, i, u0, g0, u, g, w_old, w_new, T, N)
+        c, aux = _pair_step(params, i, u0, g0, u, g, w_old, w_new, T, N)
         code[i] = c
         for a in range(3):
             for b in range(3):
@@ -210,20 +371,13 @@ def interface_step_tangent(params, u0, g0, u, g, w_old, w_new, T, N, code, J):  
             continue
         kt = params[i, 0]
         kn = params[i, 1]
+        mu = params[i, 2]
         J[i, 2, 2] = kn
-        if c == STICK_SLIP:
-            J[i, 0, 0] = kt
-            J[i, 1, 1] = kt
-        else:
-            n1 = t1 / r
-            n2 = t2 / r
-            k = s * kt
-            J[i, 0, 0] = k * (1.0 - n1 * n1)
-            J[i, 0, 1] = -k * n1 * n2
-            J[i, 1, 0] = -k * n1 * n2
-            J[i, 1, 1] = k * (1.0 - n2 * n2)
-            J[i, 0, 2] = params[i, 2] * kn * n1
-            J[i, 1, 2] = params[i, 2] * kn * n2
+        for k in range(3):
+            d1, d2 = _dpair(kt, kn, mu, aux, 0.0, 0.0, 0.0, 1.0 if k == 0 else 0.0, 1.0 if k == 1 else 0.0,
+                            1.0 if k == 2 else 0.0, 0.0, 0.0)[:2]
+            J[i, 0, k] = d1
+            J[i, 1, k] = d2
 
 
 @jit
@@ -459,17 +613,31 @@ class Interface:
         f : ndarray (ndof,)
             Generalised forces the pairs exert on the structure, N (:meth:`forces`).
         K : ndarray (ndof, ndof)
-            Their stiffness ``-df/dx = B^T J B`` (N/m) with the 3 x 3 blocks J of
-            :func:`interface_step_tangent` and B of :meth:`selection` (at fixed ``x0`` and ``w``):
-            each pair couples only its own DOFs. All pairs stuck: the springs kt, kt, kn between
-            their DOFs; all open: 0.
+            Their stiffness ``-df/dx = B^T J B`` (N/m) with the 3 x 3 blocks J = d(T1, T2, N) /
+            d(u1, u2, g) and B of :meth:`selection`: each pair couples only its own DOFs. With
+            ``x0`` the blocks of :func:`interface_step_tangent` (start point and sliders fixed);
+            without, the start moves with ``x`` (a step without motion: the radial return of
+            the trial, whose derivative :func:`interface_step_jvp` gives). All pairs stuck: the
+            springs kt, kt, kn between their DOFs; all open: 0.
         """
         u, g = self.relative(x)
-        u0, g0 = (u, g) if x0 is None else self.relative(x0)
         n = u.shape[0]
         w = self.check_state(w)
         T, N, J = np.empty((n, 2)), np.empty(n), np.empty((n, 3, 3))
-        interface_step_tangent(self.params, u0, g0, u, g, w, np.empty((n, 2)), T, N, np.empty(n, dtype=np.int8), J)
+        code, w_new = np.empty(n, dtype=np.int8), np.empty((n, 2))
+        if x0 is not None:
+            u0, g0 = self.relative(x0)
+            interface_step_tangent(self.params, u0, g0, u, g, w, w_new, T, N, code, J)
+        else:
+            du = np.zeros((n, 2, 3))
+            du[:, 0, 0] = du[:, 1, 1] = 1.0
+            dg = np.zeros((n, 3))
+            dg[:, 2] = 1.0
+            dT, dN = np.empty((n, 2, 3)), np.empty((n, 3))
+            interface_step_jvp(self.params, u, du, g, dg, u, du, g, dg, w, np.zeros((n, 2, 3)), w_new,
+                               np.empty((n, 2, 3)), T, dT, N, dN, code)
+            J[:, :2, :] = dT
+            J[:, 2, :] = dN
         ndof = np.asarray(x).size
         B = self.selection(ndof)
         Jd = np.zeros((3 * n, 3 * n))

@@ -3,9 +3,11 @@
 docs/model.md section 10. Each pair of an :class:`~jointdyn.interfaces.Interface`
 is given its relative tangential displacement (u1, u2) and normal approach g
 as functions of time; inertia plays no part, so time only orders the
-samples. Between samples the histories are taken linear, so every instant
-where the normal load ``P + kn g`` of a pair changes sign is inserted as a
-sample (separation and re-contact are never smeared over a step). Each
+samples. Between samples the histories are taken linear and the element is
+exact along them (docs/model.md section 10); every instant where the normal
+load ``P + kn g`` of a pair changes sign is also inserted as a sample, so
+that the metrics (the work by the trapezoidal rule, the open fraction) see
+separation and re-contact at their instants. Each
 full period is a cycle; the result gives, per pair and for the last full
 cycle, the work of the tangential force (the energy dissipated per cycle on
 a closed steady cycle) and the fractions of the cycle the pair sticks,
