@@ -176,6 +176,15 @@ def test_branch_with_interfaces_balances_energy_and_condenses_exactly():
     assert e_pairs > 0.01 * e_in  # the pairs slip
     assert abs(e_in - e_visc - e_pairs - e_n) <= 1e-8 * e_in
     np.testing.assert_allclose(pairs["stick"] + pairs["slip"] + pairs["open"], 1.0, rtol=0, atol=1e-12)
+    # the slip map's data in the branch's Dataset, per point and pair
+    from jointdyn.hb import branch_dataset
+
+    ds = branch_dataset(br)
+    assert ds["pair_energy_j"].dims == ("point", "pair") and ds.sizes["pair"] == 2
+    np.testing.assert_allclose(ds["pair_energy_j"].values[i], pairs["energy_j"], rtol=1e-12, atol=0)
+    frac = sum(ds[f"pair_{k}_fraction"].values for k in ("stick", "slip", "open"))
+    np.testing.assert_allclose(frac, 1.0, rtol=0, atol=1e-12)
+    assert np.all(ds["pair_energy_j"].values >= -1e-12 * e_in)
     # the problem condensed onto the pairs' DOFs (and the response DOF) has the same solution
     from jointdyn.hb.condense import make_problem
 

@@ -78,16 +78,41 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
     }
     if branch.parameter != "gamma":
         data[branch.parameter] = ("point", branch.lam)
+    data.update(_pair_variables(branch))
     attrs = {"gamma": {"long_name": "w / w0"}, "amplitude_q": {"long_name": "kt X / fy", "units": "1"},
              **{v: {"units": "m"} for v in ("amplitude_m", "offset_m", "max_abs_m", "harmonic_amplitude_m",
                                             "peak_amplitude_m")},
-             "point_status": {"flag_meanings": " ".join(s.value for s in PointStatus)}}
+             "point_status": {"flag_meanings": " ".join(s.value for s in PointStatus)},
+             "pair_energy_j": {"units": "J", "long_name": "energy dissipated per cycle by each interface pair"},
+             **{f"pair_{s}_fraction": {"units": "1", "long_name": f"fraction of the period the pair is {w}"}
+                for s, w in (("stick", "stuck"), ("slip", "slipping"), ("open", "open"))}}
     # variables built with their attributes (no DataArray round trips afterwards)
     data = {k: xr.Variable(dims, np.asarray(v), attrs=attrs.get(k)) for k, (dims, v) in data.items()}
-    ds = xr.Dataset(data, coords={"point": np.arange(branch.lam.size), "harmonic": np.arange(p.H + 1),
-                                  "peak": np.arange(len(branch.peaks))})
+    coords = {"point": np.arange(branch.lam.size), "harmonic": np.arange(p.H + 1),
+              "peak": np.arange(len(branch.peaks))}
+    if p.has_interfaces:
+        coords["pair"] = np.arange(p.pair_params.shape[0])
+    ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(_branch_attrs(branch, dof, ds))
     return ds
+
+
+def _pair_variables(branch: HBBranch) -> dict:
+    """Per point and node pair of the interfaces (all interfaces stacked; none without interfaces), the data
+    of a slip map: ``pair_energy_j`` (energy dissipated per cycle, J), ``pair_stick_fraction``,
+    ``pair_slip_fraction`` and ``pair_open_fraction`` (of the period, over the AFT samples), from one
+    evaluation per point (:meth:`~jointdyn.hb.problem.HBProblem.pair_results`)."""
+    p = branch.problem
+    if not p.has_interfaces:
+        return {}
+    keys = (("energy_j", "pair_energy_j"), ("stick", "pair_stick_fraction"), ("slip", "pair_slip_fraction"),
+            ("open", "pair_open_fraction"))
+    out = {name: np.empty((branch.lam.size, p.pair_params.shape[0])) for _, name in keys}
+    for i, (X, lam) in enumerate(zip(branch.X, branch.lam)):
+        res = p.pair_results(X, p.evaluate(X, lam))
+        for k, name in keys:
+            out[name][i] = res[k]
+    return {name: (("point", "pair"), v) for name, v in out.items()}
 
 
 def _peak_variables(branch: HBBranch, dof: int, qs: float) -> dict:
