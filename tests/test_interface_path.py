@@ -6,7 +6,7 @@ special case without turning, and the dissipation of a turning slip in closed fo
 import math
 
 import numpy as np
-from hypothesis import assume, event, given, settings
+from hypothesis import assume, event, example, given, settings
 from hypothesis import strategies as st
 
 from reference_interface import OPEN, SLIP, STICK, path_step, radial_step, substep
@@ -51,6 +51,13 @@ def _label(start, end, code):
 
 @settings(max_examples=60, deadline=None)
 @given(case=_step_case())
+@example(case=(0.0, 0.0, -1.4e-3, 2e-3, 1e-3, 1e-3, 0.0, 0.0))  # re-closes, then slips at once
+@example(case=(0.0, 0.0, -1.2e-3, 1e-4, 0.0, 0.5e-3, 0.0, 0.0))  # re-closes and sticks
+@example(case=(0.0, 0.0, 0.0, 1.5e-3, 0.5e-3, 0.0, 0.9, 2.0))  # sticks, leaves the disc, turns
+@example(case=(0.0, 0.0, 0.0, 1e-3, 0.0, -1.2e-3, 0.5, 1.0))  # opens inside the step
+@example(case=(0.0, 0.0, 0.0, 1e-3, 1e-3, 1e-3, 1.0, 1.0))  # slipping, turning, N rising
+@example(case=(0.0, 0.0, 0.0, 1e-3, 1e-3, -0.8e-3, 1.0, 1.0))  # slipping, turning, N falling
+@example(case=(0.0, 0.0, 0.0, 1e-4, 0.0, -0.8e-3, 1.0, 2.5))  # stuck, N falls and makes it slip
 def test_closed_form_equals_the_radial_return_in_many_substeps(case):
     """The reference's closed form (exit instant from the quadratic, slip angle from tan(phi / 2))
     against the radial return along the same straight path in 1000 and 2000 sub-steps, extrapolated

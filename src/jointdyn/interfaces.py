@@ -57,10 +57,10 @@ with the arguments::
 
 The derivatives are exact: forward mode through the closed form (``_dpair``), along directions
 of the start point (du0, dg0), the end point (du, dg) and the committed slider (dw_old). The
-derivative of the slider carries the history (as ``step_jvp`` of the contact laws, ``jointdyn.laws._base``): the chain rule through a march is
-exact away from the measure-zero instants where a pair changes state.
-``interface_step_jvp`` and ``interface_step_tangent`` return the primal
-outputs of ``interface_step`` bit for bit.
+derivative of the slider carries the history (as ``step_jvp`` of the contact laws,
+``jointdyn.laws._base``): the chain rule through a march is exact away from the measure-zero
+instants where a pair changes state. ``interface_step_jvp`` and ``interface_step_tangent``
+return the primal outputs of ``interface_step`` bit for bit.
 """
 
 from __future__ import annotations
