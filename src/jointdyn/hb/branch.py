@@ -142,20 +142,26 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     periodic_error = np.zeros(n)
     force_period = np.zeros(n, dtype=int)
     response0 = np.full((n, 3), np.nan)
-    JXs = np.empty((n, problem.size, problem.size))
+    ws = np.array([problem.omega(v) for v in lam])
+    growth = np.empty(n)
+    # Hill stability of every point (hill_stability's criterion; NaN where a condensed problem does not compute
+    # it), on chunks of points whose Jacobians fit in config.HB_JACOBIAN_BUDGET_BYTES
+    chunk = max(1, min(n, config.HB_JACOBIAN_BUDGET_BYTES // (8 * problem.size * problem.size)))
+    JXs = np.empty((chunk, problem.size, problem.size))
     for i in range(n):
         ev = tr.evaluations.get(float(lam[i]))
-        if ev is None or ev[0].tobytes() != X[i].tobytes():  # not kept for this very X
-            ev = (X[i], problem.evaluate(X[i], lam[i]))
-        elif len(ev) > 2:
+        if ev is None or ev[0].tobytes() != X[i].tobytes() or ev[1].JX is None:  # not kept for this very X
+            ev = (X[i], problem.evaluate(X[i], lam[i]), *(ev[2:] if ev is not None and ev[1].JX is None else ()))
+        if len(ev) > 2:
             response0[i] = ev[2]
         ev = ev[1]
-        JXs[i] = ev.JX
+        JXs[i % chunk] = ev.JX
         passes[i] = int(ev.info[INFO_PASSES])
         periodic_error[i] = ev.info[INFO_ERROR]
         force_period[i] = int(ev.info[INFO_PERIOD])
-    # Hill stability of every point (hill_stability's criterion; NaN where a condensed problem does not compute it)
-    growth = problem.hill_growth(JXs, np.array([problem.omega(v) for v in lam]))
+        if i % chunk == chunk - 1 or i == n - 1:
+            lo = i - i % chunk
+            growth[lo:i + 1] = problem.hill_growth(JXs[:i + 1 - lo], ws[lo:i + 1])
     stable, checked = _confirmed_stability(problem, X, lam, growth)
     counters = {**parts.counters, "monodromy_checks": checked}
     # folds need the stability on both sides; without it (a large condensed problem) the turning points stand
@@ -319,7 +325,11 @@ class _Tracker:
         q = self.q(amps[0])
         lam = lam_s * ps
         if self.last is not None:
-            self.evaluations[float(lam)] = (X, self.last, amps)
+            ev = self.last
+            size = ev.JX.shape[0]
+            if (len(self.evaluations) + 1) * 8 * size * size > config.HB_JACOBIAN_BUDGET_BYTES:
+                ev = dataclasses.replace(ev, JX=None, scaled=None)  # the Jacobian is evaluated again when needed
+            self.evaluations[float(lam)] = (X, ev, amps)
         if not math.isfinite(q) or q > config.HB_UNBOUNDED_Q:
             return (ContinuationStatus.UNBOUNDED,
                     f"q = kt X / fy = {q:.4g} exceeds {config.HB_UNBOUNDED_Q:g} at {name} = {lam:.6g}")
