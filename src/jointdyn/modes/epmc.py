@@ -260,7 +260,8 @@ def _points(problem: EPMCProblem, lam, V, stash):
         out["omega_rad_s"][i] = w
         out["xi_rad_s"][i] = xi
         out["damping_ratio"][i] = xi / (2.0 * w)
-        out["damping_ratio_contacts"][i] = (float(np.sum(contact)) + float(np.sum(pairs))) / (2.0 * w * kin)
+        dissipated = float(np.sum(contact)) + (0.0 if pairs is None else float(np.sum(pairs)))
+        out["damping_ratio_contacts"][i] = dissipated / (2.0 * w * kin)
         out["damping_ratio_viscous"][i] = visc / (2.0 * w * kin)
         out["modal_amplitude"][i] = problem.modal_amplitude(X)
         out["energy_viscous_j"][i] = visc
