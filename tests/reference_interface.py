@@ -37,8 +37,10 @@ def radial_step(kt, kn, mu, P, u1, u2, g, w):
 
 def _exit_root(A, B, C, length):
     """First x in [0, length) where A x^2 + B x + C (C <= 0 at x = 0) rises above 0, or None."""
-    if C == 0.0 and (B > 0.0 or (B == 0.0 and A > 0.0)):
-        return 0.0
+    if C == 0.0:  # on the circle: the roots are 0 and -B / A
+        if B > 0.0 or (B == 0.0 and A > 0.0):
+            return 0.0
+        return -B / A if A > 0.0 and -B / A < length else None
     if A == 0.0:
         roots = [-C / B] if B != 0.0 else []
     else:
