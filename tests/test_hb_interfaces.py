@@ -158,7 +158,7 @@ def _energy_balance(q, X, p, ev):
     g = np.stack([sum(s * dg[:, q.pair_positions[i, c]] for c, s in ((2, 1.0), (5, -1.0))
                       if q.pair_positions[i, c] >= 0) for i in range(q.pair_positions.shape[0])])
     e_n = float(np.sum((ev.pair_N - q.pair_params[:, 3:4]) * g)) * 2.0 * np.pi / q.Ns
-    return e_in, e_visc, float(np.sum(pairs["energy_j"])), e_n, pairs
+    return e_in, e_visc, float(np.sum(pairs["energy_J"])), e_n, pairs
 
 
 def test_branch_with_interfaces_balances_energy_and_condenses_exactly():
@@ -180,11 +180,11 @@ def test_branch_with_interfaces_balances_energy_and_condenses_exactly():
     from jointdyn.hb import branch_dataset
 
     ds = branch_dataset(br)
-    assert ds["pair_energy_j"].dims == ("point", "pair") and ds.sizes["pair"] == 2
-    np.testing.assert_allclose(ds["pair_energy_j"].values[i], pairs["energy_j"], rtol=1e-12, atol=0)
+    assert ds["pair_energy_J"].dims == ("point", "pair") and ds.sizes["pair"] == 2
+    np.testing.assert_allclose(ds["pair_energy_J"].values[i], pairs["energy_J"], rtol=1e-12, atol=0)
     frac = sum(ds[f"pair_{k}_fraction"].values for k in ("stick", "slip", "open"))
     np.testing.assert_allclose(frac, 1.0, rtol=0, atol=1e-12)
-    assert np.all(ds["pair_energy_j"].values >= -1e-12 * e_in)
+    assert np.all(ds["pair_energy_J"].values >= -1e-12 * e_in)
     # the problem condensed onto the pairs' DOFs (and the response DOF) has the same solution
     from jointdyn.hb.condense import make_problem
 
@@ -202,12 +202,12 @@ def test_epmc_backbone_with_interfaces_balances_energy():
     assert bb.status.ok and bb.points >= 20
     np.testing.assert_allclose(bb.damping_ratio, bb.damping_ratio_contacts + bb.damping_ratio_viscous,
                                rtol=1e-6, atol=0)
-    assert bb.energy_pair_j.shape == (bb.points, 2) and np.max(bb.energy_pair_j[-1]) > 0.0
+    assert bb.energy_pair_J.shape == (bb.points, 2) and np.max(bb.energy_pair_J[-1]) > 0.0
     # small amplitude: the linear stuck mode with the pairs' springs
     assert bb.omega_rad_s[0] == pytest.approx(bb.linear.omega_rad_s, rel=1e-9)
     from jointdyn.modes.backbone import backbone_dataset
 
-    assert backbone_dataset(bb)["energy_pair_j"].dims == ("point", "pair")
+    assert backbone_dataset(bb)["energy_pair_J"].dims == ("point", "pair")
 
 
 SYSTEM = """\

@@ -74,7 +74,7 @@ def df_table() -> str:
         b = epmc(_damper(model), (1e-2 * XS, 1e2 * XS), harmonics=1, samples=DF_SAMPLES[model], progress=False)
         tb, kinks = BACKBONES[model]
         ew = eD = eE = 0.0
-        for a, w, D, E in zip(b.amplitude_m, b.omega_rad_s, b.damping_ratio, b.energy_contact_j[:, 0]):
+        for a, w, D, E in zip(b.amplitude_m, b.omega_rad_s, b.damping_ratio, b.energy_contact_J[:, 0]):
             w_ref, D_ref, E_ref = ref.describing_function(M_, K_, tb, kinks, a)
             ew = max(ew, abs(w / w_ref - 1))
             if D_ref > 1e-12:

@@ -131,7 +131,7 @@ def _compute(args, system, amps):
 
 def _result(args, ds, label) -> dict:
     keys = ("amplitude_m", "amplitude_q", "omega_rad_s", "frequency_hz", "damping_ratio", "damping_ratio_contacts",
-            "damping_ratio_viscous", "energy_contact_j")
+            "damping_ratio_viscous", "energy_contact_J")
     return {"method": args.method, "system": label, "mode": int(ds.attrs["linear_mode"]),
             "output_dof": int(ds.attrs["output_dof"]), "harmonics": int(ds.attrs["harmonics"]),
             "samples": int(ds.attrs["samples"]), "omega_linear_rad_s": float(ds.attrs["omega_linear_rad_s"]),

@@ -83,7 +83,7 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
              **{v: {"units": "m"} for v in ("amplitude_m", "offset_m", "max_abs_m", "harmonic_amplitude_m",
                                             "peak_amplitude_m")},
              "point_status": {"flag_meanings": " ".join(s.value for s in PointStatus)},
-             "pair_energy_j": {"units": "J", "long_name": "energy dissipated per cycle by each interface pair"},
+             "pair_energy_J": {"units": "J", "long_name": "energy dissipated per cycle by each interface pair"},
              **{f"pair_{s}_fraction": {"units": "1", "long_name": f"fraction of the period the pair is {w}"}
                 for s, w in (("stick", "stuck"), ("slip", "slipping"), ("open", "open"))}}
     # variables built with their attributes (no DataArray round trips afterwards)
@@ -99,13 +99,13 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
 
 def _pair_variables(branch: HBBranch) -> dict:
     """Per point and node pair of the interfaces (all interfaces stacked; none without interfaces), the data
-    of a slip map: ``pair_energy_j`` (energy dissipated per cycle, J), ``pair_stick_fraction``,
+    of a slip map: ``pair_energy_J`` (energy dissipated per cycle, J), ``pair_stick_fraction``,
     ``pair_slip_fraction`` and ``pair_open_fraction`` (of the period, over the AFT samples), from one
     evaluation per point (:meth:`~jointdyn.hb.problem.HBProblem.pair_results`)."""
     p = branch.problem
     if not p.has_interfaces:
         return {}
-    keys = (("energy_j", "pair_energy_j"), ("stick", "pair_stick_fraction"), ("slip", "pair_slip_fraction"),
+    keys = (("energy_J", "pair_energy_J"), ("stick", "pair_stick_fraction"), ("slip", "pair_slip_fraction"),
             ("open", "pair_open_fraction"))
     out = {name: np.empty((branch.lam.size, p.pair_params.shape[0])) for _, name in keys}
     for i, (X, lam) in enumerate(zip(branch.X, branch.lam)):

@@ -516,7 +516,7 @@ class HBProblem:
 
     def pair_results(self, X, ev: _Eval) -> dict | None:
         """Per node pair of the interfaces (stacked over them) at coefficients X (m) and their evaluation
-        ``ev``: ``energy_j`` the energy dissipated per cycle, ``oint T . du`` (J, the sum over the AFT samples,
+        ``ev``: ``energy_J`` the energy dissipated per cycle, ``oint T . du`` (J, the sum over the AFT samples,
         the quadrature of the Galerkin projection, so that the energy balance holds to the residual), and the
         fractions of the period ``stick``, ``slip`` and ``open`` (over the samples, their sum 1): the data
         of a slip map. None without interfaces."""
@@ -532,7 +532,7 @@ class HBProblem:
                 Y[:, live, k] += sign * Xm[:, pos[live]]
         du = np.einsum("jh,hpk->pjk", self.E @ derivative_matrix(self.H), Y)  # du/dtau at the samples, m
         code = ev.pair_code
-        return {"energy_j": np.einsum("pjk,pjk->p", ev.pair_T, du) * (2.0 * math.pi / self.Ns),
+        return {"energy_J": np.einsum("pjk,pjk->p", ev.pair_T, du) * (2.0 * math.pi / self.Ns),
                 "stick": np.mean(code == STICK_SLIP, axis=1), "slip": np.mean(code == MACROSLIP, axis=1),
                 "open": np.mean(code == SEPARATION, axis=1)}
 

@@ -82,10 +82,12 @@ class Backbone:
         Harmonic coefficients of the mode shape, harmonic-major
         (``X[h * n + i]``: coefficient h of DOF i; the basis of
         :mod:`jointdyn.fourier`), m.
-    energy_contact_j : ndarray (points, contacts)
-        Energy dissipated per cycle by each contact, J.
-    energy_viscous_j : ndarray (points,)
-        Energy dissipated per cycle by C, J.
+    energy_contact_J : ndarray (points, contacts)
+        Energy dissipated per cycle by each contact, J (``energy_contact_j``
+        is a deprecated alias).
+    energy_viscous_J : ndarray (points,)
+        Energy dissipated per cycle by C, J (``energy_viscous_j`` is a
+        deprecated alias).
     counters : dict
         Solver counters (points, residual evaluations, rejected steps, ...).
     problem : object, optional
@@ -117,10 +119,10 @@ class Backbone:
     damping_ratio_viscous: np.ndarray
     modal_amplitude: np.ndarray
     X: np.ndarray
-    energy_contact_j: np.ndarray
-    energy_viscous_j: np.ndarray
+    energy_contact_J: np.ndarray
+    energy_viscous_J: np.ndarray
     #: energy dissipated per cycle by each node pair of the interfaces (points, pairs), J (None without)
-    energy_pair_j: np.ndarray | None = None
+    energy_pair_J: np.ndarray | None = None
     counters: dict = field(default_factory=dict)
     problem: object = None
     reduction: object = None
@@ -129,6 +131,16 @@ class Backbone:
     def points(self) -> int:
         """Number of points."""
         return int(self.amplitude_m.size)
+
+    @property
+    def energy_contact_j(self) -> np.ndarray:
+        """Deprecated alias of :attr:`energy_contact_J`."""
+        return self.energy_contact_J
+
+    @property
+    def energy_viscous_j(self) -> np.ndarray:
+        """Deprecated alias of :attr:`energy_viscous_J`."""
+        return self.energy_viscous_J
 
     @property
     def full_output_dof(self) -> int:
@@ -167,7 +179,7 @@ def backbone_dataset(backbone: Backbone):
     ``omega_ratio`` (omega over the linear stuck frequency),
     ``damping_ratio``, ``damping_ratio_contacts``,
     ``damping_ratio_viscous``, ``xi_rad_s``, ``modal_amplitude``,
-    ``energy_viscous_j``; ``energy_contact_j`` (point, contact);
+    ``energy_viscous_J``; ``energy_contact_J`` (point, contact);
     ``mode_shape_m`` (point, coefficient, dof): the harmonic coefficients
     (0, cos 1, sin 1, ..., cos H, sin H); ``harmonic_amplitude_m`` (point,
     harmonic, dof). Attributes: ``method``, ``status``, ``message``,
@@ -204,14 +216,14 @@ def backbone_dataset(backbone: Backbone):
         "damping_ratio_viscous": (point, b.damping_ratio_viscous, {"units": "1"}),
         "xi_rad_s": (point, b.xi_rad_s, {"units": "1/s", "long_name": "self-excitation coefficient"}),
         "modal_amplitude": (point, b.modal_amplitude, {"units": "kg^0.5 m"}),
-        "energy_viscous_j": (point, b.energy_viscous_j, {"units": "J", "long_name": "energy dissipated per cycle by C"}),
-        "energy_contact_j": (("point", "contact"), b.energy_contact_j,
+        "energy_viscous_J": (point, b.energy_viscous_J, {"units": "J", "long_name": "energy dissipated per cycle by C"}),
+        "energy_contact_J": (("point", "contact"), b.energy_contact_J,
                              {"units": "J", "long_name": "energy dissipated per cycle by each contact"}),
         "mode_shape_m": (("point", "coefficient", "dof"), X, {"units": "m"}),
         "harmonic_amplitude_m": (("point", "harmonic", "dof"), _harmonic_amplitudes(b.X, H, n), {"units": "m"}),
     }
-    if b.energy_pair_j is not None:
-        data["energy_pair_j"] = (("point", "pair"), b.energy_pair_j,
+    if b.energy_pair_J is not None:
+        data["energy_pair_J"] = (("point", "pair"), b.energy_pair_J,
                                  {"units": "J", "long_name": "energy dissipated per cycle by each interface pair"})
     variables = {k: xr.Variable(dims, np.asarray(v), attrs=a) for k, (dims, v, a) in data.items()}
     coords = {"point": np.arange(b.points), "contact": np.arange(len(s.contacts)),

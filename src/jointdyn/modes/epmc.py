@@ -219,7 +219,7 @@ class EPMCProblem:
         du = hb.E @ (DX @ self.B.T)  # (Ns, contacts): du_c/dtau at the samples, m
         contact = np.einsum("cj,jc->c", ev.T, du) * (2.0 * math.pi / hb.Ns)
         pairs = hb.pair_results(X, ev)
-        return kin, visc, contact, (None if pairs is None else pairs["energy_j"])
+        return kin, visc, contact, (None if pairs is None else pairs["energy_J"])
 
     def modal_amplitude(self, X) -> float:
         """sqrt(a1^T M a1 + b1^T M b1) of the first harmonic, kg^1/2 m."""
@@ -247,9 +247,9 @@ def _points(problem: EPMCProblem, lam, V, stash):
     nc = len(problem.system.contacts)
     out = {k: np.empty(p) for k in ("amplitude_m", "omega_rad_s", "xi_rad_s", "damping_ratio",
                                       "damping_ratio_contacts", "damping_ratio_viscous", "modal_amplitude",
-                                      "energy_viscous_j")}
+                                      "energy_viscous_J")}
     out["X"] = np.empty((p, problem.size))
-    out["energy_contact_j"] = np.empty((p, nc))
+    out["energy_contact_J"] = np.empty((p, nc))
     for i in range(p):
         X, w, xi = problem.unpack(V[i], lam[i])
         ev = stash.get(X.tobytes())
@@ -264,10 +264,10 @@ def _points(problem: EPMCProblem, lam, V, stash):
         out["damping_ratio_contacts"][i] = dissipated / (2.0 * w * kin)
         out["damping_ratio_viscous"][i] = visc / (2.0 * w * kin)
         out["modal_amplitude"][i] = problem.modal_amplitude(X)
-        out["energy_viscous_j"][i] = visc
-        out["energy_contact_j"][i] = contact
+        out["energy_viscous_J"][i] = visc
+        out["energy_contact_J"][i] = contact
         if pairs is not None:
-            out.setdefault("energy_pair_j", np.empty((p, pairs.size)))[i] = pairs
+            out.setdefault("energy_pair_J", np.empty((p, pairs.size)))[i] = pairs
         out["X"][i] = X
     return out
 
