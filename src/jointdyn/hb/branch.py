@@ -210,11 +210,14 @@ def _confirmed_stability(problem: HBProblem, X, lam, growth):
     therefore decided by the Floquet multipliers of the time-domain period
     map (:func:`~jointdyn.hb.monodromy.monodromy_multipliers`): unstable
     when one lies outside the unit circle by more than
-    ``2 pi config.HB_STABILITY_RTOL``.
+    ``2 pi config.HB_STABILITY_RTOL``. Systems with interfaces keep Hill's criterion there: the
+    time-domain period map does not march interfaces yet.
     """
     from .monodromy import monodromy_multipliers
 
     stable = growth <= config.HB_STABILITY_RTOL
+    if problem.has_interfaces:
+        return stable, 0
     marginal = np.flatnonzero(~stable & (growth < config.HB_STABILITY_CONFIRM))
     for i in marginal:
         mu = np.max(np.abs(monodromy_multipliers(problem, X[i], lam[i])))
