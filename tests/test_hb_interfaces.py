@@ -92,7 +92,10 @@ def test_all_stuck_is_the_linear_structure_with_the_pair_springs(gamma):
     f = (1e-3, 5e-4, 0.0, 0.0)
     q = HBProblem(_system(itf, force=f), harmonics=3, samples=32)
     X = _newton(q, gamma, q.linear_guess(gamma))
-    assert np.all(q.evaluate(X, gamma).pair_code == STICK_SLIP)
+    ev = q.evaluate(X, gamma)
+    assert np.all(ev.pair_code == STICK_SLIP)
+    res = q.pair_results(X, ev)  # stuck all period: no dissipation (to rounding of the loop's area)
+    assert res["stick"].tolist() == [1.0, 1.0] and np.all(np.abs(res["energy_J"]) < 1e-12 * 5.0 * np.max(np.abs(X)))
     w = gamma * q.w0
     x = _frf(K4 + _pair_springs(itf), w, f, [0.0, 90.0, 0.0, 0.0])
     got = X[4:8] - 1j * X[8:12]
@@ -106,7 +109,10 @@ def test_all_open_is_the_structure_without_the_pairs():
     f = (0.1, 0.05, 0.0, 0.0)
     q = HBProblem(_system(itf, force=f), harmonics=3, samples=32)
     X = _newton(q, 1.1, q.linear_guess(1.1, stuck=False))
-    assert np.all(q.evaluate(X, 1.1).pair_code == SEPARATION)
+    ev = q.evaluate(X, 1.1)
+    assert np.all(ev.pair_code == SEPARATION)
+    res = q.pair_results(X, ev)
+    assert res["open"].tolist() == [1.0, 1.0] and np.all(res["energy_J"] == 0.0)
     x = _frf(K4, 1.1 * q.w0, f, [0.0, 90.0, 0.0, 0.0])
     got = X[4:8] - 1j * X[8:12]
     assert np.max(np.abs(got - x)) <= 1e-9 * np.max(np.abs(x))
