@@ -122,11 +122,10 @@ def test_system_validates_its_interfaces():
 
 def test_solvers_refuse_interfaces_they_do_not_march(tmp_path, capsys):
     s = jd.read_system(_write(tmp_path, BASE))
-    from jointdyn.modes import epmc, qsma
+    from jointdyn.modes import qsma
 
-    calls = [  # time integration marches interfaces (tests/test_interface_dynamics.py)
-        lambda: jd.harmonic_balance(s, 1.0),
-        lambda: epmc(s, [1e-4, 1e-3]),
+    # time integration, harmonic balance and EPMC march interfaces (test_interface_dynamics, test_hb_interfaces)
+    calls = [
         lambda: qsma(s, [1e-4, 1e-3]),
         lambda: jd.reduce_system(s, 1),
     ]
@@ -134,8 +133,7 @@ def test_solvers_refuse_interfaces_they_do_not_march(tmp_path, capsys):
         with pytest.raises(ValueError, match="^interfaces: .* do(es)? not take interfaces yet"):
             call()
     p = str(tmp_path / "sys.toml")
-    for argv in (["frc", "--method", "hb", "--system", p, "--gamma", "0.9:1.1:0.1", "--json"],
-                 ["modes", "--system", p, "--json"]):
+    for argv in (["modes", "--method", "qsma", "--system", p, "--json"],):
         try:
             rc = main(argv)
         except SystemExit as exc:

@@ -427,6 +427,11 @@ HB_CONDENSE_CHECK_RTOL = 1e-9
 #: a condensed problem computes Hill stability (on the full Jacobian it
 #: assembles) when the full companion matrix has at most this many rows
 HB_CONDENSED_HILL_ROWS = 200
+#: bytes of dense Jacobians a branch keeps at once: the continuation monitor
+#: keeps the evaluations of accepted points with their Jacobians while they fit
+#: (beyond, without: the point is evaluated again for its stability), and
+#: Hill's method runs on chunks of points that fit
+HB_JACOBIAN_BUDGET_BYTES = 2**28
 
 # --- nonlinear modes (jointdyn.modes) ------------------------------------------------
 #: default amplitude range of a backbone (first-harmonic amplitude of the

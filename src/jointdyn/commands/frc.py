@@ -449,15 +449,15 @@ def _run_time(args, gammas):
 def _hb_branches(br, dofs=()) -> list:
     """The segments of an HBBranch as JSON objects (per point: gamma, amplitudes, stability, status;
     ``dofs``: the amplitude and offset of each of these DOFs too, under ``dofs``)."""
-    from ..hb.problem import contact_of
+    from ..hb.problem import reference_scales
 
-    law = contact_of(br.problem.system).law
+    kt, fy = reference_scales(br.problem.system)
     amp, off, mx = br.response()
     gam = br.gamma()
     out = []
     for b in dict.fromkeys(br.segment.tolist()):
         idx = np.flatnonzero(br.segment == b)
-        one = {"gamma": gam[idx], "amplitude_q": law.kt * amp[idx] / law.fy, "amplitude_m": amp[idx],
+        one = {"gamma": gam[idx], "amplitude_q": kt * amp[idx] / fy, "amplitude_m": amp[idx],
                "offset_m": off[idx], "max_abs_m": mx[idx]}
         one = {k: _jsonable(v) for k, v in one.items()}
         if len(dofs):

@@ -71,7 +71,7 @@ from ..systems import System
 from ._aft import INFO_ERROR, INFO_PASSES, INFO_PERIOD
 from .condense import make_problem
 from .parameters import F1, GAMMA
-from .problem import HBProblem, contact_of
+from .problem import HBProblem, reference_scales
 from .results import HBBranch, HBPeak, PointStatus
 
 __all__ = ["continued_branch", "solve_point"]
@@ -143,20 +143,26 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     periodic_error = np.zeros(n)
     force_period = np.zeros(n, dtype=int)
     response0 = np.full((n, 3), np.nan)
-    JXs = np.empty((n, problem.size, problem.size))
+    ws = np.array([problem.omega(v) for v in lam])
+    growth = np.empty(n)
+    # Hill stability of every point (hill_stability's criterion; NaN where a condensed problem does not compute
+    # it), on chunks of points whose Jacobians fit in config.HB_JACOBIAN_BUDGET_BYTES
+    chunk = max(1, min(n, config.HB_JACOBIAN_BUDGET_BYTES // (8 * problem.size * problem.size)))
+    JXs = np.empty((chunk, problem.size, problem.size))
     for i in range(n):
         ev = tr.evaluations.get(float(lam[i]))
-        if ev is None or ev[0].tobytes() != X[i].tobytes():  # not kept for this very X
-            ev = (X[i], problem.evaluate(X[i], lam[i]))
-        elif len(ev) > 2:
+        if ev is None or ev[0].tobytes() != X[i].tobytes() or ev[1].JX is None:  # not kept for this very X
+            ev = (X[i], problem.evaluate(X[i], lam[i]), *(ev[2:] if ev is not None and ev[1].JX is None else ()))
+        if len(ev) > 2:
             response0[i] = ev[2]
         ev = ev[1]
-        JXs[i] = ev.JX
+        JXs[i % chunk] = ev.JX
         passes[i] = int(ev.info[INFO_PASSES])
         periodic_error[i] = ev.info[INFO_ERROR]
         force_period[i] = int(ev.info[INFO_PERIOD])
-    # Hill stability of every point (hill_stability's criterion; NaN where a condensed problem does not compute it)
-    growth = problem.hill_growth(JXs, np.array([problem.omega(v) for v in lam]))
+        if i % chunk == chunk - 1 or i == n - 1:
+            lo = i - i % chunk
+            growth[lo:i + 1] = problem.hill_growth(JXs[:i + 1 - lo], ws[lo:i + 1])
     stable, checked = _confirmed_stability(problem, X, lam, growth)
     counters = {**parts.counters, "monodromy_checks": checked}
     # folds need the stability on both sides; without it (a large condensed problem) the turning points stand
@@ -205,11 +211,14 @@ def _confirmed_stability(problem: HBProblem, X, lam, growth):
     therefore decided by the Floquet multipliers of the time-domain period
     map (:func:`~jointdyn.hb.monodromy.monodromy_multipliers`): unstable
     when one lies outside the unit circle by more than
-    ``2 pi config.HB_STABILITY_RTOL``.
+    ``2 pi config.HB_STABILITY_RTOL``. Systems with interfaces keep Hill's criterion there: the
+    time-domain period map does not march interfaces yet.
     """
     from .monodromy import monodromy_multipliers
 
     stable = growth <= config.HB_STABILITY_RTOL
+    if problem.has_interfaces:
+        return stable, 0
     marginal = np.flatnonzero(~stable & (growth < config.HB_STABILITY_CONFIRM))
     for i in marginal:
         mu = np.max(np.abs(monodromy_multipliers(problem, X[i], lam[i])))
@@ -219,9 +228,9 @@ def _confirmed_stability(problem: HBProblem, X, lam, growth):
 
 def _scales(problem: HBProblem, start: float):
     """(xs, fs, ps): units of the unknowns (fy/kt, m), of the residual (max(F1, fy), N) and of the parameter."""
-    c = contact_of(problem.system)
-    xs = c.law.fy / c.law.kt if c.law.fy > 0 else 1.0
-    fs = max(problem.f1_ref, c.law.fy, 1e-300)
+    kt, fy = reference_scales(problem.system)
+    xs = fy / kt if fy > 0 else 1.0
+    fs = max(problem.f1_ref, fy, 1e-300)
     return xs, fs, problem.parameter.scale(problem, start)
 
 
@@ -265,8 +274,7 @@ class _Tracker:
         self.problem = problem
         self.scales = scales
         self.dof = dof
-        law = contact_of(problem.system).law
-        self.kt, self.fy = law.kt, law.fy
+        self.kt, self.fy = reference_scales(problem.system)
         self.last = None
         #: parameter value -> (X, evaluation, amplitudes of the response DOF) at accepted points
         self.evaluations = {}
@@ -321,7 +329,11 @@ class _Tracker:
         q = self.q(amps[0])
         lam = lam_s * ps
         if self.last is not None:
-            self.evaluations[float(lam)] = (X, self.last, amps)
+            ev = self.last
+            size = ev.JX.shape[0]
+            if (len(self.evaluations) + 1) * 8 * size * size > config.HB_JACOBIAN_BUDGET_BYTES:
+                ev = dataclasses.replace(ev, JX=None, scaled=None)  # the Jacobian is evaluated again when needed
+            self.evaluations[float(lam)] = (X, ev, amps)
         if not math.isfinite(q) or q > config.HB_UNBOUNDED_Q:
             return (ContinuationStatus.UNBOUNDED,
                     f"q = kt X / fy = {q:.4g} exceeds {config.HB_UNBOUNDED_Q:g} at {name} = {lam:.6g}")

@@ -73,7 +73,7 @@ from .._cache import by_identity
 from .._jit import jit
 from ..kinematics import contact_kinematics, selection_matrix
 from ..systems import System
-from .problem import HBProblem, _linear_blocks
+from .problem import HBProblem, _linear_blocks, contacts_only
 from .stability import hill_growth, hill_stability
 
 __all__ = ["Receptance", "receptance", "retained_dofs", "CondensedHBProblem", "make_problem", "use_condensed"]
@@ -456,10 +456,13 @@ def _check(system: System, rec: Receptance, w2) -> None:
 
 def retained_dofs(system: System, response_dofs=()) -> np.ndarray:
     """Sorted DOFs kept by a condensed problem: contact selections (tangential
-    and, for normal springs, normal), DOF 0 and ``response_dofs``."""
-    kin = contact_kinematics(system)
+    and, for normal springs, normal), the DOFs of the interfaces' node pairs, DOF 0 and
+    ``response_dofs``."""
+    kin = contact_kinematics(contacts_only(system))
     B = np.vstack([selection_matrix(kin, system.ndof), selection_matrix(kin, system.ndof, normal=True)])
     keep = set(np.flatnonzero(np.any(B != 0.0, axis=0)).tolist()) | {0}
+    for itf in system.interfaces:  # the six DOFs of every node pair
+        keep |= set(itf.pairs[itf.pairs >= 0].tolist())
     for d in response_dofs:
         d = int(d)
         if not 0 <= d < system.ndof:

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from .problem import contact_of
+from .problem import reference_scales
 from .results import HBBranch, PointStatus
 
 __all__ = ["branch_dataset", "discretisation_attrs"]
@@ -51,14 +51,14 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
     dof = branch.response_dof if response_dof is None else response_dof
     if not 0 <= dof < p.system.ndof:
         raise ValueError(f"response_dof must be in [0, {p.system.ndof - 1}], got {dof!r}")
-    law = contact_of(p.system).law
+    kt, fy = reference_scales(p.system)
     amp, off, mx = branch.response(dof)
     Xd = p.dof_coefficients(branch.X, dof, branch.lam) if branch.X.size else np.empty((0, p.nh))
     harm = np.empty((Xd.shape[0], p.H + 1))
     harm[:, 0] = np.abs(Xd[:, 0])
     for k in range(1, p.H + 1):
         harm[:, k] = np.hypot(Xd[:, 2 * k - 1], Xd[:, 2 * k])
-    qs = law.kt / law.fy if law.fy > 0 else np.nan
+    qs = kt / fy if fy > 0 else np.nan
     data = {
         "gamma": ("point", branch.gamma()),
         "amplitude_q": ("point", qs * amp),
@@ -78,16 +78,41 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
     }
     if branch.parameter != "gamma":
         data[branch.parameter] = ("point", branch.lam)
+    data.update(_pair_variables(branch))
     attrs = {"gamma": {"long_name": "w / w0"}, "amplitude_q": {"long_name": "kt X / fy", "units": "1"},
              **{v: {"units": "m"} for v in ("amplitude_m", "offset_m", "max_abs_m", "harmonic_amplitude_m",
                                             "peak_amplitude_m")},
-             "point_status": {"flag_meanings": " ".join(s.value for s in PointStatus)}}
+             "point_status": {"flag_meanings": " ".join(s.value for s in PointStatus)},
+             "pair_energy_J": {"units": "J", "long_name": "energy dissipated per cycle by each interface pair"},
+             **{f"pair_{s}_fraction": {"units": "1", "long_name": f"fraction of the period the pair is {w}"}
+                for s, w in (("stick", "stuck"), ("slip", "slipping"), ("open", "open"))}}
     # variables built with their attributes (no DataArray round trips afterwards)
     data = {k: xr.Variable(dims, np.asarray(v), attrs=attrs.get(k)) for k, (dims, v) in data.items()}
-    ds = xr.Dataset(data, coords={"point": np.arange(branch.lam.size), "harmonic": np.arange(p.H + 1),
-                                  "peak": np.arange(len(branch.peaks))})
+    coords = {"point": np.arange(branch.lam.size), "harmonic": np.arange(p.H + 1),
+              "peak": np.arange(len(branch.peaks))}
+    if p.has_interfaces:
+        coords["pair"] = np.arange(p.pair_params.shape[0])
+    ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(_branch_attrs(branch, dof, ds))
     return ds
+
+
+def _pair_variables(branch: HBBranch) -> dict:
+    """Per point and node pair of the interfaces (all interfaces stacked; none without interfaces), the data
+    of a slip map: ``pair_energy_J`` (energy dissipated per cycle, J), ``pair_stick_fraction``,
+    ``pair_slip_fraction`` and ``pair_open_fraction`` (of the period, over the AFT samples), from one
+    evaluation per point (:meth:`~jointdyn.hb.problem.HBProblem.pair_results`)."""
+    p = branch.problem
+    if not p.has_interfaces:
+        return {}
+    keys = (("energy_J", "pair_energy_J"), ("stick", "pair_stick_fraction"), ("slip", "pair_slip_fraction"),
+            ("open", "pair_open_fraction"))
+    out = {name: np.empty((branch.lam.size, p.pair_params.shape[0])) for _, name in keys}
+    for i, (X, lam) in enumerate(zip(branch.X, branch.lam)):
+        res = p.pair_results(X, p.evaluate(X, lam))
+        for k, name in keys:
+            out[name][i] = res[k]
+    return {name: (("point", "pair"), v) for name, v in out.items()}
 
 
 def _peak_variables(branch: HBBranch, dof: int, qs: float) -> dict:

@@ -24,7 +24,7 @@ from .branch import _forcing_problem, _Request, solve_point
 from .discretisation import _adaptive_branch, first_level
 from .export import branch_dataset
 from .parameters import GAMMA, parameter_named
-from .problem import HBProblem, contact_of
+from .problem import HBProblem, reference_scales
 from .results import AUTO, HBBranch, HBSolution
 
 __all__ = ["continue_hb", "frc_hb", "harmonic_balance"]
@@ -98,7 +98,7 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
     """
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
-    contact_of(system)
+    reference_scales(system)
     par = parameter_named(parameter)
     start = V.finite(par.name + " start", start)
     stop = V.finite(par.name + " stop", stop)

@@ -38,12 +38,14 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from .._cache import by_value
-from ..fourier import STARTS, STOPS, extrema, fourier_matrices, phases, separation_grid
+from .._cache import by_identity, by_value
+from ..fourier import STARTS, STOPS, derivative_matrix, extrema, fourier_matrices, phases, separation_grid
 from ..kinematics import NORMAL_SPRING, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
 from ..laws import law_dispatch
+from ..laws._base import MACROSLIP, SEPARATION, STICK_SLIP
 from ..systems import Contact, System
 from ._aft import NO_EVENT, eval_kernel, recontact_events
+from ._aft_pairs import pair_directions, pairs_aft
 from .parameters import SystemParameter, _FixedFrequency, parameter_named
 from .stability import hill_growth, hill_stability
 
@@ -63,6 +65,11 @@ class _Eval:
     scaled: tuple | None = None
     #: (contacts, Ns): normal-load samples of each contact, N (prescribed, or max(0, P + kn g))
     N: np.ndarray | None = None
+    #: interfaces' node pairs, all interfaces in turn (None without interfaces): tangential forces
+    #: (pairs, Ns, 2) N, normal loads (pairs, Ns) N and motion codes (pairs, Ns) of the last marched period
+    pair_T: np.ndarray | None = None
+    pair_N: np.ndarray | None = None
+    pair_code: np.ndarray | None = None
 
 
 def _pad_rows(rows, width=None):
@@ -192,7 +199,8 @@ class HBProblem:
         #: per system DOF, sin and cos of the forcing phase: f sin(w t + phi) has the
         #: coefficients f sin(phi) of cos(w t) and f cos(phi) of sin(w t)
         self.phase_sin, self.phase_cos = np.sin(phi), np.cos(phi)
-        self._contact_inputs(contact_kinematics(system))
+        self._contact_inputs(contact_kinematics(contacts_only(system)))
+        self._interface_inputs()
         #: the AFT's phases and matrices (:meth:`_aft_grid`); evaluations report the uniform samples
         self._taug, self._Eg, self._Pg, self._uniform = self._aft_grid()
         self._dummy = np.zeros((1, 1))
@@ -234,6 +242,24 @@ class HBProblem:
             self._Pm, self._ssz = _pad_rows([]), 1
             self._kernel = eval_kernel(no_contact_step_jvp, no_contact_init_jvp)
 
+    def _interface_inputs(self) -> None:
+        """The interfaces' pairs on the unknown DOFs and their parameters, all interfaces stacked (built once)."""
+        itfs = self.system.interfaces
+        #: True when the system has interfaces (their pairs are evaluated by :func:`~jointdyn.hb._aft_pairs.pairs_aft`)
+        self.has_interfaces = bool(itfs)
+        if not itfs:
+            return
+        table = np.vstack([itf.pairs for itf in itfs])
+        pos = np.full(table.shape, -1, dtype=np.int64)
+        for (i, k), d in np.ndenumerate(table):
+            if d >= 0:
+                pos[i, k] = self.dof_index(int(d))
+        #: per pair (stacked over the interfaces) the positions of its six DOFs among the unknowns (-1: fixed)
+        self.pair_positions = pos
+        #: per pair kt, kn, mu, preload (N/m, N/m, -, N)
+        self.pair_params = np.ascontiguousarray(np.vstack([itf.params for itf in itfs]))
+        self._pair_dirs = pair_directions(self.E)
+
     def _aft_grid(self):
         """(tau, E, P, uniform) of the AFT: the phases the laws are marched at, their synthesis and analysis
         matrices, and the positions of the uniform samples among the phases (None: the phases are the
@@ -242,7 +268,7 @@ class HBProblem:
         :func:`~jointdyn.fourier.separation_grid` (extra phases graded towards each separation, the
         re-contact corners taken into account); the uniform samples and projection otherwise."""
         uniform = (self.tau, self.E, self.P, None)
-        if not self.contacts or self.has_springs or self.parameter.enters_loads:
+        if not self.contacts or self.has_springs or self.parameter.enters_loads or self.system.interfaces:
             return uniform
         events = {_load_events(*co) for co in self.load_coefficients}
         if len(events) != 1:
@@ -339,12 +365,28 @@ class HBProblem:
         q = self.problem_at(p) if isinstance(self.parameter, SystemParameter) else self
         w = self.omega(p)
         A = q.linear_matrix(w)
+        Kc = q.pair_stiffness(stuck) if q.has_interfaces else np.zeros((q.n, q.n))
         if stuck:
             for c, b, bn, kn in zip(q.contacts, q.B, q.Bn, q._Sp[:, 1]):
-                Kc = c.law.kt * np.outer(b, b) + kn * np.outer(bn, bn)
-                for h in range(q.nh):
-                    A[h * q.n:(h + 1) * q.n, h * q.n:(h + 1) * q.n] += Kc
+                Kc += c.law.kt * np.outer(b, b) + kn * np.outer(bn, bn)
+        for h in range(q.nh):
+            A[h * q.n:(h + 1) * q.n, h * q.n:(h + 1) * q.n] += Kc
         return np.linalg.solve(A, q.forcing(q.parameter.forcing(q, p)[0], w))
+
+    def pair_stiffness(self, stuck: bool = True) -> np.ndarray:
+        """Stiffness (n, n) N/m of the interfaces' pairs on the unknown DOFs: every pair closed at rest
+        (preload > 0) as its springs kt, kt, kn (``stuck``) or kn alone; the other pairs open (nothing)."""
+        Kp = np.zeros((self.n, self.n))
+        for pos, (kt, kn, _, P) in zip(self.pair_positions, self.pair_params):
+            if not P > 0.0:
+                continue
+            for k, ks in ((0, kt if stuck else 0.0), (1, kt if stuck else 0.0), (2, kn)):
+                b = np.zeros(self.n)
+                for col, sign in ((k, 1.0), (k + 3, -1.0)):
+                    if pos[col] >= 0:
+                        b[pos[col]] += sign
+                Kp += ks * np.outer(b, b)
+        return Kp
 
     # --- residual -----------------------------------------------------------
     def evaluate(self, X, p, scales=None) -> _Eval:
@@ -398,7 +440,23 @@ class HBProblem:
         if self._uniform is not None:
             at = self._uniform
             T, code, Nout = T[:, at], code[:, at], Nout[:, at]
-        return _Eval(R, JX, Jp, T, code, info, None if scales is None else scaled[1:], Nout)
+        ev = _Eval(R, JX, Jp, T, code, info, None if scales is None else scaled[1:], Nout)
+        if self.has_interfaces:
+            self._add_pairs(X, ev, scaled)
+        return ev
+
+    def _add_pairs(self, X, ev: _Eval, scaled) -> None:
+        """The interfaces' reactions and exact Jacobian added to ``ev`` (and its scaled copies)."""
+        npairs, ns = self.pair_params.shape[0], self.Ns
+        ev.pair_T, ev.pair_N = np.empty((npairs, ns, 2)), np.empty((npairs, ns))
+        ev.pair_code = np.empty((npairs, ns), dtype=np.int8)
+        pairs_aft(self.pair_positions, self.pair_params, X, self.n, self.E, self.P, *self._pair_dirs,
+                  int(self.max_passes), float(config.HB_PERIODIC_RTOL), ev.R, ev.JX, ev.pair_T, ev.pair_N,
+                  ev.pair_code, ev.info)
+        if ev.scaled is not None:
+            scl = scaled[0]
+            np.divide(ev.R, scl[0], out=scaled[1])
+            np.multiply(ev.JX, scl[1], out=scaled[2])
 
     def problem_at(self, p: float):
         """The harmonic-balance problem of the System that this problem's
@@ -456,6 +514,28 @@ class HBProblem:
         c = self.dof_coefficients(X, dof, p)
         return math.hypot(c[1], c[2])
 
+    def pair_results(self, X, ev: _Eval) -> dict | None:
+        """Per node pair of the interfaces (stacked over them) at coefficients X (m) and their evaluation
+        ``ev``: ``energy_J`` the energy dissipated per cycle, ``oint T . du`` (J, the sum over the AFT samples,
+        the quadrature of the Galerkin projection, so that the energy balance holds to the residual), and the
+        fractions of the period ``stick``, ``slip`` and ``open`` (over the samples, their sum 1): the data
+        of a slip map. None without interfaces."""
+        if not self.has_interfaces:
+            return None
+        npairs = self.pair_positions.shape[0]
+        Xm = np.asarray(X, dtype=np.float64).reshape(self.nh, self.n)
+        Y = np.zeros((self.nh, npairs, 2))
+        for k in range(2):
+            for col, sign in ((k, 1.0), (k + 3, -1.0)):
+                pos = self.pair_positions[:, col]
+                live = pos >= 0
+                Y[:, live, k] += sign * Xm[:, pos[live]]
+        du = np.einsum("jh,hpk->pjk", self.E @ derivative_matrix(self.H), Y)  # du/dtau at the samples, m
+        code = ev.pair_code
+        return {"energy_J": np.einsum("pjk,pjk->p", ev.pair_T, du) * (2.0 * math.pi / self.Ns),
+                "stick": np.mean(code == STICK_SLIP, axis=1), "slip": np.mean(code == MACROSLIP, axis=1),
+                "open": np.mean(code == SEPARATION, axis=1)}
+
     # --- stability ----------------------------------------------------------
     def hill_growth(self, JXs, ws):
         """max Re(s) / w of the Floquet exponents (Hill's method) at many points (:func:`~jointdyn.hb.stability.hill_growth`)."""
@@ -464,6 +544,33 @@ class HBProblem:
     def hill_stability(self, JX, w):
         """(stable, growth, multipliers) of one solution (:func:`~jointdyn.hb.stability.hill_stability`)."""
         return hill_stability(JX, self.system.M, self.system.C, w, self.H)
+
+
+def contacts_only(system: System) -> System:
+    """The system itself without interfaces, else a copy without them (cached per object): what the
+    scalar contacts' packing (:func:`~jointdyn.kinematics.contact_kinematics`) reads; the interfaces' pairs
+    are evaluated on their own (:func:`~jointdyn.hb._aft_pairs.pairs_aft`)."""
+    if not system.interfaces:
+        return system
+    return _stripped(system)
+
+
+@by_identity
+def _stripped(system: System) -> System:
+    return dataclasses.replace(system, interfaces=(), w0_rad_s=system.w0)
+
+
+def reference_scales(system: System) -> tuple[float, float]:
+    """(kt N/m, fy N) that normalise amplitudes (q = kt x / fy): the first contact's law, else the
+    interfaces' patch as a whole along one tangential direction (kt the sum of the pairs' kt, fy the sum
+    of their slip forces at rest, mu P); ValueError naming ``system`` when it has neither."""
+    if system.contacts:
+        law = system.contacts[0].law
+        return float(law.kt), float(law.fy)
+    if system.interfaces:
+        kt = sum(float(np.sum(itf.kt)) for itf in system.interfaces)
+        return kt, sum(float(np.sum(itf.mu * itf.preload)) for itf in system.interfaces)
+    raise ValueError("system must have at least one contact or interface")
 
 
 def contact_of(system: System) -> Contact:

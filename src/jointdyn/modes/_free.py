@@ -74,7 +74,7 @@ def check_free_vibration(system, method: str, *, springs: bool = True) -> System
     """
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
-    if not system.contacts:
+    if not system.contacts and not (springs and system.interfaces):
         raise ValueError(f"system must have at least one contact: {method} computes the modes of a structure "
                          "with frictional contacts")
     for i, c in enumerate(system.contacts):
@@ -115,11 +115,20 @@ def output_dof_of(system: System, output_dof) -> int:
 
 
 def stuck_stiffness(system: System) -> np.ndarray:
-    """K_reference + sum_c kt_c b_c b_c^T (N/m): the structure with every contact stuck."""
-    B = selection_matrix(contact_kinematics(system), system.ndof)
+    """K_reference + sum_c kt_c b_c b_c^T (N/m): the structure with every contact stuck (and every interface
+    pair closed at rest stuck: its springs kt, kt beside the kn of K_reference)."""
+    from ..hb.problem import contacts_only
+
+    B = selection_matrix(contact_kinematics(contacts_only(system)), system.ndof)
     K = system.K_reference.copy()
     for c, b in zip(system.contacts, B):
         K += c.law.kt * np.outer(b, b)
+    for itf in system.interfaces:
+        Bi = itf.selection(system.ndof)
+        closed = itf.preload > 0.0
+        for k in range(2):
+            rows = Bi[k::3][closed]
+            K += rows.T @ (itf.kt[closed][:, None] * rows)
     return K
 
 
@@ -151,9 +160,12 @@ def linear_stuck_mode(system: System, mode: int, output_dof: int) -> LinearMode:
 
 
 def contact_scale(system: System) -> float:
-    """fy / kt of the first contact (m): the displacement scale of the default amplitudes."""
-    law = system.contacts[0].law
-    return law.fy / law.kt
+    """fy / kt of the first contact, else of the interfaces' patch (m): the displacement scale of the default
+    amplitudes (:func:`jointdyn.hb.problem.reference_scales`)."""
+    from ..hb.problem import reference_scales
+
+    kt, fy = reference_scales(system)
+    return fy / kt
 
 
 def amplitude_range(system: System, amplitude) -> tuple[float, float]:

@@ -121,6 +121,8 @@ class Backbone:
     X: np.ndarray
     energy_contact_J: np.ndarray
     energy_viscous_J: np.ndarray
+    #: energy dissipated per cycle by each node pair of the interfaces (points, pairs), J (None without)
+    energy_pair_J: np.ndarray | None = None
     counters: dict = field(default_factory=dict)
     problem: object = None
     reduction: object = None
@@ -194,8 +196,11 @@ def backbone_dataset(backbone: Backbone):
     b = backbone
     s = b.system
     n, H = s.ndof, b.harmonics
-    law = s.contacts[0].law
-    scale = law.fy / law.kt
+    from ..hb.problem import reference_scales
+
+    kt, fy = reference_scales(s)
+    scale = fy / kt
+    law = s.contacts[0].law if s.contacts else None
     X = b.X.reshape(-1, 2 * H + 1, n) if b.X.size else np.empty((0, 2 * H + 1, n))
     point = ("point",)
     data = {
@@ -217,13 +222,17 @@ def backbone_dataset(backbone: Backbone):
         "mode_shape_m": (("point", "coefficient", "dof"), X, {"units": "m"}),
         "harmonic_amplitude_m": (("point", "harmonic", "dof"), _harmonic_amplitudes(b.X, H, n), {"units": "m"}),
     }
+    if b.energy_pair_J is not None:
+        data["energy_pair_J"] = (("point", "pair"), b.energy_pair_J,
+                                 {"units": "J", "long_name": "energy dissipated per cycle by each interface pair"})
     variables = {k: xr.Variable(dims, np.asarray(v), attrs=a) for k, (dims, v, a) in data.items()}
     coords = {"point": np.arange(b.points), "contact": np.arange(len(s.contacts)),
               "coefficient": np.arange(2 * H + 1), "harmonic": np.arange(H + 1), "dof": np.arange(n)}
     ds = xr.Dataset(variables, coords=coords)
     ds.attrs.update(method=b.method, status=b.status.value, message=b.message, linear_mode=b.linear.index,
                     output_dof=b.output_dof, harmonics=H, samples=b.samples,
-                    omega_linear_rad_s=b.linear.omega_rad_s, w0_rad_s=s.w0, model=law.name, law=repr(law),
+                    omega_linear_rad_s=b.linear.omega_rad_s, w0_rad_s=s.w0,
+                    model=law.name if law is not None else "interface", law=repr(law) if law is not None else "",
                     points=b.points,
                     **{f"counter_{k}": int(v) for k, v in b.counters.items()})
     if b.reduction is not None:  # dof: the reduced coordinates (boundary DOFs first)

@@ -66,6 +66,7 @@ from ..continuation import (ContinuationOptions, ContinuationStatus, ParameterPr
                             newton)
 from ..fourier import derivative_matrix
 from ..hb import HBProblem
+from ..hb.problem import contacts_only
 from ..kinematics import contact_kinematics, selection_matrix
 from ._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
 from .backbone import Backbone, ModeStatus
@@ -141,7 +142,7 @@ class EPMCProblem:
         self.i_xi = 2 * n + self.output_dof
         self.w_ref = self.linear.omega_rad_s
         self.k_ref = float(np.max(np.abs(np.diag(self.linear.stiffness))))
-        self.B = selection_matrix(contact_kinematics(system), n)
+        self.B = selection_matrix(contact_kinematics(contacts_only(system)), n)
         self.last = None
 
     # --- unknowns -----------------------------------------------------------
@@ -201,7 +202,8 @@ class EPMCProblem:
 
     # --- per point ----------------------------------------------------------
     def energies(self, X, omega, ev):
-        """Per period: (int x'^T M x' dt in J s, viscous energy J, energy of each contact J).
+        """Per period: (int x'^T M x' dt in J s, viscous energy J, energy of each contact J, energy of each
+        interface pair J or None, :meth:`~jointdyn.hb.HBProblem.pair_results`).
 
         Integrals of products of trigonometric polynomials are exact on the
         coefficients; the contact energies ``oint T_c du_c`` are the
@@ -217,7 +219,8 @@ class EPMCProblem:
         visc = omega * math.pi * float(np.einsum("ri,ij,rj->", DX, C, DX))
         du = hb.E @ (DX @ self.B.T)  # (Ns, contacts): du_c/dtau at the samples, m
         contact = np.einsum("cj,jc->c", ev.T, du) * (2.0 * math.pi / hb.Ns)
-        return kin, visc, contact
+        pairs = hb.pair_results(X, ev)
+        return kin, visc, contact, (None if pairs is None else pairs["energy_J"])
 
     def modal_amplitude(self, X) -> float:
         """sqrt(a1^T M a1 + b1^T M b1) of the first harmonic, kg^1/2 m."""
@@ -253,16 +256,19 @@ def _points(problem: EPMCProblem, lam, V, stash):
         ev = stash.get(X.tobytes())
         if ev is None:
             ev = problem.evaluate(X, w)
-        kin, visc, contact = problem.energies(X, w, ev)
+        kin, visc, contact, pairs = problem.energies(X, w, ev)
         out["amplitude_m"][i] = 10.0 ** lam[i]
         out["omega_rad_s"][i] = w
         out["xi_rad_s"][i] = xi
         out["damping_ratio"][i] = xi / (2.0 * w)
-        out["damping_ratio_contacts"][i] = float(np.sum(contact)) / (2.0 * w * kin)
+        dissipated = float(np.sum(contact)) + (0.0 if pairs is None else float(np.sum(pairs)))
+        out["damping_ratio_contacts"][i] = dissipated / (2.0 * w * kin)
         out["damping_ratio_viscous"][i] = visc / (2.0 * w * kin)
         out["modal_amplitude"][i] = problem.modal_amplitude(X)
         out["energy_viscous_J"][i] = visc
         out["energy_contact_J"][i] = contact
+        if pairs is not None:
+            out.setdefault("energy_pair_J", np.empty((p, pairs.size)))[i] = pairs
         out["X"][i] = X
     return out
 
