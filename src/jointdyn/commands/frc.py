@@ -267,13 +267,19 @@ def _check_hb_static(system) -> None:
     """Harmonic balance starts from the static stiffness with every contact stuck and every normal
     spring closed: a DOF that this holds by nothing (a rigid-body mode) has no unique mean position,
     and the structure is refused naming it (the time domain takes it)."""
+    from ..hb.problem import contacts_only
     from ..kinematics import contact_kinematics, selection_matrix
     from ..systems import rigid_mode_dof
 
-    K = system.K_reference.copy()
+    K = system.K_reference.copy()  # with the normal springs of the contacts and pairs closed at rest
     if system.contacts:
-        B = selection_matrix(contact_kinematics(system), system.ndof)
+        B = selection_matrix(contact_kinematics(contacts_only(system)), system.ndof)
         K += (B.T * [c.law.kt for c in system.contacts]) @ B
+    for itf in system.interfaces:  # the pairs closed at rest, stuck: their tangential springs kt
+        B = itf.selection(system.ndof)
+        shear = np.zeros(B.shape[0])
+        shear[0::3] = shear[1::3] = np.where(itf.preload > 0.0, itf.kt, 0.0)
+        K += (B.T * shear) @ B
     dof = rigid_mode_dof(K)
     if dof is None:
         return
