@@ -208,12 +208,12 @@ def test_epmc_backbone_with_interfaces_balances_energy():
     assert bb.status.ok and bb.points >= 20
     np.testing.assert_allclose(bb.damping_ratio, bb.damping_ratio_contacts + bb.damping_ratio_viscous,
                                rtol=1e-6, atol=0)
-    assert bb.energy_pair_J.shape == (bb.points, 2) and np.max(bb.energy_pair_J[-1]) > 0.0
+    assert bb.pair_energy_J.shape == (bb.points, 2) and np.max(bb.pair_energy_J[-1]) > 0.0
     # small amplitude: the linear stuck mode with the pairs' springs
     assert bb.omega_rad_s[0] == pytest.approx(bb.linear.omega_rad_s, rel=1e-9)
     from jointdyn.modes.backbone import backbone_dataset
 
-    assert backbone_dataset(bb)["energy_pair_J"].dims == ("point", "pair")
+    assert backbone_dataset(bb)["pair_energy_J"].dims == ("point", "pair")
 
 
 SYSTEM = """\

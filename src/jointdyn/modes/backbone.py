@@ -122,7 +122,7 @@ class Backbone:
     energy_contact_J: np.ndarray
     energy_viscous_J: np.ndarray
     #: energy dissipated per cycle by each node pair of the interfaces (points, pairs), J (None without)
-    energy_pair_J: np.ndarray | None = None
+    pair_energy_J: np.ndarray | None = None
     counters: dict = field(default_factory=dict)
     problem: object = None
     reduction: object = None
@@ -222,8 +222,8 @@ def backbone_dataset(backbone: Backbone):
         "mode_shape_m": (("point", "coefficient", "dof"), X, {"units": "m"}),
         "harmonic_amplitude_m": (("point", "harmonic", "dof"), _harmonic_amplitudes(b.X, H, n), {"units": "m"}),
     }
-    if b.energy_pair_J is not None:
-        data["energy_pair_J"] = (("point", "pair"), b.energy_pair_J,
+    if b.pair_energy_J is not None:
+        data["pair_energy_J"] = (("point", "pair"), b.pair_energy_J,
                                  {"units": "J", "long_name": "energy dissipated per cycle by each interface pair"})
     variables = {k: xr.Variable(dims, np.asarray(v), attrs=a) for k, (dims, v, a) in data.items()}
     coords = {"point": np.arange(b.points), "contact": np.arange(len(s.contacts)),

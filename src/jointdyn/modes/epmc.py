@@ -268,7 +268,7 @@ def _points(problem: EPMCProblem, lam, V, stash):
         out["energy_viscous_J"][i] = visc
         out["energy_contact_J"][i] = contact
         if pairs is not None:
-            out.setdefault("energy_pair_J", np.empty((p, pairs.size)))[i] = pairs
+            out.setdefault("pair_energy_J", np.empty((p, pairs.size)))[i] = pairs
         out["X"][i] = X
     return out
 
