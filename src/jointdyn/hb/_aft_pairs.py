@@ -31,11 +31,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, specialize
 from ..interfaces import interface_step_jvp
 from ._aft import INFO_ERROR, INFO_PASSES, INFO_PERIOD, PERIOD_NONE, PERIOD_ONE
 
-__all__ = ["pair_directions", "pairs_aft"]
+__all__ = ["pair_directions", "pairs_aft", "pairs_aft_kernel"]
 
 
 def pair_directions(E: np.ndarray):
@@ -152,9 +152,12 @@ def _project_scatter(pairs, i, P0, n, P, Tb, dTb, Nb, dNb, F, G, R, JX):  # prag
                             JX[h * n + r, g * n + c] += sg * G[k * nh + h, m * nh + g]
 
 
-@jit
 def pairs_aft(pairs, params, X, n, E, P, DU, DG, max_passes, rtol, R, JX, T, N, code, info):  # pragma: no cover
     """Add the reactions of every pair and their exact Jacobian to R and JX (see the module docstring).
+
+    A template: :func:`pairs_aft_kernel` compiles it with the pair's step bound as ``PAIR_STEP_JVP``,
+    so that its disk cache follows the source of :mod:`jointdyn.interfaces` (a direct call would keep a
+    stale cache after the element changes).
 
     Parameters
     ----------
@@ -210,8 +213,8 @@ def pairs_aft(pairs, params, X, n, E, P, DU, DG, max_passes, rtol, R, JX, T, N, 
             tmax = 0.0
             for j in range(ns):
                 q = j - 1 if j > 0 else (ns if passes == 0 else ns - 1)
-                interface_step_jvp(prm, Us[q], DU[q], Gs[q], DG[q], Us[j], DU[j], Gs[j], DG[j], a, da, b, db,
-                                   Tb[j], dTb[j], Nb[j], dNb[j], cb[j])
+                PAIR_STEP_JVP(prm, Us[q], DU[q], Gs[q], DG[q], Us[j], DU[j], Gs[j], DG[j], a, da, b, db,  # noqa: F821
+                              Tb[j], dTb[j], Nb[j], dNb[j], cb[j])
                 a, b = b, a
                 da, db = db, da
                 for k in range(2):
@@ -243,3 +246,9 @@ def pairs_aft(pairs, params, X, n, E, P, DU, DG, max_passes, rtol, R, JX, T, N, 
             info[INFO_ERROR] = err
         if period == PERIOD_NONE:
             info[INFO_PERIOD] = PERIOD_NONE
+
+
+def pairs_aft_kernel():
+    """:func:`pairs_aft` compiled with :func:`jointdyn.interfaces.interface_step_jvp` bound as its pair step
+    (memoised; disk-cached under a name that carries the hash of the element's source)."""
+    return specialize(pairs_aft, PAIR_STEP_JVP=interface_step_jvp)

@@ -45,7 +45,7 @@ from ..laws import law_dispatch
 from ..laws._base import MACROSLIP, SEPARATION, STICK_SLIP
 from ..systems import Contact, System
 from ._aft import NO_EVENT, eval_kernel, recontact_events
-from ._aft_pairs import pair_directions, pairs_aft
+from ._aft_pairs import pair_directions, pairs_aft_kernel
 from .parameters import SystemParameter, _FixedFrequency, parameter_named
 from .stability import hill_growth, hill_stability
 
@@ -450,9 +450,9 @@ class HBProblem:
         npairs, ns = self.pair_params.shape[0], self.Ns
         ev.pair_T, ev.pair_N = np.empty((npairs, ns, 2)), np.empty((npairs, ns))
         ev.pair_code = np.empty((npairs, ns), dtype=np.int8)
-        pairs_aft(self.pair_positions, self.pair_params, X, self.n, self.E, self.P, *self._pair_dirs,
-                  int(self.max_passes), float(config.HB_PERIODIC_RTOL), ev.R, ev.JX, ev.pair_T, ev.pair_N,
-                  ev.pair_code, ev.info)
+        pairs_aft_kernel()(self.pair_positions, self.pair_params, X, self.n, self.E, self.P, *self._pair_dirs,
+                           int(self.max_passes), float(config.HB_PERIODIC_RTOL), ev.R, ev.JX, ev.pair_T,
+                           ev.pair_N, ev.pair_code, ev.info)
         if ev.scaled is not None:
             scl = scaled[0]
             np.divide(ev.R, scl[0], out=scaled[1])
