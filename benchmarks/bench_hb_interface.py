@@ -1,6 +1,6 @@
 """Harmonic balance with interfaces (issue 23): AFT evaluation cost per node pair against the number of pairs.
 
-One AFT evaluation of the pairs (``hb._aft_pairs.pairs_aft``: samples of
+One AFT evaluation of the pairs (``hb._aft_pairs.pairs_aft_kernel()``: samples of
 (u1, u2, g), the march with exact derivatives along the 3 (2H+1)
 coefficients of each pair until the slider repeats, projection and scatter
 of the 3 x 3 harmonic blocks), H = 5 and 128 samples, at 16 and 256 pairs,
@@ -71,7 +71,7 @@ def _time(q, X, count):
     """Microseconds (CPU) per pair of the pairs' AFT kernel alone; for the scalar contacts, per contact of
     their whole evaluation (it includes their problem's linear part, small at 32 DOFs)."""
     from jointdyn import config
-    from jointdyn.hb._aft_pairs import pairs_aft
+    from jointdyn.hb._aft_pairs import pairs_aft_kernel
 
     if not q.has_interfaces:
         t0 = time.thread_time()
@@ -80,9 +80,10 @@ def _time(q, X, count):
     npairs = q.pair_params.shape[0]
     R, JX = np.zeros(q.size), np.zeros((q.size, q.size))
     T, N, code, info = np.empty((npairs, q.Ns, 2)), np.empty((npairs, q.Ns)), np.empty((npairs, q.Ns), np.int8), np.zeros(3)
+    kernel = pairs_aft_kernel()
     t0 = time.thread_time()
-    pairs_aft(q.pair_positions, q.pair_params, X, q.n, q.E, q.P, *q._pair_dirs, int(q.max_passes),
-              float(config.HB_PERIODIC_RTOL), R, JX, T, N, code, info)
+    kernel(q.pair_positions, q.pair_params, X, q.n, q.E, q.P, *q._pair_dirs, int(q.max_passes),
+           float(config.HB_PERIODIC_RTOL), R, JX, T, N, code, info)
     t = (time.thread_time() - t0) / count * 1e6
     return t, type("Ev", (), {"info": info, "pair_code": code})
 
