@@ -49,6 +49,17 @@ def atomic_write_text(path, text: str) -> Path:
     return Path(path)
 
 
+def write_table_and_figure(out, stem: str, table, png: bytes) -> list:
+    """``stem.csv`` (a DataFrame, floats to 17 digits so that they read back exactly) and ``stem.png``
+    (its bytes) in the folder ``out``, each written atomically; returns the two paths."""
+    out = Path(out)
+    csv_text = table.to_csv(index=False, float_format="%.17g")
+    paths = [atomic_write_text(out / f"{stem}.csv", csv_text), out / f"{stem}.png"]
+    with atomic_path(paths[1]) as tmp:
+        Path(tmp).write_bytes(png)
+    return paths
+
+
 def jsonable(values):
     """``values`` as JSON takes them: arrays, lists and tuples as (nested) lists of Python numbers (through
     NumPy), NaN and infinities as None (JSON has no NaN); any other value as it is, a non-finite float as

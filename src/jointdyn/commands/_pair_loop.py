@@ -112,7 +112,7 @@ def _plot_png(args, res) -> bytes:
 def _write_files(args, res) -> None:
     import pandas as pd
 
-    from .._io import atomic_path
+    from .._io import write_table_and_figure
     from ..laws import STATE_NAMES
 
     png = _plot_png(args, res)
@@ -120,12 +120,7 @@ def _write_files(args, res) -> None:
                           "T1": res.T[:, 0, 0], "T2": res.T[:, 0, 1], "N": res.N[:, 0],
                           "state": np.asarray(STATE_NAMES, dtype=object)[res.code[:, 0].astype(np.intp)],
                           "inserted": res.inserted})
-    csv_text = table.to_csv(index=False, float_format="%.17g")
-    out = Path(args.out)
-    with atomic_path(out / "loop.csv") as tmp:
-        Path(tmp).write_text(csv_text)
-    with atomic_path(out / "loop.png") as tmp:
-        Path(tmp).write_bytes(png)
+    write_table_and_figure(args.out, "loop", table, png)
 
 
 def run(args) -> int:

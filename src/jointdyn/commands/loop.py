@@ -262,7 +262,7 @@ def _write_files(args, res) -> None:
     """loop.png and loop.csv, each atomically (everything is computed)."""
     import pandas as pd
 
-    from .._io import atomic_path
+    from .._io import write_table_and_figure
 
     title = f"{args.model}: kt={args.kt:g} N/m, mu={args.mu:g}, N_ref={args.n_ref:g} N"
     if args.input is None:
@@ -270,12 +270,7 @@ def _write_files(args, res) -> None:
     png = _plot_png(res, title)
     table = pd.DataFrame({"t": res.t, "x": res.x, "N": res.N, "T": res.T, "state": res.state,
                           "inserted": res.inserted})
-    csv_text = table.to_csv(index=False, float_format="%.17g")
-    out = Path(args.out)
-    with atomic_path(out / "loop.csv") as tmp:
-        Path(tmp).write_text(csv_text)
-    with atomic_path(out / "loop.png") as tmp:
-        Path(tmp).write_bytes(png)
+    write_table_and_figure(args.out, "loop", table, png)
 
 
 def _print_console(args, law, res, report, period) -> None:
