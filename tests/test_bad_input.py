@@ -37,7 +37,7 @@ HANG_GUARD_S = 600
 
 # --- helpers --------------------------------------------------------------------
 class _Reached(AssertionError):
-    """Computing was reached: validation came too late."""
+    """Computing (or reading a huge array) was reached: validation came too late."""
 
 
 def _boom(*args, **kwargs):
@@ -50,6 +50,7 @@ def no_compute(monkeypatch, tmp_path):
     directory is an empty temporary one (default outputs would land there)."""
     import jointdyn.drivers
     import jointdyn.figures
+    import jointdyn.modes
     import jointdyn.sweeps
     from jointdyn.commands import frc as frc_cmd
 
@@ -58,6 +59,8 @@ def no_compute(monkeypatch, tmp_path):
     monkeypatch.setattr(jointdyn.sweeps, "frc_sweep", _boom)
     monkeypatch.setattr(frc_cmd, "_run_hb", _boom)
     monkeypatch.setattr(jointdyn.figures, "make_figure", _boom)
+    monkeypatch.setattr(jointdyn.modes, "epmc", _boom)
+    monkeypatch.setattr(jointdyn.modes, "qsma", _boom)
     monkeypatch.setattr(_points, "_steady_state_fn", lambda: _boom)
     work = tmp_path / "work"
     work.mkdir()
@@ -71,23 +74,24 @@ def _tree(root: Path) -> set:
 
 def _cli(capsys, argv):
     try:
-        rc = main(list(argv))
+        rc = main([str(a) for a in argv])
     except SystemExit as exc:  # argparse usage errors
         rc = exc.code
     cap = capsys.readouterr()
     return rc, cap.out, cap.err
 
 
-def refused(capsys, root: Path, argv, word: str) -> str:
-    """Run the CLI; assert exit 2, one stderr line naming ``word``, no
-    traceback, nothing on stdout, no file written under ``root``."""
+def refused(capsys, root: Path, argv, *words, rc_expected: int = 2) -> str:
+    """Run the CLI; assert exit ``rc_expected``, one stderr line holding every
+    word, no traceback, nothing on stdout, no file written under ``root``."""
     before = _tree(root)
     rc, out, err = _cli(capsys, argv)
     lines = err.strip().splitlines()
-    assert rc == 2, (rc, err)
+    assert rc == rc_expected, (rc, err)
     assert len(lines) == 1, err
     assert "Traceback" not in err
-    assert word in lines[0], lines[0]
+    for w in words:
+        assert w in lines[0], (w, lines[0])
     assert out == ""
     assert _tree(root) == before
     return lines[0]

@@ -29,67 +29,11 @@ from jointdyn import config
 from jointdyn.cli import main
 from jointdyn.files import read_matrices, read_system
 from jointdyn.sweeps import _points
+from test_bad_input import _Reached, _boom, _cli, _tree, no_compute, refused  # noqa: F401 (no_compute: a fixture)
 
 SRC = str(Path(__file__).resolve().parents[1] / "src")
 #: a hang guard for subprocesses, not a speed requirement
 HANG_GUARD_S = 600
-
-
-class _Reached(AssertionError):
-    """Computing (or reading a huge array) was reached: the check came too late."""
-
-
-def _boom(*args, **kwargs):
-    raise _Reached("reached before the input was refused")
-
-
-@pytest.fixture
-def no_compute(monkeypatch, tmp_path):
-    """The compute entry points of the commands fail the test; the working directory is empty."""
-    import jointdyn.drivers
-    import jointdyn.modes
-    import jointdyn.sweeps
-    from jointdyn.commands import frc as frc_cmd
-
-    monkeypatch.setattr(jointdyn.drivers, "quasistatic", _boom)
-    monkeypatch.setattr(jointdyn.drivers, "harmonic_history", _boom)
-    monkeypatch.setattr(jointdyn.sweeps, "frc_sweep", _boom)
-    monkeypatch.setattr(frc_cmd, "_run_hb", _boom)
-    monkeypatch.setattr(jointdyn.modes, "epmc", _boom)
-    monkeypatch.setattr(jointdyn.modes, "qsma", _boom)
-    monkeypatch.setattr(_points, "_steady_state_fn", lambda: _boom)
-    work = tmp_path / "work"
-    work.mkdir()
-    monkeypatch.chdir(work)
-    return work
-
-
-def _tree(root: Path) -> set:
-    return {str(p.relative_to(root)) for p in root.rglob("*")}
-
-
-def _cli(capsys, argv):
-    try:
-        rc = main([str(a) for a in argv])
-    except SystemExit as exc:
-        rc = exc.code
-    cap = capsys.readouterr()
-    return rc, cap.out, cap.err
-
-
-def refused(capsys, root: Path, argv, *words, rc_expected: int = 2) -> str:
-    """Exit ``rc_expected``, one stderr line holding every word, nothing on stdout, no file written."""
-    before = _tree(root)
-    rc, out, err = _cli(capsys, argv)
-    lines = err.strip().splitlines()
-    assert rc == rc_expected, (rc, err)
-    assert len(lines) == 1, err
-    assert "Traceback" not in err
-    for w in words:
-        assert w in lines[0], (w, lines[0])
-    assert out == ""
-    assert _tree(root) == before
-    return lines[0]
 
 
 # --- system files written for the tests -----------------------------------------------------
