@@ -62,12 +62,9 @@ def chain(nodes: int, pairs: bool = True):
     return jd.System(**kw, contacts=cs)
 
 
-def _backbone(s):
-    from jointdyn.hb.problem import reference_scales
+def _backbone(s, a):
     from jointdyn.modes import epmc
 
-    kt, fy = reference_scales(s)
-    a = fy / kt  # the mean slip displacement of the pairs (contacts)
     t0 = time.perf_counter()
     b = epmc(s, (0.01 * a, 10.0 * a), harmonics=H, samples=NS)
     return time.perf_counter() - t0, b.status.value, b.points
@@ -98,9 +95,14 @@ def _branch(s):
 def run(quick: bool) -> dict:
     nodes = 16 if quick else 167
     out = {"nodes": nodes, "dofs": 3 * nodes, "pairs": nodes, "harmonics": H, "samples": NS}
+    from jointdyn.hb.problem import reference_scales
+
+    # one amplitude range for both backbones: the pairs' mean slip displacement (the default scale of the
+    # contacts, the first contact's fy / kt, is that of the lightest pair at the end of the chain, 3 times smaller)
+    kt, fy = reference_scales(chain(nodes, True))
     for name, pairs in (("interface", True), ("contacts", False)):
         s = chain(nodes, pairs)
-        t, status, points = _backbone(s)
+        t, status, points = _backbone(s, fy / kt)
         out[f"{name}_epmc_s"], out[f"{name}_epmc_status"], out[f"{name}_epmc_points"] = t, status, points
         t, status, points, hill = _branch(s)
         out[f"{name}_hb_s"], out[f"{name}_hb_status"], out[f"{name}_hb_points"] = t, status, points
