@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from jointdyn import config
-from jointdyn.figures import FIGURES
+from jointdyn.figures import FIGURES, figure_names
 from jointdyn.figures.lap import lap_joint_data, lap_joint_system
 
 
@@ -53,6 +53,10 @@ def test_stuck_forced_response_is_the_linear_modes(stuck_tables):
     peak = frc[frc.flank == 0]
     assert float(peak.frequency_hz.iloc[0]) == pytest.approx(w * math.sqrt(1 - 2 * config.LAP_ZETA**2) / (2 * math.pi),
                                                              rel=1e-9)
+
+
+def test_registered():
+    assert "lap_joint" in figure_names()
 
 
 def test_plot_from_the_tables(stuck_tables, tmp_path):
