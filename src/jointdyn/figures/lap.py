@@ -141,7 +141,8 @@ def _plot_maps(axes, slip):
             ax.set_yticks([])
             if row == 0:
                 a = sub.amplitude_m.iloc[0]
-                ax.set_title(f"a = {1e3 * a:.3g} mm, {sub.frequency_hz.iloc[0]:.1f} Hz\n"
+                note = "" if bool(sub.converged.iloc[0]) else " (Newton did not converge)"
+                ax.set_title(f"a = {1e3 * a:.3g} mm, {sub.frequency_hz.iloc[0]:.1f} Hz{note}\n"
                              f"pairs dissipate {1e3 * sub.energy_J.sum():.3g} mJ per cycle", fontsize=8)
             if col == 0:
                 ax.set_ylabel("(d) " + label, fontsize=8)
