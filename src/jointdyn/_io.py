@@ -84,11 +84,16 @@ def point_table(ds):
 
 def write_dataset(ds, out, stem: str, table=point_table) -> list:
     """Write ``ds`` as ``out/<stem>.nc`` (netCDF3, scipy engine) and ``out/<stem>.csv`` (``table(ds)``,
-    default :func:`point_table`), each atomically; returns both paths."""
+    default :func:`point_table`), each atomically; returns both paths.
+
+    The netCDF file leaves out the dimensions of length 0 and the variables on them (e.g. the per-contact
+    variables of a system whose only contacts are interfaces): they hold no values, and a netCDF3 file
+    with such a variable cannot be read back (scipy's reader fails on it)."""
     out = Path(out)
     nc, csv = out / f"{stem}.nc", out / f"{stem}.csv"
+    empty = [d for d, size in ds.sizes.items() if size == 0]
     with atomic_path(nc) as tmp:
-        ds.to_netcdf(tmp, engine="scipy")
+        (ds.drop_dims(empty) if empty else ds).to_netcdf(tmp, engine="scipy")
     with atomic_path(csv) as tmp:
         table(ds).to_csv(tmp, index=False)
     return [nc, csv]

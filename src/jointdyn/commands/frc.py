@@ -439,6 +439,9 @@ def _run_time(args, gammas):
         }
         if "contact" in one.dims or "dof" in one.dims:
             result["directions"][d].update(_loop_outputs(one))
+        if "pair" in one.dims:  # the interfaces' node pairs (NaN sums where a point has no steady state)
+            result["directions"][d].update(_pair_json(one.pair_energy_J.values, {
+                k: one[f"pair_{k}_fraction"].values for k in ("stick", "slip", "open")}))
     flagged = int(line.negative_dissipation.sum())
     if flagged:
         print(f"jointdyn frc: warning: {flagged} periodic points where the contact creates energy over the period "
@@ -455,10 +458,12 @@ def _run_time(args, gammas):
 def _hb_branches(br, dofs=()) -> list:
     """The segments of an HBBranch as JSON objects (per point: gamma, amplitudes, stability, status;
     ``dofs``: the amplitude and offset of each of these DOFs too, under ``dofs``)."""
+    from ..hb.export import pair_arrays
     from ..hb.problem import reference_scales
 
     kt, fy = reference_scales(br.problem.system)
     amp, off, mx = br.response()
+    pairs = pair_arrays(br)
     gam = br.gamma()
     out = []
     for b in dict.fromkeys(br.segment.tolist()):
@@ -473,8 +478,20 @@ def _hb_branches(br, dofs=()) -> list:
         one["point_status"] = [str(s) for s in br.point_status[idx]]
         one["folds"] = [int(i) for i in np.flatnonzero(br.fold[idx])]
         one["branch"] = int(b)  # the segment (0: from START; then continued back from STOP or over a jump)
+        if pairs:  # the interfaces' node pairs: total and per pair, per point
+            one.update(_pair_json(pairs["pair_energy_J"][idx],
+                                  {k: pairs[f"pair_{k}_fraction"][idx] for k in ("stick", "slip", "open")}))
         out.append(one)
     return out
+
+
+def _pair_json(energy, fractions) -> dict:
+    """``energy_pairs_J`` (per point, J) and ``pairs`` (per point and pair: ``energy_J``, J, and the
+    ``stick_fraction``, ``slip_fraction``, ``open_fraction`` of the period) of the JSON."""
+    energy = np.asarray(energy, dtype=float)
+    return {"energy_pairs_J": _jsonable(energy.sum(axis=1)),
+            "pairs": {"energy_J": _jsonable(energy),
+                      **{f"{k}_fraction": _jsonable(np.asarray(v, dtype=float)) for k, v in fractions.items()}}}
 
 
 def _hb_peaks(br) -> list:

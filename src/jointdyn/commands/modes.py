@@ -150,6 +150,11 @@ def _result(args, ds, label) -> dict:
             "damping_ratio_viscous", "energy_contact_J")
     branch = {k: _jsonable(ds[k].values) for k in keys}
     branch["energy_contact_j"] = branch["energy_contact_J"]  # deprecated alias: JSON keys are added, never renamed
+    if "pair" in ds.dims:  # the interfaces' node pairs: the total per point, and per point and pair
+        branch["energy_pairs_J"] = _jsonable(ds["energy_pairs_J"].values)
+        branch["pairs"] = {"energy_J": _jsonable(ds["pair_energy_J"].values),
+                           **{f"{k}_fraction": _jsonable(ds[f"pair_{k}_fraction"].values)
+                              for k in ("stick", "slip", "open")}}
     return {"method": args.method, "system": label, "title": args.title, "mode": int(ds.attrs["linear_mode"]),
             "output_dof": int(ds.attrs["output_dof"]), "harmonics": int(ds.attrs["harmonics"]),
             "samples": int(ds.attrs["samples"]), "omega_linear_rad_s": float(ds.attrs["omega_linear_rad_s"]),

@@ -13,7 +13,7 @@ import numpy as np
 from .problem import reference_scales
 from .results import HBBranch, PointStatus
 
-__all__ = ["branch_dataset", "discretisation_attrs"]
+__all__ = ["branch_dataset", "discretisation_attrs", "pair_arrays"]
 
 
 def branch_dataset(branch: HBBranch, response_dof: int | None = None):
@@ -84,6 +84,7 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
                                             "peak_amplitude_m")},
              "point_status": {"flag_meanings": " ".join(s.value for s in PointStatus)},
              "pair_energy_J": {"units": "J", "long_name": "energy dissipated per cycle by each interface pair"},
+             "energy_pairs_J": {"units": "J", "long_name": "energy dissipated per cycle by all interface pairs"},
              **{f"pair_{s}_fraction": {"units": "1", "long_name": f"fraction of the period the pair is {w}"}
                 for s, w in (("stick", "stuck"), ("slip", "slipping"), ("open", "open"))}}
     # variables built with their attributes (no DataArray round trips afterwards)
@@ -97,11 +98,11 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
     return ds
 
 
-def _pair_variables(branch: HBBranch) -> dict:
-    """Per point and node pair of the interfaces (all interfaces stacked; none without interfaces), the data
-    of a slip map: ``pair_energy_J`` (energy dissipated per cycle, J), ``pair_stick_fraction``,
-    ``pair_slip_fraction`` and ``pair_open_fraction`` (of the period, over the AFT samples), from one
-    evaluation per point (:meth:`~jointdyn.hb.problem.HBProblem.pair_results`)."""
+def pair_arrays(branch: HBBranch) -> dict:
+    """Per point and node pair of the interfaces (all interfaces stacked; empty without interfaces), the data
+    of a slip map, arrays (points, pairs): ``pair_energy_J`` (energy dissipated per cycle, J),
+    ``pair_stick_fraction``, ``pair_slip_fraction`` and ``pair_open_fraction`` (of the period, over the AFT
+    samples), from one evaluation per point (:meth:`~jointdyn.hb.problem.HBProblem.pair_results`)."""
     p = branch.problem
     if not p.has_interfaces:
         return {}
@@ -112,7 +113,16 @@ def _pair_variables(branch: HBBranch) -> dict:
         res = p.pair_results(X, p.evaluate(X, lam))
         for k, name in keys:
             out[name][i] = res[k]
-    return {name: (("point", "pair"), v) for name, v in out.items()}
+    return out
+
+
+def _pair_variables(branch: HBBranch) -> dict:
+    """:func:`pair_arrays` as Dataset variables (dims point, pair), with ``energy_pairs_J`` (dim point: the
+    energy all pairs dissipate per cycle, J, which the point table carries)."""
+    out = {name: (("point", "pair"), v) for name, v in pair_arrays(branch).items()}
+    if out:
+        out["energy_pairs_J"] = ("point", out["pair_energy_J"][1].sum(axis=1))
+    return out
 
 
 def _peak_variables(branch: HBBranch, dof: int, qs: float) -> dict:

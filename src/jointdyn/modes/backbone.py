@@ -29,7 +29,7 @@ from ..status import Status
 from ..systems import System
 from ._free import LinearMode
 
-__all__ = ["ModeStatus", "Backbone", "backbone_dataset"]
+__all__ = ["ModeStatus", "Backbone", "backbone_dataset", "pair_fractions"]
 
 
 class ModeStatus(Status):
@@ -170,6 +170,22 @@ def _harmonic_amplitudes(X: np.ndarray, H: int, n: int) -> np.ndarray:
     return out
 
 
+def pair_fractions(backbone: Backbone) -> dict:
+    """Per point and interface node pair, the fractions of the period each pair is stuck, slipping and open
+    (over the AFT samples; one evaluation per point of the backbone's problem): ``{"stick": (array
+    (points, pairs), "stuck"), "slip": ..., "open": ...}``; empty without pairs or without the problem."""
+    p = backbone.problem
+    if backbone.pair_energy_J is None or p is None or not hasattr(p, "hb"):
+        return {}
+    out = {k: np.empty(backbone.pair_energy_J.shape) for k in ("stick", "slip", "open")}
+    for i in range(backbone.points):
+        X, w = backbone.X[i], backbone.omega_rad_s[i]
+        res = p.hb.pair_results(X, p.evaluate(X, w))
+        for k in out:
+            out[k][i] = res[k]
+    return {k: (v, w) for (k, v), w in zip(out.items(), ("stuck", "slipping", "open"))}
+
+
 def backbone_dataset(backbone: Backbone):
     """xarray Dataset of a backbone (dim ``point``).
 
@@ -182,7 +198,10 @@ def backbone_dataset(backbone: Backbone):
     ``energy_viscous_J``; ``energy_contact_J`` (point, contact);
     ``mode_shape_m`` (point, coefficient, dof): the harmonic coefficients
     (0, cos 1, sin 1, ..., cos H, sin H); ``harmonic_amplitude_m`` (point,
-    harmonic, dof). Attributes: ``method``, ``status``, ``message``,
+    harmonic, dof); with interfaces (dim ``pair``: their node pairs one after the other) ``pair_energy_J``
+    (energy per cycle of each pair, J), ``energy_pairs_J`` (dim point: their sum, J) and
+    ``pair_stick_fraction``, ``pair_slip_fraction``, ``pair_open_fraction`` (of the period; the data of a
+    slip map, :func:`pair_fractions`). Attributes: ``method``, ``status``, ``message``,
     ``linear_mode`` (the linear stuck mode it starts from; the name
     ``mode`` is taken by netCDF files), ``output_dof``, ``harmonics``, ``samples``,
     ``omega_linear_rad_s``, ``w0_rad_s``, ``model`` and ``law`` (class
@@ -225,6 +244,11 @@ def backbone_dataset(backbone: Backbone):
     if b.pair_energy_J is not None:
         data["pair_energy_J"] = (("point", "pair"), b.pair_energy_J,
                                  {"units": "J", "long_name": "energy dissipated per cycle by each interface pair"})
+        data["energy_pairs_J"] = (point, b.pair_energy_J.sum(axis=1),
+                                  {"units": "J", "long_name": "energy dissipated per cycle by all interface pairs"})
+        for key, (values, what) in pair_fractions(b).items():
+            data[f"pair_{key}_fraction"] = (("point", "pair"), values,
+                                            {"units": "1", "long_name": f"fraction of the period the pair is {what}"})
     variables = {k: xr.Variable(dims, np.asarray(v), attrs=a) for k, (dims, v, a) in data.items()}
     coords = {"point": np.arange(b.points), "contact": np.arange(len(s.contacts)),
               "coefficient": np.arange(2 * H + 1), "harmonic": np.arange(H + 1), "dof": np.arange(n)}

@@ -60,6 +60,7 @@ from ._points import (
     INT_VARIABLES,
     NOT_COMPUTED,
     NOT_COMPUTED_NAME,
+    PAIR_VARIABLES,
     STATE_VARIABLE,
     STATUS_CODES,
     VARIABLES,
@@ -75,6 +76,7 @@ __all__ = [
     "INT_VARIABLES",
     "DOF_VARIABLES",
     "CONTACT_VARIABLES",
+    "PAIR_VARIABLES",
     "RUN_ATTRIBUTES",
     "status_name",
     "to_frame",
@@ -110,17 +112,18 @@ def default_workers() -> int:
 class _LineRun:
     """One line during a sweep: its spec, where it stands, its results so far."""
 
-    def __init__(self, index, spec, system_index, system, ncontacts, dofs, where=""):
+    def __init__(self, index, spec, system_index, system, ncontacts, dofs, where="", npairs=0):
         self.index = index
         self.where = where
         self.spec = spec
         self.system_index = system_index
         self.rdof = int(system.response_dof)
         self.ncontacts = ncontacts
+        self.npairs = npairs
         self.dofs = dofs
         g = list(spec.gammas)
         self.gammas = tuple(g if spec.direction == "up" else g[::-1])
-        self.arrays = empty_arrays(len(g), len(dofs), ncontacts, spec.loop_outputs)
+        self.arrays = empty_arrays(len(g), len(dofs), ncontacts, spec.loop_outputs, npairs)
         self.next = 0
         self.start = None
 
@@ -135,7 +138,7 @@ class _LineRun:
         return ChunkTask(line=self.index, system_index=self.system_index, first=self.next,
                          gammas=self.gammas[self.next:stop], start=self.start, rdof=self.rdof, dofs=self.dofs,
                          ncontacts=self.ncontacts, loop_outputs=self.spec.loop_outputs,
-                         steps_per_period=self.spec.steps_per_period, where=self.where)
+                         steps_per_period=self.spec.steps_per_period, where=self.where, npairs=self.npairs)
 
     def accept(self, chunk) -> None:
         """Store a chunk that starts where the line stands."""
@@ -262,6 +265,7 @@ def _prepare_kernels(systems) -> None:
 
 def _line_runs(family, directions, g, spp, dofs, loop_outputs) -> list:
     nc = max((len(s.contacts) for _, _, s in family.entries), default=0)
+    npairs = max((_npairs(s) for _, _, s in family.entries), default=0)
     runs = []
     for i, (_, label, system) in enumerate(family.entries):
         key = fingerprint(system)
@@ -269,8 +273,13 @@ def _line_runs(family, directions, g, spp, dofs, loop_outputs) -> list:
             spec = LineSpec(label=label, system=key, direction=d, gammas=g, steps_per_period=spp, dofs=dofs,
                             loop_outputs=loop_outputs)
             where = f"system {label!r}: " if family.dims else ""
-            runs.append(_LineRun(len(runs), spec, i, system, nc, dofs, where))
+            runs.append(_LineRun(len(runs), spec, i, system, nc, dofs, where, npairs))
     return runs
+
+
+def _npairs(system) -> int:
+    """Node pairs of all the interfaces of ``system``."""
+    return sum(int(itf.pairs.shape[0]) for itf in system.interfaces)
 
 
 def frc_sweep(
@@ -379,7 +388,9 @@ def frc_sweep(
         contact's q), :data:`INT_VARIABLES`, ``status`` (int8; legend in its
         ``legend`` attribute); with ``loop_outputs`` also
         :data:`DOF_VARIABLES` (dim ``dof``), :data:`CONTACT_VARIABLES` (dim
-        ``contact``) and ``state_fraction`` (dims ``contact, state``).
+        ``contact``) and ``state_fraction`` (dims ``contact, state``);
+        with interfaces :data:`PAIR_VARIABLES` (dim ``pair``: energy per
+        period and stick, slip, open fractions of every node pair).
         Only points with status 0 (periodic) carry steady values. Attribute
         ``reused_points``: points loaded from ``out``; ``stale_points``:
         points of checkpoints of another solver version, recomputed.
@@ -519,6 +530,13 @@ def _assemble(family, runs, directions, g, dofs, spp, loop_outputs):
         coords["dof"] = (("dof",), np.asarray(dofs, dtype=np.int64), {"long_name": "degree of freedom"})
         coords["contact"] = (("contact",), np.arange(nc, dtype=np.int64), {"long_name": "contact index"})
         coords["state"] = (("state",), np.asarray(STATE_NAMES, dtype=str), {"long_name": "motion state"})
+    npairs = runs[0].npairs if runs else 0
+    if npairs:  # a slip map per point: every pair of the interfaces, with or without loop outputs
+        for name, (unit, desc, _) in PAIR_VARIABLES.items():
+            data[name] = ((*dims, "pair"), _stack(runs, family, directions, name, (m, npairs), float, np.nan),
+                          {"units": unit, "long_name": desc})
+        coords["pair"] = (("pair",), np.arange(npairs, dtype=np.int64),
+                          {"long_name": "interface node pair (all interfaces one after the other)"})
     attrs = {"title": "steady-state frequency response (time domain)", **family.attrs,
              "steps_per_period": int(spp) if spp is not None else "solver default",
              "solver_version": int(SOLVER_VERSION), "jointdyn_version": __version__}
@@ -553,7 +571,7 @@ def to_frame(ds):
 
 
 def _column_part(dim: str, value) -> str:
-    return {"dof": f"dof{value}", "contact": f"c{value}"}.get(dim, str(value))
+    return {"dof": f"dof{value}", "contact": f"c{value}", "pair": f"p{value}"}.get(dim, str(value))
 
 
 def write_outputs(ds, out) -> list[Path]:

@@ -11,7 +11,11 @@ Per point: the steady state's status and scalars (:data:`VARIABLES`,
 :data:`INT_VARIABLES`); with ``loop_outputs`` also, from the recorded steady
 period (:func:`loop_statistics`), the amplitude and offset of each requested
 DOF and per contact the dissipated energy, the mean and extreme normal
-force and the fraction of time in each motion state.
+force and the fraction of time in each motion state. A system with
+interfaces also records, per node pair, the energy it dissipates per period
+and the fractions of the period it sticks, slips and is open
+(:data:`PAIR_VARIABLES`, from the steady state itself, with or without
+``loop_outputs``): the data of a slip map.
 """
 
 from __future__ import annotations
@@ -33,6 +37,7 @@ __all__ = [
     "DOF_VARIABLES",
     "CONTACT_VARIABLES",
     "STATE_VARIABLE",
+    "PAIR_VARIABLES",
     "LoopStatistics",
     "loop_statistics",
     "ChunkTask",
@@ -78,6 +83,14 @@ CONTACT_VARIABLES = {
     "normal_mean_N": ("N", "time mean of the contact's normal force max(0, N)"),
     "normal_min_N": ("N", "smallest normal force max(0, N) over the recorded samples"),
     "normal_max_N": ("N", "largest normal force max(0, N) over the recorded samples"),
+}
+#: per interface node pair (dimension ``pair``, the pairs of all interfaces one after the other): the names of
+#: the harmonic-balance branch's Dataset, with the SteadyState field each comes from
+PAIR_VARIABLES = {
+    "pair_energy_J": ("J", "energy dissipated by the node pair per forcing period", "pair_energy_J"),
+    "pair_stick_fraction": ("1", "fraction of the steady period the pair is stuck", "pair_stick"),
+    "pair_slip_fraction": ("1", "fraction of the steady period the pair is slipping", "pair_slip"),
+    "pair_open_fraction": ("1", "fraction of the steady period the pair is open", "pair_open"),
 }
 #: per contact and motion state (dimensions ``contact``, ``state``)
 STATE_VARIABLE = ("state_fraction", "1", "fraction of the steady period spent in each motion state "
@@ -226,6 +239,8 @@ class ChunkTask:
         DOFs recorded per point (with ``loop_outputs``).
     ncontacts : int
         Width of the per-contact arrays.
+    npairs : int
+        Width of the per-pair arrays (0: none recorded).
     loop_outputs : bool
         Record per-DOF and per-contact outputs (keeps the steady loop).
     steps_per_period : int or None
@@ -246,6 +261,7 @@ class ChunkTask:
     loop_outputs: bool
     steps_per_period: int | None
     where: str = ""
+    npairs: int = 0
 
 
 @dataclass(frozen=True)
@@ -315,9 +331,12 @@ def _solver():
     return _steady_state_fn()
 
 
-def empty_arrays(m: int, ndofs: int, nc: int, loop_outputs: bool) -> dict:
-    """Result arrays of ``m`` points, not computed (NaN, 0, status NOT_COMPUTED)."""
+def empty_arrays(m: int, ndofs: int, nc: int, loop_outputs: bool, npairs: int = 0) -> dict:
+    """Result arrays of ``m`` points, not computed (NaN, 0, status NOT_COMPUTED); per-pair arrays
+    (:data:`PAIR_VARIABLES`) when ``npairs`` > 0."""
     out = {name: np.full(m, np.nan) for name in VARIABLES}
+    if npairs:
+        out.update({name: np.full((m, npairs), np.nan) for name in PAIR_VARIABLES})
     out.update({name: np.zeros(m, dtype=np.int32) for name in INT_VARIABLES})
     out["status"] = np.full(m, NOT_COMPUTED, dtype=np.int8)
     if loop_outputs:
@@ -349,6 +368,10 @@ def _store(out: dict, k: int, res, system, task: ChunkTask) -> None:
     out["period_multiple"][k] = int(getattr(res, "period_multiple", 0) or 0)
     out["not_settled_reason"][k] = not_settled_reason(res)
     out["negative_dissipation"][k] = int(getattr(res, "energy_check", None) == EnergyCheck.NEGATIVE_DISSIPATION)
+    if task.npairs:
+        for name, (_, _, field_name) in PAIR_VARIABLES.items():
+            val = np.asarray(getattr(res, field_name, ()), dtype=np.float64)
+            out[name][k, : val.shape[0]] = val
     loop = getattr(res, "loop", None)
     if task.loop_outputs and loop is not None:
         st = loop_statistics(loop, system, task.dofs, out["period_multiple"][k])
@@ -365,7 +388,7 @@ def solve_chunk(task: ChunkTask, system, ctx: Context | None = None) -> ChunkRes
     """
     solve = _solver()
     m = len(task.gammas)
-    out = empty_arrays(m, len(task.dofs), task.ncontacts, task.loop_outputs)
+    out = empty_arrays(m, len(task.dofs), task.ncontacts, task.loop_outputs, task.npairs)
     kwargs = {"keep_loop": bool(task.loop_outputs), "response_dof": task.rdof}
     if task.steps_per_period is not None:
         kwargs["steps_per_period"] = task.steps_per_period
