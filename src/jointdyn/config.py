@@ -171,6 +171,15 @@ CONT_REFINE_GTOL = 1e-7
 #: the compiled elimination is 1.2-3.5x faster at 16 to 751 unknowns with
 #: single-threaded BLAS; beyond the sizes measured, LAPACK)
 CONT_SMALL_SOLVE = 800
+#: from this many unknowns, a walk's bordered systems are solved by GMRES
+#: preconditioned with the LU factors of an earlier matrix of the walk, and
+#: factorised anew only when that fails (jointdyn.continuation.linalg): a
+#: factorisation costs seconds there (benchmarks/bench_linalg.py)
+CONT_KRYLOV_SOLVE = 2000
+#: a GMRES solution is accepted when |A x - b| <= this |b| (true residual)
+CONT_KRYLOV_RTOL = 1e-9
+#: GMRES iterations (one cycle, no restart) before the matrix is factorised
+CONT_KRYLOV_MAXITER = 12
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history

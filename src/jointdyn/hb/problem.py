@@ -129,6 +129,16 @@ def _linear_blocks(system: System, H: int):
     return AK, AC, AM
 
 
+def harmonic_columns(n: int, H: int) -> np.ndarray:
+    """(n (2H+1), 2) int64: per row of the unknowns (harmonic-major: mean, cos 1, sin 1, ...), the columns
+    ``[lo, hi)`` of its harmonic's block, where alone the linear terms of harmonic balance couple it."""
+    h = np.arange(n * (2 * H + 1)) // n
+    k = (h + 1) // 2
+    lo = np.where(k == 0, 0, (2 * k - 1) * n)
+    hi = np.where(k == 0, n, (2 * k + 1) * n)
+    return np.ascontiguousarray(np.stack((lo, hi), axis=1), dtype=np.int64)
+
+
 class HBProblem:
     """Harmonic-balance residual R(X, p) and its exact Jacobian.
 
@@ -186,6 +196,7 @@ class HBProblem:
         self.n = self.dofs.size
         self.nh = 2 * self.H + 1
         self.size = self.n * self.nh
+        self._lin_cols = harmonic_columns(self.n, self.H)
         self.w0 = system.w0
         if not self.w0 > 0:
             raise ValueError("system must have a positive lowest natural frequency w0 (K positive definite)")
@@ -433,7 +444,7 @@ class HBProblem:
                 self._scl = np.array([fs, xs / fs, ps / fs])
                 self._scales_seen = scales
             scaled = (self._scl, np.empty(size), np.empty((size, size)), np.empty(size))
-        self._kernel((*self._linear_terms(w), float(dwdp), X, Fe, Fp),
+        self._kernel((*self._linear_terms(w), float(dwdp), X, Fe, Fp, self._lin_cols),
                      (self._Bm, self._Pm, self._ssz, self._Bnm, self._Sp, self.has_springs),
                      (Nsamp, dN if has_p else self._dummy, has_p, events), (self._Eg, self._Pg),
                      (int(self.max_passes), float(config.HB_PERIODIC_RTOL)), (R, JX, Jp, T, Nout, code, info), scaled)

@@ -76,18 +76,6 @@ __all__ = ["EPMCProblem", "epmc"]
 _LN10 = math.log(10.0)
 
 
-def mass_damping_block(M: np.ndarray, H: int) -> np.ndarray:
-    """A_M: the harmonic-balance damping block of harmonics 0..H with M for C (size n (2H + 1))."""
-    n = M.shape[0]
-    A = np.zeros((n * (2 * H + 1), n * (2 * H + 1)))
-    for k in range(1, H + 1):
-        ic = (2 * k - 1) * n
-        is_ = 2 * k * n
-        A[ic:ic + n, is_:is_ + n] = k * M
-        A[is_:is_ + n, ic:ic + n] = -k * M
-    return A
-
-
 class EPMCProblem:
     """Scaled EPMC residual ``R(v, lam)`` and its exact Jacobians (module docstring).
 
@@ -137,7 +125,6 @@ class EPMCProblem:
             raise ValueError(f"{exc} (EPMC evaluates the contacts by harmonic balance)") from None
         self.linear = linear_stuck_mode(system, mode, self.output_dof)
         self.n, self.H, self.size = n, self.hb.H, self.hb.size
-        self.A_M = mass_damping_block(system.M, self.H)
         self.i_omega = n + self.output_dof
         self.i_xi = 2 * n + self.output_dof
         self.w_ref = self.linear.omega_rad_s
@@ -184,16 +171,41 @@ class EPMCProblem:
         Y = X / a
         ev = self.evaluate(X, w)
         self.last = (X, w, xi, ev)
-        cx = self.A_M @ X
+        cx = self._times_mass_damping(X)
         R = ev.R - (xi * w) * cx
-        J = ev.JX - (xi * w) * self.A_M
+        # in place on the evaluation's own Jacobian (nothing reads it afterwards): at thousands of unknowns
+        # every copy of an N x N array costs as much as the AFT of hundreds of node pairs
+        J = ev.JX
+        self._subtract_mass_damping(J, xi * w)
         ka = self.k_ref * a
         Rs = R / ka
         Jlam = _LN10 * (J @ Y / self.k_ref - Rs)
-        Jv = J / self.k_ref
+        Jv = J
+        Jv /= self.k_ref
         Jv[:, self.i_omega] = self.w_ref * (ev.Jp / self.hb.w0 - xi * cx) / ka
         Jv[:, self.i_xi] = -self.w_ref * w * cx / ka
         return Rs, Jv, Jlam
+
+    def _blocks(self):
+        """(k, rows of cos k, rows of sin k) of the harmonics 1..H: where A_M has its blocks k M and -k M."""
+        n = self.n
+        return [(k, slice((2 * k - 1) * n, 2 * k * n), slice(2 * k * n, (2 * k + 1) * n)) for k in range(1, self.H + 1)]
+
+    def _times_mass_damping(self, X):
+        """A_M @ X by blocks, m kg (A_M is zero outside its 2H blocks)."""
+        out = np.zeros_like(X)
+        M = self.system.M
+        for k, c, s in self._blocks():
+            out[c] = (k * M) @ X[s]
+            out[s] = (-k * M) @ X[c]
+        return out
+
+    def _subtract_mass_damping(self, J, f):
+        """J -= f A_M in place, on A_M's blocks only."""
+        M = self.system.M
+        for k, c, s in self._blocks():
+            J[c, s] -= f * (k * M)
+            J[s, c] -= f * (-k * M)
 
     def solve(self, amplitude: float, guess, options: ContinuationOptions | None = None, **overrides):
         """Newton at a fixed amplitude (m) from scaled unknowns ``guess``: ``(v, converged, iterations)``."""
@@ -372,7 +384,8 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         last = problem.last
         X = problem.unpack(v, lam)[0]
         if last is not None and last[0].tobytes() == X.tobytes():
-            stash[X.tobytes()] = last[3]
+            # without its Jacobian (modified in place, and N x N per point): the per-point results do not use it
+            stash[X.tobytes()] = dataclasses.replace(last[3], JX=None, scaled=None)
 
     # the bar fills over the range of log10(amplitude), not against max_points
     with ParameterProgress(lam0, lam1, "EPMC", progress, name="log10(a / m)") as bar:
