@@ -436,6 +436,12 @@ HB_CONDENSE_CHECK_RTOL = 1e-9
 #: a condensed problem computes Hill stability (on the full Jacobian it
 #: assembles) when the full companion matrix has at most this many rows
 HB_CONDENSED_HILL_ROWS = 200
+#: a (full) harmonic-balance problem computes Hill stability when the
+#: companion matrix has at most this many rows (2 n (2H+1)); beyond, all its
+#: eigenvalues cost more than the branch (about a minute per point at 10^4
+#: rows on 2 cores): stability is not computed (growth NaN, the Dataset's
+#: ``stability`` attribute says so)
+HB_HILL_MAX_ROWS = 4000
 #: bytes of dense Jacobians a branch keeps at once: the continuation monitor
 #: keeps the evaluations of accepted points with their Jacobians while they fit
 #: (beyond, without: the point is evaluated again for its stability), and

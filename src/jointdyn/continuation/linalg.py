@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import warnings
 
 import numpy as np
 import scipy.linalg as sla
@@ -201,7 +202,9 @@ class FactorReuse:
             if x is not None:
                 return x, True
         A = _bordered(Jy, Jl, d)
-        lu = sla.lu_factor(A, overwrite_a=True, check_finite=False)
+        with warnings.catch_warnings():  # an exactly singular matrix is reported by ok = False below
+            warnings.simplefilter("ignore", sla.LinAlgWarning)
+            lu = sla.lu_factor(A, overwrite_a=True, check_finite=False)
         self.counts["factorisations"] += 1
         if not np.all(np.isfinite(lu[0].diagonal())) or np.any(lu[0].diagonal() == 0.0):
             self.lu = None

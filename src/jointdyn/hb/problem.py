@@ -548,12 +548,24 @@ class HBProblem:
                 "open": np.mean(code == SEPARATION, axis=1)}
 
     # --- stability ----------------------------------------------------------
+    def hill_affordable(self) -> bool:
+        """True when the companion matrix of Hill's method (2 n (2H+1) rows) has at most
+        ``config.HB_HILL_MAX_ROWS`` rows: all its eigenvalues cost O(rows^3), about a minute per point at
+        10^4 rows on two cores, far more than the point itself."""
+        return 2 * self.size <= config.HB_HILL_MAX_ROWS
+
     def hill_growth(self, JXs, ws):
-        """max Re(s) / w of the Floquet exponents (Hill's method) at many points (:func:`~jointdyn.hb.stability.hill_growth`)."""
+        """max Re(s) / w of the Floquet exponents (Hill's method) at many points
+        (:func:`~jointdyn.hb.stability.hill_growth`); NaN when not :meth:`hill_affordable`."""
+        if not self.hill_affordable():
+            return np.full(len(ws), np.nan)
         return hill_growth(JXs, self.system.M, self.system.C, ws, self.H)
 
     def hill_stability(self, JX, w):
-        """(stable, growth, multipliers) of one solution (:func:`~jointdyn.hb.stability.hill_stability`)."""
+        """(stable, growth, multipliers) of one solution (:func:`~jointdyn.hb.stability.hill_stability`), or
+        (False, NaN, empty) when not :meth:`hill_affordable`."""
+        if not self.hill_affordable():
+            return False, math.nan, np.empty(0, dtype=complex)
         return hill_stability(JX, self.system.M, self.system.C, w, self.H)
 
 
