@@ -178,8 +178,13 @@ CONT_SMALL_SOLVE = 800
 CONT_KRYLOV_SOLVE = 2000
 #: a GMRES solution is accepted when |A x - b| <= this |b| (true residual)
 CONT_KRYLOV_RTOL = 1e-9
-#: GMRES iterations (one cycle, no restart) before the matrix is factorised
-CONT_KRYLOV_MAXITER = 12
+#: GMRES iterations (one cycle, no restart) before the matrix is factorised;
+#: at 5500 unknowns an iteration (a product with the matrix and a solve with
+#: the kept factors) costs about 1/20 of a factorisation
+CONT_KRYLOV_MAXITER = 20
+#: a solve that needed more iterations than this has the next matrix factorised
+#: at once (the kept factors have drifted from the walk's matrices)
+CONT_KRYLOV_REFRESH = 10
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history

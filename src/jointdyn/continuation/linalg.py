@@ -15,7 +15,9 @@ factorised bordered matrix precondition GMRES on the current one
 new factorisation. The solution is accepted only when its true residual
 ``|A x - b| <= config.CONT_KRYLOV_RTOL |b|``; otherwise, or after
 ``config.CONT_KRYLOV_MAXITER`` iterations, the current matrix is factorised
-and solved directly (and its factors kept for the next solves). The
+and solved directly (and its factors kept for the next solves); after a
+solve that needed more than ``config.CONT_KRYLOV_REFRESH`` iterations, the
+next matrix is factorised at once. The
 preconditioner changes the work, not the answer beyond that tolerance: the
 Newton corrector still stops on its own residual.
 """
@@ -192,15 +194,17 @@ class FactorReuse:
 
     def __init__(self):
         self.lu = None
+        self.stale = False
         self.counts = {"factorisations": 0, "krylov_solves": 0, "krylov_iterations": 0}
 
     def solve(self, Jy, Jl, d, b):
         """``(x, ok)``: the solution of the bordered system (R_y alone when ``d`` is empty)."""
         n = Jy.shape[0]
-        if self.lu is not None and self.lu[0].shape[0] == b.size:
+        if self.lu is not None and self.lu[0].shape[0] == b.size and not self.stale:
             x = self._krylov(Jy, Jl, d, b, n)
             if x is not None:
                 return x, True
+        self.stale = False
         A = _bordered(Jy, Jl, d)
         with warnings.catch_warnings():  # an exactly singular matrix is reported by ok = False below
             warnings.simplefilter("ignore", sla.LinAlgWarning)
@@ -240,6 +244,9 @@ class FactorReuse:
         if not np.isfinite(x).all() or np.linalg.norm(times(x) - b) > config.CONT_KRYLOV_RTOL * nb:
             return None
         self.counts["krylov_solves"] += 1
+        # the factors drift from the walk's matrices: factorise at the next solve instead of first
+        # spending GMRES iterations on a preconditioner that is likely to fail
+        self.stale = it[0] > config.CONT_KRYLOV_REFRESH
         return x
 
 
