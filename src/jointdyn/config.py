@@ -180,11 +180,15 @@ CONT_KRYLOV_SOLVE = 2000
 CONT_KRYLOV_RTOL = 1e-9
 #: GMRES iterations (one cycle, no restart) before the matrix is factorised;
 #: at 5500 unknowns an iteration (a product with the matrix and a solve with
-#: the kept factors) costs about 1/20 of a factorisation
-CONT_KRYLOV_MAXITER = 20
+#: the kept factors) costs about 1/20 of a factorisation. Measured on the
+#: 167-pair chain of benchmarks/bench_hb_interface_chain.py (HB branch, 23
+#: points): 20 instead of 12 saved no factorisation (21 either way; the
+#: factors of the previous point do not reach the tolerance at the next) and
+#: cost 372 instead of 245 iterations
+CONT_KRYLOV_MAXITER = 12
 #: a solve that needed more iterations than this has the next matrix factorised
 #: at once (the kept factors have drifted from the walk's matrices)
-CONT_KRYLOV_REFRESH = 10
+CONT_KRYLOV_REFRESH = 8
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history
