@@ -35,7 +35,8 @@ def test_factor_reuse_solves_like_lapack_and_factorises_only_when_gmres_fails():
     J, Jl, d, b = _bordered_case(rng, 120)
     fr = linalg.FactorReuse()
     x, ok = fr.solve(J, Jl, d, b)
-    assert ok and fr.counts == {"factorisations": 1, "krylov_solves": 0, "krylov_iterations": 0}
+    assert ok and fr.counts == {"factorisations": 1, "krylov_solves": 0, "krylov_iterations": 0,
+                                "sparse_factorisations": 0}
     np.testing.assert_allclose(x, _direct(J, Jl, d, b), rtol=1e-10, atol=1e-12)
     # a nearby matrix (the next point of a branch): GMRES with the kept factors, no factorisation
     J2 = J + 1e-3 * rng.standard_normal(J.shape)
@@ -54,6 +55,40 @@ def test_factor_reuse_solves_like_lapack_and_factorises_only_when_gmres_fails():
     np.testing.assert_allclose(J @ x4, b[:-1], rtol=0, atol=1e-10 * np.abs(b).max())
     S = J.copy()
     S[:, 5] = 0.0
+    assert not linalg.FactorReuse().solve(S, Jl, np.zeros(0), b[:-1])[1]
+
+
+def _banded(rng, n, width=3):
+    J = np.zeros((n, n))
+    for k in range(-width, width + 1):
+        J += np.diag(rng.standard_normal(n - abs(k)), k)
+    return J + 4 * width * np.eye(n)
+
+
+def test_sparse_matrices_are_factorised_by_superlu_while_their_factors_stay_sparse():
+    rng = np.random.default_rng(8)
+    n = 400
+    J, Jl, d, b = _banded(rng, n), rng.standard_normal(n), rng.standard_normal(n + 1), rng.standard_normal(n + 1)
+    fr = linalg.FactorReuse()
+    for k in range(3):
+        Jk = J + 1e-3 * k * _banded(rng, n)
+        x, ok = fr.solve(Jk, Jl, d, b)
+        assert ok and fr.sparse
+        ref = _direct(Jk, Jl, d, b)
+        assert np.linalg.norm(x - ref) <= 1e-12 * np.linalg.norm(ref)
+    assert fr.counts["sparse_factorisations"] == 3 and fr.counts["factorisations"] == 0
+    # a sparse matrix whose factors fill in: solved, and the walk goes on dense
+    R = np.where(rng.random((n, n)) < 0.01, rng.standard_normal((n, n)), 0.0) + 3 * np.eye(n)
+    fr = linalg.FactorReuse()
+    x, ok = fr.solve(R, Jl, d, b)
+    assert ok and fr.sparse is False and fr.counts["sparse_factorisations"] == 1
+    np.testing.assert_allclose(x, _direct(R, Jl, d, b), rtol=1e-9, atol=1e-11)
+    x, ok = fr.solve(R + 1e-4 * np.eye(n), Jl, d, b)
+    assert ok and fr.counts["sparse_factorisations"] == 1 and fr.counts["factorisations"] + fr.counts[
+        "krylov_solves"] == 1
+    # exactly singular, sparse
+    S = J.copy()
+    S[:, 7] = 0.0
     assert not linalg.FactorReuse().solve(S, Jl, np.zeros(0), b[:-1])[1]
 
 
@@ -104,9 +139,13 @@ def _chain(nodes=4, phase=90.0):
                      interfaces=(Interface(kt=2e4, kn=5e4, mu=0.5, preload=P, pairs=table),))
 
 
-def _reuse_everywhere(monkeypatch):
+def _reuse_everywhere(monkeypatch, path):
+    """Every bordered solve through FactorReuse: dense (GMRES with kept factors) or sparse (SuperLU)."""
     monkeypatch.setattr(config, "CONT_SMALL_SOLVE", 0)
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
+    monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0 if path == "sparse" else 0.0)
+    monkeypatch.setattr(config, "CONT_SPARSE_FILL", 1.0)
+    return "sparse_factorisations" if path == "sparse" else "krylov_solves"
 
 
 def test_epmc_in_place_jacobian_equals_the_dense_mass_block():
@@ -130,7 +169,8 @@ def test_epmc_in_place_jacobian_equals_the_dense_mass_block():
     np.testing.assert_array_equal(J, ref)
 
 
-def test_epmc_points_with_reused_factors_equal_direct_solves(monkeypatch):
+@pytest.mark.parametrize("path", ["dense", "sparse"])
+def test_epmc_points_with_reused_factors_equal_direct_solves(monkeypatch, path):
     from jointdyn.hb.problem import reference_scales
     from jointdyn.modes.epmc import EPMCProblem
 
@@ -150,21 +190,22 @@ def test_epmc_points_with_reused_factors_equal_direct_solves(monkeypatch):
 
     direct, counts = points()
     assert counts["factorisations"] == 0  # small: the compiled elimination, no reuse
-    _reuse_everywhere(monkeypatch)
+    key = _reuse_everywhere(monkeypatch, path)
     reused, counts = points()
-    assert counts["krylov_solves"] > 0 and counts["factorisations"] < counts["krylov_solves"]
+    assert counts[key] > 0
     np.testing.assert_allclose(reused, direct, rtol=0, atol=1e-8 * np.abs(direct).max())
 
 
-def test_hb_branch_with_reused_factors_has_the_same_peak(monkeypatch):
+@pytest.mark.parametrize("path", ["dense", "sparse"])
+def test_hb_branch_with_reused_factors_has_the_same_peak(monkeypatch, path):
     from jointdyn.hb import continue_hb
 
     s = _chain(3)
     a = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False)
-    _reuse_everywhere(monkeypatch)
+    key = _reuse_everywhere(monkeypatch, path)
     b = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False)
     assert a.status.ok and b.status.ok
-    assert b.counters["krylov_solves"] > 0 and "krylov_solves" not in a.counters
+    assert b.counters[key] > 0 and key not in a.counters
     pa, pb = a.response()[0].max(), b.response()[0].max()
     assert pb == pytest.approx(pa, rel=1e-6)
 

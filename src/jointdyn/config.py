@@ -189,6 +189,14 @@ CONT_KRYLOV_MAXITER = 12
 #: a solve that needed more iterations than this has the next matrix factorised
 #: at once (the kept factors have drifted from the walk's matrices)
 CONT_KRYLOV_REFRESH = 8
+#: from CONT_KRYLOV_SOLVE unknowns, a walk whose first matrix has at most this
+#: fraction of nonzero entries factorises by SuperLU (scipy.sparse.linalg.splu)
+#: at every solve (the 60-node chain of benchmarks/bench_hb_interface_chain.py,
+#: 1980 unknowns, 0.7 % nonzero: 4 ms against 227 ms for dense LAPACK), ...
+CONT_SPARSE_DENSITY = 0.02
+#: ... while its factors hold at most this fraction of N^2 entries (else dense:
+#: SuperLU on a matrix that fills in costs about 5x dense LAPACK)
+CONT_SPARSE_FILL = 0.05
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history

@@ -17,7 +17,9 @@ new factorisation. The solution is accepted only when its true residual
 ``config.CONT_KRYLOV_MAXITER`` iterations, the current matrix is factorised
 and solved directly (and its factors kept for the next solves); after a
 solve that needed more than ``config.CONT_KRYLOV_REFRESH`` iterations, the
-next matrix is factorised at once. The
+next matrix is factorised at once. A sparse matrix (structures with sparse
+K, M and C: each pair couples only its own DOFs) is factorised by SuperLU
+at every solve instead, while its factors stay sparse. The
 preconditioner changes the work, not the answer beyond that tolerance: the
 Newton corrector still stops on its own residual.
 """
@@ -30,6 +32,7 @@ import warnings
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from .. import config
@@ -188,19 +191,33 @@ class FactorReuse:
 
     Keeps the LU factors (``scipy.linalg.lu_factor``) of the last matrix it
     factorised; the next solves run GMRES on the current matrix with those
-    factors as (left) preconditioner. ``counts`` holds the factorisations,
-    the solves accepted from GMRES and its iterations.
+    factors as (left) preconditioner. A sparse matrix (at most
+    ``config.CONT_SPARSE_DENSITY`` of its entries nonzero: a structure with
+    sparse K, M, C, whose pairs couple only their own DOFs) is factorised by
+    SuperLU (``scipy.sparse.linalg.splu``) at every solve instead, while its
+    factors stay sparse (at most ``config.CONT_SPARSE_FILL`` of N^2 entries;
+    else the walk goes on dense). ``counts`` holds the factorisations (dense
+    and sparse), the solves accepted from GMRES and its iterations.
     """
 
     def __init__(self):
         self.lu = None
         self.stale = False
-        self.counts = {"factorisations": 0, "krylov_solves": 0, "krylov_iterations": 0}
+        self.sparse = None  # decided at the first factorisation of the walk
+        self.counts = {"factorisations": 0, "krylov_solves": 0, "krylov_iterations": 0, "sparse_factorisations": 0}
 
     def solve(self, Jy, Jl, d, b):
         """``(x, ok)``: the solution of the bordered system (R_y alone when ``d`` is empty)."""
         n = Jy.shape[0]
-        if self.lu is not None and self.lu[0].shape[0] == b.size and not self.stale:
+        if self.sparse is None:
+            self.sparse = np.count_nonzero(Jy) <= config.CONT_SPARSE_DENSITY * n * n
+        if self.sparse:
+            x = self._sparse(Jy, Jl, d, b)
+            if x is not None:
+                return x, bool(np.isfinite(x).all())
+            if self.sparse:  # exactly singular
+                return b, False
+        elif self.lu is not None and self.lu[0].shape[0] == b.size and not self.stale:
             x = self._krylov(Jy, Jl, d, b, n)
             if x is not None:
                 return x, True
@@ -216,6 +233,19 @@ class FactorReuse:
         self.lu = lu
         x = sla.lu_solve(lu, b, check_finite=False)
         return x, bool(np.isfinite(x).all())
+
+    def _sparse(self, Jy, Jl, d, b):
+        """The solution by SuperLU; None when singular, or when the factors filled in (``self.sparse``
+        then False: dense from now on)."""
+        A = sps.csc_matrix(_bordered(Jy, Jl, d))
+        try:
+            f = spla.splu(A)
+        except RuntimeError:  # exactly singular
+            return None
+        self.counts["sparse_factorisations"] += 1
+        if f.L.nnz + f.U.nnz > config.CONT_SPARSE_FILL * A.shape[0] ** 2:
+            self.sparse = False
+        return f.solve(b)
 
     def _krylov(self, Jy, Jl, d, b, n):
         """GMRES preconditioned by the kept factors; the solution, or None when not accurate enough."""

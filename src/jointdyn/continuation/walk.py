@@ -460,7 +460,7 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
         raise ValueError("lam_stop must differ from lam0")
     with reusing_factors() as fr:
         res = _walk(residual, y0, lam0, lam_stop, opt, monitor, progress, observe, lam_name)
-    if fr.counts["factorisations"]:  # large bordered systems (continuation.linalg): how they were solved
+    if any(fr.counts.values()):  # large bordered systems (continuation.linalg): how they were solved
         res.counters.update(fr.counts)
     return res
 
