@@ -116,7 +116,10 @@ def _linear_blocks(system: System, H: int):
     n = system.ndof
     nh = 2 * H + 1
     M, C, K = system.M, system.C, system.K
-    AK = np.kron(np.eye(nh), K)
+    # block by block into zeroed arrays (np.kron writes every entry: seconds at thousands of unknowns)
+    AK = np.zeros((n * nh, n * nh))
+    for h in range(nh):
+        AK[h * n:(h + 1) * n, h * n:(h + 1) * n] = K
     AC = np.zeros((n * nh, n * nh))
     AM = np.zeros((n * nh, n * nh))
     for k in range(1, H + 1):
@@ -347,7 +350,11 @@ class HBProblem:
         """Block matrix A(w) of the linear terms (size n(2H+1)): per harmonic k
         ``[[K - k^2 w^2 M, k w C], [-k w C, K - k^2 w^2 M]]``, K for k = 0."""
         AK, AC, AM = self._lin
-        return AK + w * AC + (w * w) * AM
+        out = np.zeros_like(AK)
+        for lo, hi in np.unique(self._lin_cols, axis=0):  # the harmonics' blocks, where alone they are nonzero
+            b = (slice(lo, hi), slice(lo, hi))
+            out[b] = AK[b] + w * AC[b] + (w * w) * AM[b]
+        return out
 
     def _linear_terms(self, w):
         """(AK, AC, AM, w) of the compiled evaluation: A(w) = AK + w AC + w^2 AM."""
