@@ -161,6 +161,9 @@ def test_epmc_in_place_jacobian_equals_the_dense_mass_block():
         c, sn = slice((2 * k - 1) * n, 2 * k * n), slice(2 * k * n, (2 * k + 1) * n)
         AM[c, sn] = k * s.M
         AM[sn, c] = -k * s.M
+    assert q.A_M is not None
+    np.testing.assert_array_equal(q.A_M, AM)
+    q.A_M = None  # the block-wise products of large problems
     X = np.random.default_rng(6).standard_normal(q.size)
     np.testing.assert_allclose(q._times_mass_damping(X), AM @ X, rtol=0, atol=1e-14 * np.abs(AM @ X).max())
     J = np.random.default_rng(7).standard_normal((q.size, q.size))

@@ -76,6 +76,18 @@ __all__ = ["EPMCProblem", "epmc"]
 _LN10 = math.log(10.0)
 
 
+def mass_damping_block(M: np.ndarray, H: int) -> np.ndarray:
+    """A_M: the harmonic-balance damping block of harmonics 0..H with M for C (size n (2H + 1))."""
+    n = M.shape[0]
+    A = np.zeros((n * (2 * H + 1), n * (2 * H + 1)))
+    for k in range(1, H + 1):
+        ic = (2 * k - 1) * n
+        is_ = 2 * k * n
+        A[ic:ic + n, is_:is_ + n] = k * M
+        A[is_:is_ + n, ic:ic + n] = -k * M
+    return A
+
+
 class EPMCProblem:
     """Scaled EPMC residual ``R(v, lam)`` and its exact Jacobians (module docstring).
 
@@ -125,6 +137,11 @@ class EPMCProblem:
             raise ValueError(f"{exc} (EPMC evaluates the contacts by harmonic balance)") from None
         self.linear = linear_stuck_mode(system, mode, self.output_dof)
         self.n, self.H, self.size = n, self.hb.H, self.hb.size
+        # dense A_M for small problems (one product beats 2H small ones); by blocks from the size where the
+        # continuation's solves go large (an N x N A_M is 240 MB at 5500 unknowns)
+        self.A_M = mass_damping_block(system.M, self.H) if self.size < config.CONT_KRYLOV_SOLVE else None
+        self._mass_blocks = [(k * system.M, -k * system.M, slice((2 * k - 1) * n, 2 * k * n),
+                              slice(2 * k * n, (2 * k + 1) * n)) for k in range(1, self.H + 1)]
         self.i_omega = n + self.output_dof
         self.i_xi = 2 * n + self.output_dof
         self.w_ref = self.linear.omega_rad_s
@@ -186,26 +203,24 @@ class EPMCProblem:
         Jv[:, self.i_xi] = -self.w_ref * w * cx / ka
         return Rs, Jv, Jlam
 
-    def _blocks(self):
-        """(k, rows of cos k, rows of sin k) of the harmonics 1..H: where A_M has its blocks k M and -k M."""
-        n = self.n
-        return [(k, slice((2 * k - 1) * n, 2 * k * n), slice(2 * k * n, (2 * k + 1) * n)) for k in range(1, self.H + 1)]
-
     def _times_mass_damping(self, X):
-        """A_M @ X by blocks, m kg (A_M is zero outside its 2H blocks)."""
+        """A_M @ X, m kg (by blocks for large problems: A_M is zero outside its 2H blocks)."""
+        if self.A_M is not None:
+            return self.A_M @ X
         out = np.zeros_like(X)
-        M = self.system.M
-        for k, c, s in self._blocks():
-            out[c] = (k * M) @ X[s]
-            out[s] = (-k * M) @ X[c]
+        for kM, mkM, c, s in self._mass_blocks:
+            out[c] = kM @ X[s]
+            out[s] = mkM @ X[c]
         return out
 
     def _subtract_mass_damping(self, J, f):
-        """J -= f A_M in place, on A_M's blocks only."""
-        M = self.system.M
-        for k, c, s in self._blocks():
-            J[c, s] -= f * (k * M)
-            J[s, c] -= f * (-k * M)
+        """J -= f A_M in place (on A_M's blocks only for large problems)."""
+        if self.A_M is not None:
+            J -= f * self.A_M
+            return
+        for kM, mkM, c, s in self._mass_blocks:
+            J[c, s] -= f * kM
+            J[s, c] -= f * mkM
 
     def solve(self, amplitude: float, guess, options: ContinuationOptions | None = None, **overrides):
         """Newton at a fixed amplitude (m) from scaled unknowns ``guess``: ``(v, converged, iterations)``."""
