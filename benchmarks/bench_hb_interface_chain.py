@@ -16,9 +16,10 @@ on the same structure.
 Quick: 16 nodes (48 DOFs, 16 pairs); full: 167 nodes (501 DOFs, 167 pairs),
 the size of the issue's target (about 500 DOFs and 200 pairs; target 60 s
 each on 2 cores). At the full size the Newton systems (5511 unknowns) reuse
-their LU factors through GMRES (``factorisations`` counts the LU
-factorisations) and Hill's method is beyond ``config.HB_HILL_MAX_ROWS``
-(stability not computed); the backbone is bounded to ``MAX_POINTS`` points.
+their LU factors through GMRES or, sparse as this chain's are, are factorised
+by SuperLU (``factorisations`` counts both), and Hill's method is beyond
+``config.HB_HILL_MAX_ROWS`` (stability not computed); the backbone is
+bounded to ``MAX_POINTS`` points.
 """
 
 from __future__ import annotations
@@ -65,16 +66,13 @@ def chain(nodes: int, pairs: bool = True):
     return jd.System(**kw, contacts=cs)
 
 
-def _backbone(s):
-    from jointdyn.hb.problem import reference_scales
+def _backbone(s, a):
     from jointdyn.modes import epmc
 
-    kt, fy = reference_scales(s)
-    a = fy / kt  # the mean slip displacement of the pairs (contacts)
     t0 = time.perf_counter()
     # bounded, so that a backbone slowed down by the kinks of hundreds of pairs' slip onsets still ends
     b = epmc(s, (0.01 * a, 10.0 * a), harmonics=H, samples=NS, max_points=MAX_POINTS)
-    return time.perf_counter() - t0, b.status.value, b.points, b.counters.get("factorisations", 0)
+    return time.perf_counter() - t0, b.status.value, b.points, _factorisations(b.counters)
 
 
 def _branch(s):
@@ -95,17 +93,27 @@ def _branch(s):
         t0 = time.perf_counter()
         br = continue_hb(s, 0.8, 1.2, harmonics=H, samples=NS, condense=False)
         return (time.perf_counter() - t0, br.status.value, int(br.lam.size), hill[0],
-                br.counters.get("factorisations", 0))
+                _factorisations(br.counters))
     finally:
         hb_branch.HBProblem.hill_growth = orig
+
+
+def _factorisations(counters) -> int:
+    """LU factorisations of the large Newton systems (dense and sparse; 0 below their size)."""
+    return int(counters.get("factorisations", 0) + counters.get("sparse_factorisations", 0))
 
 
 def run(quick: bool) -> dict:
     nodes = 16 if quick else 167
     out = {"nodes": nodes, "dofs": 3 * nodes, "pairs": nodes, "harmonics": H, "samples": NS}
+    from jointdyn.hb.problem import reference_scales
+
+    # one amplitude range for both backbones: the pairs' mean slip displacement (the default scale of the
+    # contacts, the first contact's fy / kt, is that of the lightest pair at the end of the chain, 3 times smaller)
+    kt, fy = reference_scales(chain(nodes, True))
     for name, pairs in (("interface", True), ("contacts", False)):
         s = chain(nodes, pairs)
-        t, status, points, nf = _backbone(s)
+        t, status, points, nf = _backbone(s, fy / kt)
         out[f"{name}_epmc_s"], out[f"{name}_epmc_status"], out[f"{name}_epmc_points"] = t, status, points
         out[f"{name}_epmc_factorisations"] = nf
         t, status, points, hill, nf = _branch(s)

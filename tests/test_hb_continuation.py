@@ -194,3 +194,25 @@ def test_hermite_start_gives_the_same_points_in_fewer_evaluations():
     assert on.counters["folds"] == off.counters["folds"] == 2 and on.lam.size == off.lam.size
     assert np.allclose(on.lam, off.lam, atol=1e-8) and np.array_equal(on.fold, off.fold)
     assert on.counters["residual_evaluations"] < off.counters["residual_evaluations"]
+
+
+def _fold_at_a_corner(y, lam):
+    """lam = y - y^2 / 2 up to y = 1.5 (a smooth fold at y = 1), then lam = 3/8 + 3 (y - 3/2): at the corner
+    y = 1.5 the branch turns by 98 degrees and lam, falling since the fold, rises again."""
+    y0 = y[0]
+    g, dg = (y0 - 0.5 * y0 * y0, 1.0 - y0) if y0 < 1.5 else (0.375 + 3.0 * (y0 - 1.5), 3.0)
+    return np.array([lam - g]), np.array([[-dg]]), np.array([1.0])
+
+
+def test_a_fold_at_a_corner_is_passed_not_walked_back():
+    # before: the corrector failed at the corner down to ds_min, Newton at fixed lam a little beyond (forward in
+    # the range) found the part of the branch just walked, the walk turned round there and went back over the
+    # smooth fold to lam0 ("turned-back"); the EPMC backbone of a chain of node pairs did the same at a fold at a
+    # corner of its piecewise-smooth branch (benchmarks/bench_hb_interface_chain.py)
+    r = continuation(_fold_at_a_corner, np.array([0.0]), 0.0, 2.0)
+    assert r.status is ContinuationStatus.COMPLETE, r.message
+    assert r.counters["folds"] == 2 and r.counters["jumps"] == 0
+    assert np.all(np.diff(r.y[:, 0]) > 0.0)  # y grows all along the branch: it never went back
+    assert r.y[-1, 0] == pytest.approx(1.5 + (2.0 - 0.375) / 3.0, rel=1e-12)
+    for y, lam in zip(r.y, r.lam):
+        assert abs(_fold_at_a_corner(y, lam)[0][0]) <= 10 * config.CONT_TOL

@@ -26,6 +26,7 @@ every solver (time integration, harmonic balance, nonlinear modes).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -354,14 +355,35 @@ def _project_forcing(T, force, phase_deg) -> tuple[np.ndarray, np.ndarray]:
 
 
 def default_boundary(system: System) -> list[int]:
-    """Contact DOFs (tangential and normal), forced DOFs and the response DOF, increasing."""
+    """Contact DOFs (tangential and normal), the DOFs of the interfaces' node pairs, forced DOFs and the
+    response DOF, increasing."""
     dofs = {system.response_dof}
     for c in system.contacts:
         dofs.update(_dofs_of(c))
         if isinstance(c.normal, NormalSpring):
             dofs.update(_dofs_of(c.normal))
+    dofs.update(_pair_dofs(system))
     dofs.update(int(i) for i in np.flatnonzero(system.force))
     return sorted(dofs)
+
+
+def _pair_dofs(system: System) -> set[int]:
+    """The DOFs named by the node pairs of the system's interfaces (the fixed sides, -1, left out)."""
+    return {int(d) for itf in system.interfaces for d in itf.pairs.ravel() if d >= 0}
+
+
+def _reduced_interfaces(system: System, cb: CraigBampton) -> tuple:
+    """The system's interfaces with their pair tables in reduced coordinates (boundary DOFs, kept as they
+    are); ValueError naming ``boundary_dofs`` when a pair's DOF is interior (a pair acts on its own DOFs
+    only: it cannot act on a combination of modes)."""
+    missing = sorted(_pair_dofs(system) - {int(d) for d in cb.boundary})
+    if missing:
+        raise ValueError(f"boundary_dofs must contain every DOF of the interfaces' node pairs, missing "
+                         f"{missing[:10]}{' ...' if len(missing) > 10 else ''}")
+    pos = np.full(system.ndof, -1, dtype=np.int64)
+    pos[cb.boundary] = np.arange(cb.boundary.size)
+    return tuple(dataclasses.replace(itf, pairs=np.where(itf.pairs >= 0, pos[np.maximum(itf.pairs, 0)], -1))
+                 for itf in system.interfaces)
 
 
 def reduce_system(system: System, n_modes: int, boundary_dofs=None) -> tuple[System, CraigBampton]:
@@ -374,29 +396,33 @@ def reduce_system(system: System, n_modes: int, boundary_dofs=None) -> tuple[Sys
     n_modes : int
         Fixed-interface modes kept (see :func:`craig_bampton`).
     boundary_dofs : sequence of int, optional
-        Default :func:`default_boundary`: the contact DOFs, the forced DOFs
-        and the response DOF (which must be a boundary DOF).
+        Default :func:`default_boundary`: the contact DOFs, the DOFs of the
+        interfaces' node pairs, the forced DOFs and the response DOF (which
+        must be a boundary DOF, as must every DOF of a node pair).
 
     Returns
     -------
     (System, CraigBampton)
         The reduced system (same contacts, laws and normal loads on the
-        reduced coordinates, forcing T^T f with its phases, w0 and response
-        DOF of the full model) and the reduction, whose ``error`` compares
-        the linear modes with the normal springs closed and the tangential
-        contacts free (``System.K_reference``).
+        reduced coordinates, the same interfaces with their pair tables on
+        the reduced coordinates of their DOFs, forcing T^T f with its
+        phases, w0 and response DOF of the full model) and the reduction,
+        whose ``error`` compares the linear modes with the normal springs
+        closed and the tangential contacts free (``System.K_reference``).
+        A pair acts on boundary DOFs only, so the reduction is exact up to
+        rounding with every interior mode kept, as for the contacts.
     """
     if not isinstance(system, System):
         raise ValueError(f"system must be a System, got {type(system).__name__}")
-    system.require_no_interfaces("reduce_system")
     b = default_boundary(system) if boundary_dofs is None else boundary_dofs
     cb = craig_bampton(system.M, system.K, b, n_modes, C=system.C, K_modes=system.K_reference)
     out = int(system.response_dof)
     if out not in cb.boundary:
         raise ValueError(f"boundary_dofs must contain the response DOF {out}")
     force, phase = _project_forcing(cb.T, system.force, system.force_phase_deg)
+    interfaces = _reduced_interfaces(system, cb)
     reduced = System(M=cb.M, C=cb.C, K=cb.K, contacts=tuple(_reduced_contact(c, cb) for c in system.contacts),
-                     force=force, force_phase_deg=phase, w0_rad_s=system.w0,
+                     interfaces=interfaces, force=force, force_phase_deg=phase, w0_rad_s=system.w0,
                      output_dof=int(np.flatnonzero(cb.boundary == out)[0]))  # fmt: skip
     return reduced, cb
 

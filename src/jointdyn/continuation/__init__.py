@@ -29,6 +29,12 @@ Bifurcation and Stability Analysis*, Springer 2010, sec. 4.4):
 * a sharp corner of a piecewise-smooth branch (turning by more than a
   right angle while lam keeps its direction) is passed by Newton at fixed
   lam just beyond it (points marked ``corner``);
+* a fold at a corner (turning by more than a right angle while lam turns
+  back: no lam beyond the corner holds a point near it) is passed along
+  the tangent of the Jacobian just ahead of the corner, on the side where
+  that Jacobian holds (points marked ``corner``, the turn counted as a
+  fold); a point found by Newton at fixed lam on the part of the branch
+  just walked, oriented back along it, is never taken as the way on;
 * a residual that jumps (a contact law with a discontinuous force, e.g.
   the closed-form Iwan rules under a varying load) can leave no solution
   on the arc: when the corrector fails at ``ds_min``, Newton at fixed lam

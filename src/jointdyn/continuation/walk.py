@@ -26,6 +26,14 @@ DLAM_SAFETY = 0.95
 #: attempts of a corner pass, each a quarter of the distance in lam of the one before
 CORNER_TRIES = 3
 
+#: a fold at a corner (:func:`_kink_pass`) is looked past at this fraction of ``corner_ds``
+KINK_STEP = 0.05
+#: ... when the tangent there differs from the one behind: |cos| of their angle below this
+KINK_MAX_COS = 0.999
+#: ... and the way on turns by less than about 154 degrees (cos above this): closer to a reversal it is the
+#: part of the branch just walked (where the residual also stays small)
+KINK_MIN_COS = -0.9
+
 
 class _Points:
     """The accepted points of a branch being computed, and its counters."""
@@ -108,6 +116,7 @@ class _Step:
     g: float = math.nan  # observable at v
     gap: bool = False
     corner: bool = False
+    kink: bool = False  # past a fold at a corner (:func:`_kink_pass`): a turning point in lam
 
 
 def _oriented(t_new, direction, n, opt):
@@ -152,8 +161,10 @@ def _jump(walk: _Walk, u, t) -> _Step | None:
         if hit is not None:
             v, tn, it = hit
             corner = _joined(walk, u, v, t)
-            return _Step(v, _oriented(tn, walk.sgn, n, opt), it, True, 1.0, g=walk.observed(v), gap=not corner,
-                         corner=corner)
+            tn = _oriented(tn, walk.sgn, n, opt)
+            if corner and tn @ t < 0.0:
+                continue  # the part of the branch just walked, oriented back along it: no way on
+            return _Step(v, tn, it, True, 1.0, g=walk.observed(v), gap=not corner, corner=corner)
     return None
 
 
@@ -182,6 +193,56 @@ def _corner_pass(walk: _Walk, u, t) -> _Step | None:
             return _Step(v, _oriented(tn, direction, n, opt), it, True, 1.0, g=walk.observed(v), corner=True)
         dlam *= 0.25
     return None
+
+
+def _kink_pass(walk: _Walk, u, t) -> _Step | None:
+    """Past a fold at a corner: a corner of a piecewise-smooth branch where lam turns back.
+
+    Where the branch turns by more than a right angle at a corner and its
+    direction of travel in lam reverses there, no hyperplane ahead of u
+    meets it and no lam beyond u holds a point near it: the corrector
+    fails at every step, the corner pass finds nothing, and Newton at a
+    lam on the other side (:func:`_jump`) finds the part of the branch
+    just walked. The branch past the corner is followed from the Jacobian
+    just ahead of u (``KINK_STEP`` times ``corner_ds`` along t, past the
+    corner): its tangent there, taken in the direction along which the
+    residual stays at its size at u (on the other side, where the
+    Jacobian behind holds, it grows linearly), and a corrector on the
+    hyperplane across it. Accepted when the tangent ahead differs from t
+    (a corner), turns lam back (a fold) but does not go back along the
+    branch just walked (``KINK_MIN_COS``), the corrector stays within
+    ``max_distance`` times the step of its prediction and the straight
+    line to the point stays within ``chord_tol`` of the curve
+    (:func:`_joined`). A jump of the residual leaves no branch on either
+    side of u close to the prediction: the jump (:func:`_jump`) is tried
+    next, as before.
+    """
+    opt, n = walk.opt, walk.n
+    h = KINK_STEP * opt.corner_ds
+    ahead = u + h * t
+    _, Jy, Jl = walk.residual(ahead[:n], ahead[n])
+    walk.cnt["residual_evaluations"] += 1
+    tk = _tangent(Jy, Jl, t)
+    if tk is None or abs(float(tk @ t)) > KINK_MAX_COS:
+        return None
+    size = []
+    for d in (tk, -tk):
+        p = u + h * d
+        size.append(float(np.max(np.abs(walk.residual(p[:n], p[n])[0]))))
+        walk.cnt["residual_evaluations"] += 1
+    d = tk if size[0] <= size[1] else -tk
+    if not d[n] * t[n] < 0.0:
+        return None  # lam goes on in its direction: a corner (:func:`_corner_pass`) or a jump, not a fold
+    if not d @ t > KINK_MIN_COS:
+        return None  # back along the part of the branch just walked
+    p = u + h * d
+    v, ok, it, (_, Jy, Jl) = _solve_damped(walk.residual, p.copy(), None, d, p, opt, walk.cnt)
+    if not ok or np.linalg.norm(v - p) > opt.max_distance * h:
+        return None
+    t_new = _tangent(Jy, Jl, d)
+    if t_new is None or not _joined(walk, u, v, d):
+        return None
+    return _Step(v, t_new, it, True, 1.0, g=walk.observed(v), corner=True, kink=True)
 
 
 def _joined(walk: _Walk, u, v, t) -> bool:
@@ -338,6 +399,10 @@ def _advance(walk: _Walk, u, t, u_prev, g_u, ds, ds_init, prev=None):
                 walk.cnt["corners"] += 1
                 return st, opt.corner_ds
         if ds < opt.ds_min:
+            st = _kink_pass(walk, u, t)
+            if st is not None:
+                walk.cnt["corners"] += 1
+                return st, ds_init
             st = _jump(walk, u, t) if walk.cnt["jumps"] < opt.max_jumps else None
             if st is None:
                 return None
@@ -491,7 +556,7 @@ def _walk(residual, y0, lam0, lam_stop, opt, monitor, progress, observe, lam_nam
                               f"corrector failed at the smallest step near {lam_name} = {u[n]:.6g}{why}")
         st, ds = adv
         v, t_new = st.v, st.t
-        fold = bool(np.sign(t_new[n]) != np.sign(t[n]) and t[n] != 0.0) and not (st.gap or st.corner)
+        fold = bool(np.sign(t_new[n]) != np.sign(t[n]) and t[n] != 0.0) and (st.kink or not (st.gap or st.corner))
         pts.cnt["folds"] += fold
         if (v[n] - lam_stop) * sgn > 0 or (v[n] - lam0) * sgn < 0:
             end = _range_end(walk, u, v, t, fold, pts, lam_stop, lam_name)

@@ -70,10 +70,16 @@ def check_free_vibration(system, method: str, *, springs: bool = True) -> System
     method : str
         Name of the method, for the messages (``"EPMC"``, ``"QSMA"``).
     springs : bool
-        Whether the method takes normal springs.
+        Whether the method takes normal springs and interfaces (node pairs, whose normal loads follow the
+        motion): QSMA takes neither.
     """
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
+    if system.interfaces and not springs:
+        npairs = sum(itf.npairs for itf in system.interfaces)
+        raise ValueError(f"system: has interfaces ({npairs} node pairs), which {method} does not support (its "
+                         "Masing construction holds for scalar contacts at constant normal loads): use EPMC for "
+                         "this system")
     if not system.contacts and not (springs and system.interfaces):
         raise ValueError(f"system must have at least one contact: {method} computes the modes of a structure "
                          "with frictional contacts")

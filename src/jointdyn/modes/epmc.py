@@ -41,8 +41,8 @@ generic pseudo-arc-length continuation (:mod:`jointdyn.continuation`).
 
 Large structures: ``epmc(system, ..., reduce=n_modes)`` computes the
 backbone on a Craig-Bampton reduction (:func:`jointdyn.reduction.reduce_system`)
-whose boundary DOFs are the contact DOFs, the forced DOFs and the output
-DOF, plus ``n_modes`` fixed-interface modes. The output DOF is a boundary
+whose boundary DOFs are the contact DOFs, the DOFs of the interfaces'
+node pairs, the forced DOFs and the output DOF, plus ``n_modes`` fixed-interface modes. The output DOF is a boundary
 DOF, kept as it is, so the backbone's amplitude is that of the full
 model's output DOF; the backbone holds the reduction (its linear-mode
 error report and the expansion of the mode shape to the full model).
@@ -308,7 +308,7 @@ def _backbone(problem: EPMCProblem, status, message, lam, V, stash, counters, re
 
 
 def _reduce(system, n_modes: int, output_dof):
-    """(reduced System, CraigBampton): boundary = contact, forced and output DOFs, plus ``n_modes`` modes."""
+    """(reduced System, CraigBampton): boundary = contact, pair, forced and output DOFs, plus ``n_modes`` modes."""
     from ..reduction import default_boundary, reduce_system
 
     out = output_dof_of(system, output_dof)
@@ -357,7 +357,8 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         Show a tqdm bar (None: only on a TTY).
     reduce : int, optional
         Compute the backbone on a Craig-Bampton reduction keeping the
-        contact DOFs, the forced DOFs and the output DOF plus this many
+        contact DOFs, the DOFs of the interfaces' node pairs, the forced
+        DOFs and the output DOF plus this many
         fixed-interface modes (0 .. interior DOFs; all of them: exact up to
         rounding). ``mode`` then counts the linear modes of the reduced
         model, the same as the full model's while the reduction resolves
