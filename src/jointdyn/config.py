@@ -171,6 +171,32 @@ CONT_REFINE_GTOL = 1e-7
 #: the compiled elimination is 1.2-3.5x faster at 16 to 751 unknowns with
 #: single-threaded BLAS; beyond the sizes measured, LAPACK)
 CONT_SMALL_SOLVE = 800
+#: from this many unknowns, a walk's bordered systems are solved by GMRES
+#: preconditioned with the LU factors of an earlier matrix of the walk, and
+#: factorised anew only when that fails (jointdyn.continuation.linalg): a
+#: factorisation costs seconds there (benchmarks/bench_linalg.py)
+CONT_KRYLOV_SOLVE = 2000
+#: a GMRES solution is accepted when |A x - b| <= this |b| (true residual)
+CONT_KRYLOV_RTOL = 1e-9
+#: GMRES iterations (one cycle, no restart) before the matrix is factorised;
+#: at 5500 unknowns an iteration (a product with the matrix and a solve with
+#: the kept factors) costs about 1/20 of a factorisation. Measured on the
+#: 167-pair chain of benchmarks/bench_hb_interface_chain.py (HB branch, 23
+#: points): 20 instead of 12 saved no factorisation (21 either way; the
+#: factors of the previous point do not reach the tolerance at the next) and
+#: cost 372 instead of 245 iterations
+CONT_KRYLOV_MAXITER = 12
+#: a solve that needed more iterations than this has the next matrix factorised
+#: at once (the kept factors have drifted from the walk's matrices)
+CONT_KRYLOV_REFRESH = 8
+#: from CONT_KRYLOV_SOLVE unknowns, a walk whose first matrix has at most this
+#: fraction of nonzero entries factorises by SuperLU (scipy.sparse.linalg.splu)
+#: at every solve (the 60-node chain of benchmarks/bench_hb_interface_chain.py,
+#: 1980 unknowns, 0.7 % nonzero: 4 ms against 227 ms for dense LAPACK), ...
+CONT_SPARSE_DENSITY = 0.02
+#: ... while its factors hold at most this fraction of N^2 entries (else dense:
+#: SuperLU on a matrix that fills in costs about 5x dense LAPACK)
+CONT_SPARSE_FILL = 0.05
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history
@@ -427,6 +453,12 @@ HB_CONDENSE_CHECK_RTOL = 1e-9
 #: a condensed problem computes Hill stability (on the full Jacobian it
 #: assembles) when the full companion matrix has at most this many rows
 HB_CONDENSED_HILL_ROWS = 200
+#: a (full) harmonic-balance problem computes Hill stability when the
+#: companion matrix has at most this many rows (2 n (2H+1)); beyond, all its
+#: eigenvalues cost more than the branch (about a minute per point at 10^4
+#: rows on 2 cores): stability is not computed (growth NaN, the Dataset's
+#: ``stability`` attribute says so)
+HB_HILL_MAX_ROWS = 4000
 #: bytes of dense Jacobians a branch keeps at once: the continuation monitor
 #: keeps the evaluations of accepted points with their Jacobians while they fit
 #: (beyond, without: the point is evaluated again for its stability), and

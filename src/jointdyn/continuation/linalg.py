@@ -5,16 +5,40 @@ unknowns a compiled Gaussian elimination with partial pivoting
 (:func:`lu_solve`, also used by :mod:`jointdyn.modes.qsma`), faster there
 because NumPy's per-call overhead costs more than the arithmetic
 (``benchmarks/bench_linalg.py``).
+
+From ``config.CONT_KRYLOV_SOLVE`` unknowns (harmonic balance of a structure
+with hundreds of node pairs: thousands of unknowns), a factorisation costs
+seconds while consecutive points of a branch have nearly the same Jacobian.
+There, within one walk (:func:`reusing_factors`), the LU factors of the last
+factorised bordered matrix precondition GMRES on the current one
+(:class:`FactorReuse`): a few products with the current matrix instead of a
+new factorisation. The solution is accepted only when its true residual
+``|A x - b| <= config.CONT_KRYLOV_RTOL |b|``; otherwise, or after
+``config.CONT_KRYLOV_MAXITER`` iterations, the current matrix is factorised
+and solved directly (and its factors kept for the next solves); after a
+solve that needed more than ``config.CONT_KRYLOV_REFRESH`` iterations, the
+next matrix is factorised at once. A sparse matrix (structures with sparse
+K, M and C: each pair couples only its own DOFs) is factorised by SuperLU
+at every solve instead, while its factors stay sparse. The
+preconditioner changes the work, not the answer beyond that tolerance: the
+Newton corrector still stops on its own residual.
 """
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+import warnings
+
 import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sps
+import scipy.sparse.linalg as spla
 
 from .. import config
 from .._jit import jit
 
-__all__ = ["lu_solve"]
+__all__ = ["FactorReuse", "lu_solve", "reusing_factors"]
 
 
 @jit
@@ -162,11 +186,134 @@ def _small(Jy) -> bool:
     return Jy.shape[0] + 1 <= config.CONT_SMALL_SOLVE
 
 
+class FactorReuse:
+    """Solves of large bordered systems ``[[R_y, R_lam], [d^T]] x = b`` within one walk (module docstring).
+
+    Keeps the LU factors (``scipy.linalg.lu_factor``) of the last matrix it
+    factorised; the next solves run GMRES on the current matrix with those
+    factors as (left) preconditioner. A sparse matrix (at most
+    ``config.CONT_SPARSE_DENSITY`` of its entries nonzero: a structure with
+    sparse K, M, C, whose pairs couple only their own DOFs) is factorised by
+    SuperLU (``scipy.sparse.linalg.splu``) at every solve instead, while its
+    factors stay sparse (at most ``config.CONT_SPARSE_FILL`` of N^2 entries;
+    else the walk goes on dense). ``counts`` holds the factorisations (dense
+    and sparse), the solves accepted from GMRES and its iterations.
+    """
+
+    def __init__(self):
+        self.lu = None
+        self.stale = False
+        self.sparse = None  # decided at the first factorisation of the walk
+        self.counts = {"factorisations": 0, "krylov_solves": 0, "krylov_iterations": 0, "sparse_factorisations": 0}
+
+    def solve(self, Jy, Jl, d, b):
+        """``(x, ok)``: the solution of the bordered system (R_y alone when ``d`` is empty)."""
+        n = Jy.shape[0]
+        if self.sparse is None:
+            self.sparse = np.count_nonzero(Jy) <= config.CONT_SPARSE_DENSITY * n * n
+        if self.sparse:
+            x = self._sparse(Jy, Jl, d, b)
+            if x is not None:
+                return x, bool(np.isfinite(x).all())
+            if self.sparse:  # exactly singular
+                return b, False
+        elif self.lu is not None and self.lu[0].shape[0] == b.size and not self.stale:
+            x = self._krylov(Jy, Jl, d, b, n)
+            if x is not None:
+                return x, True
+        self.stale = False
+        A = _bordered(Jy, Jl, d)
+        with warnings.catch_warnings():  # an exactly singular matrix is reported by ok = False below
+            warnings.simplefilter("ignore", sla.LinAlgWarning)
+            lu = sla.lu_factor(A, overwrite_a=True, check_finite=False)
+        self.counts["factorisations"] += 1
+        if not np.all(np.isfinite(lu[0].diagonal())) or np.any(lu[0].diagonal() == 0.0):
+            self.lu = None
+            return b, False
+        self.lu = lu
+        x = sla.lu_solve(lu, b, check_finite=False)
+        return x, bool(np.isfinite(x).all())
+
+    def _sparse(self, Jy, Jl, d, b):
+        """The solution by SuperLU; None when singular, or when the factors filled in (``self.sparse``
+        then False: dense from now on)."""
+        A = sps.csc_matrix(_bordered(Jy, Jl, d))
+        try:
+            f = spla.splu(A)
+        except RuntimeError:  # exactly singular
+            return None
+        self.counts["sparse_factorisations"] += 1
+        if f.L.nnz + f.U.nnz > config.CONT_SPARSE_FILL * A.shape[0] ** 2:
+            self.sparse = False
+        return f.solve(b)
+
+    def _krylov(self, Jy, Jl, d, b, n):
+        """GMRES preconditioned by the kept factors; the solution, or None when not accurate enough."""
+        bordered = d.shape[0] > 0
+
+        def times(x):
+            y = Jy @ x[:n]
+            if bordered:
+                y = np.append(y + Jl * x[n], d @ x)
+            return y
+
+        lu = self.lu
+        A = spla.LinearOperator((b.size, b.size), matvec=times, dtype=np.float64)
+        P = spla.LinearOperator((b.size, b.size), matvec=lambda r: sla.lu_solve(lu, r, check_finite=False),
+                                dtype=np.float64)
+        it = [0]
+
+        def count(_):
+            it[0] += 1
+
+        k = config.CONT_KRYLOV_MAXITER
+        x, _ = spla.gmres(A, b, x0=P.matvec(b), M=P, rtol=0.1 * config.CONT_KRYLOV_RTOL, atol=0.0, restart=k,
+                          maxiter=1, callback=count, callback_type="pr_norm")
+        self.counts["krylov_iterations"] += it[0]
+        nb = np.linalg.norm(b)
+        if not np.isfinite(x).all() or np.linalg.norm(times(x) - b) > config.CONT_KRYLOV_RTOL * nb:
+            return None
+        self.counts["krylov_solves"] += 1
+        # the factors drift from the walk's matrices: factorise at the next solve instead of first
+        # spending GMRES iterations on a preconditioner that is likely to fail
+        self.stale = it[0] > config.CONT_KRYLOV_REFRESH
+        return x
+
+
+_REUSE: contextvars.ContextVar[FactorReuse | None] = contextvars.ContextVar("jointdyn_factor_reuse", default=None)
+
+
+@contextlib.contextmanager
+def reusing_factors():
+    """Within the block, large bordered solves reuse factors (:class:`FactorReuse`); yields it.
+
+    Nested blocks share the outer one. The factors are dropped on exit.
+    """
+    outer = _REUSE.get()
+    if outer is not None:
+        yield outer
+        return
+    fr = FactorReuse()
+    token = _REUSE.set(fr)
+    try:
+        yield fr
+    finally:
+        _REUSE.reset(token)
+
+
+def _large_solve(Jy, Jl, d, b):
+    """A bordered solve above ``config.CONT_SMALL_SOLVE``: with reused factors where they pay, else ``dgesv``."""
+    fr = _REUSE.get()
+    if fr is not None and Jy.shape[0] + 1 >= config.CONT_KRYLOV_SOLVE:
+        return fr.solve(Jy, Jl, d, b)
+    return _lapack_solve(_bordered(Jy, Jl, d), b)
+
+
 def _newton_direction(Jy, Jl, d, R, v, u_pred):
     """Newton step of R(y, lam) = 0 (and d^T (v - u_pred) = 0 when d has entries): ``(dv, ok)``."""
     if _small(Jy):
         return _newton_direction_small(Jy, Jl, d, R, v, u_pred)
-    return _lapack_solve(_bordered(Jy, Jl, d), _border_rhs(R, d, v, u_pred))
+    return _large_solve(Jy, Jl, d, _border_rhs(R, d, v, u_pred))
 
 
 def _tangent(Jy, Jl, t_prev):
@@ -180,7 +327,7 @@ def _tangent(Jy, Jl, t_prev):
     else:
         e = np.zeros(Jy.shape[0] + 1)
         e[-1] = 1.0
-        t, ok = _lapack_solve(_bordered(Jy, Jl, t_prev), e)
+        t, ok = _large_solve(Jy, Jl, t_prev, e)
         if ok:
             t, ok = _normalise(t)
     return t if ok else None

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from .linalg import _as_arrays, _merit, _newton_direction
+from .linalg import _as_arrays, _merit, _newton_direction, reusing_factors
 from .options import ContinuationOptions, make_options
 
 __all__ = ["newton"]
@@ -78,5 +78,6 @@ def newton(residual, y, lam, options: ContinuationOptions | None = None, *, coun
     """
     opt = make_options(options, overrides)
     cnt = counter if counter is not None else {"residual_evaluations": 0}
-    y, ok, it, _ = _solve_damped(residual, np.asarray(y, dtype=float), lam, None, None, opt, cnt)
+    with reusing_factors():
+        y, ok, it, _ = _solve_damped(residual, np.asarray(y, dtype=float), lam, None, None, opt, cnt)
     return y, ok, it

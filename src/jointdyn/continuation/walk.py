@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import _validate as V
 from ..status import Status
-from .linalg import _tangent
+from .linalg import _tangent, reusing_factors
 from .newton import _solve_damped, newton
 from .options import ContinuationOptions, ContinuationResult, ContinuationStatus, make_options
 
@@ -523,6 +523,15 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
     lam_stop = V.finite("lam_stop", lam_stop)
     if lam_stop == lam0:
         raise ValueError("lam_stop must differ from lam0")
+    with reusing_factors() as fr:
+        res = _walk(residual, y0, lam0, lam_stop, opt, monitor, progress, observe, lam_name)
+    if any(fr.counts.values()):  # large bordered systems (continuation.linalg): how they were solved
+        res.counters.update(fr.counts)
+    return res
+
+
+def _walk(residual, y0, lam0, lam_stop, opt, monitor, progress, observe, lam_name) -> ContinuationResult:
+    """The walk of :func:`continuation` (arguments checked)."""
     ds = ds_init = min(max(opt.ds, opt.ds_min), opt.ds_max)
     sgn = 1.0 if lam_stop > lam0 else -1.0
     n = len(np.asarray(y0).ravel())

@@ -66,9 +66,10 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
 
     Arguments are tuples of arrays (and scalars):
 
-    * ``lin = (AK, AC, AM, w, dwdp, X, Fe, Fp)``: ``A = AK + w AC + w^2 AM``,
+    * ``lin = (AK, AC, AM, w, dwdp, X, Fe, Fp, cols)``: ``A = AK + w AC + w^2 AM``,
       ``R = A X - Fe``, ``JX = A``, ``Jp = dwdp (AC + 2 w AM) X - Fp``
-      (see ``problem.py``);
+      (see ``problem.py``), row i of the linear terms nonzero only in
+      columns ``cols[i, 0] .. cols[i, 1] - 1`` (its harmonic, :func:`_linear_part`);
     * ``con = (Bm, Pm, ssz, Bnm, Sp, spr)``: selection row ``Bm[c]`` and
       kernel parameters ``Pm[c]`` of each contact, state length ``ssz``,
       normal row ``Bnm[c]`` (g = Bnm[c] . x) and ``Sp[c] = (P, kn, restart load)`` of a
@@ -212,19 +213,30 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
 
 @jit(inline="always")
 def _linear_part(lin, R, JX, Jp):  # pragma: no cover - compiled
-    """R = A X - Fe, JX = A, Jp = dwdp (AC + 2 w AM) X - Fp with A = AK + w AC + w^2 AM."""
-    AK, AC, AM, w, dwdp, X, Fe, Fp = lin
+    """R = A X - Fe, JX = A, Jp = dwdp (AC + 2 w AM) X - Fp with A = AK + w AC + w^2 AM.
+
+    The linear terms couple the coefficients of one harmonic only: row i of
+    AK, AC and AM is zero outside the columns ``cols[i, 0] .. cols[i, 1] - 1``
+    (its harmonic's block), which alone are read (JX is zero elsewhere).
+    """
+    AK, AC, AM, w, dwdp, X, Fe, Fp, cols = lin
     size = X.shape[0]
     w2 = w * w
     w2x = 2.0 * w
     for i in range(size):
+        lo = cols[i, 0]
+        hi = cols[i, 1]
+        for j in range(lo):
+            JX[i, j] = 0.0
         r = 0.0
         jp = 0.0
-        for j in range(size):
+        for j in range(lo, hi):
             a = AK[i, j] + w * AC[i, j] + w2 * AM[i, j]
             JX[i, j] = a
             r += a * X[j]
             jp += (AC[i, j] + w2x * AM[i, j]) * X[j]
+        for j in range(hi, size):
+            JX[i, j] = 0.0
         R[i] = r - Fe[i]
         Jp[i] = jp * dwdp - Fp[i]
 

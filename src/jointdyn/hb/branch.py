@@ -147,20 +147,24 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     growth = np.empty(n)
     # Hill stability of every point (hill_stability's criterion; NaN where a condensed problem does not compute
     # it), on chunks of points whose Jacobians fit in config.HB_JACOBIAN_BUDGET_BYTES
-    chunk = max(1, min(n, config.HB_JACOBIAN_BUDGET_BYTES // (8 * problem.size * problem.size)))
-    JXs = np.empty((chunk, problem.size, problem.size))
+    hill = problem.hill_affordable()  # else growth NaN: no Jacobian needed
+    chunk = max(1, min(n, config.HB_JACOBIAN_BUDGET_BYTES // (8 * problem.size * problem.size))) if hill else 1
+    JXs = np.empty((chunk, problem.size, problem.size) if hill else (1, 0, 0))
     for i in range(n):
         ev = tr.evaluations.get(float(lam[i]))
-        if ev is None or ev[0].tobytes() != X[i].tobytes() or ev[1].JX is None:  # not kept for this very X
+        if ev is None or ev[0].tobytes() != X[i].tobytes() or (hill and ev[1].JX is None):  # not kept for this X
             ev = (X[i], problem.evaluate(X[i], lam[i]), *(ev[2:] if ev is not None and ev[1].JX is None else ()))
         if len(ev) > 2:
             response0[i] = ev[2]
         ev = ev[1]
-        JXs[i % chunk] = ev.JX
+        if hill:
+            JXs[i % chunk] = ev.JX
         passes[i] = int(ev.info[INFO_PASSES])
         periodic_error[i] = ev.info[INFO_ERROR]
         force_period[i] = int(ev.info[INFO_PERIOD])
-        if i % chunk == chunk - 1 or i == n - 1:
+        if not hill:
+            growth[i] = np.nan
+        elif i % chunk == chunk - 1 or i == n - 1:
             lo = i - i % chunk
             growth[lo:i + 1] = problem.hill_growth(JXs[:i + 1 - lo], ws[lo:i + 1])
     stable, checked = _confirmed_stability(problem, X, lam, growth)

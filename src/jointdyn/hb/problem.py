@@ -116,7 +116,10 @@ def _linear_blocks(system: System, H: int):
     n = system.ndof
     nh = 2 * H + 1
     M, C, K = system.M, system.C, system.K
-    AK = np.kron(np.eye(nh), K)
+    # block by block into zeroed arrays (np.kron writes every entry: seconds at thousands of unknowns)
+    AK = np.zeros((n * nh, n * nh))
+    for h in range(nh):
+        AK[h * n:(h + 1) * n, h * n:(h + 1) * n] = K
     AC = np.zeros((n * nh, n * nh))
     AM = np.zeros((n * nh, n * nh))
     for k in range(1, H + 1):
@@ -127,6 +130,16 @@ def _linear_blocks(system: System, H: int):
         AC[ic:ic + n, is_:is_ + n] = k * C
         AC[is_:is_ + n, ic:ic + n] = -k * C
     return AK, AC, AM
+
+
+def harmonic_columns(n: int, H: int) -> np.ndarray:
+    """(n (2H+1), 2) int64: per row of the unknowns (harmonic-major: mean, cos 1, sin 1, ...), the columns
+    ``[lo, hi)`` of its harmonic's block, where alone the linear terms of harmonic balance couple it."""
+    h = np.arange(n * (2 * H + 1)) // n
+    k = (h + 1) // 2
+    lo = np.where(k == 0, 0, (2 * k - 1) * n)
+    hi = np.where(k == 0, n, (2 * k + 1) * n)
+    return np.ascontiguousarray(np.stack((lo, hi), axis=1), dtype=np.int64)
 
 
 class HBProblem:
@@ -186,6 +199,7 @@ class HBProblem:
         self.n = self.dofs.size
         self.nh = 2 * self.H + 1
         self.size = self.n * self.nh
+        self._lin_cols = harmonic_columns(self.n, self.H)
         self.w0 = system.w0
         if not self.w0 > 0:
             raise ValueError("system must have a positive lowest natural frequency w0 (K positive definite)")
@@ -336,7 +350,11 @@ class HBProblem:
         """Block matrix A(w) of the linear terms (size n(2H+1)): per harmonic k
         ``[[K - k^2 w^2 M, k w C], [-k w C, K - k^2 w^2 M]]``, K for k = 0."""
         AK, AC, AM = self._lin
-        return AK + w * AC + (w * w) * AM
+        out = np.zeros_like(AK)
+        for lo, hi in np.unique(self._lin_cols, axis=0):  # the harmonics' blocks, where alone they are nonzero
+            b = (slice(lo, hi), slice(lo, hi))
+            out[b] = AK[b] + w * AC[b] + (w * w) * AM[b]
+        return out
 
     def _linear_terms(self, w):
         """(AK, AC, AM, w) of the compiled evaluation: A(w) = AK + w AC + w^2 AM."""
@@ -433,7 +451,7 @@ class HBProblem:
                 self._scl = np.array([fs, xs / fs, ps / fs])
                 self._scales_seen = scales
             scaled = (self._scl, np.empty(size), np.empty((size, size)), np.empty(size))
-        self._kernel((*self._linear_terms(w), float(dwdp), X, Fe, Fp),
+        self._kernel((*self._linear_terms(w), float(dwdp), X, Fe, Fp, self._lin_cols),
                      (self._Bm, self._Pm, self._ssz, self._Bnm, self._Sp, self.has_springs),
                      (Nsamp, dN if has_p else self._dummy, has_p, events), (self._Eg, self._Pg),
                      (int(self.max_passes), float(config.HB_PERIODIC_RTOL)), (R, JX, Jp, T, Nout, code, info), scaled)
@@ -537,12 +555,24 @@ class HBProblem:
                 "open": np.mean(code == SEPARATION, axis=1)}
 
     # --- stability ----------------------------------------------------------
+    def hill_affordable(self) -> bool:
+        """True when the companion matrix of Hill's method (2 n (2H+1) rows) has at most
+        ``config.HB_HILL_MAX_ROWS`` rows: all its eigenvalues cost O(rows^3), about a minute per point at
+        10^4 rows on two cores, far more than the point itself."""
+        return 2 * self.size <= config.HB_HILL_MAX_ROWS
+
     def hill_growth(self, JXs, ws):
-        """max Re(s) / w of the Floquet exponents (Hill's method) at many points (:func:`~jointdyn.hb.stability.hill_growth`)."""
+        """max Re(s) / w of the Floquet exponents (Hill's method) at many points
+        (:func:`~jointdyn.hb.stability.hill_growth`); NaN when not :meth:`hill_affordable`."""
+        if not self.hill_affordable():
+            return np.full(len(ws), np.nan)
         return hill_growth(JXs, self.system.M, self.system.C, ws, self.H)
 
     def hill_stability(self, JX, w):
-        """(stable, growth, multipliers) of one solution (:func:`~jointdyn.hb.stability.hill_stability`)."""
+        """(stable, growth, multipliers) of one solution (:func:`~jointdyn.hb.stability.hill_stability`), or
+        (False, NaN, empty) when not :meth:`hill_affordable`."""
+        if not self.hill_affordable():
+            return False, math.nan, np.empty(0, dtype=complex)
         return hill_stability(JX, self.system.M, self.system.C, w, self.H)
 
 

@@ -137,7 +137,11 @@ class EPMCProblem:
             raise ValueError(f"{exc} (EPMC evaluates the contacts by harmonic balance)") from None
         self.linear = linear_stuck_mode(system, mode, self.output_dof)
         self.n, self.H, self.size = n, self.hb.H, self.hb.size
-        self.A_M = mass_damping_block(system.M, self.H)
+        # dense A_M for small problems (one product beats 2H small ones); by blocks from the size where the
+        # continuation's solves go large (an N x N A_M is 240 MB at 5500 unknowns)
+        self.A_M = mass_damping_block(system.M, self.H) if self.size < config.CONT_KRYLOV_SOLVE else None
+        self._mass_blocks = [(k * system.M, -k * system.M, slice((2 * k - 1) * n, 2 * k * n),
+                              slice(2 * k * n, (2 * k + 1) * n)) for k in range(1, self.H + 1)]
         self.i_omega = n + self.output_dof
         self.i_xi = 2 * n + self.output_dof
         self.w_ref = self.linear.omega_rad_s
@@ -184,16 +188,39 @@ class EPMCProblem:
         Y = X / a
         ev = self.evaluate(X, w)
         self.last = (X, w, xi, ev)
-        cx = self.A_M @ X
+        cx = self._times_mass_damping(X)
         R = ev.R - (xi * w) * cx
-        J = ev.JX - (xi * w) * self.A_M
+        # in place on the evaluation's own Jacobian (nothing reads it afterwards): at thousands of unknowns
+        # every copy of an N x N array costs as much as the AFT of hundreds of node pairs
+        J = ev.JX
+        self._subtract_mass_damping(J, xi * w)
         ka = self.k_ref * a
         Rs = R / ka
         Jlam = _LN10 * (J @ Y / self.k_ref - Rs)
-        Jv = J / self.k_ref
+        Jv = J
+        Jv /= self.k_ref
         Jv[:, self.i_omega] = self.w_ref * (ev.Jp / self.hb.w0 - xi * cx) / ka
         Jv[:, self.i_xi] = -self.w_ref * w * cx / ka
         return Rs, Jv, Jlam
+
+    def _times_mass_damping(self, X):
+        """A_M @ X, m kg (by blocks for large problems: A_M is zero outside its 2H blocks)."""
+        if self.A_M is not None:
+            return self.A_M @ X
+        out = np.zeros_like(X)
+        for kM, mkM, c, s in self._mass_blocks:
+            out[c] = kM @ X[s]
+            out[s] = mkM @ X[c]
+        return out
+
+    def _subtract_mass_damping(self, J, f):
+        """J -= f A_M in place (on A_M's blocks only for large problems)."""
+        if self.A_M is not None:
+            J -= f * self.A_M
+            return
+        for kM, mkM, c, s in self._mass_blocks:
+            J[c, s] -= f * kM
+            J[s, c] -= f * mkM
 
     def solve(self, amplitude: float, guess, options: ContinuationOptions | None = None, **overrides):
         """Newton at a fixed amplitude (m) from scaled unknowns ``guess``: ``(v, converged, iterations)``."""
@@ -373,7 +400,8 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         last = problem.last
         X = problem.unpack(v, lam)[0]
         if last is not None and last[0].tobytes() == X.tobytes():
-            stash[X.tobytes()] = last[3]
+            # without its Jacobian (modified in place, and N x N per point): the per-point results do not use it
+            stash[X.tobytes()] = dataclasses.replace(last[3], JX=None, scaled=None)
 
     # the bar fills over the range of log10(amplitude), not against max_points
     with ParameterProgress(lam0, lam1, "EPMC", progress, name="log10(a / m)") as bar:

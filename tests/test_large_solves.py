@@ -1,0 +1,225 @@
+"""Large harmonic-balance problems: reused LU factors as GMRES preconditioner, block-wise linear terms,
+EPMC's in-place Jacobian, and Hill's method skipped where it costs more than the branch.
+
+The oracles: LAPACK's direct solve (the answer the reuse must reproduce), the dense block matrices that
+the block-wise code replaces (written out here), and the same HB / EPMC solutions computed with the
+reuse switched off.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import jointdyn as jd
+from jointdyn import config
+from jointdyn.continuation import linalg
+from jointdyn.interfaces import Interface
+
+
+def _bordered_case(rng, n):
+    J = rng.standard_normal((n, n)) + n ** 0.5 * np.eye(n)
+    Jl = rng.standard_normal(n)
+    d = rng.standard_normal(n + 1)
+    b = rng.standard_normal(n + 1)
+    return J, Jl, d, b
+
+
+def _direct(J, Jl, d, b):
+    A = np.block([[J, Jl[:, None]], [d[None, :]]])
+    return np.linalg.solve(A, b)
+
+
+def test_factor_reuse_solves_like_lapack_and_factorises_only_when_gmres_fails():
+    rng = np.random.default_rng(3)
+    J, Jl, d, b = _bordered_case(rng, 120)
+    fr = linalg.FactorReuse()
+    x, ok = fr.solve(J, Jl, d, b)
+    assert ok and fr.counts == {"factorisations": 1, "krylov_solves": 0, "krylov_iterations": 0,
+                                "sparse_factorisations": 0}
+    np.testing.assert_allclose(x, _direct(J, Jl, d, b), rtol=1e-10, atol=1e-12)
+    # a nearby matrix (the next point of a branch): GMRES with the kept factors, no factorisation
+    J2 = J + 1e-3 * rng.standard_normal(J.shape)
+    x2, ok = fr.solve(J2, Jl, d, b)
+    ref = _direct(J2, Jl, d, b)
+    assert ok and fr.counts["factorisations"] == 1 and fr.counts["krylov_solves"] == 1
+    assert np.linalg.norm(x2 - ref) <= 1e-8 * np.linalg.norm(ref)
+    # an unrelated matrix: GMRES does not reach the tolerance in its iterations, the matrix is factorised
+    J3, Jl3, d3, b3 = _bordered_case(np.random.default_rng(4), 120)
+    x3, ok = fr.solve(J3, Jl3, d3, b3)
+    assert ok and fr.counts["factorisations"] == 2
+    np.testing.assert_allclose(x3, _direct(J3, Jl3, d3, b3), rtol=1e-10, atol=1e-12)
+    # R_y alone (no border), and an exactly singular matrix is reported
+    x4, ok = linalg.FactorReuse().solve(J, Jl, np.zeros(0), b[:-1])
+    assert ok
+    np.testing.assert_allclose(J @ x4, b[:-1], rtol=0, atol=1e-10 * np.abs(b).max())
+    S = J.copy()
+    S[:, 5] = 0.0
+    assert not linalg.FactorReuse().solve(S, Jl, np.zeros(0), b[:-1])[1]
+
+
+def _banded(rng, n, width=3):
+    J = np.zeros((n, n))
+    for k in range(-width, width + 1):
+        J += np.diag(rng.standard_normal(n - abs(k)), k)
+    return J + 4 * width * np.eye(n)
+
+
+def test_sparse_matrices_are_factorised_by_superlu_while_their_factors_stay_sparse():
+    rng = np.random.default_rng(8)
+    n = 400
+    J, Jl, d, b = _banded(rng, n), rng.standard_normal(n), rng.standard_normal(n + 1), rng.standard_normal(n + 1)
+    fr = linalg.FactorReuse()
+    for k in range(3):
+        Jk = J + 1e-3 * k * _banded(rng, n)
+        x, ok = fr.solve(Jk, Jl, d, b)
+        assert ok and fr.sparse
+        ref = _direct(Jk, Jl, d, b)
+        assert np.linalg.norm(x - ref) <= 1e-12 * np.linalg.norm(ref)
+    assert fr.counts["sparse_factorisations"] == 3 and fr.counts["factorisations"] == 0
+    # a sparse matrix whose factors fill in: solved, and the walk goes on dense
+    R = np.where(rng.random((n, n)) < 0.01, rng.standard_normal((n, n)), 0.0) + 3 * np.eye(n)
+    fr = linalg.FactorReuse()
+    x, ok = fr.solve(R, Jl, d, b)
+    assert ok and fr.sparse is False and fr.counts["sparse_factorisations"] == 1
+    np.testing.assert_allclose(x, _direct(R, Jl, d, b), rtol=1e-9, atol=1e-11)
+    x, ok = fr.solve(R + 1e-4 * np.eye(n), Jl, d, b)
+    assert ok and fr.counts["sparse_factorisations"] == 1 and fr.counts["factorisations"] + fr.counts[
+        "krylov_solves"] == 1
+    # exactly singular, sparse
+    S = J.copy()
+    S[:, 7] = 0.0
+    assert not linalg.FactorReuse().solve(S, Jl, np.zeros(0), b[:-1])[1]
+
+
+def test_reusing_factors_is_scoped_and_nests():
+    assert linalg._REUSE.get() is None
+    with linalg.reusing_factors() as outer:
+        with linalg.reusing_factors() as inner:
+            assert inner is outer
+        assert linalg._REUSE.get() is outer
+    assert linalg._REUSE.get() is None
+
+
+def test_harmonic_columns_cover_every_nonzero_of_the_linear_terms():
+    from jointdyn.hb.problem import _linear_blocks, harmonic_columns
+
+    rng = np.random.default_rng(5)
+    n, H = 4, 3
+    A = rng.standard_normal((n, n))
+    s = jd.System(M=np.eye(n) + 0.1 * (A + A.T) ** 2 / n, C=0.3 * np.eye(n) + 0.01 * A @ A.T,
+                  K=10 * np.eye(n) + A @ A.T, force=np.ones(n))
+    cols = harmonic_columns(n, H)
+    inside = np.zeros((n * (2 * H + 1),) * 2, dtype=bool)
+    for i, (lo, hi) in enumerate(cols):
+        inside[i, lo:hi] = True
+    for B in _linear_blocks(s, H):
+        assert np.all(B[~inside] == 0.0)
+        assert np.any(B[inside] != 0.0)
+
+
+def _chain(nodes=4, phase=90.0):
+    n = 3 * nodes
+    K = np.zeros((n, n))
+    for i in range(nodes - 1):
+        for dd, kd in enumerate((1e5, 1.3e5, 2e5)):
+            a, b = 3 * i + dd, 3 * (i + 1) + dd
+            K[a, a] += kd
+            K[b, b] += kd
+            K[a, b] -= kd
+            K[b, a] -= kd
+    K[np.arange(n), np.arange(n)] += np.tile([1e3, 4e3, 1e3], nodes)
+    P = 10.0 * (0.2 + np.exp(-((np.arange(nodes) - nodes / 2) / (nodes / 4)) ** 2))
+    table = np.full((nodes, 6), -1)
+    table[:, :3] = 3 * np.arange(nodes)[:, None] + np.arange(3)
+    f = np.zeros(n)
+    f[0], f[1] = 1.0, 0.5
+    return jd.System(M=0.1 * np.eye(n), C=1e-4 * K, K=K, force=f,
+                     force_phase_deg=np.where(np.arange(n) == 1, phase, 0.0), output_dof=0,
+                     interfaces=(Interface(kt=2e4, kn=5e4, mu=0.5, preload=P, pairs=table),))
+
+
+def _reuse_everywhere(monkeypatch, path):
+    """Every bordered solve through FactorReuse: dense (GMRES with kept factors) or sparse (SuperLU)."""
+    monkeypatch.setattr(config, "CONT_SMALL_SOLVE", 0)
+    monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
+    monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0 if path == "sparse" else 0.0)
+    monkeypatch.setattr(config, "CONT_SPARSE_FILL", 1.0)
+    return "sparse_factorisations" if path == "sparse" else "krylov_solves"
+
+
+def test_epmc_in_place_jacobian_equals_the_dense_mass_block():
+    """EPMC's xi w A_M term by blocks equals the dense block matrix A_M = [[0, k M], [-k M, 0]] per harmonic."""
+    from jointdyn.modes.epmc import EPMCProblem
+
+    s = _chain(3)
+    s = jd.System(M=s.M + 0.01 * np.ones_like(s.M), C=s.C, K=s.K, interfaces=s.interfaces, output_dof=0)
+    q = EPMCProblem(s, harmonics=3, samples=16)
+    n, H = q.n, q.H
+    AM = np.zeros((q.size, q.size))
+    for k in range(1, H + 1):
+        c, sn = slice((2 * k - 1) * n, 2 * k * n), slice(2 * k * n, (2 * k + 1) * n)
+        AM[c, sn] = k * s.M
+        AM[sn, c] = -k * s.M
+    assert q.A_M is not None
+    np.testing.assert_array_equal(q.A_M, AM)
+    q.A_M = None  # the block-wise products of large problems
+    X = np.random.default_rng(6).standard_normal(q.size)
+    np.testing.assert_allclose(q._times_mass_damping(X), AM @ X, rtol=0, atol=1e-14 * np.abs(AM @ X).max())
+    J = np.random.default_rng(7).standard_normal((q.size, q.size))
+    ref = J - 0.37 * AM
+    q._subtract_mass_damping(J, 0.37)
+    np.testing.assert_array_equal(J, ref)
+
+
+@pytest.mark.parametrize("path", ["dense", "sparse"])
+def test_epmc_points_with_reused_factors_equal_direct_solves(monkeypatch, path):
+    from jointdyn.hb.problem import reference_scales
+    from jointdyn.modes.epmc import EPMCProblem
+
+    s = jd.System(M=_chain().M, C=_chain().C, K=_chain().K, interfaces=_chain().interfaces, output_dof=0)
+    kt, fy = reference_scales(s)
+    amps = fy / kt * np.array([0.05, 0.3, 1.0, 3.0])
+
+    def points():
+        q = EPMCProblem(s, harmonics=3, samples=32)
+        v, out = q.linear_guess(), []
+        with linalg.reusing_factors() as fr:
+            for a in amps:
+                v, ok, _ = q.solve(a, v, tol=1e-11)
+                assert ok
+                out.append(v.copy())
+        return np.array(out), fr.counts
+
+    direct, counts = points()
+    assert counts["factorisations"] == 0  # small: the compiled elimination, no reuse
+    key = _reuse_everywhere(monkeypatch, path)
+    reused, counts = points()
+    assert counts[key] > 0
+    np.testing.assert_allclose(reused, direct, rtol=0, atol=1e-8 * np.abs(direct).max())
+
+
+@pytest.mark.parametrize("path", ["dense", "sparse"])
+def test_hb_branch_with_reused_factors_has_the_same_peak(monkeypatch, path):
+    from jointdyn.hb import continue_hb
+
+    s = _chain(3)
+    a = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False)
+    key = _reuse_everywhere(monkeypatch, path)
+    b = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False)
+    assert a.status.ok and b.status.ok
+    assert b.counters[key] > 0 and key not in a.counters
+    pa, pb = a.response()[0].max(), b.response()[0].max()
+    assert pb == pytest.approx(pa, rel=1e-6)
+
+
+def test_hill_is_not_computed_beyond_its_size_and_the_branch_says_so(monkeypatch):
+    from jointdyn.hb import branch_dataset, continue_hb
+
+    s = _chain(2)
+    monkeypatch.setattr(config, "HB_HILL_MAX_ROWS", 2 * 6 * 5 - 1)  # 2 n (2H+1) rows with n = 6, H = 2
+    br = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False)
+    assert br.status.ok and br.lam.size > 5
+    assert np.all(np.isnan(br.growth)) and not np.any(br.stable)
+    assert branch_dataset(br).attrs["stability"] == "not-computed"
+    assert not br.problem.hill_stability(np.eye(br.problem.size), 1.0)[0]
