@@ -364,14 +364,15 @@ def contact_kinematics(system, with_interfaces: bool = False) -> ContactKinemati
     ``(preload, kn, 0)`` with their normal selection row. A System with
     interfaces is refused (ValueError naming ``interfaces``) unless
     ``with_interfaces`` (a solver that marches the interfaces itself: time
-    integration); the solvers that pack their contacts here otherwise do
-    not march interfaces yet.
+    integration); harmonic balance and EPMC pack the scalar contacts of
+    :func:`~jointdyn.hb.problem.contacts_only` here and evaluate the
+    interfaces themselves; the remaining callers (QSMA, which refuses
+    interfaces before, the time-domain period map) take scalar contacts only.
     """
     if getattr(system, "interfaces", ()) and not with_interfaces:
-        # the frequency-domain solvers pack their contacts here: none of them marches interfaces yet
-        raise ValueError(f"interfaces: harmonic balance and nonlinear modes do not take interfaces yet (the System "
-                         f"has {len(system.interfaces)}); time integration (integrate, steady_state, frc --system) "
-                         "and the quasi-static loops (jointdyn.drivers.interface_loop) do")
+        raise ValueError(f"interfaces: this computation takes scalar contacts only (the System has "
+                         f"{len(system.interfaces)} interfaces); harmonic balance, EPMC backbones, time integration "
+                         "and the quasi-static loops (jointdyn.drivers.interface_loop) take interfaces")
     cs = system.contacts
     nc = len(cs)
     tan_idx, tan_w = _pack_rows([_sparse_selection(c.dof, c.dof2, c.direction) for c in cs])
