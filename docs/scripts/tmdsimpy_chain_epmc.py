@@ -221,7 +221,8 @@ def run(nodes: int, H: int, Nt: int, points: int = 40) -> dict:
     rows = [_amplitude_row(X, res(X, False)[0], n, dof) for X in sols]
     return {"nodes": nodes, "harmonics": H, "samples": Nt, "wall_s": wall, "cpu_s": cpu, "compile_s": compile_s,
             "residual_evaluations": evaluations, "points": len(rows), "solves": len(path) - 1, "halvings": halvings,
-            "wall_s_to_last_point": last[0], "cpu_s_to_last_point": last[1], "no_solution_from_la": stopped, "la_range": [S["la0"], S["la1"]], "a_ref_m": S["a_ref"],
+            "wall_s_to_last_point": last[0], "cpu_s_to_last_point": last[1], "no_solution_from_la": stopped,
+            "la_range": [S["la0"], S["la1"]], "a_ref_m": S["a_ref"],
             "omega_stuck_rad_s": S["w0"], "backbone": rows}
 
 
@@ -344,7 +345,8 @@ def _provenance(commit: str | None) -> dict:
 
     folder = Path(tmdsimpy.__file__).resolve().parent
     r = subprocess.run(["git", "-C", str(folder), "rev-parse", "HEAD"], check=False, capture_output=True, text=True)
-    return {"tmdsimpy": commit or r.stdout.strip() or "(commit unknown: not a git checkout)", "python": platform.python_version(),
+    return {"tmdsimpy": commit or r.stdout.strip() or "(commit unknown: not a git checkout)",
+            "python": platform.python_version(),
             "numpy": np.__version__, "scipy": scipy.__version__, "jax": jax.__version__}
 
 
