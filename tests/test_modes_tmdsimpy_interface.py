@@ -123,8 +123,8 @@ def test_epmc_of_the_pair_chain_equals_tmdsimpy():
     rule over the same samples: the same discrete equations (measured largest differences over the
     compared points: 1.7e-13 in DOF 0's amplitude, 1.8e-13 in the frequency, 2.9e-12 in the damping
     ratio), hence ``TEST_MODES_TMDSIMPY_SAME_RTOL``. The points are followed in tmdsimpy's
-    parameter, the modal amplitude: DOF 0's amplitude (jointdyn's) folds back along this branch, so
-    a sweep in it cannot reach every point. Compared: the points before the branch splits
+    parameter, the modal amplitude: the same sweep in DOF 0's amplitude (jointdyn's parameter) finds
+    no solution past 3.2e-4 m on this branch. Compared: the points before the branch splits
     (``ONE_BRANCH``, reference_tmdsimpy_interface.py).
     """
     problem = EPMCProblem(_chain(), harmonics=HARMONICS, samples=SAMPLES)

@@ -39,8 +39,8 @@ with a message, status 0, where they are not. How tmdsimpy is set up:
   (:data:`SOLVER_CONFIG`, :data:`CONTINUATION_CONFIG`) left the branch at the onset of slip (it
   jumped to log-amplitudes of order -1e11); ``--continuation`` runs it and reports its points.
 * ``--jointdyn TMDSIMPY_JSON`` (in jointdyn's environment) solves jointdyn's EPMC
-  (:class:`jointdyn.modes.EPMCProblem`, bordered by the same modal amplitude: jointdyn's own
-  parameter, DOF 0's amplitude, folds back on this branch) of ``chain(nodes)`` at the
+  (:class:`jointdyn.modes.EPMCProblem`, bordered by the same modal amplitude: a sweep in
+  jointdyn's own parameter, DOF 0's amplitude, finds no solution past 3.2e-4 m on this branch) of ``chain(nodes)`` at the
   log-amplitudes of a tmdsimpy result by the same natural continuation, times it, and gives the
   largest differences in DOF 0's amplitude, frequency and damping ratio.
 
