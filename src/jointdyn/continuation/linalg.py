@@ -237,7 +237,7 @@ class FactorReuse:
     def _sparse(self, Jy, Jl, d, b):
         """The solution by SuperLU; None when singular, or when the factors filled in (``self.sparse``
         then False: dense from now on)."""
-        A = sps.csc_matrix(_bordered(Jy, Jl, d))
+        A = _sparse_bordered(Jy, Jl, d)
         try:
             f = spla.splu(A)
         except RuntimeError:  # exactly singular
@@ -278,6 +278,18 @@ class FactorReuse:
         # spending GMRES iterations on a preconditioner that is likely to fail
         self.stale = it[0] > config.CONT_KRYLOV_REFRESH
         return x
+
+
+def _sparse_bordered(Jy, Jl, d):
+    """The bordered matrix of :func:`_bordered` as a CSC matrix, from the nonzeros of R_y (no dense copy)."""
+    n = Jy.shape[0]
+    idx = np.flatnonzero(Jy)
+    r, c = np.divmod(idx, n)
+    if d.shape[0] == 0:
+        return sps.csc_matrix((Jy.ravel()[idx], (r, c)), shape=(n, n))
+    rows = np.concatenate((r, np.arange(n), np.full(n + 1, n)))
+    cols = np.concatenate((c, np.full(n, n), np.arange(n + 1)))
+    return sps.csc_matrix((np.concatenate((Jy.ravel()[idx], Jl, d)), (rows, cols)), shape=(n + 1, n + 1))
 
 
 _REUSE: contextvars.ContextVar[FactorReuse | None] = contextvars.ContextVar("jointdyn_factor_reuse", default=None)
