@@ -13,6 +13,9 @@ with the file of the same path in NEW:
   compared line by line;
 * a leaf name of OLD is mapped through the documented renames (``RENAMES``,
   from CHANGELOG.md) before it is looked up in NEW;
+* a file whose path differs only in a 12-hex-digit key (the sweeps'
+  checkpoint folders, named by a hash of their inputs) is matched to the one
+  file of NEW with the same path but that key;
 * numbers (scalars and arrays, also numbers written as text as in CSV or
   ``repr`` strings) are equal only when their bits are equal: the same shape
   and ``float.hex`` of every element (NaN equals NaN);
@@ -237,6 +240,19 @@ def compare_leaves(old: dict, new: dict, dirs: tuple[str, ...]) -> dict:
     return rep
 
 
+_HASH = re.compile(r"_[0-9a-f]{12}(?=/|$)")
+
+
+def _same_but_hash(rel: Path, new_dir: Path) -> Path | None:
+    """The one file of ``new_dir`` whose path differs from ``rel`` only in 12-hex-digit keys
+    (the sweeps' checkpoint folders are named by a hash of their inputs, whose recipe may change)."""
+    if not _HASH.search(rel.as_posix()):
+        return None
+    want = _HASH.sub("_<hash>", rel.as_posix())
+    found = [p for p in new_dir.rglob(rel.name) if _HASH.sub("_<hash>", p.relative_to(new_dir).as_posix()) == want]
+    return found[0] if len(found) == 1 else None
+
+
 def compare_dirs(old_dir: Path, new_dir: Path) -> list[tuple[str, str, dict]]:
     """(file, verdict, details) for every output file of ``old_dir``."""
     dirs = tuple(str(d) for d in sorted({old_dir, old_dir.resolve(), new_dir, new_dir.resolve()}, key=lambda p: -len(str(p))))
@@ -247,12 +263,16 @@ def compare_dirs(old_dir: Path, new_dir: Path) -> list[tuple[str, str, dict]]:
             continue
         other = new_dir / rel
         if not other.is_file():
+            other = _same_but_hash(rel, new_dir)
+        if other is None:
             results.append((str(rel), "MISSING", {}))
             continue
+        note = [] if other == new_dir / rel else [str(other.relative_to(new_dir))]
         if path.read_bytes() == other.read_bytes():
-            results.append((str(rel), "identical", {}))
+            results.append((str(rel), "identical", {"matched_by_name_without_hash": note} if note else {}))
             continue
         rep = compare_leaves(read_leaves(path), read_leaves(other), dirs)
+        rep["matched_by_name_without_hash"] = note
         verdict = ("NUMERIC-DIFF" if rep["numeric"] else "REMOVED-NUMBERS" if rep["removed_numbers"]
                    else "same-numbers")
         results.append((str(rel), verdict, rep))
@@ -269,8 +289,8 @@ def report(results) -> str:
         if not rep:
             lines.append(f"| {rel} | {verdict} | | | |")
             continue
-        lines.append(f"| {rel} | {verdict} | {len(rep['renamed'])} | {len(rep['added'])} "
-                     f"| {len(rep['labels_renamed'])} / {len(rep['labels'])} |")
+        n = {k: len(rep.get(k, ())) for k in ("renamed", "added", "labels_renamed", "labels")}
+        lines.append(f"| {rel} | {verdict} | {n['renamed']} | {n['added']} | {n['labels_renamed']} / {n['labels']} |")
         details.append(f"\n### {rel}: {verdict}")
         for k, v in rep.items():
             if v:

@@ -90,3 +90,15 @@ def test_netcdf_variables_attributes_and_nan(tmp_path):
     assert res[0][1] == "same-numbers" and res[0][2]["labels_renamed"] == ["var:status@legend"]
     res = _pair(tmp_path, "f.nc", ds(3.0, "x"), ds(np.nextafter(3.0, 4.0), "x"), write)
     assert res[0][1] == "NUMERIC-DIFF" and res[0][2]["numeric"][0].startswith("var:q")
+
+
+def test_checkpoint_folder_matched_without_its_hash(tmp_path):
+    for side, key in (("old", "a929becaaaca"), ("new", "60c2c5d96567")):
+        d = tmp_path / side / "lines" / f"eta0.5_down_{key}"
+        d.mkdir(parents=True)
+        np.savez(d / "p000000.npz", q=np.array([1.0, 2.0]))
+    (rel, verdict, rep), = co.compare_dirs(tmp_path / "old", tmp_path / "new")
+    assert verdict in ("identical", "same-numbers")
+    assert rep["matched_by_name_without_hash"] == ["lines/eta0.5_down_60c2c5d96567/p000000.npz"]
+    np.savez(tmp_path / "new" / "lines" / "eta0.5_down_60c2c5d96567" / "p000000.npz", q=np.array([1.0, 2.5]))
+    assert co.compare_dirs(tmp_path / "old", tmp_path / "new")[0][1] == "NUMERIC-DIFF"
