@@ -21,11 +21,11 @@ The comparison takes, for every numeric leaf of the JSON present on both
 sides, the best over rounds of each side (the smallest time, the largest
 rate), and reports the ratio ``new / old`` of times (for rates, ``old / new``:
 above 1 means the new tree is slower either way), flagging ratios above
-``--threshold`` (1.10). Leaves are classified by name: a rate has ``per_s``
-or ``per_second`` in its name; a time has ``seconds``, ends in ``_s``, or
-is a ``ns_``/``us_``/``ms_per`` figure; targets, ratios, speedups, counts and
-sizes are not timings and are left out of the table (they are listed apart
-when their values differ). Cold-compile figures (``compile``/``cold`` in the
+``--threshold`` (1.10). Leaves are classified by their path: a rate has
+``per_s`` (``steps_per_s``, ``rows_per_s_new``) or ``per_second`` in it; a
+time has ``seconds``, a part ending in ``_s``, or a ``ns_``/``us_``/``ms_per``
+figure; targets, ratios, speedups, counts and sizes are not timings and are
+left out of the table (they are listed apart when their values differ). Cold-compile figures (``compile``/``cold`` in the
 path) are listed in their own table.
 """
 
@@ -39,18 +39,18 @@ import sys
 import time
 from pathlib import Path
 
-_NOT_TIMING = re.compile(r"target|ratio|speedup|_over_|_vs_|rate$|load_average|_mb|bytes|omega")
+_NOT_TIMING = re.compile(r"target|ratio|speedup|_over_|_vs_|load_average|_mb|bytes|omega|status_counts|rate$")
+_RATE = re.compile(r"per_s($|_|/)|per_second")
+_TIME = re.compile(r"seconds|_s($|/)|(^|/)cpu_s|(^|/|_)(ns|us|ms)_per")
 
 
 def _kind(path: str) -> str | None:
-    """'rate', 'time' or None (not a timing) for a leaf path ``a/b/c``."""
-    name = path.rsplit("/", 1)[-1]
-    if _NOT_TIMING.search(name):
+    """'rate', 'time' or None (not a timing) for a leaf path ``a/b/c`` (see the module docstring)."""
+    if _NOT_TIMING.search(path):
         return None
-    if "per_s" in name or "per_second" in name:
+    if _RATE.search(path):
         return "rate"
-    if ("seconds" in name or name.endswith("_s") or re.search(r"(^|_)(ns|us|ms)_per", name)
-            or name.startswith("cpu_s")):
+    if _TIME.search(path):
         return "time"
     return None
 

@@ -209,6 +209,8 @@ def _compare_leaf(key: str, a, b, dirs: tuple[str, ...], rep: dict) -> None:
             rep["numeric"].append(f"{key}: {_max_rel(na, nb)}")
         return
     la, lb = _label(a, dirs), _label(b, dirs)
+    if la == lb and _label(a, ()) != _label(b, ()):
+        rep["output_folder_only"].append(key)
     if la != lb:
         if _renamed_label(la) == lb:
             rep["labels_renamed"].append(key)
@@ -219,7 +221,7 @@ def _compare_leaf(key: str, a, b, dirs: tuple[str, ...], rep: dict) -> None:
 def compare_leaves(old: dict, new: dict, dirs: tuple[str, ...]) -> dict:
     """Classified differences between the leaves of two versions of one file."""
     rep = {"renamed": [], "added": [], "removed_numbers": [], "removed_other": [], "labels": [],
-           "labels_renamed": [], "numeric": [], "timing_skipped": []}
+           "labels_renamed": [], "output_folder_only": [], "numeric": [], "timing_skipped": []}
     matched = set()
     for key, a in old.items():
         if TIMING.search(key):
