@@ -25,8 +25,15 @@ above 1 means the new tree is slower either way), flagging ratios above
 ``per_s`` (``steps_per_s``, ``rows_per_s_new``) or ``per_second`` in it; a
 time has ``seconds``, a part ending in ``_s``, or a ``ns_``/``us_``/``ms_per``
 figure; targets, ratios, speedups, counts and sizes are not timings and are
-left out of the table (they are listed apart when their values differ). Cold-compile figures (``compile``/``cold`` in the
-path) are listed in their own table.
+left out of the table (they are listed apart when their values differ).
+Cold-compile figures (``compile``, ``cold`` or ``startup`` in the path) are
+listed in their own table.
+
+To tell noise from a regression, run the flagged benchmark alone, alternated
+several times (``--only NAME --rounds 3``: A, B, A, B, A, B). Figures that
+are the same code on both sides (``python_reference_*``, ``*_previous``,
+``march_reference_seconds``, ``cli_hb_process_floor_*``) show the noise of
+the machine in that run.
 """
 
 from __future__ import annotations

@@ -1,9 +1,9 @@
 """Compare two folders of jointdyn outputs number by number: ``python benchmarks/compare_outputs.py OLD NEW``.
 
-Both folders hold the same workloads run by two versions of jointdyn (e.g.
-``docs/scripts/reference_outputs.sh``, see ``benchmarks/README-compare.md``):
-CLI JSON (``*.json``), tables (``*.csv``), Datasets (``*.nc``) and arrays (``*.npz``). Every file
-of OLD (except ``*.err``, ``*.png``, ``*.svg`` and ``log.txt``) is compared
+Both folders hold the same workloads run by two versions of jointdyn
+(``benchmarks/reference_outputs.py``, which says how to set up each tree):
+CLI JSON (``*.json``), tables (``*.csv``), Datasets (``*.nc``) and arrays
+(``*.npz``). Every file of OLD (except ``*.err``, ``*.png``, ``*.svg`` and ``log.txt``) is compared
 with the file of the same path in NEW:
 
 * each file is read into leaves: a JSON object is flattened to paths
@@ -257,7 +257,8 @@ def _same_but_hash(rel: Path, new_dir: Path) -> Path | None:
 
 def compare_dirs(old_dir: Path, new_dir: Path) -> list[tuple[str, str, dict]]:
     """(file, verdict, details) for every output file of ``old_dir``."""
-    dirs = tuple(str(d) for d in sorted({old_dir, old_dir.resolve(), new_dir, new_dir.resolve()}, key=lambda p: -len(str(p))))
+    folders = {old_dir, old_dir.resolve(), new_dir, new_dir.resolve()}
+    dirs = tuple(str(d) for d in sorted(folders, key=lambda p: -len(str(p))))
     results = []
     for path in sorted(p for p in old_dir.rglob("*") if p.is_file()):
         rel = path.relative_to(old_dir)

@@ -2,12 +2,16 @@
 
 Runs the same workloads with ``TREE/.venv`` (an editable install of TREE), so
 that two versions of jointdyn can be compared number by number with
-``benchmarks/compare_outputs.py``::
+``benchmarks/compare_outputs.py``. The procedure, e.g. for a refactoring
+that must leave every output unchanged (OLD: a worktree of the commit before
+it, ``git worktree add OLD COMMIT``; NEW: the tree after it, each with its
+own virtual environment)::
 
     python -m venv --system-site-packages OLD/.venv && OLD/.venv/bin/pip install --no-deps -e OLD
     python benchmarks/reference_outputs.py OLD out-old
     python benchmarks/reference_outputs.py NEW out-new
-    python benchmarks/compare_outputs.py out-old out-new
+    python benchmarks/compare_outputs.py out-old out-new     # exit 0: every number bit for bit
+    python benchmarks/ab.py --old OLD --new NEW --rounds 2 --quick   # speed, alternated
 
 The workloads: the CLI's JSON (``--json``) and files (``--out``) of
 response curves by harmonic balance (Jenkins, the exact and closed-form Iwan

@@ -30,10 +30,11 @@ def _run(result, wall=1.0):
 
 
 def test_compare_best_of_rounds_and_flags():
-    runs = {"old": [_run({"hb": {"branch_seconds": 1.0, "points": 3}, "laws": {"steps_per_s": 100.0}, "gone": {"x_s": 1}}),
-                    _run({"hb": {"branch_seconds": 2.0, "points": 3}, "laws": {"steps_per_s": 50.0}})],
-            "new": [_run({"hb": {"branch_seconds": 1.05, "points": 4}, "laws": {"steps_per_s": 80.0}, "added": {"y_s": 1}}),
-                    _run({"hb": {"branch_seconds": 1.5, "points": 4}, "laws": {"steps_per_s": 60.0}})]}
+    old1 = {"hb": {"branch_seconds": 1.0, "points": 3}, "laws": {"steps_per_s": 100.0}, "gone": {"x_s": 1}}
+    old2 = {"hb": {"branch_seconds": 2.0, "points": 3}, "laws": {"steps_per_s": 50.0}}
+    new1 = {"hb": {"branch_seconds": 1.05, "points": 4}, "laws": {"steps_per_s": 80.0}, "added": {"y_s": 1}}
+    new2 = {"hb": {"branch_seconds": 1.5, "points": 4}, "laws": {"steps_per_s": 60.0}}
+    runs = {"old": [_run(old1), _run(old2)], "new": [_run(new1), _run(new2)]}
     text = ab.compare(runs, 1.10)
     assert "| `hb/branch_seconds` | time | 1 | 1.05 | 1.050 |  |" in text
     assert "| `laws/steps_per_s` | rate | 100 | 80 | 1.250 | SLOWER |" in text
