@@ -14,7 +14,6 @@ import pytest
 import jointdyn as jd
 from jointdyn import config
 from jointdyn.continuation import linalg
-from jointdyn.interfaces import Interface
 
 
 def _bordered_case(rng, n):
@@ -118,25 +117,11 @@ def test_harmonic_columns_cover_every_nonzero_of_the_linear_terms():
         assert np.any(B[inside] != 0.0)
 
 
-def _chain(nodes=4, phase=90.0):
-    n = 3 * nodes
-    K = np.zeros((n, n))
-    for i in range(nodes - 1):
-        for dd, kd in enumerate((1e5, 1.3e5, 2e5)):
-            a, b = 3 * i + dd, 3 * (i + 1) + dd
-            K[a, a] += kd
-            K[b, b] += kd
-            K[a, b] -= kd
-            K[b, a] -= kd
-    K[np.arange(n), np.arange(n)] += np.tile([1e3, 4e3, 1e3], nodes)
-    P = 10.0 * (0.2 + np.exp(-((np.arange(nodes) - nodes / 2) / (nodes / 4)) ** 2))
-    table = np.full((nodes, 6), -1)
-    table[:, :3] = 3 * np.arange(nodes)[:, None] + np.arange(3)
-    f = np.zeros(n)
-    f[0], f[1] = 1.0, 0.5
-    return jd.System(M=0.1 * np.eye(n), C=1e-4 * K, K=K, force=f,
-                     force_phase_deg=np.where(np.arange(n) == 1, phase, 0.0), output_dof=0,
-                     interfaces=(Interface(kt=2e4, kn=5e4, mu=0.5, preload=P, pairs=table),))
+def _chain(nodes=4):
+    """The node-pair chain of benchmarks/bench_hb_interface_chain.py (sparse K, M, C; a pair at every node)."""
+    from test_modes_tmdsimpy_interface import _module
+
+    return _module("benchmarks/bench_hb_interface_chain.py").chain(nodes)
 
 
 def _reuse_everywhere(monkeypatch, path):
@@ -177,7 +162,8 @@ def test_epmc_points_with_reused_factors_equal_direct_solves(monkeypatch, path):
     from jointdyn.hb.problem import reference_scales
     from jointdyn.modes.epmc import EPMCProblem
 
-    s = jd.System(M=_chain().M, C=_chain().C, K=_chain().K, interfaces=_chain().interfaces, output_dof=0)
+    c = _chain()
+    s = jd.System(M=c.M, C=c.C, K=c.K, interfaces=c.interfaces, output_dof=0)
     kt, fy = reference_scales(s)
     amps = fy / kt * np.array([0.05, 0.3, 1.0, 3.0])
 
