@@ -31,9 +31,6 @@ import contextvars
 import warnings
 
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sps
-import scipy.sparse.linalg as spla
 
 from .. import config
 from .._jit import jit
@@ -208,6 +205,8 @@ class FactorReuse:
 
     def solve(self, Jy, Jl, d, b):
         """``(x, ok)``: the solution of the bordered system (R_y alone when ``d`` is empty)."""
+        import scipy.linalg as sla  # here: small problems never need it, and the CLI starts without it
+
         n = Jy.shape[0]
         if self.sparse is None:
             self.sparse = np.count_nonzero(Jy) <= config.CONT_SPARSE_DENSITY * n * n
@@ -237,6 +236,8 @@ class FactorReuse:
     def _sparse(self, Jy, Jl, d, b):
         """The solution by SuperLU; None when singular, or when the factors filled in (``self.sparse``
         then False: dense from now on)."""
+        import scipy.sparse.linalg as spla
+
         A = _sparse_bordered(Jy, Jl, d)
         try:
             f = spla.splu(A)
@@ -249,6 +250,9 @@ class FactorReuse:
 
     def _krylov(self, Jy, Jl, d, b, n):
         """GMRES preconditioned by the kept factors; the solution, or None when not accurate enough."""
+        import scipy.linalg as sla
+        import scipy.sparse.linalg as spla
+
         bordered = d.shape[0] > 0
 
         def times(x):
@@ -282,6 +286,8 @@ class FactorReuse:
 
 def _sparse_bordered(Jy, Jl, d):
     """The bordered matrix of :func:`_bordered` as a CSC matrix, from the nonzeros of R_y (no dense copy)."""
+    import scipy.sparse as sps
+
     n = Jy.shape[0]
     idx = np.flatnonzero(Jy)
     r, c = np.divmod(idx, n)
