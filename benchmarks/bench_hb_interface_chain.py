@@ -32,9 +32,10 @@ import numpy as np
 
 H, NS = 5, 128
 MAX_POINTS = 150
-#: top of the full size's backbone range, in units of the patch's fy / kt: just below the amplitude (about
-#: 0.34 fy / kt) where dozens of end pairs start to slip together and the full three decades stall (a run to
-#: 10 fy / kt, one thread beside the test suite, had not reached 150 points after 25 minutes); the quick size runs the three decades
+#: top of the full size's backbone range, in units of the patch's fy / kt: just below the amplitude
+#: (about 0.34 fy / kt) where dozens of end pairs start to slip together and the full three decades
+#: stall (a run to 10 fy / kt, one thread beside the test suite, had not reached 150 points after
+#: 25 minutes); the quick size runs the three decades
 FULL_TOP = 0.3
 
 
