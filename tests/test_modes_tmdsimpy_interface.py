@@ -56,29 +56,9 @@ def test_the_script_model_is_the_benchmark_chain():
 
 
 def _at_modal_amplitude(problem: EPMCProblem):
-    """jointdyn's scaled EPMC residual with log10 of DOF 0's amplitude as one more unknown and one more
-    equation: log10 of the modal amplitude sqrt(a1^T M a1 + b1^T M b1) = ``la`` (tmdsimpy's parameter;
-    kg^1/2 m), and its exact Jacobian: ``(R, dR/dz, dR/dla)`` of ``z = (v, lam)``, for
-    :func:`jointdyn.continuation.newton`."""
-    n, M = problem.n, problem.system.M
-    fixed = [problem.i_omega, problem.i_xi]
-
-    def residual(z, la):
-        v, lam = z[:-1], float(z[-1])
-        Rs, Jv, Jlam = problem.residual(v, lam)
-        Y = problem.unpack(v, lam)[0] / 10.0 ** lam
-        m2 = float(Y[n:2 * n] @ M @ Y[n:2 * n] + Y[2 * n:3 * n] @ M @ Y[2 * n:3 * n])
-        g = np.zeros(z.size)
-        g[n:3 * n] = np.concatenate((M @ Y[n:2 * n], M @ Y[2 * n:3 * n])) / (m2 * math.log(10.0))
-        g[fixed] = 0.0  # omega and xi sit where Y holds 1 and 0
-        g[-1] = 1.0
-        R = np.append(Rs, lam + 0.5 * math.log10(m2) - la)
-        J = np.vstack((np.column_stack((Jv, Jlam)), g))
-        dla = np.zeros(z.size)
-        dla[-1] = -1.0
-        return R, J, dla
-
-    return residual
+    """jointdyn's EPMC residual bordered by the modal amplitude, the one the script solved with
+    (``docs/scripts/tmdsimpy_chain_epmc.py``: ``_jointdyn_at_modal_amplitude``)."""
+    return _module("docs/scripts/tmdsimpy_chain_epmc.py")._jointdyn_at_modal_amplitude(problem)
 
 
 def _backbone_at(problem: EPMCProblem, las):
