@@ -194,9 +194,21 @@ CONT_KRYLOV_REFRESH = 8
 #: at every solve (the 60-node chain of benchmarks/bench_hb_interface_chain.py,
 #: 1980 unknowns, 0.7 % nonzero: 4 ms against 227 ms for dense LAPACK), ...
 CONT_SPARSE_DENSITY = 0.02
-#: ... while its factors hold at most this fraction of N^2 entries (else dense:
-#: SuperLU on a matrix that fills in costs about 5x dense LAPACK)
-CONT_SPARSE_FILL = 0.05
+#: ... while its factors hold at most this fraction of N^2 entries (else dense
+#: from then on: SuperLU on a matrix that fills in completely costs about 5x
+#: dense LAPACK). As the pairs of the 167-node chain slip, their blocks couple
+#: all harmonics and the fill grows: measured at 5512 unknowns, fill 0.17 took
+#: 0.24 s against 2.7-8.7 s for dense LAPACK (2 cores, loaded), fill 0.083
+#: 0.10-0.18 s; the former bound 0.05 sent that walk to dense LAPACK
+CONT_SPARSE_FILL = 0.25
+#: SuperLU's thresholds for preferring the diagonal pivot, tried in turn until
+#: the solution's true residual is at most CONT_KRYLOV_RTOL |b| (0: the
+#: diagonal unless it is zero, least fill; 0.1: the usual threshold pivoting;
+#: SuperLU's default 1 is partial pivoting). On the slipping 167-node chain's
+#: bordered matrix (5512 unknowns, 0.6 % nonzero): 0 fill 0.010 in 0.04 s,
+#: 0.1 fill 0.25 in 0.68 s, 0.01 fill 0.20 in 0.58 s, all with residuals of
+#: 1e-11; at a lower amplitude 0.1 gave fill 0.010 where 1 gave 0.083
+CONT_SPARSE_PIVOTS = (0.0, 0.1)
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history

@@ -18,10 +18,11 @@ new factorisation. The solution is accepted only when its true residual
 and solved directly (and its factors kept for the next solves); after a
 solve that needed more than ``config.CONT_KRYLOV_REFRESH`` iterations, the
 next matrix is factorised at once. A sparse matrix (structures with sparse
-K, M and C: each pair couples only its own DOFs) is factorised by SuperLU
-at every solve instead, while its factors stay sparse. The
-preconditioner changes the work, not the answer beyond that tolerance: the
-Newton corrector still stops on its own residual.
+K, M and C: each pair couples only its own DOFs; R_y may come as a
+``scipy.sparse`` matrix) is factorised by SuperLU instead, its factors
+reused in the same way, while they stay sparse. The preconditioner changes
+the work, not the answer beyond that tolerance: the Newton corrector still
+stops on its own residual.
 """
 
 from __future__ import annotations
@@ -191,14 +192,17 @@ class FactorReuse:
     factors as (left) preconditioner. A sparse matrix (at most
     ``config.CONT_SPARSE_DENSITY`` of its entries nonzero: a structure with
     sparse K, M, C, whose pairs couple only their own DOFs) is factorised by
-    SuperLU (``scipy.sparse.linalg.splu``) at every solve instead, while its
-    factors stay sparse (at most ``config.CONT_SPARSE_FILL`` of N^2 entries;
-    else the walk goes on dense). ``counts`` holds the factorisations (dense
+    SuperLU (``scipy.sparse.linalg.splu``, the pivot thresholds of
+    ``config.CONT_SPARSE_PIVOTS`` in turn until the solve is accurate)
+    instead, and its factors precondition GMRES in the same way, while they
+    stay sparse (at most ``config.CONT_SPARSE_FILL`` of N^2 entries; else
+    the walk goes on dense). ``counts`` holds the factorisations (dense
     and sparse), the solves accepted from GMRES and its iterations.
     """
 
     def __init__(self):
         self.lu = None
+        self.splu = None  # the kept sparse factors (scipy.sparse.linalg.SuperLU)
         self.stale = False
         self.sparse = None  # decided at the first factorisation of the walk
         self.counts = {"factorisations": 0, "krylov_solves": 0, "krylov_iterations": 0, "sparse_factorisations": 0}
@@ -209,15 +213,15 @@ class FactorReuse:
 
         n = Jy.shape[0]
         if self.sparse is None:
-            self.sparse = np.count_nonzero(Jy) <= config.CONT_SPARSE_DENSITY * n * n
+            nnz = Jy.nnz if _is_sparse(Jy) else np.count_nonzero(Jy)
+            self.sparse = nnz <= config.CONT_SPARSE_DENSITY * n * n
         if self.sparse:
-            x = self._sparse(Jy, Jl, d, b)
-            if x is not None:
-                return x, bool(np.isfinite(x).all())
-            if self.sparse:  # exactly singular
-                return b, False
-        elif self.lu is not None and self.lu[0].shape[0] == b.size and not self.stale:
-            x = self._krylov(Jy, Jl, d, b, n)
+            return self._sparse(Jy, Jl, d, b)
+        Jy = _dense(Jy)  # a sparse R_y whose factors filled in: dense from then on
+        if self.lu is not None and self.lu[0].shape[0] == b.size and not self.stale:
+            lu = self.lu
+            x = self._krylov(lambda x: _bordered_times(Jy, Jl, d, x), lambda r: sla.lu_solve(lu, r, check_finite=False),
+                             b)
             if x is not None:
                 return x, True
         self.stale = False
@@ -234,37 +238,43 @@ class FactorReuse:
         return x, bool(np.isfinite(x).all())
 
     def _sparse(self, Jy, Jl, d, b):
-        """The solution by SuperLU; None when singular, or when the factors filled in (``self.sparse``
-        then False: dense from now on)."""
+        """``(x, ok)`` by the kept sparse factors (GMRES, as the dense ones) or SuperLU on this matrix
+        (``self.sparse`` False when its factors filled in: dense from then on)."""
         import scipy.sparse.linalg as spla
 
         A = _sparse_bordered(Jy, Jl, d)
-        try:
-            f = spla.splu(A)
-        except RuntimeError:  # exactly singular
-            return None
-        self.counts["sparse_factorisations"] += 1
+        f = self.splu
+        if f is not None and f.shape == A.shape and not self.stale:
+            x = self._krylov(A.dot, f.solve, b)
+            if x is not None:
+                return x, True
+        self.stale = False
+        f = x = None
+        nb = np.linalg.norm(b)
+        for thresh in config.CONT_SPARSE_PIVOTS:  # the diagonal pivots first (least fill), then safer ones
+            try:
+                f = spla.splu(A, diag_pivot_thresh=thresh)
+            except RuntimeError:  # exactly singular with these pivots
+                f = None
+                continue
+            self.counts["sparse_factorisations"] += 1
+            x = f.solve(b)
+            if np.isfinite(x).all() and np.linalg.norm(A @ x - b) <= config.CONT_KRYLOV_RTOL * nb:
+                break
+        self.splu = f
+        if f is None:
+            return b, False
         if f.L.nnz + f.U.nnz > config.CONT_SPARSE_FILL * A.shape[0] ** 2:
-            self.sparse = False
-        return f.solve(b)
+            self.sparse, self.splu = False, None
+        return x, bool(np.isfinite(x).all())
 
-    def _krylov(self, Jy, Jl, d, b, n):
-        """GMRES preconditioned by the kept factors; the solution, or None when not accurate enough."""
-        import scipy.linalg as sla
+    def _krylov(self, times, precondition, b):
+        """GMRES on ``times`` (the current matrix's product) preconditioned by ``precondition`` (a solve with
+        the kept factors); the solution, or None when not accurate enough."""
         import scipy.sparse.linalg as spla
 
-        bordered = d.shape[0] > 0
-
-        def times(x):
-            y = Jy @ x[:n]
-            if bordered:
-                y = np.append(y + Jl * x[n], d @ x)
-            return y
-
-        lu = self.lu
         A = spla.LinearOperator((b.size, b.size), matvec=times, dtype=np.float64)
-        P = spla.LinearOperator((b.size, b.size), matvec=lambda r: sla.lu_solve(lu, r, check_finite=False),
-                                dtype=np.float64)
+        P = spla.LinearOperator((b.size, b.size), matvec=precondition, dtype=np.float64)
         it = [0]
 
         def count(_):
@@ -284,11 +294,25 @@ class FactorReuse:
         return x
 
 
+def _bordered_times(Jy, Jl, d, x):
+    """The bordered matrix of :func:`_bordered` times x, without forming it."""
+    n = Jy.shape[0]
+    y = Jy @ x[:n]
+    if d.shape[0] > 0:
+        y = np.append(y + Jl * x[n], d @ x)
+    return y
+
+
 def _sparse_bordered(Jy, Jl, d):
-    """The bordered matrix of :func:`_bordered` as a CSC matrix, from the nonzeros of R_y (no dense copy)."""
+    """The bordered matrix of :func:`_bordered` as a CSC matrix, from the nonzeros of R_y (no dense copy;
+    R_y itself when sparse)."""
     import scipy.sparse as sps
 
     n = Jy.shape[0]
+    if _is_sparse(Jy):
+        if d.shape[0] == 0:
+            return sps.csc_matrix(Jy)
+        return sps.bmat([[Jy, Jl[:, None]], [d[None, :n], d[n:, None]]], format="csc")
     idx = np.flatnonzero(Jy)
     r, c = np.divmod(idx, n)
     if d.shape[0] == 0:
@@ -324,12 +348,24 @@ def _large_solve(Jy, Jl, d, b):
     fr = _REUSE.get()
     if fr is not None and Jy.shape[0] + 1 >= config.CONT_KRYLOV_SOLVE:
         return fr.solve(Jy, Jl, d, b)
-    return _lapack_solve(_bordered(Jy, Jl, d), b)
+    return _lapack_solve(_bordered(_dense(Jy), Jl, d), b)
+
+
+def _is_sparse(Jy) -> bool:
+    """True for a ``scipy.sparse`` Jacobian (a residual may return one at thousands of unknowns: interfaces on
+    a sparse structure, :meth:`jointdyn.hb.HBProblem.evaluate_sparse`); without importing scipy."""
+    return type(Jy) is not np.ndarray and hasattr(Jy, "tocsc")
+
+
+def _dense(Jy):
+    """R_y as a dense array (a sparse one converted)."""
+    return Jy.toarray() if _is_sparse(Jy) else Jy
 
 
 def _newton_direction(Jy, Jl, d, R, v, u_pred):
     """Newton step of R(y, lam) = 0 (and d^T (v - u_pred) = 0 when d has entries): ``(dv, ok)``."""
     if _small(Jy):
+        Jy = _dense(Jy)
         return _newton_direction_small(Jy, Jl, d, R, v, u_pred)
     return _large_solve(Jy, Jl, d, _border_rhs(R, d, v, u_pred))
 
@@ -338,7 +374,10 @@ def _tangent(Jy, Jl, t_prev):
     """Unit t with [R_y R_lam] t = 0, t_prev^T t = 1 (normalised), or None if singular."""
     f = np.float64
     Jl = np.ascontiguousarray(Jl, dtype=f).reshape(-1)
-    Jy = np.ascontiguousarray(Jy, dtype=f).reshape(Jl.size, -1)
+    if _is_sparse(Jy) and _small(Jy):
+        Jy = _dense(Jy)
+    if not _is_sparse(Jy):
+        Jy = np.ascontiguousarray(Jy, dtype=f).reshape(Jl.size, -1)
     t_prev = np.ascontiguousarray(t_prev, dtype=f)
     if _small(Jy):
         t, ok = _tangent_small(Jy, Jl, t_prev)
@@ -352,8 +391,12 @@ def _tangent(Jy, Jl, t_prev):
 
 
 def _as_arrays(R, Jy, Jl):
-    """(R, R_y, R_lam) as C-contiguous float64 arrays of dims 1, 2, 1 (no copy when they are)."""
+    """(R, R_y, R_lam) as C-contiguous float64 arrays of dims 1, 2, 1 (no copy when they are); a
+    ``scipy.sparse`` R_y is passed on as it is (:func:`_is_sparse`)."""
     f = np.float64
+    if _is_sparse(Jy):
+        R = np.ascontiguousarray(R, dtype=f).reshape(-1)
+        return R, Jy, np.ascontiguousarray(Jl, dtype=f).reshape(-1)
     if (type(R) is np.ndarray and type(Jy) is np.ndarray and type(Jl) is np.ndarray and R.dtype == f
             and Jy.dtype == f and Jl.dtype == f and R.ndim == 1 and Jy.ndim == 2 and Jl.ndim == 1
             and R.flags.c_contiguous and Jy.flags.c_contiguous and Jl.flags.c_contiguous):
