@@ -106,8 +106,9 @@ def _same(a, da, s, ds, rtol):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _project_scatter(pairs, i, P0, n, P, Tb, dTb, Nb, dNb, F, G, R, JX):  # pragma: no cover - compiled
-    """F = P (T1, T2, N - P0), G = P d(.)/dY; R += +-F and JX += +-G on the pair's DOFs."""
+def _project(P0, P, Tb, dTb, Nb, dNb, F, G):  # pragma: no cover - compiled
+    """F = P (T1, T2, N - P0) (3, nh) and G = P d(.)/dY (3 nh, 3 nh): the pair's projected forces and
+    their exact Jacobian along its own coefficients."""
     nh, ns = P.shape
     nd = G.shape[1]
     for h in range(nh):
@@ -134,6 +135,12 @@ def _project_scatter(pairs, i, P0, n, P, Tb, dTb, Nb, dNb, F, G, R, JX):  # prag
             G[h, d] = g1
             G[nh + h, d] = g2
             G[2 * nh + h, d] = g3
+
+
+@jit(inline="always")
+def _scatter(pairs, i, n, F, G, R, JX, jx):  # pragma: no cover - compiled
+    """R += +-F on the pair's DOFs, and JX += +-G there when ``jx`` (else the caller keeps G)."""
+    nh = F.shape[1]
     for k in range(3):
         for sr in range(2):
             r = pairs[i, k + 3 * sr]
@@ -142,6 +149,8 @@ def _project_scatter(pairs, i, P0, n, P, Tb, dTb, Nb, dNb, F, G, R, JX):  # prag
             sgr = 1.0 - 2.0 * sr
             for h in range(nh):
                 R[h * n + r] += sgr * F[k, h]
+                if not jx:
+                    continue
                 for m in range(3):
                     for sc in range(2):
                         c = pairs[i, m + 3 * sc]
@@ -152,7 +161,7 @@ def _project_scatter(pairs, i, P0, n, P, Tb, dTb, Nb, dNb, F, G, R, JX):  # prag
                             JX[h * n + r, g * n + c] += sg * G[k * nh + h, m * nh + g]
 
 
-def pairs_aft(pairs, params, X, n, E, P, DU, DG, max_passes, rtol, R, JX, T, N, code, info):  # pragma: no cover
+def pairs_aft(pairs, params, X, n, E, P, DU, DG, max_passes, rtol, R, JX, Gout, T, N, code, info):  # pragma: no cover
     """Add the reactions of every pair and their exact Jacobian to R and JX (see the module docstring).
 
     A template: :func:`pairs_aft_kernel` compiles it with the pair's step bound as ``PAIR_STEP_JVP``,
@@ -170,7 +179,12 @@ def pairs_aft(pairs, params, X, n, E, P, DU, DG, max_passes, rtol, R, JX, T, N, 
     E, P : synthesis (Ns, nh) and analysis (nh, Ns) matrices.
     DU, DG : :func:`pair_directions` of E.
     max_passes, rtol : bound on the marched periods and the periodicity tolerance.
-    R, JX : residual (N) and Jacobian (N/m), added to.
+    R, JX : residual (N) and Jacobian (N/m), added to (JX only when ``Gout`` is empty).
+    Gout : float64 (np, 3 nh, 3 nh) or (0, 0, 0)
+        When not empty, each pair's Jacobian G (N/m) of its projected forces
+        ``(F1, F2, F3)`` (rows ``k nh + h``) along its coefficients of
+        ``(u1, u2, g)`` (columns ``m nh + g``), instead of the scatter into JX
+        (:meth:`jointdyn.hb.HBProblem.evaluate` with a sparse Jacobian).
     T, N, code : outputs (np, Ns, 2), (np, Ns), (np, Ns): forces, loads and states of the last pass.
     info : float64 (3,), updated with the worst case over the pairs (``INFO_*`` of ``_aft``).
     """
@@ -234,7 +248,13 @@ def pairs_aft(pairs, params, X, n, E, P, DU, DG, max_passes, rtol, R, JX, T, N, 
                 break
             s[:, :] = a
             ds[:, :, :] = da
-        _project_scatter(pairs, i, prm[0, 3], n, P, Tb, dTb, Nb, dNb, F, G, R, JX)
+        _project(prm[0, 3], P, Tb, dTb, Nb, dNb, F, G)
+        keep = Gout.shape[0] > 0
+        _scatter(pairs, i, n, F, G, R, JX, not keep)
+        if keep:
+            for r in range(nd):
+                for c in range(nd):
+                    Gout[i, r, c] = G[r, c]
         for j in range(ns):
             T[i, j, 0] = Tb[j, 0, 0]
             T[i, j, 1] = Tb[j, 0, 1]

@@ -286,10 +286,20 @@ class _Tracker:
         self._amps = {}
         #: the amplitudes of every accepted point (the branch's observable asks for them again)
         self._accepted_amps = {}
+        #: True when the Jacobian stays sparse from the evaluation on (:meth:`HBProblem.evaluate_sparse`):
+        #: interfaces on a sparse structure, from the size where the continuation's solves go large, where
+        #: Hill's method (which needs the dense Jacobians) is beyond its size anyway
+        pat = problem.sparse_pattern() if problem.size >= config.CONT_KRYLOV_SOLVE else None
+        self.sparse = (pat is not None and pat.density <= config.CONT_SPARSE_DENSITY
+                       and not problem.hill_affordable())
 
     def residual(self, y, lam_s):
-        xs, _, ps = self.scales
-        ev = self.problem.evaluate(y * xs, lam_s * ps, self.scales)
+        xs, fs, ps = self.scales
+        if self.sparse:
+            ev = self.problem.evaluate_sparse(y * xs, lam_s * ps)
+            ev.scaled = (ev.R / fs, ev.JX * (xs / fs), ev.Jp * (ps / fs))
+        else:
+            ev = self.problem.evaluate(y * xs, lam_s * ps, self.scales)
         self.last = ev
         return ev.scaled
 

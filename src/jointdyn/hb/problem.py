@@ -44,7 +44,7 @@ from ..kinematics import NORMAL_SPRING, contact_kinematics, no_contact_init_jvp,
 from ..laws import law_dispatch
 from ..laws._base import MACROSLIP, SEPARATION, STICK_SLIP
 from ..systems import Contact, System
-from ._aft import NO_EVENT, eval_kernel, recontact_events
+from ._aft import NO_EVENT, PERIOD_ONE, eval_kernel, recontact_events
 from ._aft_pairs import pair_directions, pairs_aft_kernel
 from .parameters import SystemParameter, _FixedFrequency, parameter_named
 from .stability import hill_growth, hill_stability
@@ -169,7 +169,7 @@ class HBProblem:
     def __init__(self, system: System, *, harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
                  parameter="gamma", gamma: float | None = None, max_passes: int = config.HB_MAX_PASSES):
         self._setup(system, harmonics, samples, parameter, gamma, max_passes, None)
-        self._lin = _linear_blocks(system, self.H)
+        self._lin_blocks = None  # (AK, AC, AM), built at their first use (:attr:`_lin`)
         # what the parameter does not move is built once
         self._fixed_forcing = None if self.parameter.enters_forcing else self._forcing_at(0.0)
         self._fixed_loads = None if self.parameter.enters_loads else self._loads_at(0.0)
@@ -218,6 +218,7 @@ class HBProblem:
         #: the AFT's phases and matrices (:meth:`_aft_grid`); evaluations report the uniform samples
         self._taug, self._Eg, self._Pg, self._uniform = self._aft_grid()
         self._dummy = np.zeros((1, 1))
+        self._no_blocks = np.zeros((0, 0, 0))
         self._zero1 = np.zeros(1)
         self._noscale = np.zeros(3)
         self._scales_seen = None
@@ -292,6 +293,14 @@ class HBProblem:
             return uniform
         tau, E, P, at = separation_grid(self.H, self.Ns, ev)
         return tau, E, P, (None if tau.size == self.Ns else at)
+
+    @property
+    def _lin(self):
+        """(AK, AC, AM) of :func:`_linear_blocks`, dense (3 N^2 entries: 730 MB at 5500 unknowns), built at
+        their first use: an evaluation with a sparse Jacobian (:meth:`evaluate_sparse`) never needs them."""
+        if getattr(self, "_lin_blocks", None) is None:
+            self._lin_blocks = _linear_blocks(self.system, self.H)
+        return self._lin_blocks
 
     @property
     def condensed(self) -> bool:
@@ -469,12 +478,52 @@ class HBProblem:
         ev.pair_T, ev.pair_N = np.empty((npairs, ns, 2)), np.empty((npairs, ns))
         ev.pair_code = np.empty((npairs, ns), dtype=np.int8)
         pairs_aft_kernel()(self.pair_positions, self.pair_params, X, self.n, self.E, self.P, *self._pair_dirs,
-                           int(self.max_passes), float(config.HB_PERIODIC_RTOL), ev.R, ev.JX, ev.pair_T,
-                           ev.pair_N, ev.pair_code, ev.info)
+                           int(self.max_passes), float(config.HB_PERIODIC_RTOL), ev.R, ev.JX, self._no_blocks,
+                           ev.pair_T, ev.pair_N, ev.pair_code, ev.info)
         if ev.scaled is not None:
             scl = scaled[0]
             np.divide(ev.R, scl[0], out=scaled[1])
             np.multiply(ev.JX, scl[1], out=scaled[2])
+
+    # --- sparse Jacobian ------------------------------------------------------
+    def sparse_pattern(self):
+        """The CSR pattern of dR/dX (:class:`jointdyn.hb._sparse.SparsePattern`; built once), or None
+        where :meth:`evaluate_sparse` does not apply: scalar contacts (their kernel writes a dense
+        Jacobian), no interfaces, a condensed problem, or a
+        :class:`~jointdyn.hb.parameters.SystemParameter`."""
+        if (self.contacts or not self.has_interfaces or self.condensed
+                or isinstance(self.parameter, SystemParameter)):
+            return None
+        if getattr(self, "_pattern", None) is None:
+            from ._sparse import SparsePattern
+
+            sys_ = self.system
+            self._pattern = SparsePattern((sys_.K, sys_.C, sys_.M), self.H, self.pair_positions)
+        return self._pattern
+
+    def evaluate_sparse(self, X, p) -> _Eval:
+        """:meth:`evaluate` with dR/dX as a ``scipy.sparse.csr_matrix`` (N/m), for a system whose only
+        nonlinear elements are interfaces (:meth:`sparse_pattern`), not condensed; no scaled copies. The linear terms
+        are summed by their nonzeros and the pairs' Jacobians assembled into the pattern: the values are
+        those of :meth:`evaluate` up to the order of the sums."""
+        pat = self.sparse_pattern()
+        if pat is None:
+            raise ValueError("evaluate_sparse: the system must have interfaces and no scalar contacts, and the "
+                             "parameter must not be a SystemParameter")
+        X = np.ascontiguousarray(X, dtype=np.float64)
+        w, dwdp, Fe, Fp, _, _, _ = self._inputs(p)
+        R, Jp, lin_values = pat.linear(X, w, dwdp, Fe, Fp)
+        npairs, ns, nd = self.pair_params.shape[0], self.Ns, 3 * self.nh
+        G = np.empty((npairs, nd, nd))
+        info = np.array([0.0, 0.0, PERIOD_ONE])
+        ev = _Eval(R, None, Jp, np.empty((0, ns)), np.empty((0, ns), dtype=np.int64), info, None, np.empty((0, ns)))
+        ev.pair_T, ev.pair_N = np.empty((npairs, ns, 2)), np.empty((npairs, ns))
+        ev.pair_code = np.empty((npairs, ns), dtype=np.int8)
+        pairs_aft_kernel()(self.pair_positions, self.pair_params, X, self.n, self.E, self.P, *self._pair_dirs,
+                           int(self.max_passes), float(config.HB_PERIODIC_RTOL), ev.R, self._dummy, G,
+                           ev.pair_T, ev.pair_N, ev.pair_code, ev.info)
+        ev.JX = pat.jacobian(lin_values, G)
+        return ev
 
     def problem_at(self, p: float):
         """The harmonic-balance problem of the System that this problem's

@@ -88,6 +88,23 @@ def mass_damping_block(M: np.ndarray, H: int) -> np.ndarray:
     return A
 
 
+def _sparse_mass_damping(M: np.ndarray, H: int):
+    """:func:`mass_damping_block` as a ``scipy.sparse.csr_matrix`` (from the nonzeros of M)."""
+    import scipy.sparse as sps
+
+    n = M.shape[0]
+    i, j = np.nonzero(M)
+    m = M[i, j]
+    rows, cols, vals = [], [], []
+    for k in range(1, H + 1):
+        ic, is_ = (2 * k - 1) * n, 2 * k * n
+        rows += [ic + i, is_ + i]
+        cols += [is_ + j, ic + j]
+        vals += [k * m, -k * m]
+    size = n * (2 * H + 1)
+    return sps.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(size, size))
+
+
 class EPMCProblem:
     """Scaled EPMC residual ``R(v, lam)`` and its exact Jacobians (module docstring).
 
@@ -144,6 +161,12 @@ class EPMCProblem:
                               slice(2 * k * n, (2 * k + 1) * n)) for k in range(1, self.H + 1)]
         self.i_omega = n + self.output_dof
         self.i_xi = 2 * n + self.output_dof
+        # interfaces on a sparse structure, from the size where the continuation's solves go large: the
+        # Jacobian stays sparse from the evaluation on (jointdyn.hb._sparse)
+        pat = self.hb.sparse_pattern() if self.size >= config.CONT_KRYLOV_SOLVE else None
+        #: True when the residual's Jacobian is a scipy.sparse matrix
+        self.sparse = pat is not None and pat.density <= config.CONT_SPARSE_DENSITY
+        self._A_M_sparse = _sparse_mass_damping(system.M, self.H) if self.sparse else None
         self.w_ref = self.linear.omega_rad_s
         self.k_ref = float(np.max(np.abs(np.diag(self.linear.stiffness))))
         self.B = selection_matrix(contact_kinematics(contacts_only(system)), n)
@@ -178,11 +201,17 @@ class EPMCProblem:
 
     # --- residual -----------------------------------------------------------
     def evaluate(self, X, omega):
-        """The harmonic-balance evaluation (residual without xi, contact forces) at X (m), omega (rad/s)."""
+        """The harmonic-balance evaluation (residual without xi, contact forces) at X (m), omega (rad/s); its
+        Jacobian sparse where :attr:`sparse`."""
+        if self.sparse:
+            return self.hb.evaluate_sparse(X, omega / self.hb.w0)
         return self.hb.evaluate(X, omega / self.hb.w0)
 
     def residual(self, v, lam):
-        """``(R_s, dR_s/dv, dR_s/dlam)``: the scaled residual and its exact Jacobians."""
+        """``(R_s, dR_s/dv, dR_s/dlam)``: the scaled residual and its exact Jacobians (dR_s/dv a
+        ``scipy.sparse`` matrix where :attr:`sparse`)."""
+        if self.sparse:
+            return self._residual_sparse(v, lam)
         a = 10.0 ** lam
         X, w, xi = self.unpack(v, lam)
         Y = X / a
@@ -201,6 +230,29 @@ class EPMCProblem:
         Jv /= self.k_ref
         Jv[:, self.i_omega] = self.w_ref * (ev.Jp / self.hb.w0 - xi * cx) / ka
         Jv[:, self.i_xi] = -self.w_ref * w * cx / ka
+        return Rs, Jv, Jlam
+
+    def _residual_sparse(self, v, lam):
+        """:meth:`residual` with the Jacobian sparse throughout (the same equations)."""
+        a = 10.0 ** lam
+        X, w, xi = self.unpack(v, lam)
+        Y = X / a
+        ev = self.evaluate(X, w)
+        self.last = (X, w, xi, ev)
+        cx = self._times_mass_damping(X)
+        R = ev.R - (xi * w) * cx
+        J = ev.JX - (xi * w) * self._A_M_sparse
+        ka = self.k_ref * a
+        Rs = R / ka
+        Jlam = _LN10 * (J @ Y / self.k_ref - Rs)
+        Jv = (J * (1.0 / self.k_ref)).tocsc()
+        for i in (self.i_omega, self.i_xi):  # their columns hold omega and xi (module docstring)
+            Jv.data[Jv.indptr[i]:Jv.indptr[i + 1]] = 0.0
+        cols = np.stack((self.w_ref * (ev.Jp / self.hb.w0 - xi * cx) / ka, -self.w_ref * w * cx / ka), axis=1)
+        r, c = np.nonzero(cols)
+        import scipy.sparse as sps
+
+        Jv = Jv + sps.csc_matrix((cols[r, c], (r, np.array((self.i_omega, self.i_xi))[c])), shape=Jv.shape)
         return Rs, Jv, Jlam
 
     def _times_mass_damping(self, X):
