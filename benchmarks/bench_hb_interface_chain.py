@@ -1,7 +1,8 @@
 """Harmonic balance with interfaces at scale (issue 23): an EPMC backbone and an HB branch of a chain model.
 
 The model: a chain of nodes with three DOFs each (t1, t2, n), springs
-between neighbours in each direction (stiffer in t2 and n, and held to ground
+between neighbours in each direction (``COUPLING``: stiff, so that the first
+mode is isolated, as a bolted beam's first bending mode is; held to ground
 more stiffly in t2, so that the first mode is in t1), and at every node a node pair against ground with a
 preload peaked in the middle of the chain (the pressure of a bolted patch),
 H = 5 and 128 samples. Measured: the EPMC backbone of mode 1 over three
@@ -15,13 +16,13 @@ on the same structure.
 
 Quick: 16 nodes (48 DOFs, 16 pairs); full: 167 nodes (501 DOFs, 167 pairs),
 the size of the issue's target (about 500 DOFs and 200 pairs; target 60 s
-each on 2 cores). At the full size the Newton systems (5511 unknowns) reuse
-their LU factors through GMRES or, sparse as this chain's are, are factorised
-by SuperLU (``factorisations`` counts both), and Hill's method is beyond
-``config.HB_HILL_MAX_ROWS`` (stability not computed); the backbone
-at the full size runs from 0.01 to ``FULL_TOP`` fy / kt (bounded to ``MAX_POINTS``
-points): over the three decades it stalls where dozens of the chain's end pairs
-start to slip together, about half-way up the range.
+each on 2 cores), 5511 unknowns. There the Jacobian stays sparse from the
+evaluation on (``jointdyn.hb._sparse``: this chain's K, M and C are sparse
+and each pair couples only its own DOFs), the Newton systems are factorised
+by SuperLU and the factors reused through GMRES (``factorisations`` counts
+the dense and sparse ones), and Hill's method is beyond
+``config.HB_HILL_MAX_ROWS`` (stability not computed). Both backbones run
+over the three decades, bounded to ``MAX_POINTS`` points.
 """
 
 from __future__ import annotations
@@ -31,16 +32,22 @@ import time
 import numpy as np
 
 H, NS = 5, 128
-MAX_POINTS = 150
-#: top of the full size's backbone range, in units of the patch's fy / kt: just below the amplitude
-#: (about 0.34 fy / kt) where dozens of end pairs start to slip together and the full three decades
-#: stall (a run to 10 fy / kt, one thread beside the test suite, had not reached 150 points after
-#: 25 minutes); the quick size runs the three decades
-FULL_TOP = 0.3
+MAX_POINTS = 400
+#: stiffness of the springs between neighbouring nodes along t1, t2 and n, N/m, of the measured chain:
+#: stiff against the pairs' kt (2e4 N/m), so that the chain's first mode is isolated as the first
+#: bending mode of a bolted beam is (with every pair stuck the next mode along t1 is at 2.0 times mode
+#: 1's frequency at 167 nodes, beyond the first t2 and n modes at 1.07 and 1.56 times)
+COUPLING = (1.8e8, 2.34e8, 3.6e8)
+#: ... and those of the chain's first version, the default of :func:`chain` (the tests and the tmdsimpy
+#: comparison at 16 nodes use it): at 167 nodes its first eight modes lie within 4 % of each other (all
+#: along t1), and its backbone followed a mode that changed its shape through that cluster as the pairs
+#: began to slip: the continuation stalled about half-way up the three decades
+SOFT_COUPLING = (1e5, 1.3e5, 2e5)
 
 
-def chain(nodes: int, pairs: bool = True):
-    """The chain System (module docstring): interface pairs, or scalar contacts (``pairs=False``)."""
+def chain(nodes: int, pairs: bool = True, coupling=SOFT_COUPLING):
+    """The chain System (module docstring): interface pairs, or scalar contacts (``pairs=False``), its
+    neighbours coupled by springs ``coupling`` (t1, t2, n; N/m)."""
     import jointdyn as jd
     from jointdyn.interfaces import Interface
     from jointdyn.kinematics import NormalSpring
@@ -49,7 +56,7 @@ def chain(nodes: int, pairs: bool = True):
     n = 3 * nodes
     K = np.zeros((n, n))
     for i in range(nodes - 1):
-        for d, kd in enumerate((1e5, 1.3e5, 2e5)):
+        for d, kd in enumerate(coupling):
             a, b = 3 * i + d, 3 * (i + 1) + d
             K[a, a] += kd
             K[b, b] += kd
@@ -118,10 +125,10 @@ def run(quick: bool) -> dict:
 
     # one amplitude range for both backbones: the pairs' mean slip displacement (the default scale of the
     # contacts, the first contact's fy / kt, is that of the lightest pair at the end of the chain, 3 times smaller)
-    kt, fy = reference_scales(chain(nodes, True))
+    kt, fy = reference_scales(chain(nodes, True, COUPLING))
     for name, pairs in (("interface", True), ("contacts", False)):
-        s = chain(nodes, pairs)
-        t, status, points, nf = _backbone(s, fy / kt, 10.0 if quick else FULL_TOP, None if quick else MAX_POINTS)
+        s = chain(nodes, pairs, COUPLING)
+        t, status, points, nf = _backbone(s, fy / kt, 10.0, MAX_POINTS)
         out[f"{name}_epmc_s"], out[f"{name}_epmc_status"], out[f"{name}_epmc_points"] = t, status, points
         out[f"{name}_epmc_factorisations"] = nf
         t, status, points, hill, nf = _branch(s)
