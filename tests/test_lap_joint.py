@@ -141,11 +141,12 @@ def test_the_tutorial_page_runs(tmp_path, monkeypatch, capsys):
     exec(compile(code, str(page), "exec"), {"__name__": "docs_lap_joint"})
     out = capsys.readouterr().out
     for said in ("25 pairs over 400.0 mm^2", "159 reduced DOFs from 1080", "stuck: [2049.8", "open: [949.3",
-                 "first bending mode, joint stuck: 823.7 Hz", "complete 21 points"):  # fmt: skip
+                 "(733, 733) 120 720",
+                 "first bending mode, joint stuck: 791.5 Hz", "complete 40 points"):  # fmt: skip
         assert said in out, f"{said!r} not in the output:\n{out}"
     # the backbone of section 6, as the page quotes it
-    printed = out[out.index("complete 21 points"):].splitlines()[1:]
-    quoted = re.search(r"```text\n(1\.00e-05 m:.*?)```", text, re.S).group(1).splitlines()
+    printed = out[out.index("complete 40 points"):].splitlines()[1:]
+    quoted = re.search(r"```text\n(3\.00e-06 m:.*?)```", text, re.S).group(1).splitlines()
     assert printed == quoted
     assert "It prints 25 pairs over 400 mm^2, 159 reduced DOFs from 1080" in text
     assert "2049.8 Hz stuck and 949.3 Hz open" in text
