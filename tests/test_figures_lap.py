@@ -32,7 +32,8 @@ def test_stuck_backbone_is_the_linear_mode_with_the_loaded_pairs_stuck(stuck_tab
     np.testing.assert_allclose(bb.damping_ratio_contacts, 0.0, atol=1e-12)
     slip = stuck_tables["slip"]
     on = slip.in_interface.astype(bool)
-    assert on.sum() == 120 and (~on).sum() == 144 and (slip.stick[on] == 1.0).all() and slip.energy_J[on].abs().max() < 1e-18
+    assert on.sum() == 120 and (~on).sum() == 144
+    assert (slip.stick[on] == 1.0).all() and slip.energy_J[on].abs().max() < 1e-18
     assert slip.stick[~on].isna().all()
     assert slip.converged.all()
 

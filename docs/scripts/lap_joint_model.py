@@ -6,10 +6,11 @@ with the joint in the middle). One M8 bolt through the middle of the patch
 clamps them with a preload of 12 kN. The script
 
 1. meshes each plate with 27-node hexahedra (scikit-fem; quadratic, so that
-   bending is not locked) and assembles M and K (about 10 000 DOFs);
+   bending is not locked; 8 x 8 elements over the patch) and assembles M
+   and K (18360 free DOFs);
 2. pairs the nodes of the patch node to node (lower plate A, upper plate B,
-   normal +z from A into B): every node of the 11 x 11 face grid except the
-   9 inside the bolt hole's radius, i.e. 112 pairs; the hole itself is not
+   normal +z from A into B): every node of the 17 x 17 face grid except the
+   25 inside the bolt hole's radius, i.e. 264 pairs; the hole itself is not
    meshed (its material stays: a small extra stiffness);
 3. states the interface stiffness per pair from its area A_i (the integral
    of its node's shape function over the patch face):
@@ -21,16 +22,24 @@ clamps them with a preload of 12 kN. The script
    A, the closed pairs are stuck (springs kt_i, kt_i, kn_i), and an active
    set removes the pairs that would pull (an open pair carries nothing);
    the preload of pair i is its normal force P_i (their sum is the bolt
-   force up to what the clamps carry; pairs that open get P_i = 0). The
-   bolt's own axial stiffness is left out: it acts as a constant force;
-5. reduces the model by Craig-Bampton onto the 672 pair DOFs (t1, t2, n of
-   both nodes of each pair, which here are x, y, z: the frames are the
-   global axes), the output DOF (z at the top of plate A, 37.5 mm from its
-   clamp, mid-width) and N_MODES fixed-interface modes;
-6. reports the linear natural frequencies of the reduced and the full model
-   with every pair stuck (springs kt, kt, kn), with the preloaded pairs
-   stuck and the others open, and with every pair open, and writes the
-   reduced model to src/jointdyn/data/lap_joint.npz (``--write``).
+   force up to what the clamps carry; pairs that open get P_i = 0: 144 of
+   the 264). The bolt's own axial stiffness is left out: it acts as a
+   constant force;
+5. reduces the model by Craig-Bampton onto the DOFs of the pairs loaded at
+   rest (120 pairs, 720 DOFs: t1, t2, n of both nodes of each pair, which
+   here are x, y, z: the frames are the global axes), the output DOF (z at
+   the top of plate A, 37.5 mm from its clamp, mid-width) and N_MODES
+   fixed-interface modes: 733 DOFs. The open pairs' nodes are interior
+   DOFs: they are apart at rest, and the interface element has no initial
+   gap (given to it, they would touch at zero load and clap in every
+   cycle), so the model's interface is the loaded pairs;
+6. reports the linear natural frequencies of the full model with every pair
+   stuck (springs kt, kt, kn), of the reduced and the full model with the
+   loaded pairs stuck and the others open, and with every pair open, and
+   writes the reduced model to src/jointdyn/data/lap_joint.npz
+   (``--write``): the loaded pairs' table, stiffnesses, friction
+   coefficients, preloads, areas and places, and the open pairs' places and
+   areas (``open_xy``, ``open_area``).
 
 Run: ``python docs/scripts/lap_joint_model.py [--write] [--figure
 docs/img/lap-joint-preload.png]`` (needs the ``fe`` extra: scikit-fem).

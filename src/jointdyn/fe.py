@@ -528,4 +528,5 @@ def lap_joint() -> LapJoint:
     freq = {s: d["frequencies_hz"][i] for i, s in enumerate(_LAP_STATES)}
     return LapJoint(M=_unpack_upper(d["M_upper"]), K=_unpack_upper(d["K_upper"]), pairs=d["pairs"], kt=d["kt"],
                     kn=d["kn"], mu=d["mu"], preload=d["preload"], area=d["area"], xy=d["xy"],
-                    open_xy=d["open_xy"], open_area=d["open_area"], output_dof=int(d["output_dof"]), frequencies_hz=freq)  # fmt: skip
+                    open_xy=d["open_xy"], open_area=d["open_area"], output_dof=int(d["output_dof"]),
+                    frequencies_hz=freq)  # fmt: skip
