@@ -574,9 +574,9 @@ SWEEP_PARENT_POLL_S = 0.5
 #: and to three digits at the largest damping (3e-4 m) (docs/lap-joint.md)
 LAP_HARMONICS = 1
 LAP_SAMPLES = 32
-#: backbone range: first-harmonic amplitude of the output DOF, m (stuck below 5e-6 m)
+#: backbone range: first-harmonic amplitude of the output DOF, m (stuck below 4.5e-6 m)
 LAP_AMPLITUDE_M = (1e-6, 2e-3)
-#: largest arc-length step of the backbone (47 points over the range, most of them between 5e-6
+#: largest arc-length step of the backbone (47 points over the range, most of them between 4.5e-6
 #: and 3e-4 m, where the pairs start to slip one after another)
 LAP_DS_MAX = 0.04
 #: amplitudes of the three slip maps, m: the onset of slip, the largest damping, deep slip
