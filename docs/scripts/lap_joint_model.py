@@ -6,10 +6,11 @@ with the joint in the middle). One M8 bolt through the middle of the patch
 clamps them with a preload of 12 kN. The script
 
 1. meshes each plate with 27-node hexahedra (scikit-fem; quadratic, so that
-   bending is not locked) and assembles M and K (about 10 000 DOFs);
+   bending is not locked; 8 x 8 elements over the patch) and assembles M
+   and K (18360 free DOFs);
 2. pairs the nodes of the patch node to node (lower plate A, upper plate B,
-   normal +z from A into B): every node of the 11 x 11 face grid except the
-   9 inside the bolt hole's radius, i.e. 112 pairs; the hole itself is not
+   normal +z from A into B): every node of the 17 x 17 face grid except the
+   25 inside the bolt hole's radius, i.e. 264 pairs; the hole itself is not
    meshed (its material stays: a small extra stiffness);
 3. states the interface stiffness per pair from its area A_i (the integral
    of its node's shape function over the patch face):
@@ -21,16 +22,24 @@ clamps them with a preload of 12 kN. The script
    A, the closed pairs are stuck (springs kt_i, kt_i, kn_i), and an active
    set removes the pairs that would pull (an open pair carries nothing);
    the preload of pair i is its normal force P_i (their sum is the bolt
-   force up to what the clamps carry; pairs that open get P_i = 0). The
-   bolt's own axial stiffness is left out: it acts as a constant force;
-5. reduces the model by Craig-Bampton onto the 672 pair DOFs (t1, t2, n of
-   both nodes of each pair, which here are x, y, z: the frames are the
-   global axes), the output DOF (z at the top of plate A, 37.5 mm from its
-   clamp, mid-width) and N_MODES fixed-interface modes;
-6. reports the linear natural frequencies of the reduced and the full model
-   with every pair stuck (springs kt, kt, kn), with the preloaded pairs
-   stuck and the others open, and with every pair open, and writes the
-   reduced model to src/jointdyn/data/lap_joint.npz (``--write``).
+   force up to what the clamps carry; pairs that open get P_i = 0: 144 of
+   the 264). The bolt's own axial stiffness is left out: it acts as a
+   constant force;
+5. reduces the model by Craig-Bampton onto the DOFs of the pairs loaded at
+   rest (120 pairs, 720 DOFs: t1, t2, n of both nodes of each pair, which
+   here are x, y, z: the frames are the global axes), the output DOF (z at
+   the top of plate A, 37.5 mm from its clamp, mid-width) and N_MODES
+   fixed-interface modes: 733 DOFs. The open pairs' nodes are interior
+   DOFs: they are apart at rest, and the interface element has no initial
+   gap (given to it, they would touch at zero load and clap in every
+   cycle), so the model's interface is the loaded pairs;
+6. reports the linear natural frequencies of the full model with every pair
+   stuck (springs kt, kt, kn), of the reduced and the full model with the
+   loaded pairs stuck and the others open, and with every pair open, and
+   writes the reduced model to src/jointdyn/data/lap_joint.npz
+   (``--write``): the loaded pairs' table, stiffnesses, friction
+   coefficients, preloads, areas and places, and the open pairs' places and
+   areas (``open_xy``, ``open_area``).
 
 Run: ``python docs/scripts/lap_joint_model.py [--write] [--figure
 docs/img/lap-joint-preload.png]`` (needs the ``fe`` extra: scikit-fem).
@@ -59,7 +68,7 @@ E, NU, RHO = 210e9, 0.3, 7850.0
 #: plate length, width, thickness and overlap, m
 LENGTH, WIDTH, THICK, OVERLAP = 0.100, 0.025, 0.005, 0.025
 #: quadratic elements: along the free part, along the overlap, across the width, through the thickness
-ELEMENTS = dict(free=10, overlap=5, width=5, thick=2)
+ELEMENTS = dict(free=10, overlap=8, width=8, thick=2)
 #: bolt: preload (N), radius of the hole (no pairs inside) and outer radius of the head's bearing annulus, m
 BOLT = dict(force=12e3, hole=0.0045, head=0.0065)
 #: normal contact stiffness per unit area, N/m^3 (a chosen value: kn of a pair is this times its area)
@@ -204,8 +213,8 @@ def frequencies(M, K, count=4):
 
 
 def _states(pairs, kt, kn, P, n):
-    return {"stuck": interface_springs(pairs, kt, kn, np.ones(len(kn)), n),
-            "preloaded stuck": pair_springs(pairs, kt, kn, n, stuck=P > 0, closed=P > 0),
+    return {"every pair stuck": interface_springs(pairs, kt, kn, np.ones(len(kn)), n),
+            "loaded pairs stuck": pair_springs(pairs, kt, kn, n, stuck=P > 0, closed=P > 0),
             "open": sp.csr_matrix((n, n))}  # fmt: skip
 
 
@@ -218,21 +227,24 @@ def build():
     kn = KN_PER_AREA * area
     kt = MINDLIN * kn
     P, iterations = preload(K, table.pairs, kt, kn, table.to_local(bolt_loads(points, triplets, side, M.shape[0])))
+    on = P > 0.0  # the interface: the pairs loaded at rest; the others' nodes are interior DOFs
     out = int(triplets[np.argmin(np.hypot(points[:, 0] - OUTPUT_X, points[:, 1] - 0.5 * WIDTH)
                                  + 10.0 * np.abs(points[:, 2] - THICK) + 10.0 * side), 2])  # fmt: skip
-    red = reduce_interface(M, K, table.pairs, N_MODES, keep=[out])
+    red = reduce_interface(M, K, table.pairs[on], N_MODES, keep=[out])
     report = dict(full_dof=int(M.shape[0]), reduced_dof=red.size, pairs=int(table.npairs),
-                  fixed_interface_modes=N_MODES, preload_n=float(P.sum()), pairs_preloaded=int(np.sum(P > 0)),
+                  fixed_interface_modes=N_MODES, preload_n=float(P.sum()), pairs_preloaded=int(np.sum(on)),
                   active_set_iterations=iterations, frequencies_hz={})  # fmt: skip
     for name, Kc in _states(table.pairs, kt, kn, P, M.shape[0]).items():
-        Kr = red.K + red.reduction.T.T @ (Kc @ red.reduction.T)
-        report["frequencies_hz"][name] = dict(full=frequencies(M, K + Kc).tolist(),
-                                              reduced=frequencies(red.M, Kr).tolist())  # fmt: skip
+        report["frequencies_hz"][name] = dict(full=frequencies(M, K + Kc).tolist())
+        if name != "every pair stuck":  # the reduced model has the loaded pairs' DOFs only
+            Kr = red.K + red.reduction.T.T @ (Kc @ red.reduction.T)
+            report["frequencies_hz"][name]["reduced"] = frequencies(red.M, Kr).tolist()
     report["seconds"] = round(time.perf_counter() - t0, 1)
-    data = dict(M=red.M, K=red.K, pairs=red.pairs, kt=kt, kn=kn, mu=np.full(kt.size, MU), preload=P, area=area,
-                xy=xy, output_dof=np.int64(red.kept[0]), frames=table.frames,
+    data = dict(M=red.M, K=red.K, pairs=red.pairs, kt=kt[on], kn=kn[on], mu=np.full(int(on.sum()), MU), preload=P[on],
+                area=area[on], xy=xy[on], open_area=area[~on], open_xy=xy[~on], output_dof=np.int64(red.kept[0]),
+                frames=table.frames[on],
                 frequencies_hz=np.array([report["frequencies_hz"][s]["reduced"] for s in
-                                         ("stuck", "preloaded stuck", "open")]))  # fmt: skip
+                                         ("loaded pairs stuck", "open")]))  # fmt: skip
     return data, report
 
 
@@ -252,19 +264,21 @@ def preload_figure(data: dict, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    xy = 1e3 * data["xy"]
-    p = data["preload"] / data["area"] / 1e6
+    xy = 1e3 * np.concatenate([data["xy"], data["open_xy"]])
+    p = np.concatenate([data["preload"] / data["area"], np.zeros(len(data["open_xy"]))]) / 1e6
     fig, ax = plt.subplots(figsize=(5.2, 4.2))
-    sc = ax.scatter(xy[:, 0], xy[:, 1], c=p, s=60, cmap="viridis", edgecolors="k", linewidths=0.4)
     opened = p == 0.0
-    ax.scatter(xy[opened, 0], xy[opened, 1], s=60, facecolors="white", edgecolors="k", linewidths=0.4,
-               label="open at rest")  # fmt: skip
+    sc = ax.scatter(xy[~opened, 0], xy[~opened, 1], c=p[~opened], s=30, cmap="viridis", edgecolors="k",
+                    linewidths=0.4, vmin=0.0)  # fmt: skip
+    ax.scatter(xy[opened, 0], xy[opened, 1], s=30, facecolors="white", edgecolors="k", linewidths=0.4,
+               label="open at rest (not in the reduced model's interface)")  # fmt: skip
     cx, cy = 1e3 * (LENGTH - 0.5 * OVERLAP), 1e3 * 0.5 * WIDTH
     for r, style in ((BOLT["hole"], "-"), (BOLT["head"], "--")):
         ax.add_patch(plt.Circle((cx, cy), 1e3 * r, fill=False, ls=style, color="0.3"))
     fig.colorbar(sc, ax=ax, label="contact pressure at rest, MPa")
-    ax.set(xlabel="x, mm (along the beam)", ylabel="y, mm", aspect="equal",
-           title=f"{len(p)} pairs, bolt {BOLT['force'] / 1e3:.0f} kN: static contact solve")  # fmt: skip
+    ax.set(xlabel="x, mm (along the beam)", ylabel="y, mm", aspect="equal")
+    ax.set_title(f"{len(p)} pairs, {np.sum(~opened)} loaded at rest, bolt {BOLT['force'] / 1e3:.0f} kN: "
+                 "static contact solve", fontsize=9)  # fmt: skip
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), frameon=False)
     fig.tight_layout()
     fig.savefig(path, dpi=110)

@@ -580,15 +580,16 @@ SWEEP_PARENT_POLL_S = 0.5
 
 # --- figures: the bolted lap joint (jointdyn.figures.lap) ----------------------------
 #: harmonics and AFT samples per period of its backbone. The reduced model has
-#: 685 DOFs, so an HB or EPMC Newton step solves 685 (2H + 1) unknowns with a dense LU: with
-#: H = 1 a backbone point costs about 2 s here, with H = 3 30-90 s. Against H = 3 (64 samples),
-#: H = 1 gives the first bending frequency within 0.2 % and its damping ratio within 10 % at the
-#: onset of slip (3e-5 m) and 4 % at the largest damping (3e-4 m) (docs/lap-joint.md)
+#: 733 DOFs, so an HB or EPMC Newton step solves 733 (2H + 1) unknowns with a dense LU: with
+#: H = 1 a backbone point costs about 1 s here. Against H = 3 (64 samples), H = 1 gives the first
+#: bending frequency within 0.1 % and its damping ratio within 2 % at the onset of slip (3e-5 m)
+#: and to three digits at the largest damping (3e-4 m) (docs/lap-joint.md)
 LAP_HARMONICS = 1
 LAP_SAMPLES = 32
-#: backbone range: first-harmonic amplitude of the output DOF, m (stuck below 1e-5 m)
+#: backbone range: first-harmonic amplitude of the output DOF, m (stuck below 4.5e-6 m)
 LAP_AMPLITUDE_M = (1e-6, 2e-3)
-#: largest arc-length step of the backbone (about 30 points over the range)
+#: largest arc-length step of the backbone (47 points over the range, most of them between 4.5e-6
+#: and 3e-4 m, where the pairs start to slip one after another)
 LAP_DS_MAX = 0.04
 #: amplitudes of the three slip maps, m: the onset of slip, the largest damping, deep slip
 LAP_SLIP_MAP_M = (3e-5, 3e-4, 1.5e-3)

@@ -2,18 +2,19 @@
 
 ``lap_joint``
     The lap joint shipped with jointdyn (:func:`jointdyn.fe.lap_joint`: two
-    steel plates, one bolt, a patch of 112 node pairs, 685 reduced DOFs)
-    with its interface: the 48 node pairs that carry the bolt's load at rest
-    (:class:`jointdyn.interfaces.Interface`; the static contact solve that
-    made the model found the other 64 apart, and the element has no initial
-    gap: given to it, they would touch at zero load and clap in every cycle,
-    so they are left out), and the plates' modal damping
+    steel plates, one bolt, a patch of 264 node pairs of which the 120 that
+    carry the bolt's load at rest are the model's interface, 733 reduced
+    DOFs) with that interface (:class:`jointdyn.interfaces.Interface`; the
+    static contact solve that made the model found the other 144 apart, and
+    the element has no initial gap: given to it, they would touch at zero
+    load and clap in every cycle, so the model keeps their nodes as interior
+    DOFs), and the plates' modal damping
     (``config.LAP_ZETA``): (a) the first
     bending mode's natural frequency and (b) its damping ratio against the
     first-harmonic amplitude of the output DOF (EPMC backbone,
     :func:`jointdyn.modes.epmc`); (c) the forced response near it to a force
     at the output DOF, synthesised from that nonlinear mode
-    (:func:`jointdyn.modes.single_mode_frc`: at the 685 DOFs of the model a
+    (:func:`jointdyn.modes.single_mode_frc`: at the 733 DOFs of the model a
     harmonic-balance branch with its Hill stability is beyond what this
     figure can afford today, docs/lap-joint.md);
     (d) slip maps of the patch at three amplitudes of the backbone: per pair
@@ -35,22 +36,21 @@ __all__ = ["lap_joint_system", "lap_joint_data"]
 
 
 def lap_joint_system(force_n: float = config.LAP_FORCE_N, zeta: float = config.LAP_ZETA):
-    """``(system, lap_joint, loaded)``: the shipped lap joint (:func:`jointdyn.fe.lap_joint`) as a
+    """``(system, lap_joint)``: the shipped lap joint (:func:`jointdyn.fe.lap_joint`) as a
     :class:`~jointdyn.systems.System`: its reduced M and K, modal damping ``zeta`` of every mode of the
-    structure with the preloaded pairs stuck, one interface of the pairs loaded at rest (``loaded``, a
-    mask over the shipped pairs; their kt, kn, mu and preload) and a force of amplitude ``force_n`` (N)
-    at the output DOF, which is also the system's output."""
+    structure with its pairs stuck, one interface of its pairs (those loaded at rest: their kt, kn, mu and
+    preload) and a force of amplitude ``force_n`` (N) at the output DOF, which is also the system's
+    output."""
     from ..fe import lap_joint
     from ..interfaces import Interface
     from ..systems import System, modal_damping
 
     lj = lap_joint()
-    on = lj.preload > 0.0
-    itf = Interface(kt=lj.kt[on], kn=lj.kn[on], mu=lj.mu[on], preload=lj.preload[on], pairs=lj.pairs[on])
+    itf = Interface(kt=lj.kt, kn=lj.kn, mu=lj.mu, preload=lj.preload, pairs=lj.pairs)
     force = np.zeros(lj.M.shape[0])
     force[lj.output_dof] = force_n
-    C = modal_damping(lj.M, lj.linear_K("preloaded stuck"), zeta)
-    return System(M=lj.M, C=C, K=lj.K, interfaces=(itf,), force=force, output_dof=lj.output_dof), lj, on
+    C = modal_damping(lj.M, lj.linear_K("stuck"), zeta)
+    return System(M=lj.M, C=C, K=lj.K, interfaces=(itf,), force=force, output_dof=lj.output_dof), lj
 
 
 def _backbone_table(bb) -> pd.DataFrame:
@@ -60,11 +60,15 @@ def _backbone_table(bb) -> pd.DataFrame:
                          "status": str(bb.status.value), "harmonics": bb.harmonics, "samples": bb.samples})
 
 
-def _slip_table(bb, amplitudes, lj, on) -> pd.DataFrame:
+def _slip_table(bb, amplitudes, lj) -> pd.DataFrame:
     """Per pair of the patch, at each amplitude: the backbone solved at exactly that amplitude (Newton from
     its nearest point), and the fractions of the period each pair is stuck, slipping and open and its energy
-    per cycle (``in_interface`` False and NaN for the pairs apart at rest, which are not in the model)."""
+    per cycle; after the model's pairs, the patch's pairs apart at rest, which are not in the model
+    (``in_interface`` False, ``pair`` -1, NaN results)."""
     problem = bb.problem
+    nopen = lj.open_xy.shape[0]
+    on = np.concatenate([np.ones(lj.npairs, bool), np.zeros(nopen, bool)])
+    xy = np.concatenate([lj.xy, lj.open_xy])
     rows = []
     for k, a in enumerate(amplitudes):
         i = int(np.argmin(np.abs(np.log(bb.amplitude_m / a))))
@@ -74,12 +78,12 @@ def _slip_table(bb, amplitudes, lj, on) -> pd.DataFrame:
         v, ok, _ = problem.solve(a, guess)
         X, w, xi = problem.unpack(v, math.log10(a))
         res = problem.hb.pair_results(X, problem.evaluate(X, w))
-        full = {key: np.full(lj.npairs, np.nan) for key in res}
-        for key, values in res.items():
-            full[key][on] = values
+        full = {key: np.concatenate([values, np.full(nopen, np.nan)]) for key, values in res.items()}
         rows.append(pd.DataFrame({"map": k, "amplitude_m": a, "converged": bool(ok), "frequency_hz": w / (2 * math.pi),
-                                  "damping_ratio": xi / (2.0 * w), "pair": np.arange(lj.npairs), "in_interface": on,
-                                  "x_mm": 1e3 * lj.xy[:, 0], "y_mm": 1e3 * lj.xy[:, 1], "preload_N": lj.preload,
+                                  "damping_ratio": xi / (2.0 * w), "in_interface": on,
+                                  "pair": np.concatenate([np.arange(lj.npairs), np.full(nopen, -1)]),
+                                  "x_mm": 1e3 * xy[:, 0], "y_mm": 1e3 * xy[:, 1],
+                                  "preload_N": np.concatenate([lj.preload, np.zeros(nopen)]),
                                   "stick": full["stick"], "slip": full["slip"], "open": full["open"],
                                   "energy_J": full["energy_J"]}))
     return pd.concat(rows, ignore_index=True)
@@ -100,12 +104,12 @@ def lap_joint_data(harmonics=config.LAP_HARMONICS, samples=config.LAP_SAMPLES, a
     """The backbone, the forced response and the slip maps of the lap joint as three tables."""
     from ..modes import epmc
 
-    system, lj, on = lap_joint_system(force_n)
+    system, lj = lap_joint_system(force_n)
     bb = epmc(system, amplitude, harmonics=harmonics, samples=samples, ds_max=config.LAP_DS_MAX, progress=False)
-    return {"backbone": _backbone_table(bb), "frc": _frc_table(bb, system), "slip": _slip_table(bb, maps, lj, on)}
+    return {"backbone": _backbone_table(bb), "frc": _frc_table(bb, system), "slip": _slip_table(bb, maps, lj)}
 
 
-@register_figure("lap_joint", "The bolted lap joint (its 48 loaded node pairs, 685 DOFs): first bending mode's "
+@register_figure("lap_joint", "The bolted lap joint (its 120 loaded node pairs, 733 DOFs): first bending mode's "
                  "frequency and damping against amplitude (EPMC), forced response near it (HB), slip maps", 90)
 def lap_joint_figure():
     return lap_joint_data()
@@ -132,9 +136,9 @@ def _plot_maps(axes, slip):
                                                   ("open", "magma", "fraction of the period open"))):
             ax = axes[row, col]
             on = sub.in_interface.to_numpy().astype(bool)
-            ax.scatter(sub.x_mm[~on], sub.y_mm[~on], s=70, marker="s", facecolors="none", edgecolors="0.7",
+            ax.scatter(sub.x_mm[~on], sub.y_mm[~on], s=36, marker="s", facecolors="none", edgecolors="0.7",
                        linewidths=0.5)
-            sc = ax.scatter(sub.x_mm[on], sub.y_mm[on], c=sub[key][on], cmap=cmap, vmin=0.0, vmax=1.0, s=70,
+            sc = ax.scatter(sub.x_mm[on], sub.y_mm[on], c=sub[key][on], cmap=cmap, vmin=0.0, vmax=1.0, s=36,
                             marker="s", edgecolors="k", linewidths=0.4)
             ax.set_aspect("equal")
             ax.set_xticks([])
@@ -178,7 +182,7 @@ def _plot_lap_joint(tables, out_dir):
     last = _plot_maps(axes, slip)
     bottom.colorbar(last, ax=axes, shrink=0.8, label="fraction of the period")
     n_on = int(slip[slip["map"] == 0].in_interface.sum())
-    fig.suptitle(f"Bolted lap joint, 685 DOFs: the {n_on} node pairs loaded at rest (H = {int(bb.harmonics.iloc[0])}, "
+    fig.suptitle(f"Bolted lap joint, 733 DOFs: the {n_on} node pairs loaded at rest (H = {int(bb.harmonics.iloc[0])}, "
                  f"{int(bb.samples.iloc[0])} samples per period); slip maps: open squares = pairs apart at rest",
                  fontsize=10)
     return save_figure(fig, out_dir, "lap_joint")
