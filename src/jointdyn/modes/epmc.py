@@ -210,50 +210,43 @@ class EPMCProblem:
     def residual(self, v, lam):
         """``(R_s, dR_s/dv, dR_s/dlam)``: the scaled residual and its exact Jacobians (dR_s/dv a
         ``scipy.sparse`` matrix where :attr:`sparse`)."""
+        a = 10.0 ** lam
+        X, w, xi = self.unpack(v, lam)
+        Y = X / a
+        ev = self.evaluate(X, w)
+        self.last = (X, w, xi, ev)
+        cx = self._times_mass_damping(X)
+        R = ev.R - (xi * w) * cx
         if self.sparse:
-            return self._residual_sparse(v, lam)
-        a = 10.0 ** lam
-        X, w, xi = self.unpack(v, lam)
-        Y = X / a
-        ev = self.evaluate(X, w)
-        self.last = (X, w, xi, ev)
-        cx = self._times_mass_damping(X)
-        R = ev.R - (xi * w) * cx
-        # in place on the evaluation's own Jacobian (nothing reads it afterwards): at thousands of unknowns
-        # every copy of an N x N array costs as much as the AFT of hundreds of node pairs
-        J = ev.JX
-        self._subtract_mass_damping(J, xi * w)
+            J = ev.JX - (xi * w) * self._A_M_sparse
+        else:
+            # in place on the evaluation's own Jacobian (nothing reads it afterwards): at thousands of unknowns
+            # every copy of an N x N array costs as much as the AFT of hundreds of node pairs
+            J = ev.JX
+            self._subtract_mass_damping(J, xi * w)
         ka = self.k_ref * a
         Rs = R / ka
         Jlam = _LN10 * (J @ Y / self.k_ref - Rs)
-        Jv = J
-        Jv /= self.k_ref
-        Jv[:, self.i_omega] = self.w_ref * (ev.Jp / self.hb.w0 - xi * cx) / ka
-        Jv[:, self.i_xi] = -self.w_ref * w * cx / ka
-        return Rs, Jv, Jlam
+        # the columns of omega and xi (module docstring)
+        c_omega = self.w_ref * (ev.Jp / self.hb.w0 - xi * cx) / ka
+        c_xi = -self.w_ref * w * cx / ka
+        return Rs, self._scaled_jacobian(J, c_omega, c_xi), Jlam
 
-    def _residual_sparse(self, v, lam):
-        """:meth:`residual` with the Jacobian sparse throughout (the same equations)."""
-        a = 10.0 ** lam
-        X, w, xi = self.unpack(v, lam)
-        Y = X / a
-        ev = self.evaluate(X, w)
-        self.last = (X, w, xi, ev)
-        cx = self._times_mass_damping(X)
-        R = ev.R - (xi * w) * cx
-        J = ev.JX - (xi * w) * self._A_M_sparse
-        ka = self.k_ref * a
-        Rs = R / ka
-        Jlam = _LN10 * (J @ Y / self.k_ref - Rs)
-        Jv = (J * (1.0 / self.k_ref)).tocsc()
-        for i in (self.i_omega, self.i_xi):  # their columns hold omega and xi (module docstring)
-            Jv.data[Jv.indptr[i]:Jv.indptr[i + 1]] = 0.0
-        cols = np.stack((self.w_ref * (ev.Jp / self.hb.w0 - xi * cx) / ka, -self.w_ref * w * cx / ka), axis=1)
-        r, c = np.nonzero(cols)
+    def _scaled_jacobian(self, J, c_omega, c_xi):
+        """dR_s/dv: J / k_ref with the columns of omega and xi replaced (in place on a dense J)."""
+        if not self.sparse:
+            J /= self.k_ref
+            J[:, self.i_omega] = c_omega
+            J[:, self.i_xi] = c_xi
+            return J
         import scipy.sparse as sps
 
-        Jv = Jv + sps.csc_matrix((cols[r, c], (r, np.array((self.i_omega, self.i_xi))[c])), shape=Jv.shape)
-        return Rs, Jv, Jlam
+        Jv = (J * (1.0 / self.k_ref)).tocsc()
+        for i in (self.i_omega, self.i_xi):
+            Jv.data[Jv.indptr[i]:Jv.indptr[i + 1]] = 0.0
+        cols = np.stack((c_omega, c_xi), axis=1)
+        r, c = np.nonzero(cols)
+        return Jv + sps.csc_matrix((cols[r, c], (r, np.array((self.i_omega, self.i_xi))[c])), shape=Jv.shape)
 
     def _times_mass_damping(self, X):
         """A_M @ X, m kg (by blocks for large problems: A_M is zero outside its 2H blocks)."""
