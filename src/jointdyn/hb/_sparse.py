@@ -17,12 +17,13 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SparsePattern"]
+__all__ = ["SparsePattern", "linear_entries"]
 
 
-def _linear_entries(K, C, M, H):
+def linear_entries(K, C, M, H):
     """(rows, cols, ak, ac, am): the entries of AK, AC and AM (``A(w) = AK + w AC + w^2 AM``, the linear
-    terms of harmonics 0..H, :func:`jointdyn.hb.problem._linear_blocks`) on their union pattern, from the
+    terms of harmonics 0..H, also the dense ones of :func:`jointdyn.hb.problem._linear_blocks`) on their
+    union pattern, from the
     nonzeros of K, C and M: per harmonic k the blocks ``K - k^2 w^2 M`` on its cosine and sine rows and
     ``+-k w C`` between them."""
     n = K.shape[0]
@@ -81,7 +82,7 @@ class SparsePattern:
         n, nh = K.shape[0], 2 * H + 1
         size = n * nh
         self.size = size
-        self.rows, self.cols, self.ak, self.ac, self.am = _linear_entries(K, C, M, H)
+        self.rows, self.cols, self.ak, self.ac, self.am = linear_entries(K, C, M, H)
         prow, pcol, self.psrc, self.psign = _pair_entries(positions, n, nh)
         keys = np.concatenate((self.rows * size + self.cols, prow * size + pcol))
         ukeys, inv = np.unique(keys, return_inverse=True)

@@ -46,6 +46,7 @@ from ..laws._base import MACROSLIP, SEPARATION, STICK_SLIP
 from ..systems import Contact, System
 from ._aft import NO_EVENT, PERIOD_ONE, eval_kernel, recontact_events
 from ._aft_pairs import pair_directions, pairs_aft_kernel
+from ._sparse import linear_entries
 from .parameters import SystemParameter, _FixedFrequency, parameter_named
 from .stability import hill_growth, hill_stability
 
@@ -112,24 +113,17 @@ def _load_events(n0: float, n1: float, delta: float) -> tuple:
 
 
 def _linear_blocks(system: System, H: int):
-    """(AK, AC, AM) with A(w) = AK + w AC + w^2 AM the linear terms of harmonics 0..H."""
-    n = system.ndof
-    nh = 2 * H + 1
-    M, C, K = system.M, system.C, system.K
-    # block by block into zeroed arrays (np.kron writes every entry: seconds at thousands of unknowns)
-    AK = np.zeros((n * nh, n * nh))
-    for h in range(nh):
-        AK[h * n:(h + 1) * n, h * n:(h + 1) * n] = K
-    AC = np.zeros((n * nh, n * nh))
-    AM = np.zeros((n * nh, n * nh))
-    for k in range(1, H + 1):
-        ic = (2 * k - 1) * n
-        is_ = 2 * k * n
-        AM[ic:ic + n, ic:ic + n] = -(k * k) * M
-        AM[is_:is_ + n, is_:is_ + n] = -(k * k) * M
-        AC[ic:ic + n, is_:is_ + n] = k * C
-        AC[is_:is_ + n, ic:ic + n] = -k * C
-    return AK, AC, AM
+    """(AK, AC, AM) with A(w) = AK + w AC + w^2 AM the linear terms of harmonics 0..H (dense; their entries
+    per harmonic block: :func:`jointdyn.hb._sparse.linear_entries`)."""
+    size = system.ndof * (2 * H + 1)
+    rows, cols, *values = linear_entries(system.K, system.C, system.M, H)
+    out = []
+    for v in values:
+        # into zeroed arrays by the blocks' entries (np.kron writes every entry: seconds at thousands of unknowns)
+        A = np.zeros((size, size))
+        A[rows, cols] = v
+        out.append(A)
+    return tuple(out)
 
 
 def harmonic_columns(n: int, H: int) -> np.ndarray:

@@ -66,6 +66,7 @@ from ..continuation import (ContinuationOptions, ContinuationStatus, ParameterPr
                             newton)
 from ..fourier import derivative_matrix
 from ..hb import HBProblem
+from ..hb._sparse import linear_entries
 from ..hb.problem import contacts_only
 from ..kinematics import contact_kinematics, selection_matrix
 from ._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
@@ -89,20 +90,15 @@ def mass_damping_block(M: np.ndarray, H: int) -> np.ndarray:
 
 
 def _sparse_mass_damping(M: np.ndarray, H: int):
-    """:func:`mass_damping_block` as a ``scipy.sparse.csr_matrix`` (from the nonzeros of M)."""
+    """:func:`mass_damping_block` as a ``scipy.sparse.csr_matrix``: the damping entries of harmonic balance
+    (:func:`jointdyn.hb._sparse.linear_entries`) with M for C."""
     import scipy.sparse as sps
 
-    n = M.shape[0]
-    i, j = np.nonzero(M)
-    m = M[i, j]
-    rows, cols, vals = [], [], []
-    for k in range(1, H + 1):
-        ic, is_ = (2 * k - 1) * n, 2 * k * n
-        rows += [ic + i, is_ + i]
-        cols += [is_ + j, ic + j]
-        vals += [k * m, -k * m]
-    size = n * (2 * H + 1)
-    return sps.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(size, size))
+    zero = np.zeros_like(M)
+    rows, cols, _, km, _ = linear_entries(zero, M, zero, H)  # M in C's place: the entries +-k M
+    on = km != 0.0
+    size = M.shape[0] * (2 * H + 1)
+    return sps.csr_matrix((km[on], (rows[on], cols[on])), shape=(size, size))
 
 
 class EPMCProblem:
