@@ -24,10 +24,10 @@ def _sweep(system, gammas):
         prev = None
         for g in direction:
             r = steady_state(system, float(g), start=prev, keep_loop=False)
-            prev = r if r.ok else None
+            prev = r if r.status.ok else None
             per.append(r.periods)
             steps.append(r.steps)
-            key = r.status if r.ok else f"{r.status}:{r.message}"
+            key = r.status if r.status.ok else f"{r.status}:{r.message}"
             status[key] = status.get(key, 0) + 1
     dt = time.perf_counter() - t0
     return dt, np.array(per), np.array(steps), status

@@ -31,7 +31,7 @@ def _sweep(system, gammas):
         prev = None
         for g in direction:
             r = steady_state(system, float(g), start=prev, keep_loop=False)
-            prev = r if r.ok else None
+            prev = r if r.status.ok else None
             amps.append(r.amplitude_m)
     return (time.process_time() - t0) / (2 * len(gammas)), np.array(amps)
 

@@ -35,7 +35,7 @@ print(f"{t.size} samples over {t[-1] - t[0]:.2f} s; N from {N.min():.0f} to {N.m
 
 r = jd.quasistatic(law, t, x, N, period=0.5)
 print(f"{r.t.size - t.size} separation/re-contact instants inserted")
-print(r.cycles[["cycle", "energy_per_cycle_J", "stick_slip_fraction", "macroslip_fraction",
+print(r.cycles[["cycle", "energy_J", "stick_slip_fraction", "macroslip_fraction",
                 "separation_fraction"]].round(5).to_string(index=False))
 
 # %%

@@ -231,3 +231,158 @@ def test_generic_layers_import_no_specific_law(sub):
             if name in text:
                 offenders.append(f"{path.relative_to(SRC)}: {name}")
     assert not offenders, "\n".join(offenders)
+
+
+def _private_imports_of_other_packages(path: Path, root: Path = SRC):
+    """(line, module) of each import in one file of a package that names a private module (a name
+    starting with ``_``) of another package of jointdyn; the helpers outside the layers are one module
+    each, not a package, and are not counted."""
+    tree = ast.parse(path.read_text(), str(path))
+    name = _module_name(path, root)
+    own = name.split(".")[1] if "." in name else None
+    package = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            modules = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package[: len(package) - (node.level - 1)] + (node.module.split(".") if node.module else [])
+            elif node.module:
+                base = node.module.split(".")
+            else:
+                continue
+            modules = [".".join(base + [alias.name]) for alias in node.names]
+        else:
+            continue
+        for module in modules:
+            parts = module.split(".")
+            if parts[0] != "jointdyn" or len(parts) < 3 or parts[1] == own:
+                continue
+            if any(p.startswith("_") and not p.startswith("__") for p in parts[2:-1]) or (
+                    parts[-1].startswith("_") and not parts[-1].startswith("__")
+                    and (root / Path(*parts[1:])).with_suffix(".py").exists()):
+                yield node.lineno, module
+
+
+def test_commands_import_no_private_module_of_another_package():
+    # the command line parses, calls public functions and writes: what it needs of a package is public
+    wrong = [f"{p.relative_to(SRC)}:{line} imports {m}" for p in sorted((SRC / "commands").rglob("*.py"))
+             for line, m in _private_imports_of_other_packages(p)]
+    assert not wrong, "\n".join(wrong)
+
+
+def test_the_private_import_check_finds_one(tmp_path):
+    pkg = tmp_path / "jointdyn"
+    for sub in ("commands", "dynamics"):
+        (pkg / sub).mkdir(parents=True)
+        (pkg / sub / "__init__.py").write_text("")
+    (pkg / "__init__.py").write_text("")
+    (pkg / "dynamics" / "_model.py").write_text("def f():\n    pass\n")
+    (pkg / "commands" / "_own.py").write_text("")
+    (pkg / "commands" / "x.py").write_text("from . import _own\nfrom .. import dynamics\n"
+                                           "def g():\n    from ..dynamics._model import f\n")
+    found = list(_private_imports_of_other_packages(pkg / "commands" / "x.py", pkg))
+    assert found == [(4, "jointdyn.dynamics._model.f")]
+
+
+#: the bases that make a class an enumeration
+_ENUM_BASES = {"Enum", "IntEnum", "StrEnum", "Flag", "IntFlag", "ReprEnum"}
+
+
+def _base_name(node: ast.expr) -> str:
+    return node.attr if isinstance(node, ast.Attribute) else getattr(node, "id", "")
+
+
+def status_outside_the_base(root: Path = SRC) -> list:
+    """Enumerations that do not derive from :class:`jointdyn.status.Status` (which alone derives from
+    ``enum.Enum``), and classes named like a status (``...Status``, ``...Verdict``) that are not one."""
+    classes = {}
+    for path in sorted(q for q in root.rglob("*.py") if "__pycache__" not in q.parts):
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, ast.ClassDef):
+                classes[(path, node.name)] = [_base_name(b) for b in node.bases]
+    family = {"Status"}
+    grew = True
+    while grew:  # the subclasses of Status, of their subclasses, ...
+        grew = False
+        for (path, name), bases in classes.items():
+            if name not in family and family & set(bases) and not (path.name == "status.py" and name == "Status"):
+                family.add(name)
+                grew = True
+    wrong = []
+    for (path, name), bases in classes.items():
+        rel = path.relative_to(root)
+        if rel == Path("status.py") and name == "Status":
+            continue
+        if _ENUM_BASES & set(bases) or (name.endswith(("Status", "Verdict")) and name not in family):
+            wrong.append(f"{rel}: {name}({', '.join(bases)})")
+    return wrong
+
+
+def test_every_status_derives_from_the_shared_base():
+    # one base: every status has a message, says whether it is ok, and codes the same way
+    wrong = status_outside_the_base()
+    assert not wrong, "\n".join(wrong)
+
+
+def test_the_status_check_finds_an_enum_of_its_own(tmp_path):
+    pkg = tmp_path / "jointdyn"
+    pkg.mkdir()
+    (pkg / "status.py").write_text("import enum\nclass Status(str, enum.Enum):\n    pass\n")
+    (pkg / "a.py").write_text("import enum\nfrom .status import Status\n"
+                              "class GoodStatus(Status):\n    A = 'a', 'x', True\n"
+                              "class Sub(GoodStatus):\n    pass\n"
+                              "class Own(str, enum.Enum):\n    A = 'a'\n"
+                              "class LoneVerdict:\n    pass\n")
+    assert status_outside_the_base(pkg) == ["a.py: Own(str, Enum)", "a.py: LoneVerdict()"]
+
+
+# --- the energy rule (docs/architecture.md, "Solvers and results") -------------------------------
+#: a total over every element of one kind: energy_<kind>_J
+ENERGY_TOTALS = {"energy_contact_J", "energy_viscous_J", "energy_interface_J"}
+#: one entry per item: <item>_energy_J
+ENERGY_PER_ITEM = {"contact_energy_J", "pair_energy_J", "cycle_energy_J"}
+#: inside an object or a row that is one item (a contact, a pair, a cycle)
+ENERGY_OF_ONE = {"energy_J"}
+#: old keys written beside their new names for one release, old -> new (CHANGELOG.md, Deprecated)
+ENERGY_DEPRECATED = {"energy_pairs_J": "energy_interface_J", "energy_per_cycle_J": "energy_J",
+                     "energy_contact_j": "contact_energy_J"}
+
+_ENERGY_NAME = r"\b[A-Za-z_]*energy[A-Za-z_]*_[jJ]\b"
+
+
+def energy_names_outside_the_rule(root: Path = SRC) -> list:
+    """Names of energies in the sources (attributes, keys, variables, text) that the rule does not
+    allow."""
+    import re
+
+    allowed = ENERGY_TOTALS | ENERGY_PER_ITEM | ENERGY_OF_ONE | set(ENERGY_DEPRECATED)
+    wrong = []
+    for path in sorted(q for q in root.rglob("*.py") if "__pycache__" not in q.parts):
+        for n, line in enumerate(path.read_text().splitlines(), 1):
+            wrong += [f"{path.relative_to(root)}:{n}: {name}" for name in re.findall(_ENERGY_NAME, line)
+                      if name not in allowed]
+    return wrong
+
+
+def test_energy_names_follow_the_documented_rule():
+    wrong = energy_names_outside_the_rule()
+    assert not wrong, "\n".join(wrong)
+
+
+def test_the_energy_rule_is_written_down_and_the_old_keys_listed():
+    root = SRC.parents[1]
+    rule = (root / "docs" / "architecture.md").read_text()
+    for name in ENERGY_TOTALS | ENERGY_PER_ITEM | ENERGY_OF_ONE | set(ENERGY_DEPRECATED):
+        assert f"`{name}`" in rule, f"docs/architecture.md does not name {name}"
+    changelog = (root / "CHANGELOG.md").read_text()
+    for old, new in ENERGY_DEPRECATED.items():
+        assert old in changelog and new in changelog, f"CHANGELOG.md does not list {old} -> {new}"
+
+
+def test_the_energy_check_finds_a_name_outside_the_rule(tmp_path):
+    pkg = tmp_path / "jointdyn"
+    pkg.mkdir()
+    (pkg / "a.py").write_text('d = {"energy_contact_J": 1.0, "pair_energy_J": 2.0}\n'
+                              'e = {"energy_pair_total_J": 3.0}\n')
+    assert energy_names_outside_the_rule(pkg) == ["a.py:2: energy_pair_total_J"]

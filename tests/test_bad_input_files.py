@@ -423,7 +423,7 @@ def test_sizes_bounded_by_memory_before_computing(argv, word, no_compute, capsys
 
 def test_memory_bound_from_config(monkeypatch, no_compute, capsys, tmp_path):
     """With config.MEMORY_LIMIT_BYTES the bound is exact: the largest size it names fits, one more does not."""
-    from jointdyn.commands._sizes import hb_bytes
+    from jointdyn.hb import hb_bytes
 
     monkeypatch.setattr(config, "MEMORY_LIMIT_BYTES", 20 << 20)
     assert V.memory_budget() == 20 << 20
@@ -456,10 +456,10 @@ def test_modes_harmonics_raise_the_default_samples(monkeypatch, capsys):
     monkeypatch.setattr(jointdyn.modes, "epmc", fake)
     with pytest.raises(_Reached):
         main(["modes", "--harmonics", "100"])
-    assert seen["harmonics"] == 100 and seen["samples"] == config.HB_AUTO  # chosen automatically, from 2H + 2
-    from jointdyn.hb.discretisation import first_level
+    from jointdyn.hb import AUTO, discretisation
 
-    assert first_level(seen["harmonics"], seen["samples"])[0] == (100, 202)
+    assert seen["harmonics"] == 100 and seen["samples"] == AUTO  # chosen automatically, from 2H + 2
+    assert discretisation(seen["harmonics"], seen["samples"]).first == (100, 202)
 
 
 def test_the_stiffest_mode_sets_the_step_and_is_named(no_compute, capsys, tmp_path):

@@ -18,7 +18,8 @@ from jointdyn.drivers import harmonic_history
 KT, MU, N0, A = 1e5, 0.1, 100.0, 0.5e-3
 FY = MU * N0
 KEYS = {
-    "energy_per_cycle_J",
+    "energy_J",
+    "energy_per_cycle_J",  # deprecated duplicate of energy_J, kept for one release
     "force_max_N",
     "force_min_N",
     "separation_fraction",
@@ -54,7 +55,7 @@ def test_json_default_matches_closed_form(capsys):
     assert d["model"] == "iwan" and d["parameters"]["capacity"] == 32
     assert d["parameters"]["kt_N_per_m"] == KT and d["parameters"]["amplitude_m"] == A
     # docs/model.md section 2, A > 2 fy / kt: E = 4 fy A - 16 fy^2 / (3 kt)
-    assert d["energy_per_cycle_J"] == pytest.approx(4 * FY * A - 16 * FY**2 / (3 * KT), rel=TEST_ENERGY_RTOL)
+    assert d["energy_J"] == pytest.approx(4 * FY * A - 16 * FY**2 / (3 * KT), rel=TEST_ENERGY_RTOL)
     assert d["force_max_N"] == pytest.approx(FY) and d["force_min_N"] == pytest.approx(-FY)
     assert d["secant_stiffness_N_per_m"] == pytest.approx(FY / A)
     assert d["separation_fraction"] == 0.0
@@ -70,7 +71,7 @@ def test_json_separation(capsys, model):
     expected = (math.pi - 2 * math.asin(1 / 1.2)) / (2 * math.pi)
     assert d["separation_fraction"] == pytest.approx(expected, abs=TEST_QS_FRACTION_ATOL)
     assert d["parameters"]["delta_deg"] == 90.0
-    assert d["energy_per_cycle_J"] > 0
+    assert d["energy_J"] > 0
     assert d["force_max_N"] <= MU * N0 * 2.2 + 1e-9
     if model == "discrete":
         assert d["parameters"]["n"] == 200
@@ -115,7 +116,7 @@ def test_input_csv(tmp_path, capsys):
     for k in KEYS - {"parameters", "model"}:
         assert per[k] == pytest.approx(ref[k], rel=1e-12, abs=1e-15)
     # the whole history (2 cycles, starting virgin) is one window: its work
-    assert whole["energy_per_cycle_J"] > per["energy_per_cycle_J"]
+    assert whole["energy_J"] > per["energy_J"]
     assert whole["t_end_s"] == 2.0
 
 
@@ -256,7 +257,7 @@ def test_contact_never_closes_is_a_warning(tmp_path, capsys):
     cap = capsys.readouterr()
     d = json.loads(cap.out)
     assert rc == 0
-    assert d["energy_per_cycle_J"] == 0.0 and d["secant_stiffness_N_per_m"] == 0.0  # the result stays
+    assert d["energy_J"] == 0.0 and d["secant_stiffness_N_per_m"] == 0.0  # the result stays
     assert len(d["warnings"]) == 1 and "never closes" in d["warnings"][0]
     assert cap.err.strip().splitlines() == [f"jointdyn loop: warning: {d['warnings'][0]}"]
 

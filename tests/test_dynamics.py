@@ -146,7 +146,7 @@ def test_den_hartog_unbounded_and_bounded():
     r = steady_state(System.paper_damper(eta=0.0, beta=0.1), 1.0)
     assert r.status == "unbounded"
     assert math.isnan(r.amplitude_q) and math.isnan(r.amplitude_m)
-    assert r.period_multiple == 0 and not r.ok
+    assert r.period_multiple == 0 and not r.status.ok
     # beta = 1 > pi/4: bounded, periodic
     r = steady_state(System.paper_damper(eta=0.0, beta=1.0), 1.0)
     assert r.status == "periodic" and np.isfinite(r.amplitude_q)
@@ -245,7 +245,7 @@ def test_event_at_the_period_boundary(delta):
     assert 0.0 <= tr.N[0, 0] <= 1e-9 * law.n_ref
     a = steady_state(s, 1.1, keep_loop=False)
     b = steady_state(s, 1.1, steps_per_period=2 * config.TI_STEPS_PER_PERIOD, keep_loop=False)
-    assert a.ok and b.ok
+    assert a.status.ok and b.status.ok
     assert b.amplitude_m == pytest.approx(a.amplitude_m, rel=tolerances.TEST_TI_STEP_HALVING_RTOL)
 
 
@@ -306,7 +306,7 @@ def test_contact_energy_is_the_loop_area(eta):
 def test_loop_is_one_closed_period_and_warm_start_is_cheap():
     s = System.paper_damper(eta=0.5, beta=2.0)
     r = steady_state(s, 1.2)
-    assert isinstance(r, SteadyState) and r.ok
+    assert isinstance(r, SteadyState) and r.status.ok
     lp = r.loop
     w = r.omega
     assert lp.t[-1] == pytest.approx(2 * math.pi / w, rel=1e-12)
@@ -315,10 +315,10 @@ def test_loop_is_one_closed_period_and_warm_start_is_cheap():
     assert np.abs(lp.x[-1, 0] - lp.x[0, 0]) <= 10 * config.SS_AMP_RTOL * r.amplitude_m
     assert isinstance(r.restart, Restart)
     r2 = steady_state(s, 1.2, start=r)
-    assert r2.ok and r2.periods <= config.SS_CHECK_PERIODS + config.SS_CHUNK + 1
+    assert r2.status.ok and r2.periods <= config.SS_CHECK_PERIODS + config.SS_CHUNK + 1
     assert r2.amplitude_m == pytest.approx(r.amplitude_m, rel=10 * config.SS_AMP_RTOL)
     r3 = steady_state(s, 1.3, start=r, keep_loop=False)
-    assert r3.ok and r3.loop is None
+    assert r3.status.ok and r3.loop is None
 
 
 def test_unsettled_response_is_not_reported_as_a_number():
@@ -345,7 +345,7 @@ def test_status_enumerations():
     assert RunStatus.OK.ok and not RunStatus.BLOW_UP.ok
     assert all(m.message for m in (*RunStatus, *SteadyStatus))
     r = steady_state(System.paper_damper(eta=0.5, beta=2.0), 1.2, keep_loop=False)
-    assert r.status is SteadyStatus.PERIODIC and r.status == "periodic" and r.ok
+    assert r.status is SteadyStatus.PERIODIC and r.status == "periodic" and r.status.ok
 
 
 def test_blow_up_is_reported():

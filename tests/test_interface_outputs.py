@@ -23,16 +23,16 @@ def _files(out, stem):
 
 def _check_pairs(ds, table, one, npoints):
     assert ds.pair_energy_J.dims == ("point", "pair") and ds.sizes["pair"] == 2
-    assert ds.pair_energy_J.attrs["units"] == "J" and ds.energy_pairs_J.attrs["units"] == "J"
+    assert ds.pair_energy_J.attrs["units"] == "J" and ds.energy_interface_J.attrs["units"] == "J"
     for k in ("stick", "slip", "open"):
         assert ds[f"pair_{k}_fraction"].attrs["units"] == "1"
     frac = sum(ds[f"pair_{k}_fraction"].values for k in ("stick", "slip", "open"))
     np.testing.assert_allclose(frac, 1.0, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(ds.energy_pairs_J.values, ds.pair_energy_J.values.sum(axis=1), rtol=1e-12)
-    np.testing.assert_allclose(table.energy_pairs_J.values, ds.energy_pairs_J.values, rtol=1e-12)
-    assert len(one["energy_pairs_J"]) == npoints
-    np.testing.assert_allclose(np.array(one["pairs"]["energy_J"]).sum(axis=1), one["energy_pairs_J"], rtol=1e-12)
-    assert np.max(ds.pair_slip_fraction.values) > 0.0 and np.max(ds.energy_pairs_J.values) > 0.0
+    np.testing.assert_allclose(ds.energy_interface_J.values, ds.pair_energy_J.values.sum(axis=1), rtol=1e-12)
+    np.testing.assert_allclose(table.energy_interface_J.values, ds.energy_interface_J.values, rtol=1e-12)
+    assert len(one["energy_interface_J"]) == npoints
+    np.testing.assert_allclose(np.array(one["pairs"]["energy_J"]).sum(axis=1), one["energy_interface_J"], rtol=1e-12)
+    assert np.max(ds.pair_slip_fraction.values) > 0.0 and np.max(ds.energy_interface_J.values) > 0.0
 
 
 def test_hb_branch_files_and_json_carry_the_pairs(tmp_path, capsys):

@@ -142,7 +142,7 @@ def test_law_module_dropped_into_a_copy_runs_through_the_cli(tmp_path):
     d = json.loads(r.stdout)
     fs = ratio * mu * n_ref
     assert d["model"] == "slider" and d["parameters"]["ratio"] == ratio
-    assert d["energy_per_cycle_J"] == pytest.approx(4 * fs * (amp - fs / kt), rel=1e-3)
+    assert d["energy_J"] == pytest.approx(4 * fs * (amp - fs / kt), rel=1e-3)
     assert d["force_max_N"] == pytest.approx(fs, rel=1e-12)
     assert "slider" in _run(env, tmp_path, "loop", "--help").stdout
 

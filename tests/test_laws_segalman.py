@@ -130,7 +130,7 @@ def test_epmc_one_harmonic_equals_the_describing_function(chi, beta):
 
     b = epmc(system, (1e-2 * xs, 3.0 * xs), harmonics=1, samples=8192, progress=False)
     assert b.status is ModeStatus.COMPLETE and b.points >= 20
-    for a, w, D, E in zip(b.amplitude_m, b.omega_rad_s, b.damping_ratio, b.energy_contact_j[:, 0]):
+    for a, w, D, E in zip(b.amplitude_m, b.omega_rad_s, b.damping_ratio, b.contact_energy_J[:, 0]):
         w_ref, D_ref, E_ref = ref.describing_function(m, k, kt, fy, chi, beta, a)
         assert abs(w - w_ref) <= 1e-6 * w_ref
         assert abs(D - D_ref) <= 1e-6 * D_ref + 1e-14

@@ -45,7 +45,7 @@ def test_one_harmonic_equals_the_describing_function(model):
     b = epmc(_damper(model), (1e-2 * XS, 1e2 * XS), harmonics=1, samples=DF_SAMPLES[model], progress=False)
     assert b.status is ModeStatus.COMPLETE and b.points >= 50
     tb, kinks = BACKBONES[model]
-    for a, w, D, E in zip(b.amplitude_m, b.omega_rad_s, b.damping_ratio, b.energy_contact_J[:, 0]):
+    for a, w, D, E in zip(b.amplitude_m, b.omega_rad_s, b.damping_ratio, b.contact_energy_J[:, 0]):
         w_ref, D_ref, E_ref = ref.describing_function(M_, K_, tb, kinks, a)
         assert abs(w - w_ref) <= tol.TEST_MODES_DF_RTOL * w_ref
         # rounding floors: of the damping ratio, and of the energy (units of the elastic energy kt a^2)
@@ -189,7 +189,7 @@ def test_dataset_and_frozen_result():
     ds = backbone_dataset(b)
     assert ds.attrs["status"] == "complete" and ds.attrs["method"] == "epmc" and ds.attrs["linear_mode"] == 1
     for v in ("amplitude_m", "amplitude_q", "omega_rad_s", "frequency_hz", "gamma", "damping_ratio",
-              "damping_ratio_contacts", "damping_ratio_viscous", "xi_rad_s", "energy_contact_J", "mode_shape_m",
+              "damping_ratio_contacts", "damping_ratio_viscous", "xi_rad_s", "contact_energy_J", "mode_shape_m",
               "harmonic_amplitude_m"):
         assert v in ds
     np.testing.assert_allclose(ds.amplitude_q, ds.amplitude_m / XS, rtol=1e-12)
@@ -276,7 +276,7 @@ def test_a_contact_split_in_two_halves_gives_the_same_mode_and_half_the_energy_e
     from jointdyn.modes import qsma
 
     one, two = (epmc(system(n), (0.1 * XS, 10 * XS), harmonics=3, progress=False) for n in (1, 2))
-    assert one.status.ok and two.status.ok and two.energy_contact_J.shape == (two.points, 2)
+    assert one.status.ok and two.status.ok and two.contact_energy_J.shape == (two.points, 2)
     for q in (0.5, 1.5, 5.0):
         w1, xi1, X1 = _at(one, q * XS)
         w2, xi2, X2 = _at(two, q * XS)
@@ -284,8 +284,8 @@ def test_a_contact_split_in_two_halves_gives_the_same_mode_and_half_the_energy_e
         E1 = one.problem.energies(X1, w1, one.problem.evaluate(X1, w1))[2]
         E2 = two.problem.energies(X2, w2, two.problem.evaluate(X2, w2))[2]
         np.testing.assert_allclose(E2, [0.5 * E1[0]] * 2, rtol=1e-8, atol=1e-14 * KT * XS * XS)
-    np.testing.assert_allclose(two.energy_contact_J[:, 0], two.energy_contact_J[:, 1], rtol=1e-12)
+    np.testing.assert_allclose(two.contact_energy_J[:, 0], two.contact_energy_J[:, 1], rtol=1e-12)
     q1, q2 = qsma(system(1), (0.1 * XS, 10 * XS)), qsma(system(2), (0.1 * XS, 10 * XS))
     np.testing.assert_allclose(q2.omega_rad_s, q1.omega_rad_s, rtol=1e-12)
-    np.testing.assert_allclose(q2.energy_contact_J, 0.5 * q1.energy_contact_J.repeat(2, axis=1), rtol=1e-9,
+    np.testing.assert_allclose(q2.contact_energy_J, 0.5 * q1.contact_energy_J.repeat(2, axis=1), rtol=1e-9,
                                atol=1e-15 * KT * XS * XS)

@@ -22,7 +22,7 @@ def test_iwan_equals_the_masing_secant_and_loop_area():
     assert b.status is ModeStatus.COMPLETE and b.method == "qsma"
     assert b.points == 4 * jd.config.QSMA_STEPS_PER_DECADE + 1
     tb, _ = ref.iwan_backbone(KT, FY)
-    for a, w, D, E in zip(b.amplitude_m, b.omega_rad_s, b.damping_ratio, b.energy_contact_J[:, 0]):
+    for a, w, D, E in zip(b.amplitude_m, b.omega_rad_s, b.damping_ratio, b.contact_energy_J[:, 0]):
         w_ref, D_ref = ref.masing_qsma(M_, K_, tb, a)
         assert w == pytest.approx(w_ref, rel=1e-13)
         # exact below macroslip (a quadratic backbone); past its onset (a kink of the
@@ -77,7 +77,7 @@ def test_viscous_part_and_energy_per_contact():
                                rtol=1e-12)
     # D_contacts = E / (2 pi alpha q), alpha q = (k a + Tb(a)) a for one DOF
     alpha_q = (K_ * b.amplitude_m + _backbone_force(b.amplitude_m)) * b.amplitude_m
-    np.testing.assert_allclose(b.damping_ratio_contacts, b.energy_contact_J[:, 0] / (2 * np.pi * alpha_q),
+    np.testing.assert_allclose(b.damping_ratio_contacts, b.contact_energy_J[:, 0] / (2 * np.pi * alpha_q),
                                rtol=1e-9)
 
 
@@ -92,8 +92,8 @@ def test_two_contacts_add_their_energies_and_multi_dof_runs():
     law = jd.make_law("iwan", kt=5e4, mu=0.3, n_ref=100.0)
     s = jd.System(M, None, K, contacts=(jd.Contact(law, dof=0), jd.Contact(law, dof=2, dof2=1)))
     b = qsma(s, (1e-6, 1e-2), output_dof=2)
-    assert b.status.ok and b.energy_contact_J.shape == (b.points, 2)
-    assert np.all(b.energy_contact_J > 0)
+    assert b.status.ok and b.contact_energy_J.shape == (b.points, 2)
+    assert np.all(b.contact_energy_J > 0)
     assert np.all(np.diff(b.omega_rad_s) < 0)  # softening as more of the interface slips
 
 

@@ -115,7 +115,7 @@ def test_harmonic_history_validates(kwargs, name):
 def test_energy_per_cycle_matches_closed_form(A, name):
     r = harmonic_loop(law(name), A, cycles=2, steps_per_cycle=1000)
     assert r.n_cycles == 2
-    E = r.last_cycle()["energy_per_cycle_J"]
+    E = r.last_cycle()["energy_J"]
     assert E == pytest.approx(energy_closed_form(A), rel=TEST_ENERGY_RTOL)
     c = r.last_cycle()
     # steady Masing loop: its tips lie on the backbone (docs/model.md section 2)
@@ -146,7 +146,7 @@ def test_macroslip_time_fraction_constant_load():
 def test_first_cycle_is_work_not_loop_area():
     A = 0.1e-3
     r = harmonic_loop(law("iwan"), A, cycles=3, steps_per_cycle=400)
-    E = r.cycles["energy_per_cycle_J"].to_numpy()
+    E = r.cycles["energy_J"].to_numpy()
     assert E[1] == pytest.approx(E[2], rel=1e-12)
     assert E[0] < E[1]  # the virgin start is not a closed loop
 
@@ -205,7 +205,7 @@ def test_separation_converges_with_step(name, delta_deg, rtol):
     it at O(dt))."""
     E = [
         harmonic_loop(law(name), 0.5e-3, eta=1.2, delta_deg=delta_deg, steps_per_cycle=s)
-        .last_cycle()["energy_per_cycle_J"]
+        .last_cycle()["energy_J"]
         for s in (500, 1000)
     ]
     assert abs(E[1] / E[0] - 1) < rtol
@@ -214,7 +214,7 @@ def test_separation_converges_with_step(name, delta_deg, rtol):
 def test_discrete_matches_closed_form_at_constant_load_with_offset():
     a = harmonic_loop(Iwan(KT, MU, N0), 0.3e-3, x_offset=0.1e-3, steps_per_cycle=500).last_cycle()
     b = harmonic_loop(DiscreteIwan(KT, MU, N0, n=1000), 0.3e-3, x_offset=0.1e-3, steps_per_cycle=500).last_cycle()
-    assert a["energy_per_cycle_J"] == pytest.approx(b["energy_per_cycle_J"], rel=TEST_ENERGY_RTOL)
+    assert a["energy_J"] == pytest.approx(b["energy_J"], rel=TEST_ENERGY_RTOL)
 
 
 # --- general histories ---------------------------------------------------------
@@ -246,7 +246,7 @@ def test_period_windows_between_samples():
     r = quasistatic(law("iwan"), t, x, N, period=1.0)
     assert r.n_cycles == 3
     np.testing.assert_allclose(r.cycles["t_start_s"], [0.0, 1.0, 2.0], atol=1e-12)
-    E = r.cycles["energy_per_cycle_J"].to_numpy()
+    E = r.cycles["energy_J"].to_numpy()
     assert E[-1] == pytest.approx(energy_closed_form(0.3e-3), rel=TEST_ENERGY_RTOL)
     assert E[-1] == pytest.approx(E[-2], rel=1e-6)
 

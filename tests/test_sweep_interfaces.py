@@ -110,7 +110,7 @@ def test_command_line_time_sweep_writes_the_pairs(tmp_path, capsys):
     ds = xr.open_dataset(out / "frc.nc")
     pe = ds.pair_energy_J.sel(direction="up").values
     assert ds.pair_energy_J.attrs["units"] == "J" and pe.shape == (3, 2)
-    np.testing.assert_allclose(up["energy_pairs_J"], pe.sum(axis=1), rtol=1e-12)
+    np.testing.assert_allclose(up["energy_interface_J"], pe.sum(axis=1), rtol=1e-12)
     np.testing.assert_allclose(up["pairs"]["energy_J"], pe, rtol=1e-12)
     for k in ("stick", "slip", "open"):
         np.testing.assert_allclose(up["pairs"][f"{k}_fraction"], ds[f"pair_{k}_fraction"].sel(direction="up").values)

@@ -386,7 +386,7 @@ def test_bad_system_form(call, word, fake):
 
 def test_status_codes_are_the_steady_state_statuses_own_codes():
     from jointdyn.dynamics import SteadyStatus
-    from jointdyn.sweeps._points import NOT_COMPUTED, NOT_COMPUTED_NAME
+    from jointdyn.sweeps import NOT_COMPUTED, NOT_COMPUTED_NAME
 
     assert STATUS_CODES == {s.value: s.code for s in SteadyStatus} == {"periodic": 0, "not-settled": 1, "unbounded": 2}
     assert all(status_name(s.code) == s.value for s in SteadyStatus)

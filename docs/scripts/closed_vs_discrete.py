@@ -57,12 +57,12 @@ def rows(A):
         disc, t3, T3 = last_cycle("discrete", A, eta, delta)
         fine, _, _ = last_cycle("discrete", A, eta, delta, n=4000)
         assert np.array_equal(t1, t3) and np.array_equal(t2, t3)  # same samples
-        Ed = disc["energy_per_cycle_J"]
+        Ed = disc["energy_J"]
         out.append(dict(
             delta=delta, eta=eta,
-            E_full=full["energy_per_cycle_J"], E_paper=paper["energy_per_cycle_J"], E_disc=Ed,
-            d_full=full["energy_per_cycle_J"] / Ed - 1, d_paper=paper["energy_per_cycle_J"] / Ed - 1,
-            d_n=fine["energy_per_cycle_J"] / Ed - 1,
+            E_full=full["energy_J"], E_paper=paper["energy_J"], E_disc=Ed,
+            d_full=full["energy_J"] / Ed - 1, d_paper=paper["energy_J"] / Ed - 1,
+            d_n=fine["energy_J"] / Ed - 1,
             T_full=float(np.max(np.abs(T1 - T3)) / FY), T_paper=float(np.max(np.abs(T2 - T3)) / FY),
             sep=disc["separation_fraction"],
         ))

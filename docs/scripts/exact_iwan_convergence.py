@@ -98,12 +98,12 @@ def quasi_static():
             res = {name: harmonic_loop(law, QS_AMP, eta=eta, delta_deg=delta) for name, law in models.items()}
             ref = res["exact K=%d" % K_REF]
             last = ref.t >= ref.t[-1] - ref.period  # the last cycle
-            e_ref = float(ref.cycles["energy_per_cycle_J"].values[-1])
+            e_ref = float(ref.cycles["energy_J"].values[-1])
             pc = _pieces(models["exact K=%d" % K_REF], ref.x, ref.N)[last]
             row = dict(eta=eta, delta=delta, energy=e_ref, pieces_max=int(pc.max()), pieces_mean=float(pc.mean()),
                        diff={}, force={})
             for name, r in res.items():
-                e = float(r.cycles["energy_per_cycle_J"].values[-1])
+                e = float(r.cycles["energy_J"].values[-1])
                 row["diff"][name] = e / e_ref - 1.0
                 row["force"][name] = float(np.max(np.abs(r.T[last] - ref.T[last]))) / fy
             e1000 = e_ref * (1 + row["diff"]["discrete n=1000"])

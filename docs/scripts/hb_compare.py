@@ -308,7 +308,7 @@ class Reference:
         g = float(gamma)
         if g not in self.cache:
             sol = harmonic_balance(self.system, g, harmonics=H, samples=SAMPLES)
-            if not sol.converged:
+            if not sol.status.ok:
                 raise RuntimeError(f"reference harmonic balance did not converge at gamma = {g}")
             self.cache[g] = KT * sol.amplitude_m / FY
         return self.cache[g]

@@ -61,7 +61,7 @@ def convergence_table() -> str:
         cells = []
         for h in HS:
             sol = harmonic_balance(s, g, harmonics=h, samples=max(256, 16 * h))
-            if not sol.converged:
+            if not sol.status.ok:
                 cells.append("no conv.")
                 continue
             rel = (sol.amplitude_m - ss.amplitude_m) / ss.amplitude_m

@@ -45,14 +45,14 @@ def table_fig2(d: Path) -> str:
     for _, r in m.iterrows():
         A = r.amplitude_m
         closed = kt**2 * A**3 / (3 * fy) if A <= 2 * fy / kt else 4 * fy * A - 16 * fy**2 / (3 * kt)
-        rows.append({"A (mm)": A * 1e3, "energy per cycle (mJ)": r.energy_per_cycle_J * 1e3,
+        rows.append({"A (mm)": A * 1e3, "energy per cycle (mJ)": r.energy_J * 1e3,
                      "closed form (mJ)": closed * 1e3, "macroslip fraction of the cycle": r.macroslip_fraction})
     return _md(pd.DataFrame(rows))
 
 
 def table_loops(d: Path, name: str) -> str:
     m = pd.read_csv(d / f"{name}_metrics.csv")
-    cols = {"eta": "eta", "energy_per_cycle_J": "energy per cycle (mJ)", "force_max_N": "max T (N)",
+    cols = {"eta": "eta", "energy_J": "energy per cycle (mJ)", "force_max_N": "max T (N)",
             "force_min_N": "min T (N)", "stick_slip_fraction": "stick-slip", "macroslip_fraction": "macroslip",
             "separation_fraction": "separation"}
     t = m[list(cols)].rename(columns=cols)

@@ -337,8 +337,6 @@ SS_UNBOUNDED_Q = 20.0
 HB_HARMONICS = 7
 #: AFT time samples per period
 HB_SAMPLES = 128
-#: the value of ``harmonics`` / ``samples`` (and of --harmonics / --samples) that asks for the automatic choice
-HB_AUTO = "auto"
 #: ``harmonics="auto"`` / ``samples="auto"`` (the defaults of HB branches): start at HB_HARMONICS and
 #: HB_SAMPLES; every refined peak is solved again with 2H + 1 harmonics and with 2 Ns samples, and the
 #: discretisation is refined (and the branch computed again) while a peak amplitude changes by more

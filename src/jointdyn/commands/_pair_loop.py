@@ -9,7 +9,7 @@ instant where ``P + kn g`` changes sign between two samples is inserted
 ``--period`` the history is cut into cycles and the metrics are those of
 the last full one; otherwise the whole history is one cycle.
 
-The JSON gives the metrics of the last full cycle: ``energy_per_cycle_J``
+The JSON gives the metrics of the last full cycle: ``energy_J``
 (work of T over it), the fractions of it the pair sticks, slips and is
 open, the largest |T| and the range of N over its samples.
 
@@ -71,7 +71,8 @@ def _report(args, res) -> dict:
         "cycle_is_period": args.period is not None,
         "t_start_s": res.t_start_s,
         "t_end_s": res.t_end_s,
-        "energy_per_cycle_J": res.energy_per_cycle_J,
+        "energy_J": res.energy_J,
+        "energy_per_cycle_J": res.energy_J,  # deprecated duplicate of energy_J, kept for one release
         "stick_fraction": float(res.stick_fraction[0]),
         "slip_fraction": float(res.slip_fraction[0]),
         "open_fraction": float(res.open_fraction[0]),
@@ -125,8 +126,7 @@ def _write_files(args, res) -> None:
 
 def run(args) -> int:
     """``jointdyn loop --model pair``; ValueError for bad input (exit 2, no file)."""
-    from ..drivers import cycle_count, interface_loop
-    from ..drivers._csv import read_pair_history_csv
+    from ..drivers import cycle_count, interface_loop, read_pair_history_csv
     from ..interfaces import Interface
 
     _validate(args)
@@ -150,7 +150,7 @@ def run(args) -> int:
     print(f"jointdyn loop: pair, slip force mu P = {args.mu * args.preload:g} N, {res.n_cycles} cycle(s), "
           f"last [{res.t_start_s:g}, {res.t_end_s:g}] s")
     what = "energy per cycle " if args.period is not None else "work of T (whole)"
-    print(f"  {what}  {report['energy_per_cycle_J']:.6g} J")
+    print(f"  {what}  {report['energy_J']:.6g} J")
     print(f"  time fractions     stick {report['stick_fraction']:.4f}, slip {report['slip_fraction']:.4f}, "
           f"open {report['open_fraction']:.4f}")
     print(f"  max |T|            {report['force_max_N']:.6g} N; N in [{report['normal_load_min_N']:.6g}, "

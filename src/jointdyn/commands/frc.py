@@ -36,12 +36,11 @@ from .. import config
 from .._io import jsonable as _jsonable
 from . import _frc_report as report
 from ._law_args import add_law_arguments, law_params, model_help
-from ._sizes import check_hb_sizes
 from ._system_args import add_system_argument, load_system_file, refuse_paper_options
 from ..systems import PAPER
 
-#: the value of --harmonics / --samples asking for the automatic choice
-AUTO = config.HB_AUTO
+#: the options that set the discretisation of harmonic balance, named in its refusals
+_HB_NAMES = ("--harmonics", "--samples")
 
 NAME = "frc"
 HELP = ("frequency-response curve (steady amplitude vs gamma) of the paper's friction damper or of a structure "
@@ -123,19 +122,6 @@ def parse_gamma(text: str) -> np.ndarray:
     return np.where(np.abs(rounded - grid) <= 1e-9 * grid, rounded, grid)
 
 
-def _count_or_auto(name: str, value, minimum: int):
-    """``"auto"`` or an integer >= minimum (the value of --harmonics or --samples)."""
-    if value == AUTO:
-        return AUTO
-    try:
-        count = int(value)
-    except (TypeError, ValueError):
-        count = None
-    if count is None or count < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum} or {AUTO!r}, got {value!r}")
-    return count
-
-
 #: options of one method only, with the reason they do not apply to the other
 _TIME_ONLY = {
     "sweep": "the continuation follows the branch through its folds, which holds the states of both "
@@ -158,8 +144,6 @@ def _check_method_options(args) -> None:
         for dest, why in _TIME_ONLY.items():
             if getattr(args, dest) is not None:
                 raise ValueError(f"{_option(dest)} applies to --method time only: {why}")
-        args.harmonics = AUTO if args.harmonics is None else args.harmonics
-        args.samples = AUTO if args.samples is None else args.samples
         return
     for dest in _HB_ONLY:
         if getattr(args, dest) is not None:
@@ -225,8 +209,12 @@ def _validate(args):
     if args.workers is not None:
         V.positive_int("--workers", args.workers)
     if args.method == "hb":
-        args.harmonics = _count_or_auto("--harmonics", args.harmonics, 1)
-        args.samples = _count_or_auto("--samples", args.samples, 4)
+        from ..hb import AUTO, discretisation
+
+        disc = discretisation(AUTO if args.harmonics is None else args.harmonics,
+                              AUTO if args.samples is None else args.samples, names=_HB_NAMES)
+        args.harmonics = AUTO if disc.harmonics_auto else disc.first.harmonics
+        args.samples = AUTO if disc.samples_auto else disc.first.samples
     args.system_file = None
     if args.system is not None:
         refuse_paper_options(args, PAPER_OPTIONS)
@@ -237,8 +225,13 @@ def _validate(args):
     if args.method == "time":
         _check_time_steps(args, gammas)
     else:
-        check_hb_sizes(_system(args), args.harmonics, args.samples, given_samples=True)
-        _check_hb_static(_system(args))
+        from ..hb import check_mean_position, check_memory
+
+        check_memory(_system(args), disc, names=_HB_NAMES)
+        try:  # the solver's own refusal, made before --out is checked and anything computed
+            check_mean_position(_system(args))
+        except ValueError as exc:
+            raise ValueError(f"--method hb: {exc}") from None
     if args.out is not None:
         subdirs = ("lines",) if args.method == "time" else ()
         V.output_dir("--out", args.out, files=("frc.nc", "frc.csv", "frc.png"), subdirs=subdirs)
@@ -249,44 +242,16 @@ def _check_time_steps(args, gammas) -> None:
     """The steps of a forcing period at the lowest gamma (the most) fit the memory bound, for the
     lines run at once: refused before computing, naming --steps-per-period when it sets the step,
     else the structure's stiffest mode."""
-    from ..dynamics._model import pack_system, period_steps
+    from ..dynamics import check_period_steps
 
     system = _system(args)
-    pack = pack_system(system)
-    spp = config.TI_STEPS_PER_PERIOD if args.steps_per_period is None else args.steps_per_period
     lines = 1 if args.sweep != "both" or args.workers == 1 else 2
     try:
-        period_steps(pack, float(gammas[0]) * system.w0, spp, refined=pack.springs, lines=lines,
-                     name="--steps-per-period")
+        check_period_steps(system, float(gammas[0]) * system.w0, args.steps_per_period, lines=lines,
+                           name="--steps-per-period")
     except ValueError as exc:
         msg = str(exc)
         raise ValueError(msg if msg.startswith("--") else f"--method time: {msg}; --method hb has no time step") from None
-
-
-def _check_hb_static(system) -> None:
-    """Harmonic balance starts from the static stiffness with every contact stuck and every normal
-    spring closed: a DOF that this holds by nothing (a rigid-body mode) has no unique mean position,
-    and the structure is refused naming it (the time domain takes it)."""
-    from ..hb.problem import contacts_only
-    from ..kinematics import contact_kinematics, selection_matrix
-    from ..systems import rigid_mode_dof
-
-    K = system.K_reference.copy()  # with the normal springs of the contacts and pairs closed at rest
-    if system.contacts:
-        B = selection_matrix(contact_kinematics(contacts_only(system)), system.ndof)
-        K += (B.T * [c.law.kt for c in system.contacts]) @ B
-    for itf in system.interfaces:  # the pairs closed at rest, stuck: their tangential springs kt
-        B = itf.selection(system.ndof)
-        shear = np.zeros(B.shape[0])
-        shear[0::3] = shear[1::3] = np.where(itf.preload > 0.0, itf.kt, 0.0)
-        K += (B.T * shear) @ B
-    dof = rigid_mode_dof(K)
-    if dof is None:
-        return
-    raise ValueError(f"--method hb: the structure has a rigid-body mode even with every contact stuck and every "
-                     f"normal spring closed (mostly DOF {dof}: held by nothing, K + kt + kn is singular), so its "
-                     "mean position is not unique; harmonic balance needs one: give that DOF a stiffness in K, "
-                     "or use --method time")
 
 
 def _connect(address):
@@ -486,10 +451,12 @@ def _hb_branches(br, dofs=()) -> list:
 
 
 def _pair_json(energy, fractions) -> dict:
-    """``energy_pairs_J`` (per point, J) and ``pairs`` (per point and pair: ``energy_J``, J, and the
-    ``stick_fraction``, ``slip_fraction``, ``open_fraction`` of the period) of the JSON."""
+    """``energy_interface_J`` (per point, J; ``energy_pairs_J`` its deprecated duplicate) and ``pairs`` (per
+    point and pair: ``energy_J``, J, and the ``stick_fraction``, ``slip_fraction``, ``open_fraction`` of the
+    period) of the JSON."""
     energy = np.asarray(energy, dtype=float)
-    return {"energy_pairs_J": _jsonable(energy.sum(axis=1)),
+    total = _jsonable(energy.sum(axis=1))
+    return {"energy_interface_J": total, "energy_pairs_J": total,
             "pairs": {"energy_J": _jsonable(energy),
                       **{f"{k}_fraction": _jsonable(np.asarray(v, dtype=float)) for k, v in fractions.items()}}}
 
@@ -554,7 +521,7 @@ def _plot(result, path: Path) -> None:
 
     from .._io import atomic_path
     from ..figures.curves import mark_legend, plot_frc_curve
-    from ..sweeps._points import NOT_COMPUTED, STATUS_CODES
+    from ..sweeps import NOT_COMPUTED, STATUS_CODES
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     if result["method"] == "time":
@@ -650,10 +617,13 @@ def exit_status(result) -> int:
     """0, or :data:`jointdyn._exit.EXIT_INCOMPLETE` for an hb branch that does not cover the range and is
     not unbounded (failed, turned back, stopped at its point bound)."""
     from .._exit import EXIT_INCOMPLETE
+    from ..continuation import ContinuationStatus
 
-    if result["method"] == "hb" and result["status"] not in ("complete", "unbounded"):
-        return EXIT_INCOMPLETE
-    return 0
+    if result["method"] != "hb":
+        return 0
+    status = ContinuationStatus(result["status"])
+    # an unbounded response is an answer: no bounded steady state over part of the range
+    return 0 if status.ok or status is ContinuationStatus.UNBOUNDED else EXIT_INCOMPLETE
 
 
 def run(args) -> int:

@@ -277,7 +277,7 @@ def _print_console(args, law, res, report, period) -> None:
     what = "last cycle" if period is not None else "whole history (work done)"
     print(f"jointdyn loop: {args.model}, fy = {law.fy:g} N, {res.n_cycles} cycle(s), {what} "
           f"[{report['t_start_s']:g}, {report['t_end_s']:g}] s")
-    print(f"  energy per cycle   {report['energy_per_cycle_J']:.6g} J")
+    print(f"  energy per cycle   {report['energy_J']:.6g} J")
     print(f"  force min / max    {report['force_min_N']:.6g} / {report['force_max_N']:.6g} N")
     ksec, loss = report["secant_stiffness_N_per_m"], report["loss_factor"]
     print(f"  secant stiffness   {float('nan') if ksec is None else ksec:.6g} N/m")

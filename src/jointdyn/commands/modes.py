@@ -32,13 +32,10 @@ from .. import config
 from .._exit import EXIT_INCOMPLETE
 from .._io import jsonable as _jsonable
 from ._law_args import add_law_arguments, law_params, model_help
-from ._sizes import check_hb_sizes
 from ._system_args import load_system_file
 
 NAME = "modes"
 HELP = "backbone of a nonlinear mode (natural frequency and damping ratio against amplitude) by EPMC or QSMA"
-#: deprecated alias of :data:`jointdyn._exit.EXIT_INCOMPLETE` (a backbone that stops short; files are still written)
-EXIT_PARTIAL = EXIT_INCOMPLETE
 #: options of the EPMC only
 _EPMC_ONLY = ("harmonics", "samples", "max_points")
 
@@ -90,7 +87,7 @@ def parse_amplitude(text: str) -> tuple[float, float]:
 def _validate(args):
     """Options checked and the System built; returns ``(system, amplitude range, label)``."""
     from ..laws import law_names
-    from ..modes._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
+    from ..modes import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
     from ..systems import System
 
     V.choice("--method", args.method, ("epmc", "qsma"))
@@ -118,15 +115,14 @@ def _validate(args):
     args.output_dof = output_dof_of(system, args.output_dof)
     linear_stuck_mode(system, V.positive_int("--mode", args.mode, 1), args.output_dof)
     if args.method == "epmc":
-        from .frc import _count_or_auto
+        from ..hb import AUTO, check_memory, discretisation
 
-        auto = config.HB_AUTO
-        given = args.samples is not None
-        args.harmonics = _count_or_auto("--harmonics", auto if args.harmonics is None else args.harmonics, 1)
-        check_hb_sizes(system, args.harmonics, None, given_samples=False)
-        h = config.HB_HARMONICS if args.harmonics == auto else args.harmonics
-        args.samples = _count_or_auto("--samples", auto if args.samples is None else args.samples, 2 * h + 2)
-        check_hb_sizes(system, args.harmonics, args.samples, given_samples=given)
+        names = ("--harmonics", "--samples")
+        disc = discretisation(AUTO if args.harmonics is None else args.harmonics,
+                              AUTO if args.samples is None else args.samples, names=names)
+        check_memory(system, disc, names=names)
+        args.harmonics = AUTO if disc.harmonics_auto else disc.first.harmonics
+        args.samples = AUTO if disc.samples_auto else disc.first.samples
         args.max_points = V.positive_int("--max-points", config.CONT_MAX_POINTS if args.max_points is None
                                          else args.max_points, 2)
     if args.out is not None:
@@ -147,11 +143,12 @@ def _compute(args, system, amps):
 
 def _result(args, ds, label) -> dict:
     keys = ("amplitude_m", "amplitude_q", "omega_rad_s", "frequency_hz", "damping_ratio", "damping_ratio_contacts",
-            "damping_ratio_viscous", "energy_contact_J")
+            "damping_ratio_viscous", "contact_energy_J")
     branch = {k: _jsonable(ds[k].values) for k in keys}
-    branch["energy_contact_j"] = branch["energy_contact_J"]  # deprecated alias: JSON keys are added, never renamed
+    # deprecated duplicates of contact_energy_J (per contact), kept for one release (CHANGELOG)
+    branch["energy_contact_J"] = branch["energy_contact_j"] = branch["contact_energy_J"]
     if "pair" in ds.dims:  # the interfaces' node pairs: the total per point, and per point and pair
-        branch["energy_pairs_J"] = _jsonable(ds["energy_pairs_J"].values)
+        branch["energy_interface_J"] = branch["energy_pairs_J"] = _jsonable(ds["energy_interface_J"].values)
         branch["pairs"] = {"energy_J": _jsonable(ds["pair_energy_J"].values),
                            **{f"{k}_fraction": _jsonable(ds[f"pair_{k}_fraction"].values)
                               for k in ("stick", "slip", "open")}}

@@ -105,8 +105,9 @@ class InterfaceLoopResult:
         return int(np.count_nonzero(self.inserted))
 
     @property
-    def energy_per_cycle_J(self) -> float:
-        """Work of the tangential forces of all pairs over the last full cycle, J."""
+    def energy_J(self) -> float:
+        """Work of the tangential forces of all pairs over the last full cycle, J (the last entry of
+        ``cycle_energy_J``)."""
         return float(self.cycle_energy_J[-1])
 
 

@@ -49,7 +49,7 @@ CYCLE_COLUMNS = (
     "cycle",
     "t_start_s",
     "t_end_s",
-    "energy_per_cycle_J",
+    "energy_J",
     "force_max_N",
     "force_min_N",
     "x_max_m",
@@ -59,6 +59,7 @@ CYCLE_COLUMNS = (
     "separation_fraction",
     "secant_stiffness_N_per_m",
     "loss_factor",
+    "energy_per_cycle_J",  # deprecated duplicate of energy_J, kept for one release (CHANGELOG)
 )
 
 
@@ -384,7 +385,7 @@ def _window_metrics(t, x, T, sep, contact, i0, i1):
     return {
         "t_start_s": float(tt[0]),
         "t_end_s": float(tt[-1]),
-        "energy_per_cycle_J": energy,
+        "energy_J": energy,
         "force_max_N": float(np.max(TT)),
         "force_min_N": float(np.min(TT)),
         "x_max_m": float(xx[imax]),
@@ -394,6 +395,7 @@ def _window_metrics(t, x, T, sep, contact, i0, i1):
         "separation_fraction": f_sep,
         "secant_stiffness_N_per_m": ksec,
         "loss_factor": loss,
+        "energy_per_cycle_J": energy,
     }
 
 
@@ -465,7 +467,8 @@ def quasistatic(law, t, x, N, *, period=None, state=None) -> LoopResult:
 
     Per-cycle metrics (columns of :attr:`LoopResult.cycles`):
 
-    - ``energy_per_cycle_J``: trapezoidal integral of T dx over the window,
+    - ``energy_J``: trapezoidal integral of T dx over the window (a row is one
+      cycle; ``energy_per_cycle_J``, the last column, is its deprecated duplicate),
       J. For a closed steady cycle this is the loop area, the energy
       dissipated per cycle (docs/model.md section 2: kt^2 A^3 / (3 fy) for
       A <= 2 fy / kt, 4 fy A - 16 fy^2 / (3 kt) beyond, at constant N).

@@ -3,11 +3,13 @@
 Public API: :func:`integrate` (harmonic loads), :func:`integrate_sampled`
 (sampled loads), :class:`Trajectory`, :class:`Restart`,
 :func:`steady_state` and :class:`SteadyState` (:func:`prepare_kernels`
-compiles its kernels ahead, for process pools), the statuses
+compiles its kernels ahead, for process pools; :func:`check_period_steps`
+refuses a step grid larger than the memory before computing), the statuses
 :class:`RunStatus` and :class:`SteadyStatus`, and the monodromy matrix of
 the period map (:func:`monodromy_matrix`, :func:`fd_monodromy`).
 """
 
+from ._model import check_period_steps
 from .integrate import Restart, Trajectory, integrate, integrate_sampled
 from .monodromy import fd_monodromy, monodromy_matrix
 from .status import EnergyCheck, RunStatus, SteadyStatus
@@ -19,6 +21,7 @@ __all__ = [
     "Trajectory",
     "Restart",
     "steady_state",
+    "check_period_steps",
     "prepare_kernels",
     "SteadyState",
     "RunStatus",

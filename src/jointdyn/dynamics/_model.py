@@ -37,7 +37,7 @@ from ..laws import law_dispatch
 from ._core import LOADS_HARMONIC, N_SUMMARY, RUN_OVERFLOW, S_OPEN, compiled_runner, grid_trig
 from .status import RunStatus, run_status
 
-__all__ = ["PackedSystem", "pack_system", "Model", "make_model", "refine_if_opened", "Grid", "RunResult", "run",
+__all__ = ["PackedSystem", "pack_system", "check_period_steps", "Model", "make_model", "refine_if_opened", "Grid", "RunResult", "run",
            "recontact_load", "pair_relative", "sliders", "set_sliders"]  # fmt: skip
 
 
@@ -441,6 +441,18 @@ def period_steps(pack: PackedSystem, w: float, steps_per_period: int, *, refined
         hint = f"{name} must be at most {top} here"
     V.memory_fits(label, (J + 1.0) * per_step, hint=hint)
     return int(J)
+
+
+def check_period_steps(system, w: float, steps_per_period: int | None = None, *, lines: int = 1,
+                       name: str = "steps_per_period") -> int:
+    """The steps of one forcing period of ``system`` at ``w`` (rad/s), refused before anything is computed
+    (ValueError naming ``name`` where ``steps_per_period`` sets the step, else the stiffest mode) when
+    ``lines`` runs at once would exceed the memory bound: :func:`period_steps` with the solver's default
+    steps (``config.TI_STEPS_PER_PERIOD``) where ``steps_per_period`` is None, refined where the system
+    has normal springs. The lowest frequency of a sweep needs the most."""
+    pack = pack_system(system)
+    spp = config.TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period
+    return period_steps(pack, w, spp, refined=pack.springs, lines=lines, name=name)
 
 
 def refine_if_opened(model: Model, summary) -> Model | None:

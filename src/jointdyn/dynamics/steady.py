@@ -49,7 +49,7 @@ class SteadyState:
         ``"periodic"``, ``"not-settled"`` or ``"unbounded"`` (its ``message``
         says what it means).
     message : str
-        More on the status (``detail`` is a deprecated alias): ``"integration"`` or ``"shooting"`` (how a
+        More on the status: ``"integration"`` or ``"shooting"`` (how a
         periodic state was reached); ``"growing"``, ``"blow-up"``
         (unbounded); ``"period-P"`` (repeats every P > SS_MAX_MULTIPLE
         periods), ``"slowly-converging"`` (Poincare distance still
@@ -126,16 +126,6 @@ class SteadyState:
     pair_stick: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
     pair_slip: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
     pair_open: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-
-    @property
-    def ok(self) -> bool:
-        """True when a periodic steady state was found."""
-        return SteadyStatus(self.status).ok
-
-    @property
-    def detail(self) -> str:
-        """Deprecated alias of :attr:`message`."""
-        return self.message
 
     def to_record(self) -> dict:
         """The scalar fields as a flat dict (one row of a sweep table)."""

@@ -283,7 +283,7 @@ _DISCRETE_STYLE = {"discrete": ("0.15", "-", 2.6), "iwan-closed": ("C0", "-", 1.
 
 def _energy_title(metrics, eta):
     """Panel title: eta and the energy per cycle of each closed form relative to the discrete model."""
-    m = metrics[metrics["eta"] == eta].set_index("model")["energy_per_cycle_J"]
+    m = metrics[metrics["eta"] == eta].set_index("model")["energy_J"]
     parts = [f"eta = {eta:g}"]
     if "discrete" in m:
         for model, short in (("iwan-closed", "full memory"), ("iwan-paper", "paper rule")):

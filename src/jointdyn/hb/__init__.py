@@ -16,11 +16,12 @@ evaluation (:mod:`~jointdyn.hb._aft`, :mod:`~jointdyn.hb.stability`,
 
 from .condense import CondensedHBProblem, Receptance, make_problem, receptance
 from .export import branch_dataset, discretisation_attrs
-from .frc import continue_hb, frc_hb, harmonic_balance
+from .frc import check_mean_position, continue_hb, frc_hb, harmonic_balance
+from .levels import AUTO, Discretisation, Level, check_memory, discretisation, hb_bytes
 from .parameters import DELTA, ETA, F1, GAMMA, N0, PARAMETERS, HBParameter, SystemParameter, parameter_named
 from .problem import HBProblem
 from .monodromy import monodromy_multipliers
-from .results import AUTO, DiscretisationCheck, HBBranch, HBPeak, HBSolution, PointStatus, SolveStatus
+from .results import DiscretisationCheck, HBBranch, HBPeak, HBSolution, PointStatus, SolveStatus
 from .stability import hill_exponents, hill_growth, hill_stability
 
 __all__ = [
@@ -32,6 +33,12 @@ __all__ = [
     "discretisation_attrs",
     "DiscretisationCheck",
     "AUTO",
+    "Level",
+    "Discretisation",
+    "discretisation",
+    "check_memory",
+    "hb_bytes",
+    "check_mean_position",
     "HBBranch",
     "HBPeak",
     "PointStatus",

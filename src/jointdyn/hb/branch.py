@@ -70,6 +70,7 @@ from ..laws import MACROSLIP, SEPARATION
 from ..systems import System
 from ._aft import INFO_ERROR, INFO_PASSES, INFO_PERIOD
 from .condense import make_problem
+from .levels import Level
 from .parameters import F1, GAMMA
 from .problem import HBProblem, reference_scales
 from .results import HBBranch, HBPeak, PointStatus
@@ -433,7 +434,7 @@ def _homotopy(problem: HBProblem, gamma: float, tol: float):
     req = _Request(system=system, start=config.HB_HOMOTOPY_START * f1, stop=f1, parameter=F1, gamma=gamma,
                    max_step=None, dof=system.response_dof, options=opt, backward=False, progress=False,
                    condense=problem.condensed)
-    br = continued_branch(req, (problem.H, problem.Ns))
+    br = continued_branch(req, Level(problem.H, problem.Ns))
     lam = br.parts.lam
     if br.status is ContinuationStatus.COMPLETE and lam.size and lam[-1] == f1:
         return br.parts.X[-1]
@@ -497,13 +498,13 @@ def _gap_fills(tr: _Tracker, parts, span: float, opt: ContinuationOptions, progr
     return fills
 
 
-def continued_branch(req: _Request, level, watch_for=None):
-    """The branch with H harmonics and Ns samples, ``level = (H, Ns)``: a :class:`_Draft`; with
+def continued_branch(req: _Request, level: Level, watch_for=None):
+    """The branch at ``level`` (a :class:`~jointdyn.hb.levels.Level`): a :class:`_Draft`; with
     ``watch_for(tracker, options)`` (a monitor of the continuation with a ``target``, None until it asks
     to stop, and a ``restart()`` for the segment continued back), that target where it stopped the branch
     (:class:`jointdyn.hb.discretisation._PeakWatch`)."""
-    problem = make_problem(req.system, condense=req.condense, response_dofs=(req.dof,), harmonics=level[0],
-                           samples=level[1], parameter=req.parameter, gamma=req.gamma)
+    problem = make_problem(req.system, condense=req.condense, response_dofs=(req.dof,), harmonics=level.harmonics,
+                           samples=level.samples, parameter=req.parameter, gamma=req.gamma)
     tr = _Tracker(problem, _scales(problem, req.start), req.dof)
     opt = req.options
     if req.max_step is not None:

@@ -3,7 +3,7 @@
 A branch is computed at a first level (H, Ns); every refined peak is solved
 again with more harmonics and with more samples, and where its amplitude
 changes by more than ``config.HB_AUTO_RTOL`` the branch is computed again
-at the level the peaks ask for (:func:`_adaptive_branch`). While the first
+at the level the peaks ask for (:func:`adaptive_branch`). While the first
 branch is continued, a passed resonance that already asks for a finer level
 stops it (:class:`_PeakWatch`). Each branch at a fixed level is
 :func:`jointdyn.hb.branch.continued_branch`.
@@ -22,40 +22,30 @@ from .. import config
 from ..continuation import ContinuationOptions, ContinuationStatus, newton, refine_maximum
 from .branch import _Request, _scales, _Tracker, continued_branch
 from .condense import make_problem
-from .results import AUTO, DiscretisationCheck, HBBranch, HBPeak
+from .levels import Discretisation, Level
+from .results import DiscretisationCheck, HBBranch, HBPeak
 
 
-def _fixed_branch(req: _Request, level, auto=(False, False), watch: bool = False):
-    """The branch with H harmonics and Ns samples, ``level = (H, Ns)``: a :class:`~jointdyn.hb.branch._Draft`,
+def _fixed_branch(req: _Request, level: Level, auto=(False, False), watch: bool = False):
+    """The branch at ``level``: a :class:`~jointdyn.hb.branch._Draft`,
     or, with ``watch``, a :class:`_Refine` where a peak asked for a finer level while the branch was continued
     (``auto``: which of (harmonics, samples) may change; :class:`_PeakWatch`)."""
     watch_for = (lambda tr, opt: _PeakWatch(tr, req, level, auto, opt)) if watch and any(auto) else None
     return continued_branch(req, level, watch_for)
 
 
-def first_level(harmonics, samples):
-    """((H, Ns) of the first branch, (harmonics auto, samples auto)); validates both."""
-    auto_h, auto_s = harmonics == AUTO, samples == AUTO
-    for name, v, auto in (("harmonics", harmonics, auto_h), ("samples", samples, auto_s)):
-        if isinstance(v, str) and not auto:
-            raise ValueError(f"{name} must be an integer or {AUTO!r}, got {v!r}")
-    H = config.HB_HARMONICS if auto_h else V.positive_int("harmonics", harmonics, 1)
-    if auto_s:
-        return (H, max(config.HB_SAMPLES, 2 * H + 2)), (auto_h, auto_s)
-    return (H, V.positive_int("samples", samples, 2 * H + 2)), (auto_h, auto_s)
-
-
-def check_levels(level, auto):
-    """(H, Ns) of the harmonics check and of the samples check one level above ``level`` (None: not made)."""
+def check_levels(level: Level, auto):
+    """The :class:`Level` of the harmonics check and of the samples check one level above ``level``
+    (None: not made)."""
     H, Ns = level
     h2 = 2 * H + 1
-    by_h = (h2, max(Ns, 2 * h2 + 2) if auto[1] else Ns) if auto[0] else None
-    if by_h is not None and by_h[1] < 2 * h2 + 2:
+    by_h = Level(h2, max(Ns, 2 * h2 + 2) if auto[1] else Ns) if auto[0] else None
+    if by_h is not None and by_h.samples < 2 * h2 + 2:
         by_h = None  # the samples fixed by the caller cannot carry more harmonics
-    return by_h, ((H, 2 * Ns) if auto[1] else None)
+    return by_h, (Level(H, 2 * Ns) if auto[1] else None)
 
 
-def next_level(level, auto, bad_h: bool, bad_s: bool):
+def next_level(level: Level, auto, bad_h: bool, bad_s: bool) -> Level:
     """The level the checks ask for, within ``config.HB_AUTO_MAX_*`` (equal to ``level``: no refinement).
 
     The samples first: with too few, the sampling error of the contact
@@ -64,17 +54,17 @@ def next_level(level, auto, bad_h: bool, bad_s: bool):
     """
     by_h, by_s = check_levels(level, auto)
     if bad_s and by_s is not None:
-        return by_s if by_s[1] <= config.HB_AUTO_MAX_SAMPLES else level
-    if bad_h and by_h is not None and by_h[0] <= config.HB_AUTO_MAX_HARMONICS:
+        return by_s if by_s.samples <= config.HB_AUTO_MAX_SAMPLES else level
+    if bad_h and by_h is not None and by_h.harmonics <= config.HB_AUTO_MAX_HARMONICS:
         return by_h
     return level
 
 
-def _at_level(req: _Request, condensed: bool, X, level):
-    """(tracker of the problem with ``level = (H, Ns)``, the harmonics X there in its scaled unknowns,
-    zero above their H)."""
-    problem = make_problem(req.system, condense=condensed, response_dofs=(req.dof,), harmonics=level[0],
-                           samples=level[1], parameter=req.parameter, gamma=req.gamma)
+def _at_level(req: _Request, condensed: bool, X, level: Level):
+    """(tracker of the problem at ``level``, the harmonics X there in its scaled unknowns, zero above
+    their H)."""
+    problem = make_problem(req.system, condense=condensed, response_dofs=(req.dof,), harmonics=level.harmonics,
+                           samples=level.samples, parameter=req.parameter, gamma=req.gamma)
     tr = _Tracker(problem, _scales(problem, req.start), req.dof)
     Xm = np.asarray(X).reshape(-1, problem.n)
     X0 = np.zeros((problem.nh, problem.n))
@@ -82,18 +72,18 @@ def _at_level(req: _Request, condensed: bool, X, level):
     return tr, X0.ravel() / tr.scales[0]
 
 
-def _solve_at(req: _Request, condensed: bool, lam: float, X, level):
-    """(amplitude of the response DOF (m; NaN where Newton failed), X) at parameter ``lam`` with
-    ``level = (H, Ns)``, by Newton from the harmonics X (zero above their H)."""
+def _solve_at(req: _Request, condensed: bool, lam: float, X, level: Level):
+    """(amplitude of the response DOF (m; NaN where Newton failed), X) at parameter ``lam`` at
+    ``level``, by Newton from the harmonics X (zero above their H)."""
     tr, y0 = _at_level(req, condensed, X, level)
     xs, _, ps = tr.scales
     y, ok, _ = newton(tr.residual, y0, lam / ps, req.options)
     return (tr.amplitudes(y)[0] if ok else math.nan), y * xs
 
 
-def _first_step_amplitude(req: _Request, condensed: bool, lam: float, X, level) -> float:
+def _first_step_amplitude(req: _Request, condensed: bool, lam: float, X, level: Level) -> float:
     """Amplitude of the response DOF (m) after one Newton step from the harmonics X at parameter
-    ``lam`` with ``level = (H, Ns)``: the solution's amplitude there to first order in the change
+    ``lam`` at ``level``: the solution's amplitude there to first order in the change
     (one evaluation; NaN where the step cannot be made)."""
     tr, y0 = _at_level(req, condensed, X, level)
     R, JX, _ = tr.residual(y0, lam / tr.scales[2])
@@ -149,10 +139,11 @@ def _combined_target(req: _Request, condensed: bool, peaks, scale: float, level,
     measures the sampling error of the contact force, and more harmonics
     cost as much as more samples in every AFT evaluation of the branch.
     """
-    target = (max([level[0]] + [w[0] for w in wanted]), max([level[1]] + [w[1] for w in wanted]))
-    if not (target[0] > level[0] and target[1] > level[1]):
+    target = Level(max([level.harmonics] + [w.harmonics for w in wanted]),
+                   max([level.samples] + [w.samples for w in wanted]))
+    if not (target.harmonics > level.harmonics and target.samples > level.samples):
         return target
-    at = (level[0], target[1])
+    at = Level(level.harmonics, target.samples)
     again = []
     for pk in peaks:
         amp, X = _solve_at(req, condensed, pk.lam, pk.X, at)
@@ -160,7 +151,7 @@ def _combined_target(req: _Request, condensed: bool, peaks, scale: float, level,
             return target
         again.append(_peak_level(req, condensed, dataclasses.replace(pk, X=X, amplitude_m=amp),
                                  scale, at, auto)[0])
-    return (max([at[0]] + [w[0] for w in again]), max([at[1]] + [w[1] for w in again]))
+    return Level(max([at.harmonics] + [w.harmonics for w in again]), max([at.samples] + [w.samples for w in again]))
 
 
 @dataclass(frozen=True)
@@ -168,9 +159,9 @@ class _Refine:
     """What :func:`_fixed_branch` returns where a peak asked for a finer level during the continuation:
     that level, the peak (a :class:`_Candidate`) and the level of the branch it stopped."""
 
-    level: tuple
+    level: Level
     peak: _Candidate = dataclasses.field(repr=False)
-    stopped: tuple
+    stopped: Level
 
 
 @dataclass(frozen=True)
@@ -200,7 +191,7 @@ class _PeakWatch:
     :class:`_Refine`): the rest of it would be discarded, and continuing
     it costs more than the check. A stop is made relative to the peak's own
     amplitude, the finished branch's check relative to its highest peak:
-    :func:`_adaptive_branch` keeps a stop only where the finished branch is
+    :func:`adaptive_branch` keeps a stop only where the finished branch is
     converged and the peak asks for the same level relative to the
     finished branch's highest peak (:func:`_confirmed`). The finished
     branch's peaks are checked again, so a branch that passes here can
@@ -263,8 +254,8 @@ class _PeakWatch:
             return None  # the finished branch decides
         self.target = _Refine(target, pk, self.level)
         name = tr.problem.parameter.name
-        return ContinuationStatus.STOPPED, (f"the peak near {name} = {pk.lam:.6g} asks for H = {target[0]}, "
-                                            f"Ns = {target[1]}")
+        return ContinuationStatus.STOPPED, (f"the peak near {name} = {pk.lam:.6g} asks for "
+                                            f"H = {target.harmonics}, Ns = {target.samples}")
 
 
 def _peak_target(req: _Request, condensed: bool, pk, scale: float, level, auto):
@@ -295,8 +286,8 @@ def _watched_branch(req: _Request, level, auto, levels, retry_failed: bool, watc
         levels.append(level)
         br = _fixed_branch(req, level, auto)
     while retry_failed and br.status is ContinuationStatus.FAILED and auto[1] \
-            and 2 * level[1] <= config.HB_AUTO_MAX_SAMPLES:
-        level = (level[0], 2 * level[1])
+            and 2 * level.samples <= config.HB_AUTO_MAX_SAMPLES:
+        level = Level(level.harmonics, 2 * level.samples)
         levels.append(level)
         br = _fixed_branch(req, level, auto)
     return br, level, stop
@@ -308,9 +299,9 @@ def _worst(values) -> float:
     return max(v) if v else math.nan
 
 
-def _adaptive_branch(req: _Request, level, auto, watch: bool = True) -> HBBranch:
-    """The branch at ``level``, computed again at a finer level while its peaks ask for one (``auto``:
-    which of (harmonics, samples) may change); with its :class:`DiscretisationCheck`.
+def adaptive_branch(req: _Request, disc: Discretisation, watch: bool = True) -> HBBranch:
+    """The branch at the first level of ``disc``, computed again at a finer level while its peaks ask for
+    one (where ``disc`` lets the harmonics or the samples change); with its :class:`DiscretisationCheck`.
 
     With ``watch``, the first branch stops at a passed resonance that asks
     for a finer level (:class:`_PeakWatch`); where the finished branch does
@@ -319,7 +310,8 @@ def _adaptive_branch(req: _Request, level, auto, watch: bool = True) -> HBBranch
     was made at a resonance lower than one found later), the whole choice
     is made again without stops.
     """
-    first = level
+    level = disc.first
+    auto = disc.auto
     levels = [level]
     if not any(auto):
         return _fixed_branch(req, level).branch()
@@ -336,16 +328,18 @@ def _adaptive_branch(req: _Request, level, auto, watch: bool = True) -> HBBranch
     ch_h, ch_s = _worst(c[1][0] for c in checks), _worst(c[1][1] for c in checks)
     converged = not (ch_h > config.HB_AUTO_RTOL or ch_s > config.HB_AUTO_RTOL)
     if stop is not None and not (converged and _confirmed(req, br.problem.condensed, stop, scale, auto)):
-        return _adaptive_branch(req, first, auto, watch=False)
+        return adaptive_branch(req, disc, watch=False)
     check = DiscretisationCheck(harmonics_auto=auto[0], samples_auto=auto[1], levels=tuple(levels),
-                                check_harmonics=by_h[0] if by_h else 0, check_samples=by_s[1] if by_s else 0,
+                                check_harmonics=by_h.harmonics if by_h else 0,
+                                check_samples=by_s.samples if by_s else 0,
                                 harmonics_change=ch_h, samples_change=ch_s, peaks=len(checks),
                                 rtol=config.HB_AUTO_RTOL, converged=converged)
     br = br.branch()
     message = br.message
     if not converged:
-        message += (f"; the peak amplitude is not converged in the discretisation at its bound (H = {level[0]}, "
-                    f"Ns = {level[1]}): it changes by {100 * _worst([ch_h, ch_s]):.3g} % with "
-                    f"{check.check_harmonics or level[0]} harmonics or {check.check_samples or level[1]} samples "
+        message += (f"; the peak amplitude is not converged in the discretisation at its bound "
+                    f"(H = {level.harmonics}, Ns = {level.samples}): it changes by "
+                    f"{100 * _worst([ch_h, ch_s]):.3g} % with {check.check_harmonics or level.harmonics} "
+                    f"harmonics or {check.check_samples or level.samples} samples "
                     f"(tolerance {100 * config.HB_AUTO_RTOL:g} %)")
     return dataclasses.replace(br, discretisation=check, message=message)

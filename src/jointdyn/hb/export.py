@@ -84,7 +84,9 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
                                             "peak_amplitude_m")},
              "point_status": {"flag_meanings": " ".join(s.value for s in PointStatus)},
              "pair_energy_J": {"units": "J", "long_name": "energy dissipated per cycle by each interface pair"},
-             "energy_pairs_J": {"units": "J", "long_name": "energy dissipated per cycle by all interface pairs"},
+             "energy_interface_J": {"units": "J", "long_name": "energy dissipated per cycle by all interface pairs"},
+             "energy_pairs_J": {"units": "J", "long_name": "energy dissipated per cycle by all interface pairs",
+                                "deprecated": "use energy_interface_J"},
              **{f"pair_{s}_fraction": {"units": "1", "long_name": f"fraction of the period the pair is {w}"}
                 for s, w in (("stick", "stuck"), ("slip", "slipping"), ("open", "open"))}}
     # variables built with their attributes (no DataArray round trips afterwards)
@@ -117,11 +119,13 @@ def pair_arrays(branch: HBBranch) -> dict:
 
 
 def _pair_variables(branch: HBBranch) -> dict:
-    """:func:`pair_arrays` as Dataset variables (dims point, pair), with ``energy_pairs_J`` (dim point: the
-    energy all pairs dissipate per cycle, J, which the point table carries)."""
+    """:func:`pair_arrays` as Dataset variables (dims point, pair), with ``energy_interface_J`` (dim point:
+    the energy all pairs dissipate per cycle, J, which the point table carries; ``energy_pairs_J`` is its
+    deprecated duplicate, kept for one release)."""
     out = {name: (("point", "pair"), v) for name, v in pair_arrays(branch).items()}
     if out:
-        out["energy_pairs_J"] = ("point", out["pair_energy_J"][1].sum(axis=1))
+        out["energy_interface_J"] = ("point", out["pair_energy_J"][1].sum(axis=1))
+        out["energy_pairs_J"] = out["energy_interface_J"]
     return out
 
 

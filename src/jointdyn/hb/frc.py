@@ -21,13 +21,33 @@ from .. import config
 from ..continuation import ContinuationOptions, make_options
 from ..systems import System
 from .branch import _forcing_problem, _Request, solve_point
-from .discretisation import _adaptive_branch, first_level
+from .discretisation import adaptive_branch
 from .export import branch_dataset
+from .levels import AUTO, Discretisation, Level, check_memory, discretisation
 from .parameters import GAMMA, parameter_named
-from .problem import HBProblem, reference_scales
-from .results import AUTO, HBBranch, HBSolution
+from .problem import HBProblem, reference_scales, stuck_stiffness
+from .results import HBBranch, HBSolution, SolveStatus
 
-__all__ = ["continue_hb", "frc_hb", "harmonic_balance"]
+__all__ = ["continue_hb", "frc_hb", "harmonic_balance", "check_mean_position"]
+
+
+def check_mean_position(system: System) -> None:
+    """ValueError naming the DOF where ``system`` has a rigid-body mode even with every contact stuck and
+    every normal spring (of the contacts and of the interfaces' pairs closed at rest) closed.
+
+    Harmonic balance starts from that static stiffness: a DOF that it holds
+    by nothing has no unique mean position, and Newton would fail on a
+    singular matrix; the time domain takes such a structure.
+    """
+    from ..systems import rigid_mode_dof
+
+    K = stuck_stiffness(system)  # with the normal springs of the contacts and pairs closed at rest
+    dof = rigid_mode_dof(K)
+    if dof is not None:
+        raise ValueError(f"the structure has a rigid-body mode even with every contact stuck and every normal "
+                         f"spring closed (mostly DOF {dof}: held by nothing, K + kt + kn is singular), so its mean "
+                         "position is not unique; harmonic balance needs one: give that DOF a stiffness in K, or "
+                         "use the time domain (--method time)")
 
 
 def continue_hb(system: System, start: float, stop: float, *, parameter="gamma", gamma: float | None = None,
@@ -99,6 +119,9 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
     reference_scales(system)
+    disc = discretisation(harmonics, samples)
+    check_memory(system, disc)
+    check_mean_position(system)
     par = parameter_named(parameter)
     start = V.finite(par.name + " start", start)
     stop = V.finite(par.name + " stop", stop)
@@ -117,10 +140,9 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         max_step = config.HB_MAX_GAMMA_STEP
     if max_step is not None:
         V.positive("max_step", max_step)
-    level, auto = first_level(harmonics, samples)
     req = _Request(system=system, start=start, stop=stop, parameter=par, gamma=gamma, max_step=max_step, dof=dof,
                    options=opt, backward=backward_after_unbounded, progress=progress, condense=condense)
-    return _adaptive_branch(req, level, auto)
+    return adaptive_branch(req, disc)
 
 
 def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: int | str = AUTO,
@@ -214,9 +236,13 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
     Returns
     -------
     HBSolution
-        ``converged`` False when Newton failed (no exception).
+        ``status`` ``not-converged`` (``status.ok`` False) when Newton failed (no exception).
     """
     gamma = V.positive("gamma", gamma)
+    if not isinstance(system, System):
+        raise ValueError("system must be a jointdyn.System")
+    check_memory(system, Discretisation(Level.of(harmonics, samples), False, False))
+    check_mean_position(system)
     # the forcing amplitude as the (fixed) parameter: a problem at this gamma
     problem = _forcing_problem(system, gamma, harmonics, samples, condense)
     X, ok, it = solve_point(problem, gamma, None if guess is None else V.finite_array("guess", guess), tol, max_iter)
@@ -229,6 +255,7 @@ def _make_solution(problem: HBProblem, X, converged, iterations, response_dof) -
     ev = problem.evaluate(X, lam)
     amp, off, mx = problem.amplitudes(X, response_dof, lam)
     stable, growth, mult = problem.hill_stability(ev.JX, problem.omega(lam))
-    return HBSolution(problem=problem, X=X, converged=bool(converged), iterations=int(iterations),
+    status = SolveStatus.CONVERGED if converged else SolveStatus.NOT_CONVERGED
+    return HBSolution(problem=problem, X=X, status=status, iterations=int(iterations),
                       residual_norm=float(np.max(np.abs(ev.R))), amplitude_m=amp, offset_m=off, max_abs_m=mx,
                       stable=stable, growth=growth, multipliers=mult, aft_info=ev.info)

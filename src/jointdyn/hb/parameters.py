@@ -251,12 +251,6 @@ class SystemParameter(HBParameter):
         for what, v in (("start", start), ("stop", stop)):
             V.in_range(f"{self.name} {what}", v, self.lower, self.upper)
 
-    def problem_at(self, problem, p: float):
-        """The harmonic-balance problem of ``build(p)`` at the problem's fixed frequency (cached);
-        condensed onto the same DOFs when ``problem`` is: ``problem.problem_at(p)``
-        (:meth:`jointdyn.hb.HBProblem.problem_at`, which problems call; kept for callers of this name)."""
-        return problem.problem_at(p)
-
     def step(self, p: float) -> float:
         """Central-difference step h at p: ``config.HB_PARAMETER_FD_STEP`` times the scale (or |p|, or 1)."""
         unit = self.scale_value if self.scale_value is not None else (abs(p) if p != 0.0 else 1.0)

@@ -47,6 +47,7 @@ from ..systems import Contact, System
 from ._aft import NO_EVENT, PERIOD_ONE, eval_kernel, recontact_events
 from ._aft_pairs import pair_directions, pairs_aft_kernel
 from ._sparse import linear_entries
+from .levels import Level
 from .parameters import SystemParameter, _FixedFrequency, parameter_named
 from .stability import hill_growth, hill_stability
 
@@ -176,8 +177,7 @@ class HBProblem:
         system.require_phase_loads("harmonic balance")
         if dofs is None:
             dofs = np.arange(system.ndof)
-        self.H = V.positive_int("harmonics", harmonics, 1)
-        self.Ns = V.positive_int("samples", samples, 2 * self.H + 2)
+        self.H, self.Ns = Level.of(harmonics, samples)
         self.parameter = parameter_named(parameter)
         self.gamma_fixed = None
         if self.parameter.needs_gamma:
@@ -626,6 +626,23 @@ def contacts_only(system: System) -> System:
     if not system.interfaces:
         return system
     return _stripped(system)
+
+
+def stuck_stiffness(system: System) -> np.ndarray:
+    """K_reference + sum_c kt_c b_c b_c^T (N/m): the structure with every contact stuck (and every interface
+    pair closed at rest stuck: its springs kt, kt beside the kn of K_reference), the static stiffness that
+    harmonic balance and the linear modes of the nonlinear modes start from."""
+    B = selection_matrix(contact_kinematics(contacts_only(system)), system.ndof)
+    K = system.K_reference.copy()
+    for c, b in zip(system.contacts, B):
+        K += c.law.kt * np.outer(b, b)
+    for itf in system.interfaces:
+        Bi = itf.selection(system.ndof)
+        closed = itf.preload > 0.0
+        for k in range(2):
+            rows = Bi[k::3][closed]
+            K += rows.T @ (itf.kt[closed][:, None] * rows)
+    return K
 
 
 @by_identity

@@ -12,13 +12,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import config
 from ..continuation import ContinuationStatus
 from ..status import Status
 from .parameters import GAMMA
 from .problem import HBProblem
 
-__all__ = ["AUTO", "JOINED", "DiscretisationCheck", "HBBranch", "HBPeak", "HBSolution", "PointStatus", "SolveStatus"]
+__all__ = ["JOINED", "DiscretisationCheck", "HBBranch", "HBPeak", "HBSolution", "PointStatus", "SolveStatus"]
 
 
 class PointStatus(Status):
@@ -36,10 +35,6 @@ class PointStatus(Status):
 #: point statuses joined to the point before them: a branch is drawn as one line per run of them
 #: (:func:`jointdyn.figures.curves.branch_pieces`)
 JOINED = (PointStatus.JOINED.value, PointStatus.CORNER.value)
-
-#: ``harmonics`` / ``samples`` value asking for the automatic choice (:func:`continue_hb`)
-AUTO = config.HB_AUTO
-
 
 @dataclass(frozen=True)
 class DiscretisationCheck:
@@ -235,8 +230,8 @@ class HBSolution:
     problem : HBProblem
     X : ndarray
         Harmonic coefficients (harmonic-major), m.
-    converged : bool
-        Newton converged (``status`` says the same with a message).
+    status : SolveStatus
+        ``converged`` (``status.ok``) or ``not-converged``.
     iterations : int
     residual_norm : float
         max |R| at X, N.
@@ -254,7 +249,7 @@ class HBSolution:
 
     problem: HBProblem
     X: np.ndarray
-    converged: bool
+    status: SolveStatus
     iterations: int
     residual_norm: float
     amplitude_m: float
@@ -264,11 +259,6 @@ class HBSolution:
     growth: float
     multipliers: np.ndarray
     aft_info: np.ndarray
-
-    @property
-    def status(self) -> SolveStatus:
-        """``converged`` or ``not-converged`` (:class:`SolveStatus`)."""
-        return SolveStatus.CONVERGED if self.converged else SolveStatus.NOT_CONVERGED
 
     @property
     def message(self) -> str:

@@ -24,10 +24,10 @@ import math
 import numpy as np
 
 from .. import config
-from ..hb.discretisation import check_levels, first_level, next_level
-from ..hb.results import AUTO
+from ..hb.discretisation import check_levels, next_level
+from ..hb.levels import discretisation
 
-__all__ = ["AUTO", "auto_backbone", "check_points", "level_changes"]
+__all__ = ["auto_backbone", "check_points", "level_changes"]
 
 
 def check_points(backbone) -> np.ndarray:
@@ -62,11 +62,12 @@ def level_changes(backbone, level, auto, mode: int) -> tuple:
         if check is None:
             changes.append(math.nan)
             continue
-        problem = type(b.problem)(system, mode=mode, output_dof=b.output_dof, harmonics=check[0], samples=check[1])
+        problem = type(b.problem)(system, mode=mode, output_dof=b.output_dof, harmonics=check.harmonics,
+                                   samples=check.samples)
         worst = 0.0
         for i in check_points(b):
             w, zeta = b.omega_rad_s[i], b.damping_ratio[i]
-            guess = problem.pack(_padded(b.X[i], n, check[0]), w, b.xi_rad_s[i])
+            guess = problem.pack(_padded(b.X[i], n, check.harmonics), w, b.xi_rad_s[i])
             v, ok, _ = problem.solve(b.amplitude_m[i], guess)
             if not ok:
                 worst = math.inf
@@ -84,10 +85,11 @@ def auto_backbone(fixed, system, amplitude, *, harmonics, samples, mode: int = 1
     """The backbone of ``fixed(system, amplitude, harmonics=H, samples=Ns, mode=mode, **kw)`` (the EPMC
     at one level) at the coarsest level whose check passes (see the module docstring); ``harmonics`` and
     ``samples`` are integers or ``"auto"``."""
-    level, auto = first_level(harmonics, samples)
+    disc = discretisation(harmonics, samples)
+    level, auto = disc.first, disc.auto
     levels = [level]
     while True:
-        b = fixed(system, amplitude, harmonics=level[0], samples=level[1], mode=mode, **kw)
+        b = fixed(system, amplitude, harmonics=level.harmonics, samples=level.samples, mode=mode, **kw)
         if not b.points:
             return b
         ch = level_changes(b, level, auto, mode)

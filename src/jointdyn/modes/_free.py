@@ -24,7 +24,8 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ..kinematics import HarmonicLoad, NormalSpring, contact_kinematics, selection_matrix
+from ..kinematics import HarmonicLoad, NormalSpring
+from ..hb.problem import stuck_stiffness
 from ..systems import System
 
 __all__ = ["LinearMode", "check_free_vibration", "linear_stuck_mode", "output_dof_of", "amplitude_range",
@@ -118,24 +119,6 @@ def output_dof_of(system: System, output_dof) -> int:
     if d >= system.ndof:
         raise ValueError(f"output_dof must be in [0, {system.ndof - 1}], got {output_dof!r}")
     return d
-
-
-def stuck_stiffness(system: System) -> np.ndarray:
-    """K_reference + sum_c kt_c b_c b_c^T (N/m): the structure with every contact stuck (and every interface
-    pair closed at rest stuck: its springs kt, kt beside the kn of K_reference)."""
-    from ..hb.problem import contacts_only
-
-    B = selection_matrix(contact_kinematics(contacts_only(system)), system.ndof)
-    K = system.K_reference.copy()
-    for c, b in zip(system.contacts, B):
-        K += c.law.kt * np.outer(b, b)
-    for itf in system.interfaces:
-        Bi = itf.selection(system.ndof)
-        closed = itf.preload > 0.0
-        for k in range(2):
-            rows = Bi[k::3][closed]
-            K += rows.T @ (itf.kt[closed][:, None] * rows)
-    return K
 
 
 def linear_stuck_mode(system: System, mode: int, output_dof: int) -> LinearMode:

@@ -82,12 +82,10 @@ class Backbone:
         Harmonic coefficients of the mode shape, harmonic-major
         (``X[h * n + i]``: coefficient h of DOF i; the basis of
         :mod:`jointdyn.fourier`), m.
-    energy_contact_J : ndarray (points, contacts)
-        Energy dissipated per cycle by each contact, J (``energy_contact_j``
-        is a deprecated alias).
+    contact_energy_J : ndarray (points, contacts)
+        Energy dissipated per cycle by each contact, J.
     energy_viscous_J : ndarray (points,)
-        Energy dissipated per cycle by C, J (``energy_viscous_j`` is a
-        deprecated alias).
+        Energy dissipated per cycle by C, J.
     counters : dict
         Solver counters (points, residual evaluations, rejected steps, ...).
     problem : object, optional
@@ -119,7 +117,7 @@ class Backbone:
     damping_ratio_viscous: np.ndarray
     modal_amplitude: np.ndarray
     X: np.ndarray
-    energy_contact_J: np.ndarray
+    contact_energy_J: np.ndarray
     energy_viscous_J: np.ndarray
     #: energy dissipated per cycle by each node pair of the interfaces (points, pairs), J (None without)
     pair_energy_J: np.ndarray | None = None
@@ -131,16 +129,6 @@ class Backbone:
     def points(self) -> int:
         """Number of points."""
         return int(self.amplitude_m.size)
-
-    @property
-    def energy_contact_j(self) -> np.ndarray:
-        """Deprecated alias of :attr:`energy_contact_J`."""
-        return self.energy_contact_J
-
-    @property
-    def energy_viscous_j(self) -> np.ndarray:
-        """Deprecated alias of :attr:`energy_viscous_J`."""
-        return self.energy_viscous_J
 
     @property
     def full_output_dof(self) -> int:
@@ -186,6 +174,19 @@ def pair_fractions(backbone: Backbone) -> dict:
     return {k: (v, w) for (k, v), w in zip(out.items(), ("stuck", "slipping", "open"))}
 
 
+#: Dataset variables renamed to the energy rule (docs/architecture.md), new name -> old name: the old one
+#: is written as a deprecated duplicate for one release (CHANGELOG)
+DEPRECATED_VARIABLES = {"contact_energy_J": "energy_contact_J", "energy_interface_J": "energy_pairs_J"}
+
+
+def _deprecated_duplicates(data: dict) -> None:
+    """Add the deprecated duplicates of :data:`DEPRECATED_VARIABLES` to ``data`` (variables by name)."""
+    for new, old in DEPRECATED_VARIABLES.items():
+        if new in data:
+            dims, values, attrs = data[new]
+            data[old] = (dims, values, {**attrs, "deprecated": f"use {new}"})
+
+
 def backbone_dataset(backbone: Backbone):
     """xarray Dataset of a backbone (dim ``point``).
 
@@ -195,11 +196,13 @@ def backbone_dataset(backbone: Backbone):
     ``omega_ratio`` (omega over the linear stuck frequency),
     ``damping_ratio``, ``damping_ratio_contacts``,
     ``damping_ratio_viscous``, ``xi_rad_s``, ``modal_amplitude``,
-    ``energy_viscous_J``; ``energy_contact_J`` (point, contact);
+    ``energy_viscous_J``; ``contact_energy_J`` (point, contact; ``energy_contact_J``
+    is a deprecated duplicate, kept for one release);
     ``mode_shape_m`` (point, coefficient, dof): the harmonic coefficients
     (0, cos 1, sin 1, ..., cos H, sin H); ``harmonic_amplitude_m`` (point,
     harmonic, dof); with interfaces (dim ``pair``: their node pairs one after the other) ``pair_energy_J``
-    (energy per cycle of each pair, J), ``energy_pairs_J`` (dim point: their sum, J) and
+    (energy per cycle of each pair, J), ``energy_interface_J`` (dim point: their sum, J;
+    ``energy_pairs_J`` is a deprecated duplicate) and
     ``pair_stick_fraction``, ``pair_slip_fraction``, ``pair_open_fraction`` (of the period; the data of a
     slip map, :func:`pair_fractions`). Attributes: ``method``, ``status``, ``message``,
     ``linear_mode`` (the linear stuck mode it starts from; the name
@@ -236,7 +239,7 @@ def backbone_dataset(backbone: Backbone):
         "xi_rad_s": (point, b.xi_rad_s, {"units": "1/s", "long_name": "self-excitation coefficient"}),
         "modal_amplitude": (point, b.modal_amplitude, {"units": "kg^0.5 m"}),
         "energy_viscous_J": (point, b.energy_viscous_J, {"units": "J", "long_name": "energy dissipated per cycle by C"}),
-        "energy_contact_J": (("point", "contact"), b.energy_contact_J,
+        "contact_energy_J": (("point", "contact"), b.contact_energy_J,
                              {"units": "J", "long_name": "energy dissipated per cycle by each contact"}),
         "mode_shape_m": (("point", "coefficient", "dof"), X, {"units": "m"}),
         "harmonic_amplitude_m": (("point", "harmonic", "dof"), _harmonic_amplitudes(b.X, H, n), {"units": "m"}),
@@ -244,11 +247,12 @@ def backbone_dataset(backbone: Backbone):
     if b.pair_energy_J is not None:
         data["pair_energy_J"] = (("point", "pair"), b.pair_energy_J,
                                  {"units": "J", "long_name": "energy dissipated per cycle by each interface pair"})
-        data["energy_pairs_J"] = (point, b.pair_energy_J.sum(axis=1),
-                                  {"units": "J", "long_name": "energy dissipated per cycle by all interface pairs"})
+        data["energy_interface_J"] = (point, b.pair_energy_J.sum(axis=1),
+                                      {"units": "J", "long_name": "energy dissipated per cycle by all interface pairs"})
         for key, (values, what) in pair_fractions(b).items():
             data[f"pair_{key}_fraction"] = (("point", "pair"), values,
                                             {"units": "1", "long_name": f"fraction of the period the pair is {what}"})
+    _deprecated_duplicates(data)
     variables = {k: xr.Variable(dims, np.asarray(v), attrs=a) for k, (dims, v, a) in data.items()}
     coords = {"point": np.arange(b.points), "contact": np.arange(len(s.contacts)),
               "coefficient": np.arange(2 * H + 1), "harmonic": np.arange(H + 1), "dof": np.arange(n)}

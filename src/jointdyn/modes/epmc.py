@@ -67,6 +67,7 @@ from ..continuation import (ContinuationOptions, ContinuationStatus, ParameterPr
 from ..fourier import derivative_matrix
 from ..hb import HBProblem
 from ..hb._sparse import linear_entries
+from ..hb.levels import AUTO, check_memory, discretisation
 from ..hb.problem import contacts_only
 from ..kinematics import contact_kinematics, selection_matrix
 from ._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
@@ -318,7 +319,7 @@ def _points(problem: EPMCProblem, lam, V, stash):
                                       "damping_ratio_contacts", "damping_ratio_viscous", "modal_amplitude",
                                       "energy_viscous_J")}
     out["X"] = np.empty((p, problem.size))
-    out["energy_contact_J"] = np.empty((p, nc))
+    out["contact_energy_J"] = np.empty((p, nc))
     for i in range(p):
         X, w, xi = problem.unpack(V[i], lam[i])
         ev = stash.get(X.tobytes())
@@ -334,7 +335,7 @@ def _points(problem: EPMCProblem, lam, V, stash):
         out["damping_ratio_viscous"][i] = visc / (2.0 * w * kin)
         out["modal_amplitude"][i] = problem.modal_amplitude(X)
         out["energy_viscous_J"][i] = visc
-        out["energy_contact_J"][i] = contact
+        out["contact_energy_J"][i] = contact
         if pairs is not None:
             out.setdefault("pair_energy_J", np.empty((p, pairs.size)))[i] = pairs
         out["X"][i] = X
@@ -416,7 +417,8 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         modes against the full model's; :meth:`Backbone.full_shape`: the
         harmonics of the mode shape on the full model's DOFs).
     """
-    if harmonics == config.HB_AUTO or samples == config.HB_AUTO:
+    check_memory(system, discretisation(harmonics, samples))
+    if harmonics == AUTO or samples == AUTO:
         from ._auto import auto_backbone
 
         return auto_backbone(epmc, system, amplitude, harmonics=harmonics, samples=samples, mode=mode,

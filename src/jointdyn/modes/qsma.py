@@ -283,6 +283,6 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     return Backbone(method="qsma", status=status, message=message, system=system, linear=linear,
                     output_dof=out_dof, harmonics=1, samples=0, amplitude_m=x[:, out_dof].copy(), omega_rad_s=w,
                     xi_rad_s=2.0 * (Dc + Dv) * w, damping_ratio=Dc + Dv, damping_ratio_contacts=Dc,
-                    damping_ratio_viscous=Dv, modal_amplitude=np.sqrt(xMx), X=X, energy_contact_J=E,
+                    damping_ratio_viscous=Dv, modal_amplitude=np.sqrt(xMx), X=X, contact_energy_J=E,
                     energy_viscous_J=np.pi * w * xCx, counters={"points": int(x.shape[0]),
                                                                  "push_steps": int(reached)})

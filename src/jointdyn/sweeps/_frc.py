@@ -72,6 +72,8 @@ __all__ = [
     "frc_sweep",
     "LineSpec",
     "STATUS_CODES",
+    "NOT_COMPUTED",
+    "NOT_COMPUTED_NAME",
     "VARIABLES",
     "INT_VARIABLES",
     "DOF_VARIABLES",
@@ -84,7 +86,6 @@ __all__ = [
     "default_workers",
 ]
 
-_MISSING = NOT_COMPUTED
 _LEGEND = ", ".join(f"{s.code}: {s.value}" for s in SteadyStatus) + f", {NOT_COMPUTED}: {NOT_COMPUTED_NAME}"
 _DIRECTIONS = ("up", "down")
 #: keyword arguments that describe the paper damper's grid (not a System's)
@@ -179,6 +180,19 @@ def _family(system_or_grid, gammas, paper: dict):
                        law_params=law_params, zeta=0.0 if paper.get("zeta") is None else paper["zeta"],
                        overrides={k: paper.get(k) for k in ("m", "k", "kt", "mu", "n0")})
     return fam, system_or_grid
+
+
+def _check_steps(family, grid, spp, lines: int) -> None:
+    """The steps of a forcing period at the lowest gamma (the most) of every System fit the memory bound
+    for ``lines`` lines run at once (:func:`jointdyn.dynamics.check_period_steps`): refused before
+    anything is computed, not point by point."""
+    from ..dynamics import check_period_steps
+
+    for _, label, system in family.entries:
+        try:
+            check_period_steps(system, float(min(grid)) * system.w0, spp, lines=lines)
+        except ValueError as exc:
+            raise ValueError(f"system {label!r}: {exc}" if len(family.entries) > 1 else str(exc)) from None
 
 
 def _grid(gammas) -> tuple:
@@ -412,6 +426,7 @@ def frc_sweep(
     if n_workers is not None:
         n_workers = V.positive_int("n_workers", n_workers)
     _check_client(client)
+    _check_steps(family, g, spp, 1 if len(directions) == 1 or n_workers == 1 else 2)
     dofs = _dofs(dofs, family)
     loop_outputs = (not family.dims or family.dims == ("system",)) if loop_outputs is None else bool(loop_outputs)
     if out is not None:  # before computing: no finished chunk is lost to an unwritable out
@@ -506,11 +521,12 @@ def _assemble(family, runs, directions, g, dofs, spp, loop_outputs):
     reasons = config.SWEEP_NOT_SETTLED_REASONS
     data["not_settled_reason"][2].update(flag_values=np.arange(len(reasons), dtype=np.int32),
                                          flag_meanings=" ".join(reasons))
-    data["status"] = (dims, _stack(runs, family, directions, "status", (m,), np.int8, _MISSING), {
+    data["status"] = (dims, _stack(runs, family, directions, "status", (m,), np.int8, NOT_COMPUTED), {
         "legend": _LEGEND,
         "flag_values": np.array([s.code for s in SteadyStatus], dtype=np.int8),
         "flag_meanings": " ".join(s.value for s in SteadyStatus),
-        "missing_code": _MISSING,
+        "not_computed_code": NOT_COMPUTED,
+        "missing_code": NOT_COMPUTED,  # deprecated duplicate of not_computed_code (CHANGELOG)
     })
     coords = dict(family.coords)
     coords["direction"] = (("direction",), np.asarray(directions, dtype="U4"), {})

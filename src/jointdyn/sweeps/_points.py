@@ -50,8 +50,6 @@ STATUS_CODES = {s.value: s.code for s in SteadyStatus}
 #: code of a point that was not computed (never written by a finished sweep), and its name
 NOT_COMPUTED = -1
 NOT_COMPUTED_NAME = "not-computed"
-#: deprecated alias of :data:`NOT_COMPUTED`
-MISSING = NOT_COMPUTED
 
 #: float result variables of a point, with units and meaning
 VARIABLES = {

@@ -16,7 +16,8 @@ periodic orbits that differ by more than ``rtol`` somewhere between the
 outermost folds (``confirmed``), whether they agree there (``not-seen``:
 the fold is not confirmed), or whether the time domain finds no periodic
 steady state between them in at least one direction (``not-periodic``:
-nothing to compare). ``docs/scripts/hb_robustness.py --folds`` writes the
+nothing to compare; not ok, as the robustness grid counts a peak it cannot
+compare, :data:`jointdyn.validation.hb_grid.NOT_COMPARED`). ``docs/scripts/hb_robustness.py --folds`` writes the
 table of the grid's folds into ``docs/hb-robustness.md``.
 """
 
@@ -26,8 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..dynamics import SteadyStatus
 from ..status import Status
-from ..sweeps import STATUS_CODES
 from .hb_grid import GRID_GAMMA
 
 __all__ = ["FoldCheck", "FoldVerdict", "fold_check", "fold_table"]
@@ -40,7 +41,7 @@ MIN_MARGIN = 1e-3
 #: points strictly between two neighbouring folds
 INNER_POINTS = 5
 #: periodic status code of a sweep's points (``frc_sweep``'s ``status`` variable)
-PERIODIC = STATUS_CODES["periodic"]
+PERIODIC = SteadyStatus.PERIODIC.code
 
 
 class FoldVerdict(Status):

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import config
+from ..continuation import ContinuationStatus
 from ..status import Status
 
 __all__ = ["GRID_MODELS", "GRID_ETAS", "GRID_BETAS", "GRID_GAMMA", "GridCase", "Verdict", "grid_case",
@@ -62,7 +63,8 @@ class Verdict(Status):
     NO_PEAK = "no-peak", "no peak to compare (unbounded, or the amplitude has no maximum)", True
     PEAK_IN_JUMP = ("peak-in-a-jump", "the highest amplitude lies at a jump of the branch, above every peak "
                     "found: the peak between the jump's ends is not resolved")
-    NOT_PERIODIC = "not-periodic", "the time domain found no periodic steady state at the peak", True
+    NOT_PERIODIC = ("not-periodic", "the time domain found no periodic steady state at the peak: nothing to "
+                    "compare (not compared)")
     SUBHARMONIC = ("subharmonic", "the time-domain steady state repeats only every p > 1 forcing periods: "
                    "a period-one harmonic balance cannot be that orbit (not compared)")
     NOT_UNIQUE = ("not-unique", "the time-domain steady state depends on the start (from the harmonic-balance "
@@ -77,17 +79,21 @@ class GridCase:
     ----------
     model : str
     eta, beta : float
-    status : str
-        Branch status (``complete``, ``unbounded``, ``failed``, ...).
+    status : ContinuationStatus
+        The branch's status (``complete``, ``unbounded``, ``failed``, ...):
+        what the branch delivered, with its own ``ok``.
     covered : bool
-        The branch covers the range, or is unbounded with beta below Den
-        Hartog's bound.
+        What the grid asks of the branch: it covers the range, or is
+        unbounded with beta below Den Hartog's bound (where friction cannot
+        bound the resonance).
     ok : bool
-        The branch covers the range, or is unbounded with beta below Den
-        Hartog's bound, and its highest peak (if any, where the time
-        domain is periodic) is within ``rtol`` of the time domain. False
-        also where the peak could not be compared (``verdict``
-        ``subharmonic`` or ``not-unique``): the table marks those ``n/c``.
+        Whether the case delivers what the grid asks: ``covered`` and the
+        ``verdict`` of the time-domain check ``ok`` (the peak agrees, or
+        there is none). A covered case whose peak could not be compared
+        (:data:`NOT_COMPARED`: the time domain is subharmonic, depends on the
+        start or is not periodic) is not ok: the table marks it ``n/c``,
+        as :mod:`jointdyn.validation.hb_folds` counts a fold check with
+        nothing to compare.
     points, folds, unstable : int
         Points, folds and unstable points of the branch.
     peak_gamma, peak_q : float
@@ -117,7 +123,7 @@ class GridCase:
     model: str
     eta: float
     beta: float
-    status: str
+    status: ContinuationStatus
     covered: bool
     ok: bool
     points: int
@@ -147,8 +153,8 @@ def grid_case(model: str, eta: float, beta: float, gamma=GRID_GAMMA, *, time_dom
     br = continue_hb(system, gamma[0], gamma[1], max_step=gamma[2], progress=False)
     ds = branch_dataset(br)
     seconds = time.process_time() - t0
-    status = str(ds.attrs["status"])
-    covered = status == "complete" or (status == "unbounded" and beta < DEN_HARTOG_BETA)
+    status = br.status
+    covered = status.ok or (status is ContinuationStatus.UNBOUNDED and beta < DEN_HARTOG_BETA)
     g_pk, q_pk = float(ds.attrs["peak_gamma"]), float(ds.attrs["peak_amplitude_q"])
     if _highest_at_jump(ds, q_pk):
         check = (Verdict.PEAK_IN_JUMP, math.nan, 0, math.nan)
@@ -217,15 +223,15 @@ def _time_check(system, br, g_pk: float, q_pk: float, rtol: float):
     top = max(br.peaks, key=lambda pk: pk.amplitude_q)
     ss = steady_state(system, g_pk, start=hb_restart(system, top.X, g_pk, br.problem.H))
     q_td = law.kt * ss.amplitude_m / law.fy
-    if ss.status != "periodic":
+    if not ss.status.ok:
         return Verdict.NOT_PERIODIC, math.nan, 0, math.nan
     if ss.period_multiple > 1:
         return Verdict.SUBHARMONIC, q_td, ss.period_multiple, math.nan
     if abs(q_pk - q_td) <= rtol * q_td:
         return Verdict.AGREES, q_td, 1, math.nan
     rest = steady_state(system, g_pk)
-    q_rest = law.kt * rest.amplitude_m / law.fy if rest.status == "periodic" else math.nan
-    if rest.status == "periodic" and rest.period_multiple == 1 and abs(q_rest - q_td) > rtol * q_td:
+    q_rest = law.kt * rest.amplitude_m / law.fy if rest.status.ok else math.nan
+    if rest.status.ok and rest.period_multiple == 1 and abs(q_rest - q_td) > rtol * q_td:
         return Verdict.NOT_UNIQUE, q_td, 1, q_rest
     return Verdict.DIFFERS, q_td, 1, q_rest
 
@@ -269,13 +275,18 @@ def _ok_mark(c: GridCase, apart) -> str:
     return "yes" if c.ok else ("n/c" if c.covered and c.verdict in apart else "**no**")
 
 
+#: verdicts where the peak is not compared with the time domain (no periodic orbit that a period-one
+#: harmonic balance can be): neither a pass nor a failure
+NOT_COMPARED = (Verdict.SUBHARMONIC, Verdict.NOT_UNIQUE, Verdict.NOT_PERIODIC)
+
+
 def grid_table(cases) -> str:
     """Markdown table of grid cases (one row each) and a summary line."""
     cases = list(cases)
     head = ("| model | eta | beta | status | points | folds | unstable | peak gamma | peak q | time-domain q | "
             "error | check | H x Ns | CPU s | ok |")
     lines = [head, "|" + "---|" * 15]
-    apart = (Verdict.SUBHARMONIC, Verdict.NOT_UNIQUE)
+    apart = NOT_COMPARED
     for c in cases:
         check = c.verdict.value
         if c.verdict is Verdict.SUBHARMONIC:
@@ -289,8 +300,8 @@ def grid_table(cases) -> str:
     nc = [sum(c.covered and c.verdict is v for c in cases) for v in apart]
     lines.append("")
     lines.append(f"{sum(c.ok for c in cases)} of {len(cases)} cases pass, {sum(nc)} not compared (time-domain "
-                 f"steady state subharmonic: {nc[0]}, dependent on the start: {nc[1]}), "
+                 f"steady state subharmonic: {nc[0]}, dependent on the start: {nc[1]}, not periodic: {nc[2]}), "
                  f"{sum(not c.ok and _ok_mark(c, apart) != 'n/c' for c in cases)} fail; "
-                 f"{sum(c.status == 'complete' for c in cases)} branches complete; CPU time of the branches "
+                 f"{sum(c.status.ok for c in cases)} branches complete; CPU time of the branches "
                  f"{sum(c.seconds for c in cases):.1f} s.")
     return "\n".join(lines)
