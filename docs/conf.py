@@ -230,6 +230,8 @@ def constant_values(app, what, name, obj, options, lines):
     tuple, dict...) has no docstring of its own, and autodoc would show its
     type's (``int([x]) -> integer``); show its value instead."""
     own = type(obj).__doc__
+    if not isinstance(own, str):  # a named tuple's field: its type's __doc__ is a slot descriptor
+        return
     if what in ("data", "attribute") and own and lines and lines[0].strip() == own.strip().splitlines()[0].strip():
         text = repr(obj)
         lines[:] = [f"Value: ``{text if len(text) <= 300 else text[:300] + ' ...'}``"]

@@ -196,10 +196,11 @@ CONT_KRYLOV_REFRESH = 8
 CONT_SPARSE_DENSITY = 0.02
 #: ... while its factors hold at most this fraction of N^2 entries (else dense
 #: from then on: SuperLU on a matrix that fills in completely costs about 5x
-#: dense LAPACK). As the pairs of the 167-node chain slip, their blocks couple
-#: all harmonics and the fill grows: measured at 5512 unknowns, fill 0.17 took
-#: 0.24 s against 2.7-8.7 s for dense LAPACK (2 cores, loaded), fill 0.083
-#: 0.10-0.18 s; the former bound 0.05 sent that walk to dense LAPACK
+#: dense LAPACK). The bound sits above the fill of the walks where SuperLU
+#: still wins: as the pairs of the 167-node chain slip, their blocks couple
+#: all harmonics and the fill grows; at 5512 unknowns fill 0.17 takes 0.24 s
+#: against 2.7-8.7 s for dense LAPACK, fill 0.083 0.10-0.18 s, so a bound
+#: below 0.17 would send that walk to the slower dense solve
 CONT_SPARSE_FILL = 0.25
 #: SuperLU's thresholds for preferring the diagonal pivot, tried in turn until
 #: the solution's true residual is at most CONT_KRYLOV_RTOL |b| (0: the

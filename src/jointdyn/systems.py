@@ -180,8 +180,8 @@ class System:
         the motion (docs/model.md section 10). The quasi-static driver
         (:func:`jointdyn.drivers.interface_loop`) and the time integration
         (:func:`jointdyn.integrate`, :func:`jointdyn.steady_state`) march
-        them; harmonic balance and nonlinear modes refuse a System with
-        interfaces (they do not take them yet).
+        them; harmonic balance and EPMC evaluate them in the AFT
+        (:mod:`jointdyn.hb._aft_pairs`); QSMA refuses them.
     """
 
     M: np.ndarray
@@ -269,12 +269,6 @@ class System:
                     K += kn * np.outer(v, v)
         return K
 
-    def require_no_interfaces(self, solver: str) -> None:
-        """ValueError naming ``interfaces`` if the System has any (for solvers that do not take them)."""
-        if self.interfaces:
-            raise ValueError(f"interfaces: {solver} does not take interfaces yet (the System has "
-                             f"{len(self.interfaces)}); their quasi-static loops are jointdyn.drivers.interface_loop")
-
     @functools.cached_property
     def w0(self) -> float:
         """Reference frequency of gamma = w / w0, rad/s.
@@ -302,13 +296,6 @@ class System:
             lam = np.linalg.eigvalsh(0.5 * A + 0.5 * A.T)
         elastic = lam[lam > config.SYSTEM_RIGID_MODE_RTOL * lam[-1]]
         return math.sqrt(elastic[0]) if elastic.size and lam[-1] > 0.0 else 0.0
-
-    def require_in_phase_forcing(self, solver: str) -> None:
-        """ValueError naming ``force_phase_deg`` if a forcing phase is not 0
-        (for solvers that take the forcing as f sin(w t))."""
-        if np.any(self.force_phase_deg != 0.0):
-            raise ValueError(f"force_phase_deg: {solver} takes in-phase forcing only (all phases 0), "
-                             f"got {self.force_phase_deg.tolist()}")
 
     def require_phase_loads(self, solver: str) -> None:
         """ValueError naming the key if a contact has a sampled normal load

@@ -91,9 +91,12 @@ def reason_name(status_code, reason_code):
 def status_cell(r, i: int) -> str:
     """The status of point ``i`` of a sweep direction for the table: a
     steady state that repeats every K > 1 forcing periods is ``periodic-KT``."""
+    from ..dynamics.status import SteadyStatus
+
     status = r["status"][i]
     multiple = r.get("period_multiple", [1] * (i + 1))[i]
-    return f"{status}-{multiple}T" if status == "periodic" and multiple > 1 else status
+    periodic = status in {s.value for s in SteadyStatus if s.ok}
+    return f"{status}-{multiple}T" if periodic and multiple > 1 else status
 
 
 #: what each not-settled reason means, for the notes under the table

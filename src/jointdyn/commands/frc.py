@@ -593,10 +593,13 @@ def _plot_hb(ax, result) -> None:
             ax.plot([pk["gamma"]], [report.peak_value(pk, result)], "^", color="C2", ms=5,
                     mfc="none" if pk.get("at_stop") else "C2", label=name if name not in first else None)
             first[name] = True
-    what = "no bounded response" if result["status"] == "unbounded" else "not computed"
+    from ..continuation import ContinuationStatus
+
+    status = ContinuationStatus(result["status"])
+    what = "no bounded response" if status is ContinuationStatus.UNBOUNDED else "not computed"
     for k, (a, b) in enumerate(result["uncovered"]):
         ax.axvspan(a, b, facecolor="0.9", edgecolor="0.6", hatch="//", lw=0, label=what if k == 0 else None)
-    if result["status"] != "complete":
+    if not status.ok:
         ax.text(0.01, 0.98, f"status: {result['status']}", transform=ax.transAxes, va="top", fontsize=8,
                 color="C3")
     ax.legend(fontsize=8)

@@ -326,8 +326,9 @@ class Model:
         Mid-separation of the first contact whose prescribed load opens (the
         minimum of a harmonic or sampled load), if every contact is open
         there; there the law states are reset, so (x, v) is the whole state
-        of the period map. A spring contact's opening depends on the motion
-        (:func:`open_section`).
+        of the period map. A normal spring's opening depends on the motion,
+        unknown before the period is run: it never sets the section (0 where
+        only springs open).
         """
         kin = self.pack.kin
         for c in range(self.nc):

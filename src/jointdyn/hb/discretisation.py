@@ -26,33 +26,34 @@ from .levels import Discretisation, Level
 from .results import DiscretisationCheck, HBBranch, HBPeak
 
 
-def _fixed_branch(req: _Request, level: Level, auto=(False, False), watch: bool = False):
+def _fixed_branch(req: _Request, level: Level, disc: Discretisation | None = None, watch: bool = False):
     """The branch at ``level``: a :class:`~jointdyn.hb.branch._Draft`,
     or, with ``watch``, a :class:`_Refine` where a peak asked for a finer level while the branch was continued
-    (``auto``: which of (harmonics, samples) may change; :class:`_PeakWatch`)."""
-    watch_for = (lambda tr, opt: _PeakWatch(tr, req, level, auto, opt)) if watch and any(auto) else None
+    (``disc``: which of the harmonics and the samples may change; :class:`_PeakWatch`)."""
+    watch_for = (lambda tr, opt: _PeakWatch(tr, req, level, disc, opt)) \
+        if watch and disc is not None and (disc.harmonics_auto or disc.samples_auto) else None
     return continued_branch(req, level, watch_for)
 
 
-def check_levels(level: Level, auto):
+def check_levels(level: Level, disc: Discretisation):
     """The :class:`Level` of the harmonics check and of the samples check one level above ``level``
     (None: not made)."""
     H, Ns = level
     h2 = 2 * H + 1
-    by_h = Level(h2, max(Ns, 2 * h2 + 2) if auto[1] else Ns) if auto[0] else None
+    by_h = Level(h2, max(Ns, 2 * h2 + 2) if disc.samples_auto else Ns) if disc.harmonics_auto else None
     if by_h is not None and by_h.samples < 2 * h2 + 2:
         by_h = None  # the samples fixed by the caller cannot carry more harmonics
-    return by_h, (Level(H, 2 * Ns) if auto[1] else None)
+    return by_h, (Level(H, 2 * Ns) if disc.samples_auto else None)
 
 
-def next_level(level: Level, auto, bad_h: bool, bad_s: bool) -> Level:
+def next_level(level: Level, disc: Discretisation, bad_h: bool, bad_s: bool) -> Level:
     """The level the checks ask for, within ``config.HB_AUTO_MAX_*`` (equal to ``level``: no refinement).
 
     The samples first: with too few, the sampling error of the contact
     force also moves the solution with more harmonics, so H is raised
     only once the samples pass their check.
     """
-    by_h, by_s = check_levels(level, auto)
+    by_h, by_s = check_levels(level, disc)
     if bad_s and by_s is not None:
         return by_s if by_s.samples <= config.HB_AUTO_MAX_SAMPLES else level
     if bad_h and by_h is not None and by_h.harmonics <= config.HB_AUTO_MAX_HARMONICS:
@@ -100,7 +101,7 @@ def _change(amp: float, ref: float, scale: float) -> float:
     return abs(amp - ref) / scale if math.isfinite(amp) and scale > 0 else math.inf
 
 
-def _peak_level(req: _Request, condensed: bool, pk: HBPeak, scale: float, level, auto):
+def _peak_level(req: _Request, condensed: bool, pk: HBPeak, scale: float, level, disc):
     """(level at which the peak converges (or the bound), (harmonics change, samples change) at ``level``).
 
     The peak is solved with more harmonics and with more samples
@@ -110,17 +111,17 @@ def _peak_level(req: _Request, condensed: bool, pk: HBPeak, scale: float, level,
     ``config.HB_AUTO_RTOL`` the peak is solved at the refined level and
     checked there again.
     """
-    return _peak_levels(req, condensed, pk, scale, level, auto)[:2]
+    return _peak_levels(req, condensed, pk, scale, level, disc)[:2]
 
 
-def _peak_levels(req: _Request, condensed: bool, pk, scale: float, level, auto):
+def _peak_levels(req: _Request, condensed: bool, pk, scale: float, level, disc):
     """:func:`_peak_level`, and whether the peak's check passed at the level returned (not at a bound)."""
     at, X, amp, first = level, pk.X, pk.amplitude_m, None
     while True:
-        solved = {lv: _solve_at(req, condensed, pk.lam, X, lv) for lv in check_levels(at, auto) if lv}
-        ch = tuple(_change(solved[lv][0], amp, scale) if lv else math.nan for lv in check_levels(at, auto))
+        solved = {lv: _solve_at(req, condensed, pk.lam, X, lv) for lv in check_levels(at, disc) if lv}
+        ch = tuple(_change(solved[lv][0], amp, scale) if lv else math.nan for lv in check_levels(at, disc))
         first = ch if first is None else first
-        nxt = next_level(at, auto, ch[0] > config.HB_AUTO_RTOL, ch[1] > config.HB_AUTO_RTOL)
+        nxt = next_level(at, disc, ch[0] > config.HB_AUTO_RTOL, ch[1] > config.HB_AUTO_RTOL)
         if nxt == at:
             return at, first, not (ch[0] > config.HB_AUTO_RTOL or ch[1] > config.HB_AUTO_RTOL)
         amp, X = solved[nxt] if nxt in solved else _solve_at(req, condensed, pk.lam, X, nxt)
@@ -129,7 +130,7 @@ def _peak_levels(req: _Request, condensed: bool, pk, scale: float, level, auto):
             return at, first, False
 
 
-def _combined_target(req: _Request, condensed: bool, peaks, scale: float, level, auto, wanted):
+def _combined_target(req: _Request, condensed: bool, peaks, scale: float, level, disc, wanted):
     """The level of the next branch: the most harmonics and the most samples that the peaks ask for
     (``wanted``: their levels from :func:`_peak_level`).
 
@@ -150,7 +151,7 @@ def _combined_target(req: _Request, condensed: bool, peaks, scale: float, level,
         if not math.isfinite(amp):
             return target
         again.append(_peak_level(req, condensed, dataclasses.replace(pk, X=X, amplitude_m=amp),
-                                 scale, at, auto)[0])
+                                 scale, at, disc)[0])
     return Level(max([at.harmonics] + [w.harmonics for w in again]), max([at.samples] + [w.samples for w in again]))
 
 
@@ -198,8 +199,8 @@ class _PeakWatch:
     still be refined.
     """
 
-    def __init__(self, tr: _Tracker, req: _Request, level, auto, opt: ContinuationOptions):
-        self.tr, self.req, self.level, self.auto, self.opt = tr, req, level, auto, opt
+    def __init__(self, tr: _Tracker, req: _Request, level, disc, opt: ContinuationOptions):
+        self.tr, self.req, self.level, self.disc, self.opt = tr, req, level, disc, opt
         self.points = []  # (log q, lam scaled, y) of the segment's accepted points
         self.top = None  # index in points of the highest point not checked yet
         self.checked = -math.inf  # log q of the highest point checked
@@ -232,7 +233,7 @@ class _PeakWatch:
         xs, _, ps = tr.scales
         g, lam_s, y = self.points[i]
         condensed = tr.problem.condensed
-        by_h, by_s = check_levels(self.level, self.auto)
+        by_h, by_s = check_levels(self.level, self.disc)
         first = by_s if by_s is not None else by_h  # the cheaper check (more samples are checked first)
         if first is None or i == 0:
             return None
@@ -249,7 +250,7 @@ class _PeakWatch:
         if not g_pk >= g:
             y_pk, lam_pk = y, lam_s
         pk = _Candidate(lam=float(lam_pk * ps), X=y_pk * xs, amplitude_m=float(tr.amplitudes(y_pk)[0]))
-        target, converged = _peak_target(self.req, condensed, pk, pk.amplitude_m, self.level, self.auto)
+        target, converged = _peak_target(self.req, condensed, pk, pk.amplitude_m, self.level, self.disc)
         if not converged or target == self.level:
             return None  # the finished branch decides
         self.target = _Refine(target, pk, self.level)
@@ -258,38 +259,38 @@ class _PeakWatch:
                                             f"H = {target.harmonics}, Ns = {target.samples}")
 
 
-def _peak_target(req: _Request, condensed: bool, pk, scale: float, level, auto):
+def _peak_target(req: _Request, condensed: bool, pk, scale: float, level, disc):
     """(the level the peak alone asks for, checked from ``level`` with its changes relative to
     ``scale``; whether its check passed there)."""
-    wanted, _, converged = _peak_levels(req, condensed, pk, scale, level, auto)
-    return _combined_target(req, condensed, [pk], scale, level, auto, [wanted]), converged
+    wanted, _, converged = _peak_levels(req, condensed, pk, scale, level, disc)
+    return _combined_target(req, condensed, [pk], scale, level, disc, [wanted]), converged
 
 
-def _confirmed(req: _Request, condensed: bool, stop: _Refine, scale: float, auto) -> bool:
+def _confirmed(req: _Request, condensed: bool, stop: _Refine, scale: float, disc) -> bool:
     """Whether the peak that stopped a branch asks for the same level with its changes relative to
     ``scale`` (the highest peak of the finished branch) as relative to its own amplitude."""
-    return _peak_target(req, condensed, stop.peak, scale, stop.stopped, auto) == (stop.level, True)
+    return _peak_target(req, condensed, stop.peak, scale, stop.stopped, disc) == (stop.level, True)
 
 
-def _watched_branch(req: _Request, level, auto, levels, retry_failed: bool, watch: bool):
+def _watched_branch(req: _Request, level, disc, levels, retry_failed: bool, watch: bool):
     """(branch, its level, the :class:`_Refine` of a stop or None): :func:`_fixed_branch` at ``level``
     (with ``watch``, watched by a :class:`_PeakWatch`), computed again at the level a peak asks for where
     one stops it, and with twice the samples where a branch asked for fails (after a stop by a peak, or
     where ``retry_failed``: a finer level may fail where the coarser went on, because a closed form's
     force jumps with the normal load and Newton fails at one sampling and not at the next). Each further
     level is appended to ``levels``."""
-    br = _fixed_branch(req, level, auto, watch=watch)
+    br = _fixed_branch(req, level, disc, watch=watch)
     stop = None
     if isinstance(br, _Refine):
         stop = br
         level, retry_failed = stop.level, True
         levels.append(level)
-        br = _fixed_branch(req, level, auto)
-    while retry_failed and br.status is ContinuationStatus.FAILED and auto[1] \
+        br = _fixed_branch(req, level, disc)
+    while retry_failed and br.status is ContinuationStatus.FAILED and disc.samples_auto \
             and 2 * level.samples <= config.HB_AUTO_MAX_SAMPLES:
         level = Level(level.harmonics, 2 * level.samples)
         levels.append(level)
-        br = _fixed_branch(req, level, auto)
+        br = _fixed_branch(req, level, disc)
     return br, level, stop
 
 
@@ -311,26 +312,25 @@ def adaptive_branch(req: _Request, disc: Discretisation, watch: bool = True) -> 
     is made again without stops.
     """
     level = disc.first
-    auto = disc.auto
     levels = [level]
-    if not any(auto):
+    if not (disc.harmonics_auto or disc.samples_auto):
         return _fixed_branch(req, level).branch()
-    br, level, stop = _watched_branch(req, level, auto, levels, False, watch)
+    br, level, stop = _watched_branch(req, level, disc, levels, False, watch)
     while True:
         scale = max([pk.amplitude_m for pk in br.peaks], default=0.0)
-        checks = [_peak_level(req, br.problem.condensed, pk, scale, level, auto) for pk in br.peaks]
-        target = _combined_target(req, br.problem.condensed, br.peaks, scale, level, auto, [c[0] for c in checks])
+        checks = [_peak_level(req, br.problem.condensed, pk, scale, level, disc) for pk in br.peaks]
+        target = _combined_target(req, br.problem.condensed, br.peaks, scale, level, disc, [c[0] for c in checks])
         if target == level:
             break
         levels.append(target)
-        br, level, _ = _watched_branch(req, target, auto, levels, br.status is not ContinuationStatus.FAILED, False)
-    by_h, by_s = check_levels(level, auto)
+        br, level, _ = _watched_branch(req, target, disc, levels, br.status is not ContinuationStatus.FAILED, False)
+    by_h, by_s = check_levels(level, disc)
     ch_h, ch_s = _worst(c[1][0] for c in checks), _worst(c[1][1] for c in checks)
     converged = not (ch_h > config.HB_AUTO_RTOL or ch_s > config.HB_AUTO_RTOL)
-    if stop is not None and not (converged and _confirmed(req, br.problem.condensed, stop, scale, auto)):
+    if stop is not None and not (converged and _confirmed(req, br.problem.condensed, stop, scale, disc)):
         return adaptive_branch(req, disc, watch=False)
-    check = DiscretisationCheck(harmonics_auto=auto[0], samples_auto=auto[1], levels=tuple(levels),
-                                check_harmonics=by_h.harmonics if by_h else 0,
+    check = DiscretisationCheck(harmonics_auto=disc.harmonics_auto, samples_auto=disc.samples_auto,
+                                levels=tuple(levels), check_harmonics=by_h.harmonics if by_h else 0,
                                 check_samples=by_s.samples if by_s else 0,
                                 harmonics_change=ch_h, samples_change=ch_s, peaks=len(checks),
                                 rtol=config.HB_AUTO_RTOL, converged=converged)

@@ -62,11 +62,6 @@ class Discretisation:
     harmonics_auto: bool
     samples_auto: bool
 
-    @property
-    def auto(self) -> tuple:
-        """(harmonics automatic, samples automatic)."""
-        return self.harmonics_auto, self.samples_auto
-
 
 def _count_or_auto(name: str, value, minimum: int):
     if isinstance(value, str) and value == AUTO:

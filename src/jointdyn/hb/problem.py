@@ -43,7 +43,7 @@ from ..fourier import STARTS, STOPS, derivative_matrix, extrema, fourier_matrice
 from ..kinematics import NORMAL_SPRING, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
 from ..laws import law_dispatch
 from ..laws._base import MACROSLIP, SEPARATION, STICK_SLIP
-from ..systems import Contact, System
+from ..systems import System
 from ._aft import NO_EVENT, PERIOD_ONE, eval_kernel, recontact_events
 from ._aft_pairs import pair_directions, pairs_aft_kernel
 from ._sparse import linear_entries
@@ -661,13 +661,6 @@ def reference_scales(system: System) -> tuple[float, float]:
         kt = sum(float(np.sum(itf.kt)) for itf in system.interfaces)
         return kt, sum(float(np.sum(itf.mu * itf.preload)) for itf in system.interfaces)
     raise ValueError("system must have at least one contact or interface")
-
-
-def contact_of(system: System) -> Contact:
-    """First contact of the system (reference for q = kt x / fy)."""
-    if not system.contacts:
-        raise ValueError("system must have at least one contact")
-    return system.contacts[0]
 
 
 @by_value(maxsize=8)

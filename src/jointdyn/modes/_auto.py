@@ -48,9 +48,9 @@ def _padded(X, n: int, H: int) -> np.ndarray:
     return out.ravel()
 
 
-def level_changes(backbone, level, auto, mode: int) -> tuple:
+def level_changes(backbone, level, disc, mode: int) -> tuple:
     """(change with more harmonics, change with more samples) of the backbone
-    computed at ``level`` (NaN: that check is not made; inf: its Newton
+    computed at ``level`` with the discretisation ``disc`` (NaN: that check is not made; inf: its Newton
     failed): the largest over :func:`check_points` of the natural
     frequency's relative change and the damping ratio's change relative to
     the backbone's largest damping ratio."""
@@ -58,7 +58,7 @@ def level_changes(backbone, level, auto, mode: int) -> tuple:
     system, n = b.problem.system, b.problem.n
     zeta_scale = float(np.nanmax(np.abs(b.damping_ratio))) if b.points else 0.0
     changes = []
-    for check in check_levels(level, auto):
+    for check in check_levels(level, disc):
         if check is None:
             changes.append(math.nan)
             continue
@@ -86,15 +86,15 @@ def auto_backbone(fixed, system, amplitude, *, harmonics, samples, mode: int = 1
     at one level) at the coarsest level whose check passes (see the module docstring); ``harmonics`` and
     ``samples`` are integers or ``"auto"``."""
     disc = discretisation(harmonics, samples)
-    level, auto = disc.first, disc.auto
+    level = disc.first
     levels = [level]
     while True:
         b = fixed(system, amplitude, harmonics=level.harmonics, samples=level.samples, mode=mode, **kw)
         if not b.points:
             return b
-        ch = level_changes(b, level, auto, mode)
+        ch = level_changes(b, level, disc, mode)
         bad = tuple(c > config.HB_AUTO_RTOL for c in ch)  # NaN (no check) compares False
-        nxt = next_level(level, auto, *bad)
+        nxt = next_level(level, disc, *bad)
         if nxt == level:
             break
         level = nxt
