@@ -386,3 +386,4 @@ def test_the_energy_check_finds_a_name_outside_the_rule(tmp_path):
     (pkg / "a.py").write_text('d = {"energy_contact_J": 1.0, "pair_energy_J": 2.0}\n'
                               'e = {"energy_pair_total_J": 3.0}\n')
     assert energy_names_outside_the_rule(pkg) == ["a.py:2: energy_pair_total_J"]
+

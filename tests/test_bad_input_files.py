@@ -456,10 +456,10 @@ def test_modes_harmonics_raise_the_default_samples(monkeypatch, capsys):
     monkeypatch.setattr(jointdyn.modes, "epmc", fake)
     with pytest.raises(_Reached):
         main(["modes", "--harmonics", "100"])
-    from jointdyn.hb import AUTO, discretisation
+    from jointdyn.hb import AUTO, Discretisation
 
     assert seen["harmonics"] == 100 and seen["samples"] == AUTO  # chosen automatically, from 2H + 2
-    assert discretisation(seen["harmonics"], seen["samples"]).first == (100, 202)
+    assert Discretisation.of(seen["harmonics"], seen["samples"]).first == (100, 202)
 
 
 def test_the_stiffest_mode_sets_the_step_and_is_named(no_compute, capsys, tmp_path):

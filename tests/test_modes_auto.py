@@ -14,7 +14,7 @@ import jointdyn as jd
 from jointdyn import config
 from jointdyn.cli import main
 from jointdyn.modes import epmc
-from jointdyn.hb import Level, discretisation
+from jointdyn.hb import Discretisation, Level
 from jointdyn.modes._auto import check_points, level_changes
 
 BLADE = Path(__file__).resolve().parents[1] / "examples" / "blade.toml"
@@ -39,10 +39,10 @@ def test_refined_where_the_contact_separates():
     auto = epmc(s, harmonics="auto", samples="auto", progress=False)
     assert auto.status.ok and auto.counters["discretisation_converged"] == 1
     assert auto.samples > config.HB_SAMPLES and auto.counters["discretisation_levels"] > 1
-    ch = level_changes(auto, Level(auto.harmonics, auto.samples), discretisation(), 1)
+    ch = level_changes(auto, Level(auto.harmonics, auto.samples), Discretisation.of(), 1)
     assert max(ch) <= config.HB_AUTO_RTOL
     coarse = epmc(s, progress=False)
-    ch0 = level_changes(coarse, Level(coarse.harmonics, coarse.samples), discretisation(), 1)
+    ch0 = level_changes(coarse, Level(coarse.harmonics, coarse.samples), Discretisation.of(), 1)
     assert max(ch0) > config.HB_AUTO_RTOL
 
 

@@ -209,9 +209,9 @@ def _validate(args):
     if args.workers is not None:
         V.positive_int("--workers", args.workers)
     if args.method == "hb":
-        from ..hb import AUTO, discretisation
+        from ..hb import AUTO, Discretisation
 
-        disc = discretisation(AUTO if args.harmonics is None else args.harmonics,
+        disc = Discretisation.of(AUTO if args.harmonics is None else args.harmonics,
                               AUTO if args.samples is None else args.samples, names=_HB_NAMES)
         args.harmonics = AUTO if disc.harmonics_auto else disc.first.harmonics
         args.samples = AUTO if disc.samples_auto else disc.first.samples

@@ -115,10 +115,10 @@ def _validate(args):
     args.output_dof = output_dof_of(system, args.output_dof)
     linear_stuck_mode(system, V.positive_int("--mode", args.mode, 1), args.output_dof)
     if args.method == "epmc":
-        from ..hb import AUTO, check_memory, discretisation
+        from ..hb import AUTO, Discretisation, check_memory
 
         names = ("--harmonics", "--samples")
-        disc = discretisation(AUTO if args.harmonics is None else args.harmonics,
+        disc = Discretisation.of(AUTO if args.harmonics is None else args.harmonics,
                               AUTO if args.samples is None else args.samples, names=names)
         check_memory(system, disc, names=names)
         args.harmonics = AUTO if disc.harmonics_auto else disc.first.harmonics

@@ -7,7 +7,8 @@ condensation onto the contact DOFs for large structures
 
 Read top to bottom: the entry points (:mod:`~jointdyn.hb.frc`), the
 Dataset export (:mod:`~jointdyn.hb.export`), the automatic choice of
-harmonics and samples (:mod:`~jointdyn.hb.discretisation`), one branch at a
+harmonics and samples (:mod:`~jointdyn.hb.discretisation`) from one
+validated request (:mod:`~jointdyn.hb.levels`), one branch at a
 fixed discretisation (:mod:`~jointdyn.hb.branch`), the result types
 (:mod:`~jointdyn.hb.results`), then the problem (:mod:`~jointdyn.hb.problem`,
 :mod:`~jointdyn.hb.condense`, :mod:`~jointdyn.hb.parameters`) and its
@@ -17,7 +18,7 @@ evaluation (:mod:`~jointdyn.hb._aft`, :mod:`~jointdyn.hb.stability`,
 from .condense import CondensedHBProblem, Receptance, make_problem, receptance
 from .export import branch_dataset, discretisation_attrs
 from .frc import check_mean_position, continue_hb, frc_hb, harmonic_balance
-from .levels import AUTO, Discretisation, Level, check_memory, discretisation, hb_bytes
+from .levels import AUTO, Discretisation, Level, check_memory, hb_bytes
 from .parameters import DELTA, ETA, F1, GAMMA, N0, PARAMETERS, HBParameter, SystemParameter, parameter_named
 from .problem import HBProblem
 from .monodromy import monodromy_multipliers
@@ -35,7 +36,6 @@ __all__ = [
     "AUTO",
     "Level",
     "Discretisation",
-    "discretisation",
     "check_memory",
     "hb_bytes",
     "check_mean_position",

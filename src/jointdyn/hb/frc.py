@@ -23,7 +23,7 @@ from ..systems import System
 from .branch import _forcing_problem, _Request, solve_point
 from .discretisation import adaptive_branch
 from .export import branch_dataset
-from .levels import AUTO, Discretisation, Level, check_memory, discretisation
+from .levels import AUTO, Discretisation, Level, check_memory
 from .parameters import GAMMA, parameter_named
 from .problem import HBProblem, reference_scales, stuck_stiffness
 from .results import HBBranch, HBSolution, SolveStatus
@@ -119,7 +119,7 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
     reference_scales(system)
-    disc = discretisation(harmonics, samples)
+    disc = Discretisation.of(harmonics, samples)
     check_memory(system, disc)
     check_mean_position(system)
     par = parameter_named(parameter)

@@ -2,7 +2,7 @@
 
 What a caller asks for (``harmonics`` and ``samples``, each an integer or
 :data:`AUTO`) is made into a :class:`Discretisation` once, by
-:func:`discretisation`, which validates both and names the one that is
+:meth:`Discretisation.of`, which validates both and names the one that is
 wrong; a branch or a backbone at one discretisation is computed at a
 :class:`Level` (H harmonics, Ns samples), which is validated where it is
 made, too. The automatic choice (:mod:`jointdyn.hb.discretisation`, and the
@@ -28,7 +28,7 @@ from .. import _validate as V
 from .. import config
 from ..kinematics import NormalSpring
 
-__all__ = ["AUTO", "Level", "Discretisation", "discretisation", "hb_bytes", "check_memory"]
+__all__ = ["AUTO", "Level", "Discretisation", "hb_bytes", "check_memory"]
 
 #: the value of ``harmonics`` or ``samples`` (and of ``--harmonics``, ``--samples``) asking for the
 #: automatic choice
@@ -62,6 +62,23 @@ class Discretisation:
     harmonics_auto: bool
     samples_auto: bool
 
+    @classmethod
+    def of(cls, harmonics=AUTO, samples=AUTO, *, names=("harmonics", "samples")) -> "Discretisation":
+        """The discretisation of ``harmonics`` and ``samples`` (each an integer or :data:`AUTO`).
+
+        Automatic harmonics start at ``config.HB_HARMONICS``; automatic
+        samples at ``config.HB_SAMPLES``, or 2H + 2 where H asks for more.
+        Fixed samples must be at least 2H + 2 of the first H. A ValueError
+        names the value that is wrong with ``names`` (the command line
+        passes its options' names), the same message from the Python API and
+        the command line.
+        """
+        h = _count_or_auto(names[0], harmonics, 1)
+        H = config.HB_HARMONICS if h == AUTO else h
+        s = _count_or_auto(names[1], samples, 2 * H + 2)
+        first = Level(H, max(config.HB_SAMPLES, 2 * H + 2) if s == AUTO else s)
+        return cls(first=first, harmonics_auto=h == AUTO, samples_auto=s == AUTO)
+
 
 def _count_or_auto(name: str, value, minimum: int):
     if isinstance(value, str) and value == AUTO:
@@ -70,22 +87,6 @@ def _count_or_auto(name: str, value, minimum: int):
         return V.positive_int(name, value, minimum)
     except ValueError:
         raise ValueError(f"{name} must be an integer >= {minimum} or {AUTO!r}, got {V.short_repr(value)}") from None
-
-
-def discretisation(harmonics=AUTO, samples=AUTO, *, names=("harmonics", "samples")) -> Discretisation:
-    """The :class:`Discretisation` of ``harmonics`` and ``samples`` (each an integer or :data:`AUTO`).
-
-    Automatic harmonics start at ``config.HB_HARMONICS``; automatic samples
-    at ``config.HB_SAMPLES``, or 2H + 2 where H asks for more. Fixed samples
-    must be at least 2H + 2 of the first H. A ValueError names the value
-    that is wrong with ``names`` (the command line passes its options'
-    names), the same message from the Python API and the command line.
-    """
-    h = _count_or_auto(names[0], harmonics, 1)
-    H = config.HB_HARMONICS if h == AUTO else h
-    s = _count_or_auto(names[1], samples, 2 * H + 2)
-    first = Level(H, max(config.HB_SAMPLES, 2 * H + 2) if s == AUTO else s)
-    return Discretisation(first=first, harmonics_auto=h == AUTO, samples_auto=s == AUTO)
 
 
 #: float64 copies of the (unknowns x unknowns) Jacobian held at once: the

@@ -25,7 +25,7 @@ import numpy as np
 
 from .. import config
 from ..hb.discretisation import check_levels, next_level
-from ..hb.levels import discretisation
+from ..hb.levels import Discretisation
 
 __all__ = ["auto_backbone", "check_points", "level_changes"]
 
@@ -85,7 +85,7 @@ def auto_backbone(fixed, system, amplitude, *, harmonics, samples, mode: int = 1
     """The backbone of ``fixed(system, amplitude, harmonics=H, samples=Ns, mode=mode, **kw)`` (the EPMC
     at one level) at the coarsest level whose check passes (see the module docstring); ``harmonics`` and
     ``samples`` are integers or ``"auto"``."""
-    disc = discretisation(harmonics, samples)
+    disc = Discretisation.of(harmonics, samples)
     level = disc.first
     levels = [level]
     while True:

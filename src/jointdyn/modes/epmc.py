@@ -67,7 +67,7 @@ from ..continuation import (ContinuationOptions, ContinuationStatus, ParameterPr
 from ..fourier import derivative_matrix
 from ..hb import HBProblem
 from ..hb._sparse import linear_entries
-from ..hb.levels import AUTO, check_memory, discretisation
+from ..hb.levels import AUTO, Discretisation, check_memory
 from ..hb.problem import contacts_only
 from ..kinematics import contact_kinematics, selection_matrix
 from ._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
@@ -417,7 +417,7 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         modes against the full model's; :meth:`Backbone.full_shape`: the
         harmonics of the mode shape on the full model's DOFs).
     """
-    check_memory(system, discretisation(harmonics, samples))
+    check_memory(system, Discretisation.of(harmonics, samples))
     if harmonics == AUTO or samples == AUTO:
         from ._auto import auto_backbone
 
