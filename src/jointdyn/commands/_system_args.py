@@ -18,7 +18,8 @@ def add_system_argument(p) -> None:
     p.add_argument("--system", default=None, metavar="FILE.toml",
                    help="a structure of your own: TOML file with [structure] M, K (C or zeta), [[force]], "
                         "[[contact]] (law and parameters, tangential and normal selection, prescribed load or "
-                        "normal spring) and [output] (docs/system-files.md); refuses the options that describe "
+                        "normal spring), [[interface]] (patches of node pairs: kt, kn, mu, preload, pairs inline or "
+                        "from a CSV file) and [output] (docs/system-files.md); refuses the options that describe "
                         "the paper damper")
 
 

@@ -61,9 +61,12 @@ def add_arguments(p) -> None:
     load = p.add_mutually_exclusive_group()
     load.add_argument("--beta", type=float, default=None, help="mu N0 / F1 (> 0; default 1.0)")
     load.add_argument("--f1", type=float, default=None, help="forcing amplitude F1 in N (> 0), instead of --beta")
-    p.add_argument("--gamma", default=g0, metavar="START:STOP:STEP",
+    p.add_argument("--gamma", default=None, metavar="START:STOP:STEP",
                    help=f"frequency-ratio grid gamma = w/w0 (default {g0}); with --system w0 is the file's "
                         "reference frequency")
+    p.add_argument("--frequency", default=None, metavar="START:STOP:STEP",
+                   help="forcing-frequency grid in Hz instead of --gamma (gamma = 2 pi f / w0); frc.csv gives "
+                        "every point in Hz and rad/s as well")
     p.add_argument("--delta", type=float, default=None, help=f"normal-load phase, degrees (default {d['delta']:g})")
     p.add_argument("--sweep", default=None,
                    help="time: up, down or both (default both); hb: refused (the continuation follows the "
@@ -98,22 +101,22 @@ def add_arguments(p) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
 
 
-def parse_gamma(text: str) -> np.ndarray:
-    """``START:STOP:STEP`` -> increasing grid (STOP included when on the grid)."""
+def parse_gamma(text: str, name: str = "--gamma") -> np.ndarray:
+    """``START:STOP:STEP`` -> increasing grid (STOP included when on the grid); errors name ``name``."""
     parts = str(text).split(":")
     if len(parts) != 3:
-        raise ValueError(f"--gamma must be START:STOP:STEP, got {text!r}")
+        raise ValueError(f"{name} must be START:STOP:STEP, got {text!r}")
     try:
         start, stop, step = (float(s) for s in parts)
     except ValueError:
-        raise ValueError(f"--gamma must be START:STOP:STEP of numbers, got {text!r}") from None
-    V.positive("--gamma START", start)
-    V.positive("--gamma STEP", step)
-    V.finite("--gamma STOP", stop)
+        raise ValueError(f"{name} must be START:STOP:STEP of numbers, got {text!r}") from None
+    V.positive(f"{name} START", start)
+    V.positive(f"{name} STEP", step)
+    V.finite(f"{name} STOP", stop)
     if not stop >= start:
-        raise ValueError(f"--gamma STOP must be >= START ({start:g}), got {stop:g}")
+        raise ValueError(f"{name} STOP must be >= START ({start:g}), got {stop:g}")
     # a float until bounded: (STOP - START) / STEP may be huge or inf
-    V.count_at_most("--gamma START:STOP:STEP", (stop - start) / step + 1.0,
+    V.count_at_most(f"{name} START:STOP:STEP", (stop - start) / step + 1.0,
                     config.SWEEP_MAX_GAMMA_POINTS, "points")
     count = int(math.floor((stop - start) / step + 1e-9)) + 1
     grid = start + step * np.arange(count)
@@ -121,6 +124,25 @@ def parse_gamma(text: str) -> np.ndarray:
         # 12 decimals clean the float noise of a grid; not where they would change a value (tiny or huge gammas)
         rounded = np.round(grid, 12)
     return np.where(np.abs(rounded - grid) <= 1e-9 * grid, rounded, grid)
+
+
+def config_gamma() -> str:
+    """The default --gamma grid, as the option writes it."""
+    return ":".join(f"{v:g}" for v in config.SWEEP_GAMMA_DEFAULT)
+
+
+def _frequency_gammas(args) -> np.ndarray:
+    """The gamma grid of ``--frequency`` (Hz): gamma = 2 pi f / w0, with w0 the system file's reference
+    frequency or the paper damper's sqrt(k / m)."""
+    if args.gamma is not None:
+        raise ValueError("--frequency and --gamma both give the frequency grid; give one")
+    hz = parse_gamma(args.frequency, "--frequency")
+    if args.system_file is not None:
+        w0 = args.system_file.system.w0
+    else:
+        w0 = math.sqrt(V.positive("--k", PAPER["k"] if args.k is None else args.k)
+                       / V.positive("--m", PAPER["m"] if args.m is None else args.m))
+    return V.finite_array("--frequency x 2 pi / w0 (gamma)", 2.0 * math.pi * hz / w0)
 
 
 def _count_or_auto(name: str, value, minimum: int):
@@ -219,7 +241,7 @@ def _validate(args):
     _check_method_options(args)
     if args.method == "time":
         V.choice("--sweep", args.sweep, ("up", "down", "both"))
-    gammas = parse_gamma(args.gamma)
+    gammas = parse_gamma(config_gamma() if args.gamma is None else args.gamma) if getattr(args, "frequency", None) is None else None
     if args.steps_per_period is not None:
         V.positive_int("--steps-per-period", args.steps_per_period, 8)
     if args.workers is not None:
@@ -231,8 +253,10 @@ def _validate(args):
     if args.system is not None:
         refuse_paper_options(args, PAPER_OPTIONS)
         args.system_file = load_system_file(args)
+        gammas = _frequency_gammas(args) if gammas is None else gammas
         _check_system_derived(args.system_file.system, gammas)
     else:
+        gammas = _frequency_gammas(args) if gammas is None else gammas
         _validate_paper(args, gammas)
     if args.method == "time":
         _check_time_steps(args, gammas)
@@ -266,23 +290,29 @@ def _check_time_steps(args, gammas) -> None:
 def _check_hb_static(system) -> None:
     """Harmonic balance starts from the static stiffness with every contact stuck and every normal
     spring closed: a DOF that this holds by nothing (a rigid-body mode) has no unique mean position,
-    and the structure is refused naming it (the time domain takes it)."""
-    from ..hb.problem import contacts_only
-    from ..kinematics import contact_kinematics, selection_matrix
+    and the structure is refused naming it (the time domain takes it). A DOF held only by stiffnesses
+    many decades apart is ill-conditioned, not free: the stiffnesses are named instead."""
+    from ..interfaces import static_springs
     from ..systems import rigid_mode_dof
 
-    K = system.K_reference.copy()  # with the normal springs of the contacts and pairs closed at rest
-    if system.contacts:
-        B = selection_matrix(contact_kinematics(contacts_only(system)), system.ndof)
-        K += (B.T * [c.law.kt for c in system.contacts]) @ B
-    for itf in system.interfaces:  # the pairs closed at rest, stuck: their tangential springs kt
-        B = itf.selection(system.ndof)
-        shear = np.zeros(B.shape[0])
-        shear[0::3] = shear[1::3] = np.where(itf.preload > 0.0, itf.kt, 0.0)
-        K += (B.T * shear) @ B
+    springs = static_springs(system)
+    K = system.K.copy()
+    for _, k, b in springs:
+        K += k * np.outer(b, b)
     dof = rigid_mode_dof(K)
     if dof is None:
         return
+    _, vec = np.linalg.eigh(K) if system.ndof <= config.SYSTEM_DENSE_CHECK_MAX_DOF else (None, None)
+    holders = [] if vec is None else [(key, k) for key, k, b in springs if abs(b @ vec[:, 0]) > 1e-6]
+    if holders:  # the mode is held, by a stiffness many decades below the largest: ill-conditioned
+        key, k = min(holders, key=lambda h: h[1])
+        top_key, top = max([("K", float(np.max(np.abs(system.K))))] + [(s[0], s[1]) for s in springs],
+                           key=lambda h: h[1])
+        raise ValueError(f"--method hb: the static stiffness with every contact stuck and every normal spring "
+                         f"closed is ill-conditioned, not singular: DOF {dof} is held by {key} = {k:.4g} N/m, "
+                         f"{k / top:.3g} times {top_key} = {top:.4g} N/m, below the ratio "
+                         f"{config.SYSTEM_RIGID_MODE_RTOL:g} that double precision resolves; bring {key} and "
+                         f"{top_key} within that ratio, or use --method time")
     raise ValueError(f"--method hb: the structure has a rigid-body mode even with every contact stuck and every "
                      f"normal spring closed (mostly DOF {dof}: held by nothing, K + kt + kn is singular), so its "
                      "mean position is not unique; harmonic balance needs one: give that DOF a stiffness in K, "
@@ -635,6 +665,14 @@ def _plot_hb(ax, result) -> None:
     ax.legend(fontsize=8)
 
 
+def _with_frequency(ds, w0: float):
+    """``ds`` with the forcing frequency of every point in rad/s and Hz beside gamma: gamma alone is
+    relative to a w0 that may be another mode than the one a user looks at."""
+    omega = ds["gamma"] * w0
+    return ds.assign(omega_rad_s=omega.assign_attrs(units="rad/s", long_name="forcing frequency w = gamma w0"),
+                     frequency_hz=(omega / (2.0 * math.pi)).assign_attrs(units="Hz", long_name="w / (2 pi)"))
+
+
 def _titled(ds, result):
     """``ds`` with the --system file's ``title`` as its ``title`` attribute (frc.nc carries it as the JSON
     and frc.png do); what the run computed, the title of a paper-damper run, moves to ``summary``."""
@@ -667,13 +705,13 @@ def run(args) -> int:
         if args.method == "time":
             from ..sweeps import write_outputs
 
-            write_outputs(_titled(ds, result), out)
+            write_outputs(_with_frequency(_titled(ds, result), _system(args).w0), out)
         else:
             from .._io import write_dataset
             from ..hb import branch_dataset
 
             # frc.csv: one row per point (per-harmonic data in frc.nc)
-            write_dataset(_titled(branch_dataset(ds), result), out, "frc")
+            write_dataset(_with_frequency(_titled(branch_dataset(ds), result), _system(args).w0), out, "frc")
         _plot(result, out / "frc.png")
     if args.json:
         print(json.dumps(result))

@@ -75,8 +75,9 @@ def _interface(where: _Where, i: int, t, n: int, folder: Path):
             if len(row) != 6 or any(isinstance(v, bool) or not isinstance(v, int) for v in row):
                 raise where.error(f"{key}.pairs[{j}]", f"must be 6 integer DOF indices (a_t1, a_t2, a_n, b_t1, "
                                                        f"b_t2, b_n; -1 = fixed), got {row!r:.60}")
-            for k, v in enumerate(row):
-                _dof(where, f"{key}.pairs[{j}][{k}]", v, n, ground=True)
+            for k, v in enumerate(row):  # a huge integer is said here, before numpy refuses its type
+                if abs(v) >= 2**62:
+                    _dof(where, f"{key}.pairs[{j}][{k}]", v, n, ground=True)
     try:
         made = Interface(pairs=pairs, **params)
         made.check_ndof(n, "")

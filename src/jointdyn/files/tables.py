@@ -464,7 +464,8 @@ def read_table(path, spec: Spec, *, name: str = "path", bound: RowBound | None =
                 raise _Refused(f"{_where(name, path)} cannot be parsed as CSV; {spec.expected}")
         cols = fast[0]
         if cols[0].size < spec.min_rows:
-            raise _Refused(f"{_where(name, path)} must have at least {spec.min_rows} data rows, got {cols[0].size}")
+            rows = "data row" if spec.min_rows == 1 else "data rows"
+            raise _Refused(f"{_where(name, path)} must have at least {spec.min_rows} {rows}, got {cols[0].size}")
         if spec.increasing is not None:
             _check_increasing(path, lay, name, cols[spec.columns.index(spec.increasing)], spec.increasing)
     except OSError as exc:
