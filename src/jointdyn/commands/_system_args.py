@@ -8,9 +8,11 @@ contacts and its forcing.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 from .. import _validate as V
 
-__all__ = ["add_system_argument", "refuse_paper_options", "load_system_file"]
+__all__ = ["add_system_argument", "refuse_paper_options", "load_system_file", "option_names"]
 
 
 def add_system_argument(p) -> None:
@@ -46,3 +48,18 @@ def load_system_file(args):
         return read_system_file(args.system)
     except ValueError as exc:
         raise ValueError(f"--system {exc}") from None
+
+
+@contextmanager
+def option_names(**names):
+    """Library errors raised inside the block, their leading Python argument (``mode``,
+    ``output_dof``, ``amplitude``) said as the CLI option that gave it (``--mode``, ...):
+    ``option_names(output_dof="--output-dof")``."""
+    try:
+        yield
+    except ValueError as exc:
+        msg = str(exc)
+        for arg, option in names.items():
+            if msg == arg or msg.startswith((f"{arg} ", f"{arg}:")):
+                raise ValueError(option + msg[len(arg):]) from None
+        raise

@@ -346,6 +346,8 @@ def _connect(address):
 
 def _system_header(sf) -> dict:
     """What the JSON says about a --system structure."""
+    from ..hb.problem import amplitude_q_meaning
+
     system = sf.system
     contacts = []
     for c in system.contacts:
@@ -355,7 +357,8 @@ def _system_header(sf) -> dict:
                          "n0": float(c.normal.n0)})
     return {"file": str(sf.path), "title": sf.title, "ndof": int(system.ndof), "w0_rad_s": float(system.w0),
             "response_dof": int(system.response_dof), "dofs": [int(d) for d in sf.dofs],
-            "fy_N": float(system.contacts[0].law.fy) if system.contacts else None, "contacts": contacts}
+            "fy_N": float(system.contacts[0].law.fy) if system.contacts else None, "contacts": contacts,
+            "amplitude_q_meaning": amplitude_q_meaning(system)}
 
 
 def _header(args) -> dict:
@@ -498,7 +501,8 @@ def _hb_branches(br, dofs=()) -> list:
     out = []
     for b in dict.fromkeys(br.segment.tolist()):
         idx = np.flatnonzero(br.segment == b)
-        one = {"gamma": gam[idx], "amplitude_q": kt * amp[idx] / fy, "amplitude_m": amp[idx],
+        q = kt * amp[idx] / fy if fy > 0.0 else np.full(idx.size, np.nan)  # no slip force: null, not a warning
+        one = {"gamma": gam[idx], "amplitude_q": q, "amplitude_m": amp[idx],
                "offset_m": off[idx], "max_abs_m": mx[idx]}
         one = {k: _jsonable(v) for k, v in one.items()}
         if len(dofs):

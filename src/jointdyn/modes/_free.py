@@ -183,8 +183,9 @@ def amplitude_range(system: System, amplitude) -> tuple[float, float]:
     if amplitude is None:
         scale = contact_scale(system)
         if not scale > 0.0:
-            raise ValueError("amplitude must be given (min, max) in m: the first contact has no friction "
-                             "(fy = 0), so there is no default range")
+            why = ("the first contact has no friction (fy = 0)" if system.contacts else
+                   "every interface pair is open at rest (mu x preload = 0: no slip force)")
+            raise ValueError(f"amplitude must be given (min, max) in m: {why}, so there is no default range")
         lo, hi = (q * scale for q in config.MODES_AMPLITUDE_Q)
         return lo, hi
     try:
