@@ -338,3 +338,13 @@ def test_a_huge_integer_in_inline_pairs_names_its_entry(tmp_path, capsys):
     f = _system(tmp_path, pairs=f"[[0, 1, 2, -1, -1, {HUGE_INT}]]")
     rc = run_cli(["frc", "--system", str(f), "--method", "hb"])
     one_line(capsys, rc, "interface[0].pairs[0][5]", "must be in [0, 2]")
+
+
+def test_hb_names_the_open_pair_that_alone_holds_a_dof(tmp_path, capsys):
+    text = SYSTEM.format(pairs="[[0, 1, 2, -1, -1, -1]]", kt="1.5e3", kn="1.5e3").replace(
+        "[0.0, 0.0, 3.0e5]", "[0.0, 0.0, 0.0]").replace("preload = 0.5", "preload = 0.0")
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    rc = run_cli(["frc", "--system", str(f), "--method", "hb", "--gamma", "0.9:1.1:0.1"])
+    err = one_line(capsys, rc, "DOF 2", "interface[0].kn", "open at rest", "--method time")
+    assert "held by nothing" not in err

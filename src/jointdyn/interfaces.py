@@ -734,14 +734,15 @@ def _selection_vector(dof: int, dof2: int, direction, n: int) -> np.ndarray:
     return b
 
 
-def static_springs(system) -> list:
+def static_springs(system, open_pairs: bool = False) -> list:
     """The springs that hold a System at rest with every contact stuck and every normal spring
     closed, beside its K: ``(key, stiffness N/m, selection vector)`` each, the key as a system
     file names it (``contact[i].kt``, ``contact[i].normal.kn``, ``interface[i].kt`` or ``.kn``,
-    pairs counted from 0). Pairs open at rest (preload 0) hold nothing."""
+    pairs counted from 0). Pairs open at rest (preload 0) hold nothing: with ``open_pairs`` they are
+    the only ones listed (the springs they would add once closed)."""
     n = system.ndof
     out = []
-    for i, c in enumerate(system.contacts):
+    for i, c in enumerate(() if open_pairs else system.contacts):
         out.append((f"contact[{i}].kt", float(c.law.kt), _selection_vector(c.dof, c.dof2, c.direction, n)))
         kn = getattr(c.normal, "kn", None)
         if kn is not None:
@@ -749,7 +750,7 @@ def static_springs(system) -> list:
             out.append((f"contact[{i}].normal.kn", float(kn), _selection_vector(nm.dof, nm.dof2, nm.direction, n)))
     for i, itf in enumerate(system.interfaces):
         for j, row in enumerate(itf.pairs):
-            if not itf.preload[j] > 0.0:
+            if (itf.preload[j] > 0.0) == open_pairs:
                 continue
             for k, (name, value) in enumerate((("kt", itf.kt[j]), ("kt", itf.kt[j]), ("kn", itf.kn[j]))):
                 b = np.zeros(n)

@@ -313,6 +313,13 @@ def _check_hb_static(system) -> None:
                          f"{k / top:.3g} times {top_key} = {top:.4g} N/m, below the ratio "
                          f"{config.SYSTEM_RIGID_MODE_RTOL:g} that double precision resolves; bring {key} and "
                          f"{top_key} within that ratio, or use --method time")
+    opened = [] if vec is None else [key for key, _, b in static_springs(system, open_pairs=True)
+                                     if abs(b @ vec[:, 0]) > 1e-6]
+    if opened:  # held only by pairs that touch without load: the mean is not unique while they are open
+        raise ValueError(f"--method hb: DOF {dof} is held only by {opened[0]}, a pair open at rest (preload 0: "
+                         "it touches without load), so its mean position is not unique while the pair is open and "
+                         "harmonic balance has no start; give the pair a preload > 0 or that DOF a stiffness in K, "
+                         "or use --method time")
     raise ValueError(f"--method hb: the structure has a rigid-body mode even with every contact stuck and every "
                      f"normal spring closed (mostly DOF {dof}: held by nothing, K + kt + kn is singular), so its "
                      "mean position is not unique; harmonic balance needs one: give that DOF a stiffness in K, "
