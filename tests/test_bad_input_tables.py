@@ -348,3 +348,19 @@ def test_hb_names_the_open_pair_that_alone_holds_a_dof(tmp_path, capsys):
     rc = run_cli(["frc", "--system", str(f), "--method", "hb", "--gamma", "0.9:1.1:0.1"])
     err = one_line(capsys, rc, "DOF 2", "interface[0].kn", "open at rest", "--method time")
     assert "held by nothing" not in err
+
+
+@pytest.mark.parametrize("argv,name", [
+    (["loop", "--input"], "HISTORY_ROWS"),
+    (["loop", "--model", "pair", "--kt", "1e3", "--kn", "1e3", "--mu", "0.5", "--preload", "1", "--input"],
+     "HISTORY_ROWS"),
+])
+def test_loop_histories_are_bounded_before_parsing(tmp_path, capsys, monkeypatch, argv, name):
+    from jointdyn.drivers import _csv
+
+    monkeypatch.setattr(_csv, name, _csv.RowBound(3, "config.QS_MAX_SAMPLES"))
+    f = tmp_path / "h.csv"
+    cols = "t,u1,u2,g" if "pair" in argv else "t,x,N"
+    row = "0,0,0,0" if "pair" in argv else "0,0,1"
+    f.write_text(cols + "\n" + "\n".join(row.replace("0", str(i), 1) for i in range(5)) + "\n")
+    one_line(capsys, run_cli([*argv, str(f)]), "--input", "at most 3 data rows", "QS_MAX_SAMPLES")
