@@ -364,3 +364,12 @@ def test_loop_histories_are_bounded_before_parsing(tmp_path, capsys, monkeypatch
     row = "0,0,0,0" if "pair" in argv else "0,0,1"
     f.write_text(cols + "\n" + "\n".join(row.replace("0", str(i), 1) for i in range(5)) + "\n")
     one_line(capsys, run_cli([*argv, str(f)]), "--input", "at most 3 data rows", "QS_MAX_SAMPLES")
+
+
+def test_epmc_calls_a_tiny_normal_stiffness_ill_conditioned(tmp_path, capsys):
+    text = SYSTEM.format(pairs="[[0, 1, 2, -1, -1, -1]]", kt="1.5e3", kn="1e-300").replace(
+        "[0.0, 0.0, 3.0e5]", "[0.0, 0.0, 0.0]")
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    err = one_line(capsys, run_cli(["modes", "--system", str(f)]), "ill-conditioned", "2e-300")
+    assert "must be positive definite" not in err

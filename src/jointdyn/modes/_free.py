@@ -103,10 +103,15 @@ def check_free_vibration(system, method: str, *, springs: bool = True) -> System
 
     lam = eigh(system.K_reference, system.M, eigvals_only=True)
     if not lam[0] > config.MODES_MIN_EIGENVALUE_RATIO * abs(lam[-1]):
-        raise ValueError(
-            f"K must be positive definite with the tangential contacts free (smallest eigenvalue of (M, K) "
-            f"{lam[0]:.6g} (rad/s)^2): {method} needs a static equilibrium of the slipping structure (the mean "
-            "of the motion is not held by friction)")
+        # a positive eigenvalue below the ratio is a stiffness too small beside the others, not a free DOF
+        what = ("is ill-conditioned with the tangential contacts free: its smallest eigenvalue of (M, K), "
+                f"{lam[0]:.6g} (rad/s)^2, is {lam[0] / lam[-1]:.3g} of the largest, below the ratio "
+                f"{config.MODES_MIN_EIGENVALUE_RATIO:g} that double precision resolves (a normal stiffness kn many "
+                "decades below the others?)" if lam[0] > 0.0 else
+                "must be positive definite with the tangential contacts free (smallest eigenvalue of (M, K) "
+                f"{lam[0]:.6g} (rad/s)^2)")
+        raise ValueError(f"K {what}: {method} needs a static equilibrium of the slipping structure (the mean "
+                         "of the motion is not held by friction)")
     return system
 
 
