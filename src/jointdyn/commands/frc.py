@@ -241,7 +241,9 @@ def _validate(args):
     _check_method_options(args)
     if args.method == "time":
         V.choice("--sweep", args.sweep, ("up", "down", "both"))
-    gammas = parse_gamma(config_gamma() if args.gamma is None else args.gamma) if getattr(args, "frequency", None) is None else None
+    gammas = None  # from --frequency once w0 is known
+    if getattr(args, "frequency", None) is None:
+        gammas = parse_gamma(config_gamma() if args.gamma is None else args.gamma)
     if args.steps_per_period is not None:
         V.positive_int("--steps-per-period", args.steps_per_period, 8)
     if args.workers is not None:
