@@ -373,3 +373,16 @@ def test_epmc_calls_a_tiny_normal_stiffness_ill_conditioned(tmp_path, capsys):
     f.write_text(text)
     err = one_line(capsys, run_cli(["modes", "--system", str(f)]), "ill-conditioned", "1e-300 (rad/s)^2")
     assert "must be positive definite" not in err
+
+
+def test_the_library_fits_keep_the_bounds_of_the_cli(monkeypatch):
+    import jointdyn as jd
+
+    monkeypatch.setattr(config, "FIT_MAX_BACKBONE_POINTS", 5)
+    monkeypatch.setattr(config, "FIT_MAX_LOOP_SAMPLES", 300)
+    A = np.logspace(-7, -4, 8)
+    with pytest.raises(ValueError, match="FIT_MAX_BACKBONE_POINTS"):
+        jd.fit_backbone(A, np.full(8, 100.0), np.full(8, 0.01), mass=1.0)
+    t, x, N, T = _loops()
+    with pytest.raises(ValueError, match="FIT_MAX_LOOP_SAMPLES"):
+        jd.fit_loops(x, N, T, t=t)

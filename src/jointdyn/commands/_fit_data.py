@@ -27,7 +27,7 @@ LOOPS = Spec(
     expected="expected a header row naming the columns t, x, N, T in SI units (s, m, N, N), "
              "e.g. 't,x,N,T' or 't [s];x [m];N [N];T [N]', then one row of numbers per sample",
     increasing="t",
-    min_rows=4,
+    min_rows=10,  # as jointdyn.fit_loops
 )
 #: one mode's measured backbone: amplitude, natural frequency and damping ratio per point
 BACKBONE = Spec(
