@@ -386,3 +386,13 @@ def test_the_library_fits_keep_the_bounds_of_the_cli(monkeypatch):
     t, x, N, T = _loops()
     with pytest.raises(ValueError, match="FIT_MAX_LOOP_SAMPLES"):
         jd.fit_loops(x, N, T, t=t)
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs here")
+def test_a_fifo_as_matrix_file_is_not_a_regular_file(tmp_path, capsys):
+    os.mkfifo(tmp_path / "k.npy")
+    text = SYSTEM.format(pairs="[[0, 1, 2, -1, -1, -1]]", kt="1.5e3", kn="1.5e3").replace(
+        "K = [[1.0e3, 0.0, 0.0], [0.0, 2.0e3, 0.0], [0.0, 0.0, 3.0e5]]", 'K = "k.npy"')
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    one_line(capsys, run_cli(["frc", "--system", str(f), "--method", "hb"]), "structure.K", "not a regular file")

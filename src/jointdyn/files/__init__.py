@@ -250,7 +250,8 @@ def _read_file(where: _Where, key: str, path: Path, loader):
     exception on a corrupt or truncated file; each is said as a file that
     cannot be read, never a traceback."""
     if not path.is_file():
-        what = "a directory" if path.is_dir() else "no such file"
+        what = ("a directory" if path.is_dir() else "not a regular file (a FIFO, a device or a broken link)"
+                if os.path.lexists(path) else "no such file")
         raise where.error(key, f"names {str(path)!r}: {what}")
     try:
         return loader(path)
