@@ -213,7 +213,7 @@ def test_fit_data_are_bounded_before_fitting(tmp_path, capsys, monkeypatch, opti
 
 
 def test_the_shipped_bounds_are_those_measured():
-    assert config.INTERFACE_MAX_PAIRS == 10_000
+    assert config.INTERFACE_MAX_PAIRS == 5_000
     assert config.FIT_MAX_BACKBONE_POINTS == 1_000
     assert config.FIT_MAX_LOOP_SAMPLES == 1_000_000
 

