@@ -332,7 +332,7 @@ def _scan(path: Path, lay: _Layout, name: str, upto_row: int | None = None):
                 continue
             fields = _split(text, lay.sep)
             if len(fields) != ncols:
-                cols = ", ".join(_shown(f) for f in lay.names[:20])
+                cols = ", ".join(f.strip() if len(f.strip()) <= _SHOWN else _shown(f) for f in lay.names[:20])
                 return lineno, f"expected {ncols} fields ({cols}), got {len(fields)}"
             for key, i in zip(lay.spec.columns, lay.use):
                 v = _number(fields[i], lay.decimal)
@@ -464,7 +464,7 @@ def read_table(path, spec: Spec, *, name: str = "path", bound: RowBound | None =
                 raise _Refused(f"{_where(name, path)} cannot be parsed as CSV; {spec.expected}")
         cols = fast[0]
         if cols[0].size < spec.min_rows:
-            rows = "data row" if spec.min_rows == 1 else "data rows"
+            rows = "data row" if spec.min_rows == 1 else "samples (data rows)"
             raise _Refused(f"{_where(name, path)} must have at least {spec.min_rows} {rows}, got {cols[0].size}")
         if spec.increasing is not None:
             _check_increasing(path, lay, name, cols[spec.columns.index(spec.increasing)], spec.increasing)
