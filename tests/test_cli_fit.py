@@ -71,10 +71,11 @@ def test_a_fit_that_does_not_determine_mu_exits_3_with_its_files(tmp_path, capsy
 
 
 @pytest.mark.parametrize("content,extra,word", [
-    ("t,x,N\n0,0,1\n1,1,1\n2,0,1\n3,1,1\n", [], "no column T"),
+    ("t,x,N\n0,0,1\n1,1,1\n2,0,1\n3,1,1\n", [], "missing column T"),
     ("t,x,N,T\n0,0,1,0\n1,abc,1,1\n2,0,1,0\n3,1,1,1\n", [], "line 3"),
-    ("t,x,N,T\n0,0,1,0\n1,1,1,1\n", [], "at least 4 data rows"),
-    ("t,x,N,T\n0,0,1,0\n0,1,1,1\n2,0,1,0\n3,1,1,1\n", [], "t must increase"),
+    ("t,x,N,T\n0,0,1,0\n1,1,1,1\n", [], "at least 10 samples"),
+    ("t,x,N,T\n0,0,1,0\n0,1,1,1\n" + "".join(f"{i},{i % 2},1,{i % 2}\n" for i in range(2, 12)), [],
+     "line 3: t must be strictly increasing"),
     (None, ["--mass", "2"], "--mass applies"),
 ])
 def test_bad_input_one_line_exit_2_no_file(tmp_path, capsys, content, extra, word):

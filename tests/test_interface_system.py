@@ -83,7 +83,7 @@ BAD = [
     (_sub('pairs = [[0, 1, 2, -1, -1, -1], [3, -1, 2, 0, -1, -1]]', 'pairs = 3'),
      "interface[0].pairs must be a list of rows"),
     (_sub('pairs = [[0, 1, 2, -1, -1, -1], [3, -1, 2, 0, -1, -1]]', 'pairs = "absent.csv"'),
-     "interface[0].pairs names"),
+     "interface[0].pairs must be an existing file"),
     (lambda text: "interface = 3\n" + text[:text.index("[[interface]]")], "interface must be an array of tables"),
 ]
 
@@ -98,10 +98,10 @@ def test_bad_interfaces_name_the_file_and_the_key(mutate, words, tmp_path):
 
 
 @pytest.mark.parametrize("csv, words", [
-    ("a_t1,a_t2,a_n,b_t1,b_t2\n0,1,2,-1,-1\n", "the header must name the columns"),
+    ("a_t1,a_t2,a_n,b_t1,b_t2\n0,1,2,-1,-1\n", "missing column b_n"),
     ("a_t1,a_t2,a_n,b_t1,b_t2,b_n\n0,1,2,-1,-1\n", "line 2: expected 6 fields"),
-    ("a_t1,a_t2,a_n,b_t1,b_t2,b_n\n0,1,x,-1,-1,-1\n", "line 2: the six DOF columns must be integers"),
-    ("a_t1,a_t2,a_n,b_t1,b_t2,b_n\n", "holds no pairs"),
+    ("a_t1,a_t2,a_n,b_t1,b_t2,b_n\n0,1,x,-1,-1,-1\n", "line 2: a_n = 'x' is not a number"),
+    ("a_t1,a_t2,a_n,b_t1,b_t2,b_n\n", "must have at least 1 data row,"),
 ])
 def test_bad_pair_csv_files(csv, words, tmp_path):
     (tmp_path / "pairs.csv").write_text(csv)

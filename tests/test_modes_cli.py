@@ -85,7 +85,7 @@ def test_system_file(capsys, tmp_path):
     (["--amplitude", "1e-3"], "--amplitude must be MIN:MAX"),
     (["--amplitude", "a:b"], "--amplitude must be MIN:MAX of numbers"),
     (["--mode", "0"], "--mode must be an integer >= 1"),
-    (["--mode", "2"], r"mode must be in [1, 1]"),
+    (["--mode", "2"], r"--mode must be in [1, 1]"),
     (["--method", "foo"], "--method must be one of epmc, qsma"),
     (["--method", "qsma", "--harmonics", "3"], "--harmonics applies to --method epmc only"),
     (["--harmonics", "0"], "--harmonics must be an integer >= 1"),
@@ -93,7 +93,7 @@ def test_system_file(capsys, tmp_path):
     (["--max-points", "1"], "--max-points must be an integer >= 2"),
     (["--model", "nope"], "--model must be one of"),
     (["--law-param", "capacity=1"], "capacity"),
-    (["--output-dof", "3"], r"output_dof must be in [0, 0]"),
+    (["--output-dof", "3"], r"--output-dof must be in [0, 0]"),
     (["--system", "/nonexistent.toml"], "--system must be an existing file"),
 ])
 def test_bad_input_exit2_no_files(argv, word, capsys, tmp_path):

@@ -51,6 +51,11 @@ SYSTEM_SEMIDEFINITE_RTOL = 1e-10
 #: most degrees of freedom of a matrix read from a system file (its dense
 #: float64 copy takes 8 n^2 bytes: 800 MB at the bound)
 FILES_MAX_DOF = 10_000
+#: most node pairs of one interface, however given (inline, a pairs CSV file, the library): every
+#: solver evaluates each pair at every sample of every step, so the time grows with the pairs (an HB
+#: branch of 2000 pairs with H = 1 and 8 samples took 40 s of CPU, 29 ms an evaluation, measured
+#: 2026-12); a pair against ground takes 3 DOFs, so FILES_MAX_DOF DOFs hold 3333 pairs on distinct nodes
+INTERFACE_MAX_PAIRS = 5_000
 
 # --- memory bounds (jointdyn._validate.memory_budget) ------------------------------------
 #: bound on the memory one computation may allocate, bytes; None: MEMORY_FRACTION of the
@@ -548,6 +553,15 @@ FIT_QUAD_NODES = 64
 #: change of every parameter below which the refinement stops
 FIT_REFINE_ITERATIONS = 4
 FIT_REFINE_RTOL = 1e-4
+#: most data rows of a loop fit (``fit --input``): the least squares evaluates the law over every sample
+#: some hundred times; 1e6 samples took 6 s of CPU time (measured, 2026-12)
+FIT_MAX_LOOP_SAMPLES = 1_000_000
+#: most points of a backbone fit (``fit --backbone``): every point costs a describing function per
+#: evaluation, 4 ms of CPU time per point for the whole fit (1000 points took 3.8 s, measured 2026-12)
+FIT_MAX_BACKBONE_POINTS = 1_000
+#: largest magnitude of a measured value a fit computes with: its squares, products and sums over
+#: every sample must stay finite in double precision (1e100 squared is 1e200)
+FIT_MAX_MAGNITUDE = 1e100
 
 # --- sweeps --------------------------------------------------------------------------
 #: gamma grid START:STOP:STEP (the paper's Fig 6 range)

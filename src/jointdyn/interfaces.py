@@ -66,11 +66,13 @@ return the primal outputs of ``interface_step`` bit for bit.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import _validate as V
+from . import config
 from ._jit import jit
 from .laws._base import _HUGE, MACROSLIP, SEPARATION, STICK_SLIP
 
@@ -457,9 +459,22 @@ def interface_scatter(pairs, T, N, params, f):  # pragma: no cover - compiled
 # --- the interface as users give it --------------------------------------------------
 
 
+#: largest stiffness (N/m) or preload (N) of a pair: that of a matrix entry of a system file, the
+#: largest double over a headroom for the sums of many pairs on one DOF and the solvers' scalings
+_MAX_PARAM = sys.float_info.max / 2.0**20
+
+
 def _per_pair(name: str, value, npairs: int, positive: bool) -> np.ndarray:
     """A parameter given as one number or one number per pair, validated, as (npairs,) float64."""
-    check = V.positive if positive else V.nonnegative
+    sign = V.positive if positive else V.nonnegative
+
+    def check(label, v):
+        v = sign(label, v)
+        if v > _MAX_PARAM:
+            raise ValueError(f"{label} must be at most {_MAX_PARAM:.4g} (the solvers add it to K, sum it over the "
+                             f"pairs and scale it), got {v!r}")
+        return v
+
     if np.ndim(value) == 0:
         return np.full(npairs, check(name, value))
     try:
@@ -476,6 +491,10 @@ def _per_pair(name: str, value, npairs: int, positive: bool) -> np.ndarray:
 def _pairs(value) -> np.ndarray:
     """The (npairs, 6) int64 DOF table, validated (entries >= -1, distinct DOFs within a pair)."""
     cols = ", ".join(PAIR_COLUMNS)
+    count = len(value) if hasattr(value, "__len__") else 0
+    if count > config.INTERFACE_MAX_PAIRS:  # before a table of them is built or evaluated
+        raise ValueError(f"pairs must have at most {config.INTERFACE_MAX_PAIRS} rows (config.INTERFACE_MAX_PAIRS: "
+                         f"every solver evaluates each pair at every sample of every step), got {count}")
     try:
         a = np.asarray(value)
     except (TypeError, ValueError):
@@ -703,3 +722,41 @@ class Interface:
         w_new = np.empty((self.npairs, 2))
         interface_step(self.params, u0, g0, u, g, w, w_new, T, N, code)
         return T, N, code, w_new
+
+
+def _selection_vector(dof: int, dof2: int, direction, n: int) -> np.ndarray:
+    if direction is not None:
+        return np.asarray(direction, dtype=np.float64).copy()
+    b = np.zeros(n)
+    b[dof] += 1.0
+    if dof2 >= 0:
+        b[dof2] -= 1.0
+    return b
+
+
+def static_springs(system, open_pairs: bool = False) -> list:
+    """The springs that hold a System at rest with every contact stuck and every normal spring
+    closed, beside its K: ``(key, stiffness N/m, selection vector)`` each, the key as a system
+    file names it (``contact[i].kt``, ``contact[i].normal.kn``, ``interface[i].kt`` or ``.kn``,
+    pairs counted from 0). Pairs open at rest (preload 0) hold nothing: with ``open_pairs`` they are
+    the only ones listed (the springs they would add once closed)."""
+    n = system.ndof
+    out = []
+    for i, c in enumerate(() if open_pairs else system.contacts):
+        out.append((f"contact[{i}].kt", float(c.law.kt), _selection_vector(c.dof, c.dof2, c.direction, n)))
+        kn = getattr(c.normal, "kn", None)
+        if kn is not None:
+            nm = c.normal
+            out.append((f"contact[{i}].normal.kn", float(kn), _selection_vector(nm.dof, nm.dof2, nm.direction, n)))
+    for i, itf in enumerate(system.interfaces):
+        for j, row in enumerate(itf.pairs):
+            if (itf.preload[j] > 0.0) == open_pairs:
+                continue
+            for k, (name, value) in enumerate((("kt", itf.kt[j]), ("kt", itf.kt[j]), ("kn", itf.kn[j]))):
+                b = np.zeros(n)
+                if row[k] >= 0:
+                    b[row[k]] += 1.0
+                if row[k + 3] >= 0:
+                    b[row[k + 3]] -= 1.0
+                out.append((f"interface[{i}].{name}" + (f" (pair {j})" if itf.npairs > 1 else ""), float(value), b))
+    return out

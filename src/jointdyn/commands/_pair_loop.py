@@ -54,6 +54,31 @@ def _validate(args) -> None:
         V.output_dir("--out", args.out, files=("loop.csv", "loop.png"))
 
 
+#: largest force, normal load or work a pair loop computes (N, N, J): the largest double over a
+#: headroom for the sums of its steps and the products of its metrics
+_HUGE = sys.float_info.max / 2.0**20
+
+
+def _check_scales(args, u1, u2, g) -> None:
+    """The forces and the work the history can produce stay finite: checked before computing, so that
+    no overflow is computed as if valid (each bound names the options and the file's columns)."""
+    with np.errstate(all="ignore"):
+        span = float(np.ptp(u1)) + float(np.ptp(u2))
+        force = args.kt * span  # the largest tangential force of a stuck pair
+        normal = args.preload + args.kn * float(np.max(g))  # the largest normal load
+        path = float(np.sum(np.abs(np.diff(u1))) + np.sum(np.abs(np.diff(u2))))
+        work = min(force, args.mu * normal) * path  # the most work the tangential force can do
+    for label, value in (
+        ("--kt x the range of u1 and u2 of --input (tangential force, N)", force),
+        ("--preload + --kn x the largest g of --input (normal load, N)", normal),
+        ("the range of u1 and u2 of --input (m)", span),
+        ("the tangential force x the path of u1 and u2 of --input (work, J)", work),
+    ):
+        if not value <= _HUGE:
+            raise ValueError(f"{label} must be at most {_HUGE:.4g} (double precision, with headroom for sums), got "
+                             f"{value:.4g}: reduce --kt, --kn, --preload or the values of --input")
+
+
 def _report(args, res) -> dict:
     from ..laws import STATE_NAMES
 
@@ -134,11 +159,15 @@ def run(args) -> int:
     t, u1, u2, g = read_pair_history_csv(args.input, name="--input")
     if args.period is not None:
         cycle_count(t, args.period, name="--period")
-    res = interface_loop(pair, t, u1, u2, g, period=args.period)
-    if not (np.all(np.isfinite(res.T)) and np.all(np.isfinite(res.N))):
-        raise ValueError("the parameters overflow double precision (T or N is not finite): reduce --kt, --kn or "
-                         "the displacements of --input")
-    report = _report(args, res)
+    _check_scales(args, u1, u2, g)
+    with np.errstate(all="ignore"):  # an overflow is refused below, in one line, not warned about
+        res = interface_loop(pair, t, u1, u2, g, period=args.period)
+        report = _report(args, res)
+    finite = all(np.all(np.isfinite(a)) for a in (res.T, res.N)) and all(
+        np.isfinite(v) for v in report.values() if isinstance(v, float))
+    if not finite:
+        raise ValueError("the parameters overflow double precision (a force, load or the work is not finite): "
+                         "reduce --kt, --kn, --preload or the displacements of --input")
     text = json.dumps(report, allow_nan=False) if args.json else None
     if args.out is not None:
         _write_files(args, res)

@@ -8,9 +8,11 @@ contacts and its forcing.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 from .. import _validate as V
 
-__all__ = ["add_system_argument", "refuse_paper_options", "load_system_file"]
+__all__ = ["add_system_argument", "refuse_paper_options", "load_system_file", "option_names"]
 
 
 def add_system_argument(p) -> None:
@@ -18,7 +20,8 @@ def add_system_argument(p) -> None:
     p.add_argument("--system", default=None, metavar="FILE.toml",
                    help="a structure of your own: TOML file with [structure] M, K (C or zeta), [[force]], "
                         "[[contact]] (law and parameters, tangential and normal selection, prescribed load or "
-                        "normal spring) and [output] (docs/system-files.md); refuses the options that describe "
+                        "normal spring), [[interface]] (patches of node pairs: kt, kn, mu, preload, pairs inline or "
+                        "from a CSV file) and [output] (docs/system-files.md); refuses the options that describe "
                         "the paper damper")
 
 
@@ -45,3 +48,18 @@ def load_system_file(args):
         return read_system_file(args.system)
     except ValueError as exc:
         raise ValueError(f"--system {exc}") from None
+
+
+@contextmanager
+def option_names(**names):
+    """Library errors raised inside the block, their leading Python argument (``mode``,
+    ``output_dof``, ``amplitude``) said as the CLI option that gave it (``--mode``, ...):
+    ``option_names(output_dof="--output-dof")``."""
+    try:
+        yield
+    except ValueError as exc:
+        msg = str(exc)
+        for arg, option in names.items():
+            if msg == arg or msg.startswith((f"{arg} ", f"{arg}:")):
+                raise ValueError(option + msg[len(arg):]) from None
+        raise

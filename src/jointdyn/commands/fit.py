@@ -25,10 +25,9 @@ converge, exits with status 3 (its results are still written).
 
 from __future__ import annotations
 
-import csv
 import io
 import json
-import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -64,7 +63,8 @@ def add_arguments(p) -> None:
 
 
 def read_columns(path, columns, name: str) -> dict:
-    """The named columns of a CSV file with a header row, as float arrays.
+    """The named columns of a CSV file with a header row, as float arrays (jointdyn's one CSV
+    reader, :mod:`jointdyn.files.tables`: BOM, ``;`` separators and unit rows accepted).
 
     Raises
     ------
@@ -72,35 +72,9 @@ def read_columns(path, columns, name: str) -> dict:
         Naming ``name`` and the file (and the line): unreadable, no header, a missing
         column, a non-numeric or non-finite value, a short row, fewer than 4 rows.
     """
-    from .. import _validate as V
+    from ._fit_data import read_columns as read
 
-    path = V.input_file(name, path)
-    try:
-        text = Path(path).read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{name} {str(path)!r} cannot be read: {exc}") from None
-    rows = [r for r in csv.reader(io.StringIO(text)) if r and any(c.strip() for c in r)]
-    if not rows:
-        raise ValueError(f"{name} {str(path)!r} is empty; expected a header row with {', '.join(columns)}")
-    header = [c.strip() for c in rows[0]]
-    missing = [c for c in columns if c not in header]
-    if missing:
-        raise ValueError(f"{name} {str(path)!r} has no column {', '.join(missing)} (header: {', '.join(header)}); "
-                         f"expected columns {', '.join(columns)}")
-    idx = [header.index(c) for c in columns]
-    data = np.empty((len(rows) - 1, len(columns)))
-    for i, row in enumerate(rows[1:]):
-        try:
-            vals = [float(row[j]) for j in idx]
-        except (IndexError, ValueError):
-            raise ValueError(f"{name} {str(path)!r} line {i + 2}: expected numbers in columns "
-                             f"{', '.join(columns)}, got {','.join(row)!r}") from None
-        if not all(math.isfinite(v) for v in vals):
-            raise ValueError(f"{name} {str(path)!r} line {i + 2}: values must be finite, got {','.join(row)!r}")
-        data[i] = vals
-    if data.shape[0] < 4:
-        raise ValueError(f"{name} {str(path)!r} must have at least 4 data rows, got {data.shape[0]}")
-    return {c: data[:, k].copy() for k, c in enumerate(columns)}
+    return read(path, columns, name)
 
 
 def _validate_args(args) -> None:
@@ -131,15 +105,14 @@ def _law_options(args) -> tuple:
 
 def _fit(args):
     from ..identify import fit_backbone, fit_loops
+    from ._fit_data import read_backbone, read_loops
 
     held, start = _law_options(args)
     if args.input is not None:
-        d = read_columns(args.input, LOOP_COLUMNS, "--input")
-        if not np.all(np.diff(d["t"]) > 0.0):
-            raise ValueError(f"--input {args.input!r}: t must increase strictly from row to row")
+        d = read_loops(args.input, "--input")
         return fit_loops(d["x"], d["N"], d["T"], args.model, t=d["t"], n_ref=args.n_ref, law_params=held,
                          start=start)
-    d = read_columns(args.backbone, BACKBONE_COLUMNS, "--backbone")
+    d = read_backbone(args.backbone, "--backbone", mass=args.mass)
     return fit_backbone(d["amplitude_m"], d["omega_rad_s"], d["damping_ratio"], mass=args.mass, model=args.model,
                         law_params=held, start=start)
 
@@ -227,17 +200,27 @@ def _print_console(args, fit) -> None:
 
 def run(args) -> int:
     _validate_args(args)
+    from ._fit_data import plausibility
+
     fit = _fit(args)
-    text = json.dumps(fit.to_dict(), allow_nan=False)
+    warnings = plausibility(fit, fit.measured if fit.kind == "loops" else None)
+    report = fit.to_dict()
+    report["warnings"] = warnings
+    try:
+        text = json.dumps(report, allow_nan=False)
+    except ValueError:
+        src = "--input" if args.input is not None else "--backbone"
+        raise ValueError(f"the fitted values overflow double precision: the data of {src} are beyond the range of "
+                         "a fit (scale them to SI units of ordinary size)") from None
     if args.out is not None:
         _write_files(args, fit, text)
     if args.json:
         print(text)
     else:
         _print_console(args, fit)
+    for w in warnings:
+        print(f"jointdyn fit: warning: {w}", file=sys.stderr)
     if not fit.status.ok:
-        import sys
-
         print(f"jointdyn fit: {fit.message}", file=sys.stderr)
         return EXIT_INCOMPLETE
     return 0

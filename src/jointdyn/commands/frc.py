@@ -60,9 +60,12 @@ def add_arguments(p) -> None:
     load = p.add_mutually_exclusive_group()
     load.add_argument("--beta", type=float, default=None, help="mu N0 / F1 (> 0; default 1.0)")
     load.add_argument("--f1", type=float, default=None, help="forcing amplitude F1 in N (> 0), instead of --beta")
-    p.add_argument("--gamma", default=g0, metavar="START:STOP:STEP",
+    p.add_argument("--gamma", default=None, metavar="START:STOP:STEP",
                    help=f"frequency-ratio grid gamma = w/w0 (default {g0}); with --system w0 is the file's "
                         "reference frequency")
+    p.add_argument("--frequency", default=None, metavar="START:STOP:STEP",
+                   help="forcing-frequency grid in Hz instead of --gamma (gamma = 2 pi f / w0); frc.csv gives "
+                        "every point in Hz and rad/s as well")
     p.add_argument("--delta", type=float, default=None, help=f"normal-load phase, degrees (default {d['delta']:g})")
     p.add_argument("--sweep", default=None,
                    help="time: up, down or both (default both); hb: refused (the continuation follows the "
@@ -97,22 +100,22 @@ def add_arguments(p) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
 
 
-def parse_gamma(text: str) -> np.ndarray:
-    """``START:STOP:STEP`` -> increasing grid (STOP included when on the grid)."""
+def parse_gamma(text: str, name: str = "--gamma") -> np.ndarray:
+    """``START:STOP:STEP`` -> increasing grid (STOP included when on the grid); errors name ``name``."""
     parts = str(text).split(":")
     if len(parts) != 3:
-        raise ValueError(f"--gamma must be START:STOP:STEP, got {text!r}")
+        raise ValueError(f"{name} must be START:STOP:STEP, got {text!r}")
     try:
         start, stop, step = (float(s) for s in parts)
     except ValueError:
-        raise ValueError(f"--gamma must be START:STOP:STEP of numbers, got {text!r}") from None
-    V.positive("--gamma START", start)
-    V.positive("--gamma STEP", step)
-    V.finite("--gamma STOP", stop)
+        raise ValueError(f"{name} must be START:STOP:STEP of numbers, got {text!r}") from None
+    V.positive(f"{name} START", start)
+    V.positive(f"{name} STEP", step)
+    V.finite(f"{name} STOP", stop)
     if not stop >= start:
-        raise ValueError(f"--gamma STOP must be >= START ({start:g}), got {stop:g}")
+        raise ValueError(f"{name} STOP must be >= START ({start:g}), got {stop:g}")
     # a float until bounded: (STOP - START) / STEP may be huge or inf
-    V.count_at_most("--gamma START:STOP:STEP", (stop - start) / step + 1.0,
+    V.count_at_most(f"{name} START:STOP:STEP", (stop - start) / step + 1.0,
                     config.SWEEP_MAX_GAMMA_POINTS, "points")
     count = int(math.floor((stop - start) / step + 1e-9)) + 1
     grid = start + step * np.arange(count)
@@ -120,6 +123,25 @@ def parse_gamma(text: str) -> np.ndarray:
         # 12 decimals clean the float noise of a grid; not where they would change a value (tiny or huge gammas)
         rounded = np.round(grid, 12)
     return np.where(np.abs(rounded - grid) <= 1e-9 * grid, rounded, grid)
+
+
+def config_gamma() -> str:
+    """The default --gamma grid, as the option writes it."""
+    return ":".join(f"{v:g}" for v in config.SWEEP_GAMMA_DEFAULT)
+
+
+def _frequency_gammas(args) -> np.ndarray:
+    """The gamma grid of ``--frequency`` (Hz): gamma = 2 pi f / w0, with w0 the system file's reference
+    frequency or the paper damper's sqrt(k / m)."""
+    if args.gamma is not None:
+        raise ValueError("--frequency and --gamma both give the frequency grid; give one")
+    hz = parse_gamma(args.frequency, "--frequency")
+    if args.system_file is not None:
+        w0 = args.system_file.system.w0
+    else:
+        w0 = math.sqrt(V.positive("--k", PAPER["k"] if args.k is None else args.k)
+                       / V.positive("--m", PAPER["m"] if args.m is None else args.m))
+    return V.finite_array("--frequency x 2 pi / w0 (gamma)", 2.0 * math.pi * hz / w0)
 
 
 #: options of one method only, with the reason they do not apply to the other
@@ -203,7 +225,9 @@ def _validate(args):
     _check_method_options(args)
     if args.method == "time":
         V.choice("--sweep", args.sweep, ("up", "down", "both"))
-    gammas = parse_gamma(args.gamma)
+    gammas = None  # from --frequency once w0 is known
+    if getattr(args, "frequency", None) is None:
+        gammas = parse_gamma(config_gamma() if args.gamma is None else args.gamma)
     if args.steps_per_period is not None:
         V.positive_int("--steps-per-period", args.steps_per_period, 8)
     if args.workers is not None:
@@ -219,8 +243,10 @@ def _validate(args):
     if args.system is not None:
         refuse_paper_options(args, PAPER_OPTIONS)
         args.system_file = load_system_file(args)
+        gammas = _frequency_gammas(args) if gammas is None else gammas
         _check_system_derived(args.system_file.system, gammas)
     else:
+        gammas = _frequency_gammas(args) if gammas is None else gammas
         _validate_paper(args, gammas)
     if args.method == "time":
         _check_time_steps(args, gammas)
@@ -281,6 +307,8 @@ def _connect(address):
 
 def _system_header(sf) -> dict:
     """What the JSON says about a --system structure."""
+    from ..hb.problem import amplitude_q_meaning
+
     system = sf.system
     contacts = []
     for c in system.contacts:
@@ -290,7 +318,8 @@ def _system_header(sf) -> dict:
                          "n0": float(c.normal.n0)})
     return {"file": str(sf.path), "title": sf.title, "ndof": int(system.ndof), "w0_rad_s": float(system.w0),
             "response_dof": int(system.response_dof), "dofs": [int(d) for d in sf.dofs],
-            "fy_N": float(system.contacts[0].law.fy) if system.contacts else None, "contacts": contacts}
+            "fy_N": float(system.contacts[0].law.fy) if system.contacts else None, "contacts": contacts,
+            "amplitude_q_meaning": amplitude_q_meaning(system)}
 
 
 def _header(args) -> dict:
@@ -433,7 +462,8 @@ def _hb_branches(br, dofs=()) -> list:
     out = []
     for b in dict.fromkeys(br.segment.tolist()):
         idx = np.flatnonzero(br.segment == b)
-        one = {"gamma": gam[idx], "amplitude_q": kt * amp[idx] / fy, "amplitude_m": amp[idx],
+        q = kt * amp[idx] / fy if fy > 0.0 else np.full(idx.size, np.nan)  # no slip force: null, not a warning
+        one = {"gamma": gam[idx], "amplitude_q": q, "amplitude_m": amp[idx],
                "offset_m": off[idx], "max_abs_m": mx[idx]}
         one = {k: _jsonable(v) for k, v in one.items()}
         if len(dofs):
@@ -605,6 +635,14 @@ def _plot_hb(ax, result) -> None:
     ax.legend(fontsize=8)
 
 
+def _with_frequency(ds, w0: float):
+    """``ds`` with the forcing frequency of every point in rad/s and Hz beside gamma: gamma alone is
+    relative to a w0 that may be another mode than the one a user looks at."""
+    omega = ds["gamma"] * w0
+    return ds.assign(omega_rad_s=omega.assign_attrs(units="rad/s", long_name="forcing frequency w = gamma w0"),
+                     frequency_hz=(omega / (2.0 * math.pi)).assign_attrs(units="Hz", long_name="w / (2 pi)"))
+
+
 def _titled(ds, result):
     """``ds`` with the --system file's ``title`` as its ``title`` attribute (frc.nc carries it as the JSON
     and frc.png do); what the run computed, the title of a paper-damper run, moves to ``summary``."""
@@ -640,13 +678,13 @@ def run(args) -> int:
         if args.method == "time":
             from ..sweeps import write_outputs
 
-            write_outputs(_titled(ds, result), out)
+            write_outputs(_with_frequency(_titled(ds, result), _system(args).w0), out)
         else:
             from .._io import write_dataset
             from ..hb import branch_dataset
 
             # frc.csv: one row per point (per-harmonic data in frc.nc)
-            write_dataset(_titled(branch_dataset(ds), result), out, "frc")
+            write_dataset(_with_frequency(_titled(branch_dataset(ds), result), _system(args).w0), out, "frc")
         _plot(result, out / "frc.png")
     if args.json:
         print(json.dumps(result))

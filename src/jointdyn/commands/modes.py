@@ -32,7 +32,7 @@ from .. import config
 from .._exit import EXIT_INCOMPLETE
 from .._io import jsonable as _jsonable
 from ._law_args import add_law_arguments, law_params, model_help
-from ._system_args import load_system_file
+from ._system_args import load_system_file, option_names
 
 NAME = "modes"
 HELP = "backbone of a nonlinear mode (natural frequency and damping ratio against amplitude) by EPMC or QSMA"
@@ -111,9 +111,10 @@ def _validate(args):
         label = f"paper's damper, {args.model}"
         args.title = args.figure_label = label
     check_free_vibration(system, args.method.upper(), springs=args.method == "epmc")
-    amps = amplitude_range(system, None if args.amplitude is None else parse_amplitude(args.amplitude))
-    args.output_dof = output_dof_of(system, args.output_dof)
-    linear_stuck_mode(system, V.positive_int("--mode", args.mode, 1), args.output_dof)
+    with option_names(amplitude="--amplitude", output_dof="--output-dof", mode="--mode"):
+        amps = amplitude_range(system, None if args.amplitude is None else parse_amplitude(args.amplitude))
+        args.output_dof = output_dof_of(system, args.output_dof)
+        linear_stuck_mode(system, V.positive_int("--mode", args.mode, 1), args.output_dof)
     if args.method == "epmc":
         from ..hb import AUTO, Discretisation, check_memory
 

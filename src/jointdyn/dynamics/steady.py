@@ -638,7 +638,7 @@ def steady_state(
     energy_rtol: float | None = None,
     check_periods: int | None = None,
     max_periods: int | None = None,
-    response_dof: int = 0,
+    response_dof: int | None = None,
     keep_loop: bool = True,
     shooting: bool = True,
     _events: bool = True,
@@ -672,8 +672,10 @@ def steady_state(
         K, windows that must agree (default ``config.SS_CHECK_PERIODS``).
     max_periods : int, optional
         Cap on integrated periods (default ``config.SS_MAX_PERIODS``).
-    response_dof : int
-        DOF whose amplitude is reported.
+    response_dof : int, optional
+        DOF whose amplitude is reported (default: the system's response DOF,
+        ``[output] dof`` of a system file, as :func:`jointdyn.frc_hb`,
+        :func:`jointdyn.frc_sweep` and the CLI report).
     keep_loop : bool
         Record the final p periods in ``loop``.
     shooting : bool
@@ -694,7 +696,7 @@ def steady_state(
     energy_rtol = V.positive("energy_rtol", config.SS_ENERGY_RTOL if energy_rtol is None else energy_rtol)
     K = V.positive_int("check_periods", config.SS_CHECK_PERIODS if check_periods is None else check_periods, 2)
     maxp = V.positive_int("max_periods", config.SS_MAX_PERIODS if max_periods is None else max_periods)
-    rdof = V.positive_int("response_dof", response_dof, 0)
+    rdof = V.positive_int("response_dof", system.response_dof if response_dof is None else response_dof, 0)
     if rdof >= system.ndof:
         raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {rdof}")
     w = _omega(system, gamma)

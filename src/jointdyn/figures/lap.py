@@ -17,9 +17,10 @@
     (:func:`jointdyn.modes.single_mode_frc`: at the 733 DOFs of the model a
     harmonic-balance branch with its Hill stability is beyond what this
     figure can afford today, docs/lap-joint.md);
-    (d) slip maps of the patch at three amplitudes of the backbone: per pair
-    the fraction of the period it slips, the fraction it is open, and the
-    energy it dissipates per cycle. Settings: ``config.LAP_*``.
+    (d) and (e) maps of the patch at three amplitudes of the backbone: per
+    pair the fraction of the period it slips (d) and the fraction it is open
+    (e), with the energy the pairs dissipate per cycle above each column.
+    Settings: ``config.LAP_*``.
 """
 
 from __future__ import annotations
@@ -149,7 +150,7 @@ def _plot_maps(axes, slip):
                 ax.set_title(f"a = {1e3 * a:.3g} mm, {sub.frequency_hz.iloc[0]:.1f} Hz{note}\n"
                              f"pairs dissipate {1e3 * sub.energy_J.sum():.3g} mJ per cycle", fontsize=8)
             if col == 0:
-                ax.set_ylabel("(d) " + label, fontsize=8)
+                ax.set_ylabel(f"({'de'[row]}) " + label, fontsize=8)  # one letter per row of maps
         last = sc
     return last
 

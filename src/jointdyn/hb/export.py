@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from .problem import reference_scales
+from .problem import amplitude_q_meaning, reference_scales
 from .results import HBBranch, PointStatus
 
 __all__ = ["branch_dataset", "discretisation_attrs", "pair_arrays"]
@@ -79,7 +79,8 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
     if branch.parameter != "gamma":
         data[branch.parameter] = ("point", branch.lam)
     data.update(_pair_variables(branch))
-    attrs = {"gamma": {"long_name": "w / w0"}, "amplitude_q": {"long_name": "kt X / fy", "units": "1"},
+    attrs = {"gamma": {"long_name": "w / w0"},
+             "amplitude_q": {"long_name": amplitude_q_meaning(p.system), "units": "1"},
              **{v: {"units": "m"} for v in ("amplitude_m", "offset_m", "max_abs_m", "harmonic_amplitude_m",
                                             "peak_amplitude_m")},
              "point_status": {"flag_meanings": " ".join(s.value for s in PointStatus)},

@@ -663,6 +663,19 @@ def reference_scales(system: System) -> tuple[float, float]:
     raise ValueError("system must have at least one contact or interface")
 
 
+def amplitude_q_meaning(system: System) -> str:
+    """What ``amplitude_q`` is for ``system`` (the long name of the variable, and of the JSON key
+    ``amplitude_q_meaning``): the reference scales of :func:`reference_scales` in words."""
+    if system.contacts:
+        return "kt X / fy of the first contact (X the amplitude in m, fy = mu n_ref)"
+    kt, fy = reference_scales(system)
+    if not fy > 0.0:
+        return ("undefined (null): every interface pair is open at rest (mu x preload = 0), so there is no slip "
+                "force to scale by; see amplitude_m")
+    return ("sum(kt) X / sum(mu preload) of the interfaces' pairs taken as one patch along one tangential "
+            "direction (X the amplitude in m)")
+
+
 @by_value(maxsize=8)
 def _problem_at(cls, parameter, H, Ns, max_passes, w, ndof, ncontacts, p, dofs):
     """Problem of class ``cls`` (:class:`HBProblem`, or the condensed problem when ``dofs`` is not None) of

@@ -129,6 +129,10 @@ def _check(A, w, D, mass):
                          f"got {A.size}, {w.size}, {D.size}")
     if A.size < 4:
         raise ValueError(f"amplitude_m must have at least 4 points, got {A.size}")
+    if A.size > config.FIT_MAX_BACKBONE_POINTS:  # the bound of fit --backbone, before any fitting
+        raise ValueError(f"amplitude_m must have at most {config.FIT_MAX_BACKBONE_POINTS} points "
+                         "(config.FIT_MAX_BACKBONE_POINTS: each costs a describing function per evaluation), "
+                         f"got {A.size}")
     if not (np.all(A > 0.0) and np.all(w > 0.0)):
         raise ValueError("amplitude_m and omega_rad_s must be > 0 (allowed range (0, inf))")
     if not np.all(D >= 0.0):

@@ -48,6 +48,9 @@ def _check(x, N, T):
         raise ValueError(f"x, N and T must have one length, got {x.size}, {N.size}, {T.size}")
     if x.size < 10:
         raise ValueError(f"x must have at least 10 samples, got {x.size}")
+    if x.size > config.FIT_MAX_LOOP_SAMPLES:  # the bound of fit --input, before any fitting
+        raise ValueError(f"x must have at most {config.FIT_MAX_LOOP_SAMPLES} samples (config.FIT_MAX_LOOP_SAMPLES: "
+                         f"the law is evaluated over every sample some hundred times), got {x.size}")
     if not np.any(N > 0.0):
         raise ValueError("N must be positive (in contact) at some samples: no sample has N > 0")
     if not np.ptp(x) > 0.0:

@@ -104,10 +104,15 @@ def check_free_vibration(system, method: str, *, springs: bool = True) -> System
 
     lam = eigh(system.K_reference, system.M, eigvals_only=True)
     if not lam[0] > config.MODES_MIN_EIGENVALUE_RATIO * abs(lam[-1]):
-        raise ValueError(
-            f"K must be positive definite with the tangential contacts free (smallest eigenvalue of (M, K) "
-            f"{lam[0]:.6g} (rad/s)^2): {method} needs a static equilibrium of the slipping structure (the mean "
-            "of the motion is not held by friction)")
+        # a positive eigenvalue below the ratio is a stiffness too small beside the others, not a free DOF
+        what = ("is ill-conditioned with the tangential contacts free: its smallest eigenvalue of (M, K), "
+                f"{lam[0]:.6g} (rad/s)^2, is {lam[0] / lam[-1]:.3g} of the largest, below the ratio "
+                f"{config.MODES_MIN_EIGENVALUE_RATIO:g} that double precision resolves (a normal stiffness kn many "
+                "decades below the others?)" if lam[0] > 0.0 else
+                "must be positive definite with the tangential contacts free (smallest eigenvalue of (M, K) "
+                f"{lam[0]:.6g} (rad/s)^2)")
+        raise ValueError(f"K {what}: {method} needs a static equilibrium of the slipping structure (the mean "
+                         "of the motion is not held by friction)")
     return system
 
 
@@ -166,8 +171,9 @@ def amplitude_range(system: System, amplitude) -> tuple[float, float]:
     if amplitude is None:
         scale = contact_scale(system)
         if not scale > 0.0:
-            raise ValueError("amplitude must be given (min, max) in m: the first contact has no friction "
-                             "(fy = 0), so there is no default range")
+            why = ("the first contact has no friction (fy = 0)" if system.contacts else
+                   "every interface pair is open at rest (mu x preload = 0: no slip force)")
+            raise ValueError(f"amplitude must be given (min, max) in m: {why}, so there is no default range")
         lo, hi = (q * scale for q in config.MODES_AMPLITUDE_Q)
         return lo, hi
     try:

@@ -218,7 +218,7 @@ def backbone_dataset(backbone: Backbone):
     b = backbone
     s = b.system
     n, H = s.ndof, b.harmonics
-    from ..hb.problem import reference_scales
+    from ..hb.problem import amplitude_q_meaning, reference_scales
 
     kt, fy = reference_scales(s)
     scale = fy / kt
@@ -228,7 +228,7 @@ def backbone_dataset(backbone: Backbone):
     data = {
         "amplitude_m": (point, b.amplitude_m, {"units": "m", "long_name": "first-harmonic amplitude of the output DOF"}),
         "amplitude_q": (point, b.amplitude_m / scale if scale > 0 else b.amplitude_m * np.nan,
-                        {"units": "1", "long_name": "kt a / fy of the first contact"}),
+                        {"units": "1", "long_name": amplitude_q_meaning(s).replace(" X ", " a ")}),
         "omega_rad_s": (point, b.omega_rad_s, {"units": "rad/s", "long_name": "natural frequency"}),
         "frequency_hz": (point, b.omega_rad_s / (2.0 * np.pi), {"units": "Hz"}),
         "gamma": (point, b.omega_rad_s / s.w0, {"long_name": "omega / w0"}),

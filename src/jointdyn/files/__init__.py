@@ -25,8 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import _validate as V
-from . import config
+from .. import _validate as V
+from .. import config
+from ._common import _dof, _number, _table, _vector, _Where
+from ._pairs import _interface
 
 __all__ = ["SystemFile", "read_system", "read_system_file", "read_matrices"]
 
@@ -41,8 +43,6 @@ _SPRING_KEYS = ("kn", "preload", *_SELECTION_KEYS)
 _HARMONIC_KEYS = ("n0", "n1", "phase_deg")
 _SAMPLED_KEYS = ("values",)
 _OUTPUT_KEYS = ("dof", "dofs")
-#: keys of an ``[[interface]]`` (docs/model.md section 10)
-_INTERFACE_KEYS = ("kt", "kn", "mu", "preload", "pairs")
 #: matrices a structure holds, in the order they are read
 _MATRICES = ("M", "K", "C")
 #: file suffixes holding one matrix per file, and several named ones
@@ -76,81 +76,6 @@ class SystemFile:
     path: Path
     title: str
     dofs: tuple
-
-
-class _Where:
-    """Key path inside one file: formats the one-line errors."""
-
-    def __init__(self, file: Path):
-        self.file = file
-
-    def error(self, key: str, message: str) -> ValueError:
-        """``<file>: <key> <message>`` as a ValueError (one line)."""
-        return ValueError(" ".join(f"{self.file}: {key} {message}".split()))
-
-    def wrap(self, key: str, exc: ValueError, fields=()) -> ValueError:
-        """A constructor's error under ``key``: ``key.field ...`` when the
-        message starts with one of ``fields``, else ``key: ...``."""
-        msg = str(exc)
-        first = msg.split(" ", 1)[0]
-        if first in fields:
-            return self.error(f"{key}.{first}", msg.split(" ", 1)[1] if " " in msg else "")
-        return ValueError(" ".join(f"{self.file}: {key}: {msg}".split()))
-
-
-def _table(where: _Where, key: str, value, allowed, required=()) -> dict:
-    """A TOML table with only ``allowed`` keys and every ``required`` one
-    (``key`` "" is the document itself)."""
-    if not isinstance(value, dict):
-        raise where.error(key, f"must be a table, got {type(value).__name__} {value!r:.60}")
-    def full(k):
-        return f"{key}.{k}" if key else k
-
-    for k in value:
-        if k not in allowed:
-            raise where.error(full(k), f"is not a known key (allowed: {', '.join(allowed)})")
-    for k in required:
-        if k not in value:
-            raise where.error(full(k), "is missing")
-    return value
-
-
-def _number(where: _Where, key: str, value, *, low=-math.inf, low_open=False) -> float:
-    """A finite TOML number (integer or float, not a string or boolean) above ``low``."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise where.error(key, f"must be a number, got {type(value).__name__} {value!r:.60}")
-    try:
-        v = float(value)
-    except OverflowError:
-        raise where.error(key, f"must be finite, got {V.short_repr(value)}") from None
-    if not math.isfinite(v):
-        raise where.error(key, f"must be finite, got {v!r}")
-    if (v <= low) if low_open else (v < low):
-        bound = f"> {low:g}" if low_open else f">= {low:g}"
-        raise where.error(key, f"must be {bound}, got {v!r}")
-    return v
-
-
-def _dof(where: _Where, key: str, value, n: int, *, ground: bool = False) -> int:
-    """A DOF index in [0, n - 1] (or -1 for ground when ``ground``)."""
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise where.error(key, f"must be an integer DOF index, got {type(value).__name__} {value!r:.60}")
-    lo = -1 if ground else 0
-    if not lo <= value < n:
-        extra = " (or -1 for ground)" if ground else ""
-        got = value if abs(value) < 10**20 else V.short_repr(value)
-        raise where.error(key, f"must be in [0, {n - 1}]{extra}, got {got}")
-    return value
-
-
-def _vector(where: _Where, key: str, value, length: int | None = None) -> np.ndarray:
-    """A list of finite numbers (of ``length`` when given)."""
-    if not isinstance(value, list) or not value:
-        raise where.error(key, f"must be a non-empty list of numbers, got {value!r:.60}")
-    out = np.array([_number(where, f"{key}[{i}]", v) for i, v in enumerate(value)])
-    if length is not None and out.size != length:
-        raise where.error(key, f"must have {length} entries (one per DOF), got {out.size}")
-    return out
 
 
 # --- matrices ---------------------------------------------------------------------
@@ -325,7 +250,8 @@ def _read_file(where: _Where, key: str, path: Path, loader):
     exception on a corrupt or truncated file; each is said as a file that
     cannot be read, never a traceback."""
     if not path.is_file():
-        what = "a directory" if path.is_dir() else "no such file"
+        what = ("a directory" if path.is_dir() else "not a regular file (a FIFO, a device or a broken link)"
+                if os.path.lexists(path) else "no such file")
         raise where.error(key, f"names {str(path)!r}: {what}")
     try:
         return loader(path)
@@ -402,7 +328,7 @@ def _matrix_value(where: _Where, key: str, value, folder: Path) -> np.ndarray:
 
 
 def _symmetric(where: _Where, key: str, A: np.ndarray) -> None:
-    from .systems import asymmetry
+    from ..systems import asymmetry
 
     scale = float(np.max(np.abs(A)))
     diff, i, j = asymmetry(A)
@@ -466,7 +392,7 @@ def _check_matrices(where: _Where, mats: dict) -> None:
             raise where.error(key, f"must be {what}, got shape {A.shape[0]} x {A.shape[1]}")
         _symmetric(where, key, A)
     if n > config.SYSTEM_DENSE_CHECK_MAX_DOF:  # a factorisation and Lanczos iterations, no eigen-decomposition
-        from .systems import definiteness_failure
+        from ..systems import definiteness_failure
 
         for name in _MATRICES:
             if name in mats:
@@ -532,7 +458,7 @@ def _selection(where: _Where, key: str, t: dict, n: int) -> dict:
 
 def _normal(where: _Where, key: str, t, n: int):
     """The normal load of a contact and its static load (the law's default n_ref)."""
-    from .kinematics import ConstantLoad, HarmonicLoad, NormalSpring, SampledLoad
+    from ..kinematics import ConstantLoad, HarmonicLoad, NormalSpring, SampledLoad
 
     if not isinstance(t, dict):
         raise where.error(key, f"must be a table, got {t!r:.60}")
@@ -571,8 +497,8 @@ def _normal(where: _Where, key: str, t, n: int):
 
 def _contact(where: _Where, i: int, c, n: int):
     """One ``[[contact]]`` entry as a Contact (its law's n_ref defaults to the static normal load)."""
-    from .laws import law_names, law_parameters, make_law
-    from .systems import Contact
+    from ..laws import law_names, law_parameters, make_law
+    from ..systems import Contact
 
     key = f"contact[{i}]"
     if not isinstance(c, dict):
@@ -606,85 +532,6 @@ def _contact(where: _Where, i: int, c, n: int):
     except ValueError as exc:
         raise where.wrap(key, exc, ("kt", "mu", "n_ref", *params)) from None
     return Contact(made, normal=normal, **tan)
-
-
-def _pair_value(where: _Where, key: str, value):
-    """A per-pair parameter: a number, or a non-empty list of numbers (one per pair)."""
-    if isinstance(value, list):
-        return _vector(where, key, value)
-    return _number(where, key, value)
-
-
-def _pairs_csv(where: _Where, key: str, path: Path) -> np.ndarray:
-    """The pair table of a CSV file: a header naming the six columns a_t1, a_t2, a_n, b_t1, b_t2, b_n
-    (any order, ``,`` separated; lines starting with ``#`` and blank lines skipped), then one row of
-    integers per pair."""
-    import csv
-
-    from .interfaces import PAIR_COLUMNS
-
-    if not path.is_file():
-        raise where.error(key, f"names {str(path)!r}: {'a directory' if path.is_dir() else 'no such file'}")
-    cols = ", ".join(PAIR_COLUMNS)
-    rows, header = [], None
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:
-            for lineno, fields in enumerate(csv.reader(fh), start=1):
-                if not fields or not "".join(fields).strip() or fields[0].lstrip().startswith("#"):
-                    continue
-                fields = [f.strip() for f in fields]
-                if header is None:
-                    missing = [c for c in PAIR_COLUMNS if c not in fields]
-                    if missing or len(set(fields)) != len(fields):
-                        raise where.error(key, f"{str(path)!r} line {lineno}: the header must name the columns "
-                                               f"{cols} once each, got {', '.join(fields)!r:.80}")
-                    header = [fields.index(c) for c in PAIR_COLUMNS]
-                    width = len(fields)
-                    continue
-                if len(fields) != width:
-                    raise where.error(key, f"{str(path)!r} line {lineno}: expected {width} fields, got {len(fields)}")
-                try:
-                    rows.append([int(fields[i]) for i in header])
-                except ValueError:
-                    raise where.error(key, f"{str(path)!r} line {lineno}: the six DOF columns must be integers "
-                                           f"(-1 = fixed), got {', '.join(fields[i] for i in header)!r:.80}") from None
-                if len(rows) > config.FILES_MAX_DOF:
-                    raise where.error(key, f"{str(path)!r} must have at most {config.FILES_MAX_DOF} pairs "
-                                           "(config.FILES_MAX_DOF)")
-    except UnicodeDecodeError:
-        raise where.error(key, f"{str(path)!r} is not UTF-8 text") from None
-    except OSError as exc:
-        raise where.error(key, f"{str(path)!r} cannot be read: {exc.strerror or exc}") from None
-    if header is None or not rows:
-        raise where.error(key, f"{str(path)!r} holds no pairs: expected a header {cols}, then one row per pair")
-    return np.array(rows, dtype=np.int64)
-
-
-def _interface(where: _Where, i: int, t, n: int, folder: Path):
-    """One ``[[interface]]`` entry as an Interface (its pairs inline or from a CSV file)."""
-    from .interfaces import Interface
-
-    key = f"interface[{i}]"
-    t = _table(where, key, t, _INTERFACE_KEYS, required=_INTERFACE_KEYS)
-    params = {k: _pair_value(where, f"{key}.{k}", t[k]) for k in ("kt", "kn", "mu", "preload")}
-    pairs = t["pairs"]
-    if isinstance(pairs, str):
-        p = Path(pairs) if Path(pairs).is_absolute() else folder / pairs
-        pairs = _pairs_csv(where, f"{key}.pairs", p)
-    elif not (isinstance(pairs, list) and pairs and all(isinstance(r, list) for r in pairs)):
-        raise where.error(f"{key}.pairs", f"must be a list of rows of 6 DOF indices or the path of a CSV file, "
-                                          f"got {pairs!r:.60}")
-    else:
-        for j, row in enumerate(pairs):
-            if len(row) != 6 or any(isinstance(v, bool) or not isinstance(v, int) for v in row):
-                raise where.error(f"{key}.pairs[{j}]", f"must be 6 integer DOF indices (a_t1, a_t2, a_n, b_t1, "
-                                                       f"b_t2, b_n; -1 = fixed), got {row!r:.60}")
-    try:
-        made = Interface(pairs=pairs, **params)
-        made.check_ndof(n, "")
-    except ValueError as exc:
-        raise where.wrap(key, exc, _INTERFACE_KEYS) from None
-    return made
 
 
 def _output(where: _Where, o, n: int):
@@ -736,7 +583,7 @@ def read_system_file(path) -> SystemFile:
     """
     import tomllib
 
-    from .systems import System, modal_damping
+    from ..systems import System, modal_damping
 
     p = Path(os.fspath(path))
     where = _Where(p)

@@ -1,0 +1,137 @@
+"""Small things a new user tripped on (issue 33): frequencies in Hz, the reported DOF, what amplitude_q
+is, the help and the option names in messages, the lap-joint figure's row labels."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import jointdyn as jd
+from jointdyn.cli import main
+
+SYSTEM = """
+[structure]
+M = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+K = [[1.0e3, 0.0, 0.0], [0.0, 2.0e3, 0.0], [0.0, 0.0, 3.0e5]]
+zeta = 0.02
+
+[[force]]
+dof = 0
+amplitude = 0.1
+
+[[interface]]
+kt = 1.5e3
+kn = 1.5e3
+mu = 0.5
+preload = {preload}
+pairs = [[0, 1, 2, -1, -1, -1]]
+"""
+
+
+def run_cli(argv):
+    try:
+        return main(argv)
+    except SystemExit as exc:
+        return exc.code
+
+
+def _system(tmp_path, preload="0.5"):
+    f = tmp_path / "s.toml"
+    f.write_text(SYSTEM.format(preload=preload))
+    return f
+
+
+def test_frc_takes_a_frequency_grid_in_hz_and_writes_both_frequencies(tmp_path, capsys):
+    f = _system(tmp_path)
+    w0 = jd.read_system(f).w0
+    out = tmp_path / "out"
+    rc = run_cli(["frc", "--system", str(f), "--method", "hb", "--harmonics", "1", "--samples", "16",
+                  "--frequency", "4:6:0.5", "--out", str(out), "--json"])
+    res = json.loads(capsys.readouterr().out)
+    assert rc == 0
+    gam = res["branches"][0]["gamma"]
+    assert gam[0] == pytest.approx(2 * np.pi * 4.0 / w0) and gam[-1] == pytest.approx(2 * np.pi * 6.0 / w0)
+    table = pd.read_csv(out / "frc.csv")
+    assert np.allclose(table["omega_rad_s"], table["gamma"] * w0, rtol=1e-12)
+    assert np.allclose(table["frequency_hz"], table["omega_rad_s"] / (2 * np.pi), rtol=1e-12)
+    assert table["frequency_hz"].iloc[0] == pytest.approx(4.0)
+
+
+def test_frequency_and_gamma_together_are_refused(tmp_path, capsys):
+    rc = run_cli(["frc", "--system", str(_system(tmp_path)), "--frequency", "4:6:0.5", "--gamma", "0.9:1.1:0.1"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and "--frequency" in err and "--gamma" in err
+
+
+def test_a_time_domain_frc_csv_has_both_frequencies(tmp_path, capsys):
+    out = tmp_path / "out"
+    rc = run_cli(["frc", "--eta", "0", "--beta", "50", "--gamma", "1.3:1.3:0.1", "--out", str(out), "--json"])
+    capsys.readouterr()
+    table = pd.read_csv(out / "frc.csv")
+    w0 = jd.System.paper_damper().w0
+    assert rc == 0 and np.allclose(table["omega_rad_s"], 1.3 * w0) and np.allclose(table["frequency_hz"],
+                                                                                 1.3 * w0 / (2 * np.pi))
+
+
+def test_steady_state_reports_the_systems_output_dof_by_default():
+    M, K = np.diag([1.0, 2.0]), np.array([[3e3, -1e3], [-1e3, 2e3]])
+    s = jd.System(M, 0.02 * K / 30.0, K, force=[1.0, 0.0], output_dof=1)
+    default = jd.steady_state(s, 1.0, max_periods=400)
+    one = jd.steady_state(s, 1.0, max_periods=400, response_dof=1)
+    zero = jd.steady_state(s, 1.0, max_periods=400, response_dof=0)
+    assert default.amplitude_m == pytest.approx(one.amplitude_m, rel=1e-9)
+    assert abs(default.amplitude_m - zero.amplitude_m) > 1e-3 * zero.amplitude_m
+
+
+@pytest.mark.parametrize("preload,words", [("0.5", "interfaces' pairs"), ("0.0", "undefined (null)")])
+def test_amplitude_q_says_what_it_is_for_an_interface_only_system(tmp_path, capsys, preload, words):
+    rc = run_cli(["frc", "--system", str(_system(tmp_path, preload)), "--method", "hb", "--harmonics", "1",
+                  "--samples", "16", "--gamma", "0.8:1.2:0.2", "--json"])
+    cap = capsys.readouterr()
+    res = json.loads(cap.out)
+    assert rc == 0 and cap.err == ""  # no numpy warning of a division by fy = 0
+    meaning = res["system"]["amplitude_q_meaning"]
+    assert words in meaning and "first contact" not in meaning and res["system"]["fy_N"] is None
+    q = res["branches"][0]["amplitude_q"]
+    assert all(v is None for v in q) if preload == "0.0" else all(v > 0 for v in q)
+
+
+def test_frc_help_names_interfaces(capsys):
+    assert run_cli(["frc", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "[[interface]]" in text and "--frequency" in text
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["--mode", "9"], ("--mode must be in [1, 3]",)),
+    (["--output-dof", "7"], ("--output-dof must be in [0, 2]",)),
+    (["--output-dof", "1"], ("--output-dof: DOF 1 does not move",)),
+])
+def test_modes_messages_name_the_cli_options(tmp_path, capsys, argv, words):
+    rc = run_cli(["modes", "--system", str(_system(tmp_path)), "--amplitude", "1e-6:1e-3", *argv])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1, err
+    for w in words:
+        assert w in err, err
+
+
+def test_open_pairs_need_an_amplitude_range_and_say_why(tmp_path, capsys):
+    rc = run_cli(["modes", "--system", str(_system(tmp_path, "0.0"))])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "--amplitude must be given" in err and "open at rest" in err and "first contact" not in err
+
+
+def test_the_lap_joint_maps_label_each_row_once():
+    from jointdyn.figures import pyplot
+    from jointdyn.figures.lap import _plot_maps
+
+    plt = pyplot()
+    rows = [{"map": k, "x_mm": float(i), "y_mm": 0.0, "in_interface": 1, "slip": 0.5, "open": 0.1,
+             "amplitude_m": 1e-4 * (k + 1), "converged": True, "frequency_hz": 100.0, "energy_J": 1e-3}
+            for k in range(3) for i in range(4)]
+    fig, axes = plt.subplots(2, 3)
+    _plot_maps(axes, pd.DataFrame(rows))
+    labels = [axes[r, 0].get_ylabel() for r in range(2)]
+    plt.close(fig)
+    assert labels[0].startswith("(d) ") and labels[1].startswith("(e) ")
