@@ -90,17 +90,19 @@ def describing_function(law, amplitude) -> tuple:
     A = np.atleast_1d(np.asarray(amplitude, dtype=float))
     F, kinks = _virgin_curve(law)
     t, w = _nodes(config.FIT_QUAD_NODES)
-    k1 = np.empty(A.size)
-    en = np.empty(A.size)
-    for i, a in enumerate(A):
-        cuts = [0.0] + sorted(math.acos(1.0 - 2.0 * xk / a) for xk in kinks if 2.0 * xk / a < 2.0) + [math.pi]
-        th = np.concatenate([lo + (hi - lo) * t for lo, hi in zip(cuts[:-1], cuts[1:]) if hi > lo])
-        ww = np.concatenate([(hi - lo) * w for lo, hi in zip(cuts[:-1], cuts[1:]) if hi > lo])
-        T = F(np.array(a)) - 2.0 * F(0.5 * a * (1.0 - np.cos(th)))
-        t1c = 2.0 / math.pi * float(np.sum(ww * T * np.cos(th)))
-        t1s = 2.0 / math.pi * float(np.sum(ww * T * np.sin(th)))
-        k1[i] = t1c / a
-        en[i] = -math.pi * a * t1s
+    # the Masing loop is smooth between 0, the angle where the virgin argument
+    # A (1 - cos theta) / 2 crosses a kink, and pi: one Gauss-Legendre piece each
+    # (a piece of zero length where the kink is not reached), all amplitudes at once
+    cut = [np.arccos(np.clip(1.0 - 2.0 * xk / A, -1.0, 1.0)) for xk in sorted(kinks)]
+    edges = np.stack([np.zeros(A.size)] + cut + [np.full(A.size, math.pi)], axis=1)
+    lo, hi = edges[:, :-1, None], edges[:, 1:, None]
+    th = (lo + (hi - lo) * t).reshape(A.size, -1)
+    ww = ((hi - lo) * w).reshape(A.size, -1)
+    T = F(A)[:, None] - 2.0 * F(0.5 * A[:, None] * (1.0 - np.cos(th)))
+    t1c = 2.0 / math.pi * np.sum(ww * T * np.cos(th), axis=1)
+    t1s = 2.0 / math.pi * np.sum(ww * T * np.sin(th), axis=1)
+    k1 = t1c / A
+    en = -math.pi * A * t1s
     return k1, en
 
 
