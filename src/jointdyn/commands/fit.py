@@ -6,7 +6,8 @@ Two forms::
     jointdyn fit --backbone BACKBONE.csv --model MODEL --mass KG [--json] [--out DIR]
 
 ``--input``: a CSV file with a header row and the columns ``t, x, N, T`` (s,
-m, N, N): a fretting-rig record, one or several cycles, from rest. The law's
+m, N, N): a fretting-rig record, one or several cycles, from rest or picked
+up anywhere in a steady cycle (its first stroke then sets the slip state). The law's
 force under the measured x and N is fitted to T by least squares
 (:func:`jointdyn.fit_loops`). ``--backbone``: columns ``amplitude_m,
 omega_rad_s, damping_ratio`` of one mode of modal mass ``--mass``, fitted
@@ -14,8 +15,11 @@ with a modal Iwan model by the describing function
 (:func:`jointdyn.fit_backbone`).
 
 The console (or ``--json``: keys ``parameters``, ``standard_errors``,
-``rms_residual``, ``status`` and more) gives every parameter with its
-standard error, or why the data do not determine it. ``--out DIR`` receives
+``rms_residual``, ``status``, ``intervals``, ``determined_combinations``,
+``record_start`` and more) gives every parameter with its standard error and
+its 95 % profile-likelihood interval, or why the data do not determine it and
+the combinations they do determine. Displacements implausible in metres (a
+file in mm) are refused. ``--out DIR`` receives
 ``fit.json``, ``fit.csv`` (measured and fitted columns) and ``fit.png``
 (measured and fitted overlaid, and the residuals), each written atomically
 after everything is computed. Bad input: one line on stderr, exit status 2,
@@ -137,9 +141,11 @@ def _fit(args):
         d = read_columns(args.input, LOOP_COLUMNS, "--input")
         if not np.all(np.diff(d["t"]) > 0.0):
             raise ValueError(f"--input {args.input!r}: t must increase strictly from row to row")
+        _plausible("--input", args.input, "x", d["x"], config.FIT_PLAUSIBLE_DISPLACEMENT_M, "m")
         return fit_loops(d["x"], d["N"], d["T"], args.model, t=d["t"], n_ref=args.n_ref, law_params=held,
                          start=start)
     d = read_columns(args.backbone, BACKBONE_COLUMNS, "--backbone")
+    _plausible("--backbone", args.backbone, "amplitude_m", d["amplitude_m"], config.FIT_PLAUSIBLE_AMPLITUDE_M, "m")
     return fit_backbone(d["amplitude_m"], d["omega_rad_s"], d["damping_ratio"], mass=args.mass, model=args.model,
                         law_params=held, start=start)
 
@@ -210,19 +216,45 @@ def _write_files(args, fit, text: str) -> None:
         Path(tmp).write_bytes(png)
 
 
+def _interval_text(iv) -> str:
+    if iv is None:
+        return ""
+    lo = "-inf" if iv.low is None else f"{iv.low:.5g}"
+    hi = "inf" if iv.high is None else f"{iv.high:.5g}"
+    return f"  ({100 * iv.level:.3g} %: [{lo}, {hi}])"
+
+
 def _print_console(args, fit) -> None:
     src = args.input if args.input is not None else args.backbone
     print(f"jointdyn fit: {fit.model} from {fit.kind} {src}: {fit.status.value}")
+    if fit.record_start is not None:
+        print(f"  record {fit.record_start}")
     for k, v in fit.parameters.items():
         se = fit.standard_errors.get(k)
+        iv = _interval_text(fit.intervals.get(k))
         if v is None:
             print(f"  {k:<8} not identifiable: {fit.not_identifiable.get(k, fit.not_identifiable.get('mu', ''))}")
         else:
-            print(f"  {k:<8} {v:.6g} +- {se:.2g}")
+            print(f"  {k:<8} {v:.6g} +- {se:.2g}{iv}" if se is not None else f"  {k:<8} {v:.6g}{iv}")
+    if fit.conditional_on:
+        print(f"  (standard errors with {', '.join(fit.conditional_on)} held; the intervals are not conditional)")
+    for k, c in fit.determined_combinations.items():
+        lo, hi = c["interval"]["low"], c["interval"]["high"]
+        print(f"  determined: {k} = {c['value']:.6g} {c['unit']} (95 %: [{lo if lo is None else f'{lo:.5g}'}, "
+              f"{hi if hi is None else f'{hi:.5g}'}]): {c['meaning']}")
     unit = "N" if fit.kind == "loops" else "(relative)"
     print(f"  rms residual {fit.rms_residual:.4g} {unit}")
     if args.out is not None:
         print(f"  wrote {', '.join(str(Path(args.out) / f) for f in _FILES)}")
+
+
+def _plausible(name, path, column, values, limit, unit) -> None:
+    """Refuse magnitudes no joint test gives in the documented SI unit (a file in mm read as m)."""
+    big = float(np.max(np.abs(values)))
+    if big > limit:
+        raise ValueError(f"{name} {str(path)!r} column {column}: values up to {big:.4g} are not plausible in {unit} "
+                         f"(a joint test stays below {limit:g} {unit}); the file may be in other units (mm?): "
+                         f"convert it to SI")
 
 
 def run(args) -> int:

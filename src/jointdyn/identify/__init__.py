@@ -7,13 +7,16 @@
   damping ratio against amplitude) by the one-harmonic describing function.
 
 Both return a :class:`FitResult` with standard errors, the correlation matrix,
-the rms residual and a :class:`FitStatus`; parameters the data do not
-determine are reported as not identifiable, with the reason.
+the rms residual, a :class:`FitStatus` and the profile-likelihood interval
+(:class:`Interval`) of every parameter; parameters the data do not determine
+are reported as not identifiable, with the reason, and the combinations they
+do determine are given.
 """
 
 from .backbone import BACKBONE_MODELS, describing_function, fit_backbone
 from .loops import LOOP_MODELS, fit_loops
+from ._profile import Interval
 from .result import FitResult, FitStatus
 
-__all__ = ["fit_loops", "fit_backbone", "describing_function", "FitResult", "FitStatus", "LOOP_MODELS",
+__all__ = ["fit_loops", "fit_backbone", "describing_function", "FitResult", "FitStatus", "Interval", "LOOP_MODELS",
            "BACKBONE_MODELS"]
