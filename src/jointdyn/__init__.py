@@ -63,6 +63,7 @@ _LAZY = {
     "CraigBampton": "reduction",
     "fit_loops": "identify",
     "fit_backbone": "identify",
+    "backbone_from_ringdown": "identify",
     "FitResult": "identify",
 }
 

@@ -576,6 +576,27 @@ FIT_FIRST_STROKE_MISFIT = 3.0
 #: a backbone, m (beyond them the file is taken to be in other units, e.g. mm)
 FIT_PLAUSIBLE_DISPLACEMENT_M = 0.01
 FIT_PLAUSIBLE_AMPLITUDE_M = 0.1
+#: ring-downs (identify.ringdown): the mode's band is where the spectrum stays above this
+#: fraction of its peak, widened by this fraction on each side; a second spectral peak in it
+#: more prominent than this fraction of the peak is a second mode
+RINGDOWN_BAND_LEVEL = 0.05
+RINGDOWN_BAND_MARGIN = 0.15
+RINGDOWN_SECOND_PEAK = 0.2
+#: ring-downs: Butterworth order of the zero-phase band-pass; fewest samples per period at the
+#: top of the band; least relative fall of the envelope over the record (else: no decay)
+RINGDOWN_FILTER_ORDER = 4
+RINGDOWN_MIN_SAMPLES_PER_PERIOD = 10
+RINGDOWN_MIN_DECAY = 0.1
+#: ring-downs: periods of odd extension at each end before the zero-phase filter
+RINGDOWN_PAD_PERIODS = 10.0
+#: ring-downs: time constants of the filter's slowest pole trimmed at each end
+RINGDOWN_TRIM_DECAYS = 7.0
+#: ring-downs: a window grows (doubling its cycles, at most RINGDOWN_MAX_CYCLES) until its decay
+#: rate has a standard error within RINGDOWN_RATE_RTOL (else the best of them is taken); where
+#: even the best is above RINGDOWN_RATE_LIMIT, the tail is in the noise and is dropped
+RINGDOWN_RATE_RTOL = 0.02
+RINGDOWN_RATE_LIMIT = 0.1
+RINGDOWN_MAX_CYCLES = 32
 
 # --- sweeps --------------------------------------------------------------------------
 #: gamma grid START:STOP:STEP (the paper's Fig 6 range)

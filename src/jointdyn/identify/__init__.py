@@ -6,7 +6,9 @@
   linear damping ratio) from a measured backbone (amplitude, frequency,
   damping ratio against amplitude) by the one-harmonic describing function.
 
-Both return a :class:`FitResult` with standard errors, the correlation matrix,
+* :func:`backbone_from_ringdown`: the backbone of one mode from its free decay.
+
+The fits return a :class:`FitResult` with standard errors, the correlation matrix,
 the rms residual, a :class:`FitStatus` and the profile-likelihood interval
 (:class:`Interval`) of every parameter; parameters the data do not determine
 are reported as not identifiable, with the reason, and the combinations they
@@ -17,6 +19,7 @@ from .backbone import BACKBONE_MODELS, describing_function, fit_backbone
 from .loops import LOOP_MODELS, fit_loops
 from ._profile import Interval
 from .result import FitResult, FitStatus
+from .ringdown import RingdownBackbone, backbone_from_ringdown
 
-__all__ = ["fit_loops", "fit_backbone", "describing_function", "FitResult", "FitStatus", "Interval", "LOOP_MODELS",
+__all__ = ["fit_loops", "fit_backbone", "describing_function", "FitResult", "FitStatus", "Interval", "backbone_from_ringdown", "RingdownBackbone", "LOOP_MODELS",
            "BACKBONE_MODELS"]

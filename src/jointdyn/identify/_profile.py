@@ -40,12 +40,15 @@ class Interval:
 
     @property
     def closed(self) -> bool:
+        """True when the data bound the parameter on both sides."""
         return self.low is not None and self.high is not None
 
     def covers(self, value: float) -> bool:
+        """Whether ``value`` lies inside (an open side covers everything beyond)."""
         return (self.low is None or self.low <= value) and (self.high is None or value <= self.high)
 
     def to_dict(self) -> dict:
+        """JSON-ready: ``low``, ``high`` (None where open), ``level``, ``method``."""
         return {"low": self.low, "high": self.high, "level": self.level, "method": "profile likelihood"}
 
 
