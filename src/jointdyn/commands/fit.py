@@ -4,6 +4,7 @@ Two forms::
 
     jointdyn fit --input LOOPS.csv --model MODEL [--json] [--out DIR]
     jointdyn fit --backbone BACKBONE.csv --model MODEL --mass KG [--json] [--out DIR]
+    jointdyn fit --ringdown DECAY.csv --model MODEL --mass KG [--json] [--out DIR]
 
 ``--input``: a CSV file with a header row and the columns ``t, x, N, T`` (s,
 m, N, N): a fretting-rig record, one or several cycles, from rest or picked
@@ -12,7 +13,10 @@ force under the measured x and N is fitted to T by least squares
 (:func:`jointdyn.fit_loops`). ``--backbone``: columns ``amplitude_m,
 omega_rad_s, damping_ratio`` of one mode of modal mass ``--mass``, fitted
 with a modal Iwan model by the describing function
-(:func:`jointdyn.fit_backbone`).
+(:func:`jointdyn.fit_backbone`). ``--ringdown``: columns ``t`` and one of
+``x``, ``v``, ``a`` of a free decay, turned into such a backbone
+(:func:`jointdyn.backbone_from_ringdown`; with ``--out``, also written as
+``ringdown_backbone.csv``) and fitted the same way.
 
 The console (or ``--json``: keys ``parameters``, ``standard_errors``,
 ``rms_residual``, ``status``, ``intervals``, ``determined_combinations``,
@@ -57,6 +61,9 @@ def add_arguments(p) -> None:
                      help="measured loops: CSV with columns t, x, N, T (s, m, N, N)")
     src.add_argument("--backbone", default=None, metavar="FILE.csv",
                      help="measured backbone: CSV with columns amplitude_m, omega_rad_s, damping_ratio")
+    src.add_argument("--ringdown", default=None, metavar="FILE.csv",
+                     help="free decay of one mode: CSV with columns t and one of x, v, a (s; m, m/s, m/s^2), "
+                          "turned into a backbone and fitted (needs --mass)")
     p.add_argument("--model", default=config.MODEL, choices=LOOP_MODELS,
                    help=f"joint law to fit (default {config.MODEL})")
     add_law_arguments(p)
@@ -110,18 +117,19 @@ def read_columns(path, columns, name: str) -> dict:
 def _validate_args(args) -> None:
     from .. import _validate as V
 
-    if args.backbone is not None:
+    if args.backbone is not None or args.ringdown is not None:
         if args.mass is None:
-            raise ValueError("--mass is required with --backbone (modal mass, kg)")
+            raise ValueError(f"--mass is required with {'--backbone' if args.backbone else '--ringdown'} "
+                             f"(modal mass, kg)")
         V.positive("--mass", args.mass)
         if args.n_ref is not None:
             raise ValueError("--n-ref applies to loop fits (--input) only")
     elif args.mass is not None:
-        raise ValueError("--mass applies to backbone fits (--backbone) only")
+        raise ValueError("--mass applies to backbone fits (--backbone, --ringdown) only")
     if args.n_ref is not None:
         V.positive("--n-ref", args.n_ref)
     if args.out is not None:
-        V.output_dir("--out", args.out, files=_FILES)
+        V.output_dir("--out", args.out, files=_FILES + (("ringdown_backbone.csv",) if args.ringdown else ()))
 
 
 def _law_options(args) -> tuple:
@@ -144,6 +152,16 @@ def _fit(args):
         _plausible("--input", args.input, "x", d["x"], config.FIT_PLAUSIBLE_DISPLACEMENT_M, "m")
         return fit_loops(d["x"], d["N"], d["T"], args.model, t=d["t"], n_ref=args.n_ref, law_params=held,
                          start=start)
+    if args.ringdown is not None:
+        from ._fit_ringdown import backbone_of
+
+        b = backbone_of(args, read_columns)
+        args.ringdown_backbone = b
+        d = {"amplitude_m": b.amplitude_m, "omega_rad_s": b.omega_rad_s, "damping_ratio": b.damping_ratio}
+        _plausible("--ringdown", args.ringdown, "x (amplitude)", d["amplitude_m"], config.FIT_PLAUSIBLE_AMPLITUDE_M,
+                   "m")
+        return fit_backbone(d["amplitude_m"], d["omega_rad_s"], d["damping_ratio"], mass=args.mass,
+                            model=args.model, law_params=held, start=start)
     d = read_columns(args.backbone, BACKBONE_COLUMNS, "--backbone")
     _plausible("--backbone", args.backbone, "amplitude_m", d["amplitude_m"], config.FIT_PLAUSIBLE_AMPLITUDE_M, "m")
     return fit_backbone(d["amplitude_m"], d["omega_rad_s"], d["damping_ratio"], mass=args.mass, model=args.model,
@@ -214,6 +232,10 @@ def _write_files(args, fit, text: str) -> None:
             Path(tmp).write_text(payload)
     with atomic_path(out / "fit.png") as tmp:
         Path(tmp).write_bytes(png)
+    if getattr(args, "ringdown_backbone", None) is not None:
+        from ._fit_ringdown import write_backbone
+
+        write_backbone(out, args.ringdown_backbone)
 
 
 def _interval_text(iv) -> str:
@@ -225,8 +247,10 @@ def _interval_text(iv) -> str:
 
 
 def _print_console(args, fit) -> None:
-    src = args.input if args.input is not None else args.backbone
+    src = next(s for s in (args.input, args.backbone, args.ringdown) if s is not None)
     print(f"jointdyn fit: {fit.model} from {fit.kind} {src}: {fit.status.value}")
+    if getattr(args, "ringdown_backbone", None) is not None:
+        print(f"  ring-down: {args.ringdown_backbone.message}")
     if fit.record_start is not None:
         print(f"  record {fit.record_start}")
     for k, v in fit.parameters.items():
@@ -245,7 +269,8 @@ def _print_console(args, fit) -> None:
     unit = "N" if fit.kind == "loops" else "(relative)"
     print(f"  rms residual {fit.rms_residual:.4g} {unit}")
     if args.out is not None:
-        print(f"  wrote {', '.join(str(Path(args.out) / f) for f in _FILES)}")
+        extra = ("ringdown_backbone.csv",) if getattr(args, "ringdown_backbone", None) is not None else ()
+        print(f"  wrote {', '.join(str(Path(args.out) / f) for f in _FILES + extra)}")
 
 
 def _plausible(name, path, column, values, limit, unit) -> None:
