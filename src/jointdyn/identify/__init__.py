@@ -6,7 +6,9 @@
   linear damping ratio) from a measured backbone (amplitude, frequency,
   damping ratio against amplitude) by the one-harmonic describing function.
 
-* :func:`backbone_from_ringdown`: the backbone of one mode from its free decay.
+* :func:`backbone_from_ringdown`: the backbone of one mode from its free decay;
+* :func:`fit_frc`: the modal Iwan model from stepped-sine response curves at several
+  force levels.
 
 The fits return a :class:`FitResult` with standard errors, the correlation matrix,
 the rms residual, a :class:`FitStatus` and the profile-likelihood interval
@@ -16,10 +18,11 @@ do determine are given.
 """
 
 from .backbone import BACKBONE_MODELS, describing_function, fit_backbone
+from .frc import fit_frc
 from .loops import LOOP_MODELS, fit_loops
 from ._profile import Interval
 from .result import FitResult, FitStatus
 from .ringdown import RingdownBackbone, backbone_from_ringdown
 
-__all__ = ["fit_loops", "fit_backbone", "describing_function", "FitResult", "FitStatus", "Interval", "backbone_from_ringdown", "RingdownBackbone", "LOOP_MODELS",
+__all__ = ["fit_loops", "fit_backbone", "fit_frc", "describing_function", "FitResult", "FitStatus", "Interval", "backbone_from_ringdown", "RingdownBackbone", "LOOP_MODELS",
            "BACKBONE_MODELS"]
