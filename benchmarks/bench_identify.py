@@ -13,7 +13,9 @@ Measured, each beside its reference in the same run:
 * a backbone fit (``jointdyn.fit_backbone``, iwan, 50 points), warm, target <= 1 s;
 * a ring-down of 10^6 samples to a fitted model (``jointdyn.backbone_from_ringdown`` then
   ``fit_backbone``, iwan), warm, target <= 5 s (issue 32), beside one zero-phase band-pass
-  of the same signal.
+  of the same signal;
+* a response-curve fit (``jointdyn.fit_frc``, iwan) of 3 x 50 points, warm, target <= 30 s
+  (issue 32), beside one describing-function evaluation of its amplitudes.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ TARGET_KERNEL_RATIO = 2.0
 TARGET_LOOP_FIT_S = 2.0
 TARGET_BACKBONE_FIT_S = 1.0
 TARGET_RINGDOWN_S = 5.0
+TARGET_FRC_S = 30.0
 KT, MU, NREF = 1e5, 0.1, 100.0
 
 
@@ -157,13 +160,41 @@ def _ringdown_fit(n, repeats):
             "kt_rel_error": (f.parameters["kt"] / KT - 1.0) if f.parameters.get("kt") else None}
 
 
+def _frc_fit(repeats):
+    """fit_frc of 3 x 50 points (HB curves, one harmonic, 1 % noise), beside one
+    describing-function evaluation of its 150 amplitudes (the reference) in the same run."""
+    import math
+
+    import jointdyn as jd
+    from jointdyn.hb import frc_hb
+    from jointdyn.identify import describing_function
+
+    law = jd.make_law("iwan", kt=KT, mu=0.2, n_ref=NREF)
+    cols = []
+    for F in (5.0, 15.0, 30.0):
+        s = jd.System.sdof(m=2.0, k=4e5, law=law, f1=F, c=2 * 0.002 * math.sqrt(5e5 * 2.0), n0=NREF)
+        ds = frc_hb(s, 0.85, 1.1, harmonics=1)
+        g, A = np.asarray(ds["gamma"]), np.asarray(ds["amplitude_m"])
+        pick = np.linspace(0, g.size - 1, 50).astype(int)
+        cols.append(np.column_stack([np.full(50, F), g[pick] * s.w0, A[pick]]))
+    F, w, A = np.concatenate(cols).T
+    A = A * (1.0 + 0.01 * np.random.default_rng(0).normal(size=A.size))
+    fits = []
+    sec = _warm(lambda: fits.append(jd.fit_frc(F, w, A, mass=2.0, model="iwan")), repeats)
+    ref = _warm(lambda: describing_function(law, A), 20)
+    f = fits[-1]
+    return {"seconds": sec, "points": int(A.size), "status": f.status.value, "evaluations": f.evaluations,
+            "reference_describing_function_s": ref, "target_s": TARGET_FRC_S, "target_met": bool(sec <= TARGET_FRC_S)}
+
+
 def run(quick: bool) -> dict:
     """Kernel ratio and fit times (module docstring)."""
     repeats = 3 if quick else 7
     n = 100_000 if quick else 1_000_000
     return {"segalman_kernel_vs_iwan": _kernels(n, repeats), "loop_fit_1e4_samples": _loop_fit(max(2, repeats // 2)),
             "backbone_fit_50_points": _backbone_fit(repeats),
-            "ringdown_to_model": _ringdown_fit(100_000 if quick else 1_000_000, 1 if quick else 2)}
+            "ringdown_to_model": _ringdown_fit(100_000 if quick else 1_000_000, 1 if quick else 2),
+            "frc_fit_3x50_points": _frc_fit(1)}
 
 
 if __name__ == "__main__":

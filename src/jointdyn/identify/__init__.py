@@ -24,5 +24,5 @@ from ._profile import Interval
 from .result import FitResult, FitStatus
 from .ringdown import RingdownBackbone, backbone_from_ringdown
 
-__all__ = ["fit_loops", "fit_backbone", "fit_frc", "describing_function", "FitResult", "FitStatus", "Interval", "backbone_from_ringdown", "RingdownBackbone", "LOOP_MODELS",
-           "BACKBONE_MODELS"]
+__all__ = ["fit_loops", "fit_backbone", "fit_frc", "describing_function", "FitResult", "FitStatus", "Interval",
+           "backbone_from_ringdown", "RingdownBackbone", "LOOP_MODELS", "BACKBONE_MODELS"]

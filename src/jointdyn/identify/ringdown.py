@@ -217,7 +217,7 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
         c, best = cycles, None
         while True:  # the shortest window whose decay rate is known to RINGDOWN_RATE_RTOL
             e = min(j + c, tc.size - 1)
-            sel = (tk >= tc[j]) & (tk < tc[e])
+            sel = slice(int(np.searchsorted(tk, tc[j])), int(np.searchsorted(tk, tc[e])))
             om = 2.0 * math.pi * (e - j) / (tc[e] - tc[j])
             amp, rate, se = _local_decay(tk[sel] - 0.5 * (tc[j] + tc[e]), yk[sel], om, corr)
             rel = se / abs(rate) if rate != 0.0 else math.inf
@@ -244,7 +244,8 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
     env = np.abs(hilbert(yk)) / w_at ** power  # for figures only: the points come from the local fits
     trimmed = (float(tk[0] - t[0]), float(t[-1] - tk[-1]) + dropped)
     msg = (f"band {low:.4g} to {high:.4g} rad/s (zero-phase Butterworth, order {config.RINGDOWN_FILTER_ORDER}); "
-           f"local decay fits between zero crossings; {trimmed[0]:.4g} s trimmed at the start and {trimmed[1]:.4g} s at the end "
+           f"local decay fits between zero crossings; {trimmed[0]:.4g} s trimmed at the start and "
+           f"{trimmed[1]:.4g} s at the end "
            f"(end effects: {trim / period:.3g} periods each{'; and the tail within the noise' if dropped else ''}); "
            f"{A.size} points of {cycles} or more cycles (the decay rate of each to "
            f"{100 * config.RINGDOWN_RATE_RTOL:g} %)")
