@@ -5,6 +5,7 @@ Two forms::
     jointdyn fit --input LOOPS.csv --model MODEL [--json] [--out DIR]
     jointdyn fit --backbone BACKBONE.csv --model MODEL --mass KG [--json] [--out DIR]
     jointdyn fit --ringdown DECAY.csv --model MODEL --mass KG [--json] [--out DIR]
+    jointdyn fit --frc CURVES.csv --model MODEL --mass KG [--json] [--out DIR]
 
 ``--input``: a CSV file with a header row and the columns ``t, x, N, T`` (s,
 m, N, N): a fretting-rig record, one or several cycles, from rest or picked
@@ -16,7 +17,9 @@ with a modal Iwan model by the describing function
 (:func:`jointdyn.fit_backbone`). ``--ringdown``: columns ``t`` and one of
 ``x``, ``v``, ``a`` of a free decay, turned into such a backbone
 (:func:`jointdyn.backbone_from_ringdown`; with ``--out``, also written as
-``ringdown_backbone.csv``) and fitted the same way.
+``ringdown_backbone.csv``) and fitted the same way. ``--frc``: columns
+``force_N, omega_rad_s, amplitude_m`` of stepped-sine response curves at
+several force levels (:func:`jointdyn.fit_frc`).
 
 The console (or ``--json``: keys ``parameters``, ``standard_errors``,
 ``rms_residual``, ``status``, ``intervals``, ``determined_combinations``,
@@ -64,6 +67,9 @@ def add_arguments(p) -> None:
     src.add_argument("--ringdown", default=None, metavar="FILE.csv",
                      help="free decay of one mode: CSV with columns t and one of x, v, a (s; m, m/s, m/s^2), "
                           "turned into a backbone and fitted (needs --mass)")
+    src.add_argument("--frc", default=None, metavar="FILE.csv",
+                     help="stepped-sine response curves: CSV with columns force_N, omega_rad_s, amplitude_m "
+                          "(several force levels; needs --mass)")
     p.add_argument("--model", default=config.MODEL, choices=LOOP_MODELS,
                    help=f"joint law to fit (default {config.MODEL})")
     add_law_arguments(p)
@@ -117,15 +123,16 @@ def read_columns(path, columns, name: str) -> dict:
 def _validate_args(args) -> None:
     from .. import _validate as V
 
-    if args.backbone is not None or args.ringdown is not None:
+    modal = next((o for o, v in (("--backbone", args.backbone), ("--ringdown", args.ringdown),
+                                  ("--frc", args.frc)) if v is not None), None)
+    if modal is not None:
         if args.mass is None:
-            raise ValueError(f"--mass is required with {'--backbone' if args.backbone else '--ringdown'} "
-                             f"(modal mass, kg)")
+            raise ValueError(f"--mass is required with {modal} (modal mass, kg)")
         V.positive("--mass", args.mass)
         if args.n_ref is not None:
             raise ValueError("--n-ref applies to loop fits (--input) only")
     elif args.mass is not None:
-        raise ValueError("--mass applies to backbone fits (--backbone, --ringdown) only")
+        raise ValueError("--mass applies to modal fits (--backbone, --ringdown, --frc) only")
     if args.n_ref is not None:
         V.positive("--n-ref", args.n_ref)
     if args.out is not None:
@@ -152,6 +159,13 @@ def _fit(args):
         _plausible("--input", args.input, "x", d["x"], config.FIT_PLAUSIBLE_DISPLACEMENT_M, "m")
         return fit_loops(d["x"], d["N"], d["T"], args.model, t=d["t"], n_ref=args.n_ref, law_params=held,
                          start=start)
+    if args.frc is not None:
+        from ..identify.frc import FRC_COLUMNS, fit_frc
+
+        d = read_columns(args.frc, FRC_COLUMNS, "--frc")
+        _plausible("--frc", args.frc, "amplitude_m", d["amplitude_m"], config.FIT_PLAUSIBLE_AMPLITUDE_M, "m")
+        return fit_frc(d["force_N"], d["omega_rad_s"], d["amplitude_m"], mass=args.mass, model=args.model,
+                       law_params=held, start=start)
     if args.ringdown is not None:
         from ._fit_ringdown import backbone_of
 
@@ -183,6 +197,15 @@ def _plot_png(fit) -> bytes:
         ar.plot(xr, f["T"] - m["T"], color="C3", lw=0.6)
         ar.set_xlabel("t (s)" if "t" in m else "sample")
         ar.set_ylabel("residual (N)")
+    elif fit.kind == "frc":
+        for F in np.unique(m["force_N"]):
+            sel = m["force_N"] == F
+            ax.plot(m["omega_rad_s"][sel], m["amplitude_m"][sel] * 1e3, ".", ms=3, label=f"F = {F:.4g} N")
+        ax.set_xlabel("omega (rad/s)")
+        ax.set_ylabel("amplitude (mm)")
+        ar.plot(m["omega_rad_s"], f["equation_error"], ".", color="C3", ms=2)
+        ar.set_xlabel("omega (rad/s)")
+        ar.set_ylabel("relative error")
     else:
         A = m["amplitude_m"]
         ax.semilogx(A, m["omega_rad_s"], "o", color="0.5", ms=3, label="measured omega")
@@ -247,7 +270,7 @@ def _interval_text(iv) -> str:
 
 
 def _print_console(args, fit) -> None:
-    src = next(s for s in (args.input, args.backbone, args.ringdown) if s is not None)
+    src = next(s for s in (args.input, args.backbone, args.ringdown, args.frc) if s is not None)
     print(f"jointdyn fit: {fit.model} from {fit.kind} {src}: {fit.status.value}")
     if getattr(args, "ringdown_backbone", None) is not None:
         print(f"  ring-down: {args.ringdown_backbone.message}")
