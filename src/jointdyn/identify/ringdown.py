@@ -241,7 +241,9 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
                          f"the record; a ring-down is a free decay")
     power = {"x": 0, "v": 1, "a": 2}[kind]  # displacement amplitude = amplitude / omega^power
     w_at = np.interp(tk, centre, w) if power else 1.0
-    env = np.abs(hilbert(yk)) / w_at ** power  # for figures only: the points come from the local fits
+    # for figures only (the points come from the local fits); of the whole filtered record, so
+    # that the transform's own end effects fall in the trimmed parts
+    env = np.abs(hilbert(yf))[keep] / w_at ** power
     trimmed = (float(tk[0] - t[0]), float(t[-1] - tk[-1]) + dropped)
     msg = (f"band {low:.4g} to {high:.4g} rad/s (zero-phase Butterworth, order {config.RINGDOWN_FILTER_ORDER}); "
            f"local decay fits between zero crossings; {trimmed[0]:.4g} s trimmed at the start and "
