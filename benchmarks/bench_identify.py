@@ -10,7 +10,12 @@ Measured, each beside its reference in the same run:
   (issue 24): within 2x of ``iwan`` per step;
 * a loop fit (``jointdyn.fit_loops``, segalman, 4 parameters) of 10^4
   samples, warm (second call), target <= 2 s;
-* a backbone fit (``jointdyn.fit_backbone``, iwan, 50 points), warm, target <= 1 s.
+* a backbone fit (``jointdyn.fit_backbone``, iwan, 50 points), warm, target <= 1 s;
+* a ring-down of 10^6 samples to a fitted model (``jointdyn.backbone_from_ringdown`` then
+  ``fit_backbone``, iwan), warm, target <= 5 s (issue 32), beside one zero-phase band-pass
+  of the same signal;
+* a response-curve fit (``jointdyn.fit_frc``, iwan) of 3 x 50 points, warm, target <= 30 s
+  (issue 32), beside one describing-function evaluation of its amplitudes.
 """
 
 from __future__ import annotations
@@ -29,6 +34,8 @@ if str(ROOT / "src") not in sys.path:
 TARGET_KERNEL_RATIO = 2.0
 TARGET_LOOP_FIT_S = 2.0
 TARGET_BACKBONE_FIT_S = 1.0
+TARGET_RINGDOWN_S = 5.0
+TARGET_FRC_S = 30.0
 KT, MU, NREF = 1e5, 0.1, 100.0
 
 
@@ -107,12 +114,87 @@ def _backbone_fit(repeats):
             "target_s": TARGET_BACKBONE_FIT_S, "target_met": bool(s <= TARGET_BACKBONE_FIT_S)}
 
 
+def _ringdown_signal(n):
+    """A free decay of n samples whose envelope and phase follow the one-harmonic backbone of an
+    Iwan oscillator (d ln A / dt = -D(A) omega(A)), 1 % noise of its peak."""
+    import jointdyn as jd
+    from jointdyn.identify.backbone import _model
+
+    law = jd.make_law("iwan", kt=KT, mu=MU, n_ref=NREF)
+    m, k, zeta = 2.0, 4e5, 0.002
+    grid = np.geomspace(1e-3, 2.0, 400) * law.x_slip
+    wg, Dg = _model(law, k, zeta, m, grid)
+    # time to decay from the top of the grid: dt = -d(ln A) / (D omega)
+    rate = 1.0 / (Dg * wg)
+    lg = np.log(grid)
+    tg = np.concatenate(([0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(lg))))[::-1]
+    tg = tg[0] - tg
+    h = tg[-1] / n  # the record spans the decay (about 600 periods: 1600 samples per period at n = 1e6)
+    t = h * np.arange(n)
+    amp = np.exp(np.interp(t, tg, lg[::-1]))
+    phase = np.cumsum(np.interp(t, tg, wg[::-1])) * h
+    x = amp * np.cos(phase)
+    return law, t, x + 0.01 * np.abs(x).max() * np.random.default_rng(2).normal(size=n)
+
+
+def _ringdown_fit(n, repeats):
+    """backbone_from_ringdown then fit_backbone, beside one zero-phase band-pass of the same
+    signal (scipy.signal.sosfiltfilt, the reference) in the same run."""
+    from scipy.signal import butter, sosfiltfilt
+
+    import jointdyn as jd
+
+    law, t, x = _ringdown_signal(n)
+    out = []
+
+    def chain():
+        b = jd.backbone_from_ringdown(t, x, "x")
+        out.append((b, jd.fit_backbone(b.amplitude_m, b.omega_rad_s, b.damping_ratio, mass=2.0, model="iwan")))
+
+    s = _warm(chain, repeats)
+    sos = butter(4, (0.4, 0.6), btype="band", output="sos")
+    ref = _warm(lambda: sosfiltfilt(sos, x), repeats)
+    b, f = out[-1]
+    return {"seconds": s, "samples": n, "points": int(b.amplitude_m.size), "status": f.status.value,
+            "reference_sosfiltfilt_s": ref, "target_s": TARGET_RINGDOWN_S, "target_met": bool(s <= TARGET_RINGDOWN_S),
+            "kt_rel_error": (f.parameters["kt"] / KT - 1.0) if f.parameters.get("kt") else None}
+
+
+def _frc_fit(repeats):
+    """fit_frc of 3 x 50 points (HB curves, one harmonic, 1 % noise), beside one
+    describing-function evaluation of its 150 amplitudes (the reference) in the same run."""
+    import math
+
+    import jointdyn as jd
+    from jointdyn.hb import frc_hb
+    from jointdyn.identify import describing_function
+
+    law = jd.make_law("iwan", kt=KT, mu=0.2, n_ref=NREF)
+    cols = []
+    for F in (5.0, 15.0, 30.0):
+        s = jd.System.sdof(m=2.0, k=4e5, law=law, f1=F, c=2 * 0.002 * math.sqrt(5e5 * 2.0), n0=NREF)
+        ds = frc_hb(s, 0.85, 1.1, harmonics=1)
+        g, A = np.asarray(ds["gamma"]), np.asarray(ds["amplitude_m"])
+        pick = np.linspace(0, g.size - 1, 50).astype(int)
+        cols.append(np.column_stack([np.full(50, F), g[pick] * s.w0, A[pick]]))
+    F, w, A = np.concatenate(cols).T
+    A = A * (1.0 + 0.01 * np.random.default_rng(0).normal(size=A.size))
+    fits = []
+    sec = _warm(lambda: fits.append(jd.fit_frc(F, w, A, mass=2.0, model="iwan")), repeats)
+    ref = _warm(lambda: describing_function(law, A), 20)
+    f = fits[-1]
+    return {"seconds": sec, "points": int(A.size), "status": f.status.value, "evaluations": f.evaluations,
+            "reference_describing_function_s": ref, "target_s": TARGET_FRC_S, "target_met": bool(sec <= TARGET_FRC_S)}
+
+
 def run(quick: bool) -> dict:
     """Kernel ratio and fit times (module docstring)."""
     repeats = 3 if quick else 7
     n = 100_000 if quick else 1_000_000
     return {"segalman_kernel_vs_iwan": _kernels(n, repeats), "loop_fit_1e4_samples": _loop_fit(max(2, repeats // 2)),
-            "backbone_fit_50_points": _backbone_fit(repeats)}
+            "backbone_fit_50_points": _backbone_fit(repeats),
+            "ringdown_to_model": _ringdown_fit(100_000 if quick else 1_000_000, 1 if quick else 2),
+            "frc_fit_3x50_points": _frc_fit(1)}
 
 
 if __name__ == "__main__":

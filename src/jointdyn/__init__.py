@@ -63,6 +63,8 @@ _LAZY = {
     "CraigBampton": "reduction",
     "fit_loops": "identify",
     "fit_backbone": "identify",
+    "backbone_from_ringdown": "identify",
+    "fit_frc": "identify",
     "FitResult": "identify",
 }
 

@@ -562,6 +562,54 @@ FIT_MAX_BACKBONE_POINTS = 1_000
 #: largest magnitude of a measured value a fit computes with: its squares, products and sums over
 #: every sample must stay finite in double precision (1e100 squared is 1e200)
 FIT_MAX_MAGNITUDE = 1e100
+#: confidence level of the intervals a fit reports (profile likelihood)
+FIT_LEVEL = 0.95
+#: profile likelihood: a scale parameter whose sum of squares stays below the threshold
+#: over this factor on one side of its optimum is not bounded on that side; the steps
+#: (doubling) taken on a side before it is called open; regula-falsi steps on the crossing
+FIT_PROFILE_SPAN = 100.0
+FIT_PROFILE_STEPS = 12
+FIT_PROFILE_REFINE = 4
+#: profile likelihood: tolerances and evaluation limit of each refit with one parameter held
+FIT_PROFILE_FTOL = 1e-10
+FIT_PROFILE_MAX_NFEV = 60
+#: global start of a Segalman fit: the grid of chi, beta and slip-force factors (times the
+#: data's start value) whose best point (least sum of squares) starts least squares
+FIT_GRID_CHI = (-0.8, -0.5, 0.0, 0.5)
+FIT_GRID_BETA = (0.0, 0.1, 1.0, 10.0, 50.0)
+FIT_GRID_SLIP = (0.7, 1.0, 1.4)
+#: loop fits: a record whose |T| at the first sample is at most this fraction of max |T|
+#: starts from rest; samples of the ramp from rest to the first sample of any other record
+FIT_REST_FORCE = 0.05
+FIT_RAMP_SAMPLES = 200
+#: loop fits: a record fitted from rest whose first stroke leaves an rms residual above this
+#: many times that of the rest was picked up mid-cycle (its first stroke then sets the state)
+FIT_FIRST_STROKE_MISFIT = 3.0
+#: jointdyn fit: largest plausible joint displacement of a loop record and modal amplitude of
+#: a backbone, m (beyond them the file is taken to be in other units, e.g. mm)
+FIT_PLAUSIBLE_DISPLACEMENT_M = 0.01
+FIT_PLAUSIBLE_AMPLITUDE_M = 0.1
+#: ring-downs (identify.ringdown): the mode's band is where the spectrum stays above this
+#: fraction of its peak, widened by this fraction on each side; a second spectral peak in it
+#: more prominent than this fraction of the peak is a second mode
+RINGDOWN_BAND_LEVEL = 0.05
+RINGDOWN_BAND_MARGIN = 0.15
+RINGDOWN_SECOND_PEAK = 0.2
+#: ring-downs: Butterworth order of the zero-phase band-pass; fewest samples per period at the
+#: top of the band; least relative fall of the envelope over the record (else: no decay)
+RINGDOWN_FILTER_ORDER = 4
+RINGDOWN_MIN_SAMPLES_PER_PERIOD = 10
+RINGDOWN_MIN_DECAY = 0.1
+#: ring-downs: periods of odd extension at each end before the zero-phase filter
+RINGDOWN_PAD_PERIODS = 10.0
+#: ring-downs: time constants of the filter's slowest pole trimmed at each end
+RINGDOWN_TRIM_DECAYS = 7.0
+#: ring-downs: a window grows (doubling its cycles, at most RINGDOWN_MAX_CYCLES) until its decay
+#: rate has a standard error within RINGDOWN_RATE_RTOL (else the best of them is taken); where
+#: even the best is above RINGDOWN_RATE_LIMIT, the tail is in the noise and is dropped
+RINGDOWN_RATE_RTOL = 0.02
+RINGDOWN_RATE_LIMIT = 0.1
+RINGDOWN_MAX_CYCLES = 32
 
 # --- sweeps --------------------------------------------------------------------------
 #: gamma grid START:STOP:STEP (the paper's Fig 6 range)

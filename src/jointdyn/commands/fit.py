@@ -4,18 +4,29 @@ Two forms::
 
     jointdyn fit --input LOOPS.csv --model MODEL [--json] [--out DIR]
     jointdyn fit --backbone BACKBONE.csv --model MODEL --mass KG [--json] [--out DIR]
+    jointdyn fit --ringdown DECAY.csv --model MODEL --mass KG [--json] [--out DIR]
+    jointdyn fit --frc CURVES.csv --model MODEL --mass KG [--json] [--out DIR]
 
 ``--input``: a CSV file with a header row and the columns ``t, x, N, T`` (s,
-m, N, N): a fretting-rig record, one or several cycles, from rest. The law's
+m, N, N): a fretting-rig record, one or several cycles, from rest or picked
+up anywhere in a steady cycle (its first stroke then sets the slip state). The law's
 force under the measured x and N is fitted to T by least squares
 (:func:`jointdyn.fit_loops`). ``--backbone``: columns ``amplitude_m,
 omega_rad_s, damping_ratio`` of one mode of modal mass ``--mass``, fitted
 with a modal Iwan model by the describing function
-(:func:`jointdyn.fit_backbone`).
+(:func:`jointdyn.fit_backbone`). ``--ringdown``: columns ``t`` and one of
+``x``, ``v``, ``a`` of a free decay, turned into such a backbone
+(:func:`jointdyn.backbone_from_ringdown`; with ``--out``, also written as
+``ringdown_backbone.csv``) and fitted the same way. ``--frc``: columns
+``force_N, omega_rad_s, amplitude_m`` of stepped-sine response curves at
+several force levels (:func:`jointdyn.fit_frc`).
 
 The console (or ``--json``: keys ``parameters``, ``standard_errors``,
-``rms_residual``, ``status`` and more) gives every parameter with its
-standard error, or why the data do not determine it. ``--out DIR`` receives
+``rms_residual``, ``status``, ``intervals``, ``determined_combinations``,
+``record_start`` and more) gives every parameter with its standard error and
+its 95 % profile-likelihood interval, or why the data do not determine it and
+the combinations they do determine. Displacements implausible in metres (a
+file in mm) are refused. ``--out DIR`` receives
 ``fit.json``, ``fit.csv`` (measured and fitted columns) and ``fit.png``
 (measured and fitted overlaid, and the residuals), each written atomically
 after everything is computed. Bad input: one line on stderr, exit status 2,
@@ -52,6 +63,12 @@ def add_arguments(p) -> None:
                      help="measured loops: CSV with columns t, x, N, T (s, m, N, N)")
     src.add_argument("--backbone", default=None, metavar="FILE.csv",
                      help="measured backbone: CSV with columns amplitude_m, omega_rad_s, damping_ratio")
+    src.add_argument("--ringdown", default=None, metavar="FILE.csv",
+                     help="free decay of one mode: CSV with columns t and one of x, v, a (s; m, m/s, m/s^2), "
+                          "turned into a backbone and fitted (needs --mass)")
+    src.add_argument("--frc", default=None, metavar="FILE.csv",
+                     help="stepped-sine response curves: CSV with columns force_N, omega_rad_s, amplitude_m "
+                          "(several force levels; needs --mass)")
     p.add_argument("--model", default=config.MODEL, choices=LOOP_MODELS,
                    help=f"joint law to fit (default {config.MODEL})")
     add_law_arguments(p)
@@ -80,18 +97,20 @@ def read_columns(path, columns, name: str) -> dict:
 def _validate_args(args) -> None:
     from .. import _validate as V
 
-    if args.backbone is not None:
+    modal = next((o for o, v in (("--backbone", args.backbone), ("--ringdown", args.ringdown),
+                                  ("--frc", args.frc)) if v is not None), None)
+    if modal is not None:
         if args.mass is None:
-            raise ValueError("--mass is required with --backbone (modal mass, kg)")
+            raise ValueError(f"--mass is required with {modal} (modal mass, kg)")
         V.positive("--mass", args.mass)
         if args.n_ref is not None:
             raise ValueError("--n-ref applies to loop fits (--input) only")
     elif args.mass is not None:
-        raise ValueError("--mass applies to backbone fits (--backbone) only")
+        raise ValueError("--mass applies to modal fits (--backbone, --ringdown, --frc) only")
     if args.n_ref is not None:
         V.positive("--n-ref", args.n_ref)
     if args.out is not None:
-        V.output_dir("--out", args.out, files=_FILES)
+        V.output_dir("--out", args.out, files=_FILES + (("ringdown_backbone.csv",) if args.ringdown else ()))
 
 
 def _law_options(args) -> tuple:
@@ -110,9 +129,28 @@ def _fit(args):
     held, start = _law_options(args)
     if args.input is not None:
         d = read_loops(args.input, "--input")
+        _plausible("--input", args.input, "x", d["x"], config.FIT_PLAUSIBLE_DISPLACEMENT_M, "m")
         return fit_loops(d["x"], d["N"], d["T"], args.model, t=d["t"], n_ref=args.n_ref, law_params=held,
                          start=start)
+    if args.frc is not None:
+        from ..identify.frc import FRC_COLUMNS, fit_frc
+
+        d = read_columns(args.frc, FRC_COLUMNS, "--frc")
+        _plausible("--frc", args.frc, "amplitude_m", d["amplitude_m"], config.FIT_PLAUSIBLE_AMPLITUDE_M, "m")
+        return fit_frc(d["force_N"], d["omega_rad_s"], d["amplitude_m"], mass=args.mass, model=args.model,
+                       law_params=held, start=start)
+    if args.ringdown is not None:
+        from ._fit_ringdown import backbone_of
+
+        b = backbone_of(args, read_columns)
+        args.ringdown_backbone = b
+        d = {"amplitude_m": b.amplitude_m, "omega_rad_s": b.omega_rad_s, "damping_ratio": b.damping_ratio}
+        _plausible("--ringdown", args.ringdown, "x (amplitude)", d["amplitude_m"], config.FIT_PLAUSIBLE_AMPLITUDE_M,
+                   "m")
+        return fit_backbone(d["amplitude_m"], d["omega_rad_s"], d["damping_ratio"], mass=args.mass,
+                            model=args.model, law_params=held, start=start)
     d = read_backbone(args.backbone, "--backbone", mass=args.mass)
+    _plausible("--backbone", args.backbone, "amplitude_m", d["amplitude_m"], config.FIT_PLAUSIBLE_AMPLITUDE_M, "m")
     return fit_backbone(d["amplitude_m"], d["omega_rad_s"], d["damping_ratio"], mass=args.mass, model=args.model,
                         law_params=held, start=start)
 
@@ -132,6 +170,15 @@ def _plot_png(fit) -> bytes:
         ar.plot(xr, f["T"] - m["T"], color="C3", lw=0.6)
         ar.set_xlabel("t (s)" if "t" in m else "sample")
         ar.set_ylabel("residual (N)")
+    elif fit.kind == "frc":
+        for F in np.unique(m["force_N"]):
+            sel = m["force_N"] == F
+            ax.plot(m["omega_rad_s"][sel], m["amplitude_m"][sel] * 1e3, ".", ms=3, label=f"F = {F:.4g} N")
+        ax.set_xlabel("omega (rad/s)")
+        ax.set_ylabel("amplitude (mm)")
+        ar.plot(m["omega_rad_s"], f["equation_error"], ".", color="C3", ms=2)
+        ar.set_xlabel("omega (rad/s)")
+        ar.set_ylabel("relative error")
     else:
         A = m["amplitude_m"]
         ax.semilogx(A, m["omega_rad_s"], "o", color="0.5", ms=3, label="measured omega")
@@ -181,21 +228,54 @@ def _write_files(args, fit, text: str) -> None:
             Path(tmp).write_text(payload)
     with atomic_path(out / "fit.png") as tmp:
         Path(tmp).write_bytes(png)
+    if getattr(args, "ringdown_backbone", None) is not None:
+        from ._fit_ringdown import write_backbone
+
+        write_backbone(out, args.ringdown_backbone)
+
+
+def _interval_text(iv) -> str:
+    if iv is None:
+        return ""
+    lo = "-inf" if iv.low is None else f"{iv.low:.5g}"
+    hi = "inf" if iv.high is None else f"{iv.high:.5g}"
+    return f"  ({100 * iv.level:.3g} %: [{lo}, {hi}])"
 
 
 def _print_console(args, fit) -> None:
-    src = args.input if args.input is not None else args.backbone
+    src = next(s for s in (args.input, args.backbone, args.ringdown, args.frc) if s is not None)
     print(f"jointdyn fit: {fit.model} from {fit.kind} {src}: {fit.status.value}")
+    if getattr(args, "ringdown_backbone", None) is not None:
+        print(f"  ring-down: {args.ringdown_backbone.message}")
+    if fit.record_start is not None:
+        print(f"  record {fit.record_start}")
     for k, v in fit.parameters.items():
         se = fit.standard_errors.get(k)
+        iv = _interval_text(fit.intervals.get(k))
         if v is None:
             print(f"  {k:<8} not identifiable: {fit.not_identifiable.get(k, fit.not_identifiable.get('mu', ''))}")
         else:
-            print(f"  {k:<8} {v:.6g} +- {se:.2g}")
+            print(f"  {k:<8} {v:.6g} +- {se:.2g}{iv}" if se is not None else f"  {k:<8} {v:.6g}{iv}")
+    if fit.conditional_on:
+        print(f"  (standard errors with {', '.join(fit.conditional_on)} held; the intervals are not conditional)")
+    for k, c in fit.determined_combinations.items():
+        lo, hi = c["interval"]["low"], c["interval"]["high"]
+        print(f"  determined: {k} = {c['value']:.6g} {c['unit']} (95 %: [{lo if lo is None else f'{lo:.5g}'}, "
+              f"{hi if hi is None else f'{hi:.5g}'}]): {c['meaning']}")
     unit = "N" if fit.kind == "loops" else "(relative)"
     print(f"  rms residual {fit.rms_residual:.4g} {unit}")
     if args.out is not None:
-        print(f"  wrote {', '.join(str(Path(args.out) / f) for f in _FILES)}")
+        extra = ("ringdown_backbone.csv",) if getattr(args, "ringdown_backbone", None) is not None else ()
+        print(f"  wrote {', '.join(str(Path(args.out) / f) for f in _FILES + extra)}")
+
+
+def _plausible(name, path, column, values, limit, unit) -> None:
+    """Refuse magnitudes no joint test gives in the documented SI unit (a file in mm read as m)."""
+    big = float(np.max(np.abs(values)))
+    if big > limit:
+        raise ValueError(f"{name} {str(path)!r} column {column}: values up to {big:.4g} are not plausible in {unit} "
+                         f"(a joint test stays below {limit:g} {unit}); the file may be in other units (mm?): "
+                         f"convert it to SI")
 
 
 def run(args) -> int:

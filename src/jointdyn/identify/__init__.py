@@ -6,14 +6,23 @@
   linear damping ratio) from a measured backbone (amplitude, frequency,
   damping ratio against amplitude) by the one-harmonic describing function.
 
-Both return a :class:`FitResult` with standard errors, the correlation matrix,
-the rms residual and a :class:`FitStatus`; parameters the data do not
-determine are reported as not identifiable, with the reason.
+* :func:`backbone_from_ringdown`: the backbone of one mode from its free decay;
+* :func:`fit_frc`: the modal Iwan model from stepped-sine response curves at several
+  force levels.
+
+The fits return a :class:`FitResult` with standard errors, the correlation matrix,
+the rms residual, a :class:`FitStatus` and the profile-likelihood interval
+(:class:`Interval`) of every parameter; parameters the data do not determine
+are reported as not identifiable, with the reason, and the combinations they
+do determine are given.
 """
 
 from .backbone import BACKBONE_MODELS, describing_function, fit_backbone
+from .frc import fit_frc
 from .loops import LOOP_MODELS, fit_loops
+from ._profile import Interval
 from .result import FitResult, FitStatus
+from .ringdown import RingdownBackbone, backbone_from_ringdown
 
-__all__ = ["fit_loops", "fit_backbone", "describing_function", "FitResult", "FitStatus", "LOOP_MODELS",
-           "BACKBONE_MODELS"]
+__all__ = ["fit_loops", "fit_backbone", "fit_frc", "describing_function", "FitResult", "FitStatus", "Interval",
+           "backbone_from_ringdown", "RingdownBackbone", "LOOP_MODELS", "BACKBONE_MODELS"]

@@ -33,9 +33,11 @@ class Param:
 
 @dataclass(frozen=True)
 class Solution:
-    """Values (by name), standard errors (by name), correlation, the residual at the
-    optimum, the names whose errors say the data do not determine them, the evaluations
-    and whether least squares converged."""
+    """Values (by name), standard errors (by name; those of the parameters not weak, with
+    the weak ones held), correlation, the residual at the optimum, the names whose
+    linearised errors say the data do not determine them (``weak``), the evaluations,
+    whether least squares converged, and, when profiled, the profile intervals by name
+    (:class:`._profile.Interval`) and the names whose interval is open (``open``)."""
 
     values: dict
     errors: dict
@@ -44,36 +46,24 @@ class Solution:
     weak: tuple
     evaluations: int
     converged: bool
+    intervals: dict = None
+    open: tuple = ()
 
 
-def solve(fun, params: list, *, diff_step=None) -> Solution:
-    """Minimise ``sum(fun(values)^2)`` over the parameters (``fun`` takes a dict of
-    values by name and returns the residual vector) with scipy's trust-region
-    least squares within the bounds; then the standard errors from the Jacobian at the
-    optimum and the residual variance. A parameter whose error exceeds
-    ``config.FIT_MAX_RELATIVE_SE`` of its value (scales) or ``config.FIT_MAX_SHAPE_SE``
-    (shapes) is *weak*: the errors of the others are then those with it held."""
+def _least_squares(resid, u0, lb, ub, diff_step):
     from scipy.optimize import least_squares
 
-    def values(u):
-        return {p.name: float(p.from_unit(float(ui))) for p, ui in zip(params, u)}
+    return least_squares(resid, np.clip(u0, lb, ub), bounds=(lb, ub), method="trf", x_scale=1.0,
+                         ftol=config.FIT_FTOL, xtol=config.FIT_XTOL, gtol=config.FIT_GTOL,
+                         max_nfev=config.FIT_MAX_NFEV, diff_step=diff_step)
 
-    def resid(u):
-        return fun(values(u))
 
-    u0 = np.array([p.to_unit(p.value) for p in params])
-    lb = np.array([p.to_unit(p.low) for p in params])
-    ub = np.array([p.to_unit(p.high) for p in params])
-    u0 = np.clip(u0, lb, ub)
-    res = least_squares(resid, u0, bounds=(lb, ub), method="trf", x_scale=1.0, ftol=config.FIT_FTOL,
-                        xtol=config.FIT_XTOL, gtol=config.FIT_GTOL, max_nfev=config.FIT_MAX_NFEV,
-                        diff_step=diff_step)
-    u = res.x
-    jac = np.asarray(res.jac, dtype=float)
+def _weak(params, u, jac, fun):
+    """Mask of the parameters kept (not weak) and the weak names, dropping the worst first."""
     keep = np.ones(len(params), bool)
     weak = []
     for _ in range(len(params)):
-        cov = covariance(jac, res.fun, keep)
+        cov = covariance(jac, fun, keep)
         se = np.sqrt(np.abs(np.diag(cov)))
         worst, excess = None, 1.0
         for i, p in enumerate(params):
@@ -87,13 +77,75 @@ def solve(fun, params: list, *, diff_step=None) -> Solution:
             break
         keep[worst] = False
         weak.append(params[worst].name)
+    return keep, weak
+
+
+def solve(fun, params: list, *, diff_step=None, profile: bool = False, level: float = config.FIT_LEVEL,
+          starts=()) -> Solution:
+    """Minimise ``sum(fun(values)^2)`` over the parameters (``fun`` takes a dict of
+    values by name and returns the residual vector) with scipy's trust-region
+    least squares within the bounds; then the standard errors from the Jacobian at the
+    optimum and the residual variance. A parameter whose error exceeds
+    ``config.FIT_MAX_RELATIVE_SE`` of its value (scales) or ``config.FIT_MAX_SHAPE_SE``
+    (shapes) is *weak*: the errors of the others are then those with it held.
+
+    ``profile``: also the profile-likelihood interval of every parameter at ``level``
+    (:mod:`._profile`); a lower sum of squares met on a profile (the optimiser stopped in
+    a local minimum) restarts least squares from there, once. ``starts``: further start
+    points (dicts of values by name, the others from ``params``); least squares begins at
+    the one of lowest sum of squares."""
+    from ._profile import Interval, profile_intervals
+
+    def values(u):
+        return {p.name: float(p.from_unit(float(ui))) for p, ui in zip(params, u)}
+
+    def resid(u):
+        return fun(values(u))
+
+    u0 = np.array([p.to_unit(p.value) for p in params])
+    lb = np.array([p.to_unit(p.low) for p in params])
+    ub = np.array([p.to_unit(p.high) for p in params])
+    if starts:
+        cands = [u0] + [np.array([p.to_unit(s.get(p.name, p.value)) for p in params]) for s in starts]
+        cost = [float(np.sum(resid(np.clip(c, lb, ub)) ** 2)) for c in cands]
+        u0 = cands[int(np.nanargmin(cost))]
+    res = _least_squares(resid, u0, lb, ub, diff_step)
+    nfev = int(res.nfev)
+    for attempt in range(2 if profile else 0):
+        se_u = np.sqrt(np.abs(np.diag(covariance(np.asarray(res.jac, float), res.fun, np.ones(len(params), bool)))))
+        bounds, best = profile_intervals(resid, params, res.x, se_u, res.fun.size, level)
+        ssr0 = float(res.fun @ res.fun)
+        if attempt == 0 and best[0] < ssr0 * (1.0 - 1e-6):
+            res = _least_squares(resid, best[1], lb, ub, diff_step)
+            nfev += int(res.nfev)
+            continue
+        break
+    u = res.x
+    jac = np.asarray(res.jac, dtype=float)
+    keep, weak = _weak(params, u, jac, res.fun)
     cov = covariance(jac, res.fun, keep)
     se_u = np.sqrt(np.abs(np.diag(cov)))
     vals = values(u)
     errors = {p.name: (float(se_u[i] * p.value) if p.positive else float(se_u[i])) if keep[i] else None
               for i, p in enumerate(params)}
+    intervals, opened = None, ()
+    if profile:
+        intervals = {p.name: Interval(None if lo is None else float(p.from_unit(lo)),
+                                      None if hi is None else float(p.from_unit(hi)), level)
+                     for p, (lo, hi) in zip(params, bounds)}
+        opened = tuple(k for k, v in intervals.items() if not v.closed)
     return Solution(values=vals, errors=errors, correlation=correlation(cov), residual=res.fun, weak=tuple(weak),
-                    evaluations=int(res.nfev), converged=bool(res.status > 0))
+                    evaluations=nfev, converged=bool(res.status > 0), intervals=intervals, open=opened)
+
+
+def open_reason(interval) -> str:
+    """Why a parameter with an open profile interval is not determined, in words."""
+    pct = f"{100 * interval.level:.3g} %"
+    if interval.low is None and interval.high is None:
+        return f"the data bound it on neither side ({pct} profile likelihood)"
+    if interval.low is None:
+        return f"the data bound it only from above, <= {interval.high:.4g} ({pct} profile likelihood)"
+    return f"the data bound it only from below, >= {interval.low:.4g} ({pct} profile likelihood)"
 
 
 def status_of(sol: Solution, reasons: dict) -> tuple:

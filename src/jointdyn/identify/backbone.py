@@ -21,6 +21,7 @@ omega_0 (what a modal dashpot gives, and what EPMC computes).
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -28,7 +29,8 @@ from .. import _validate as V
 from .. import config
 from ..laws import law_parameters, make_law
 from ..laws.segalman import CHI_MAX, CHI_MIN, segalman_constants
-from ._lsq import Param, solve, status_of
+from ._lsq import Param, open_reason, solve, status_of
+from ._microslip import MICROSLIP_MODELS, microslip_backbone, microslip_constants, microslip_model
 from .result import FitResult, FitStatus
 
 __all__ = ["fit_backbone", "describing_function", "BACKBONE_MODELS"]
@@ -90,17 +92,19 @@ def describing_function(law, amplitude) -> tuple:
     A = np.atleast_1d(np.asarray(amplitude, dtype=float))
     F, kinks = _virgin_curve(law)
     t, w = _nodes(config.FIT_QUAD_NODES)
-    k1 = np.empty(A.size)
-    en = np.empty(A.size)
-    for i, a in enumerate(A):
-        cuts = [0.0] + sorted(math.acos(1.0 - 2.0 * xk / a) for xk in kinks if 2.0 * xk / a < 2.0) + [math.pi]
-        th = np.concatenate([lo + (hi - lo) * t for lo, hi in zip(cuts[:-1], cuts[1:]) if hi > lo])
-        ww = np.concatenate([(hi - lo) * w for lo, hi in zip(cuts[:-1], cuts[1:]) if hi > lo])
-        T = F(np.array(a)) - 2.0 * F(0.5 * a * (1.0 - np.cos(th)))
-        t1c = 2.0 / math.pi * float(np.sum(ww * T * np.cos(th)))
-        t1s = 2.0 / math.pi * float(np.sum(ww * T * np.sin(th)))
-        k1[i] = t1c / a
-        en[i] = -math.pi * a * t1s
+    # the Masing loop is smooth between 0, the angle where the virgin argument
+    # A (1 - cos theta) / 2 crosses a kink, and pi: one Gauss-Legendre piece each
+    # (a piece of zero length where the kink is not reached), all amplitudes at once
+    cut = [np.arccos(np.clip(1.0 - 2.0 * xk / A, -1.0, 1.0)) for xk in sorted(kinks)]
+    edges = np.stack([np.zeros(A.size)] + cut + [np.full(A.size, math.pi)], axis=1)
+    lo, hi = edges[:, :-1, None], edges[:, 1:, None]
+    th = (lo + (hi - lo) * t).reshape(A.size, -1)
+    ww = ((hi - lo) * w).reshape(A.size, -1)
+    T = F(A)[:, None] - 2.0 * F(0.5 * A[:, None] * (1.0 - np.cos(th)))
+    t1c = 2.0 / math.pi * np.sum(ww * T * np.cos(th), axis=1)
+    t1s = 2.0 / math.pi * np.sum(ww * T * np.sin(th), axis=1)
+    k1 = t1c / A
+    en = -math.pi * A * t1s
     return k1, en
 
 
@@ -188,8 +192,6 @@ def _refine(sol, params, fun, law_of, m, A, harmonics, samples):
     change by less than ``config.FIT_REFINE_RTOL``. Returns (solution, True) or
     (the describing-function solution, False) when an EPMC backbone fails, and the last
     defect (zeros when none was computed)."""
-    from dataclasses import replace
-
     defect = (np.zeros(A.size), np.zeros(A.size))
     for _ in range(config.FIT_REFINE_ITERATIONS):
         v = sol.values
@@ -205,6 +207,93 @@ def _refine(sol, params, fun, law_of, m, A, harmonics, samples):
         if change <= config.FIT_REFINE_RTOL:
             break
     return sol, True, defect
+
+
+def _params(s0) -> list:
+    out = [Param("k", s0["k"], True, 1e-6 * s0["k"], 1e3 * s0["k"]),
+           Param("kt", s0["kt"], True, 1e-4 * s0["kt"], 1e3 * s0["kt"]),
+           Param("fy", s0["fy"], True, 1e-4 * s0["fy"], 1e4 * s0["fy"]),
+           Param("zeta", s0["zeta"], True, 0.0, 1.0 / s0["zeta"])]
+    if "chi" in s0:
+        out.append(Param("chi", s0["chi"], False, CHI_MIN, CHI_MAX))
+    if "beta" in s0:
+        out.append(Param("beta", s0["beta"], False, 0.0, config.FIT_BETA_MAX))
+    return out
+
+
+def _grid(s0) -> list:
+    """Further start points of a Segalman backbone fit (a global start): chi, beta and the
+    slip force (factors of the data's start ``s0``) on the grid of ``config.FIT_GRID_*``."""
+    if "beta" not in s0:
+        return []
+    return [{**s0, "chi": c, "beta": b, "fy": f * s0["fy"]}
+            for c in config.FIT_GRID_CHI for b in config.FIT_GRID_BETA for f in config.FIT_GRID_SLIP]
+
+
+def _weights(r, n, p) -> list:
+    """Weights of the frequency and damping residuals that give both the same variance (each
+    column's noise has its own size; the profile's threshold assumes one variance)."""
+    dof = max(n - 0.5 * p, 1.0)
+    sw, sd = math.sqrt(float(r[:n] @ r[:n]) / dof), math.sqrt(float(r[n:] @ r[n:]) / dof)
+    if not (sw > 1e-9 and sd > 1e-9):  # noise-free data (rounding only): nothing to balance
+        return [1.0, 1.0]
+    s = math.sqrt(sw * sd)
+    return [s / sw, s / sd]
+
+
+def _microslip_result(model, law, sol, m, A, w, D, dscale, weights, defect, refined):
+    """The result of a backbone that stays below the fitted slip displacement: k, kt, fy (and
+    beta) not determined apart; k + kt, R, chi and zeta fitted with their intervals."""
+    chi, R, pm = microslip_constants(law)
+    v = sol.values
+    combos, msol = microslip_backbone(A, w - defect[0], D - defect[1], m,
+                                      {"K": v["k"] + v["kt"], "R": R, "chi": chi, "zeta": v["zeta"]},
+                                      fit_chi=model == "segalman", dscale=dscale, weights=weights)
+    why = (f"the amplitudes stay in microslip (largest {A.max():.4g} m, below the slip displacement of every "
+           f"model that fits): there the backbone depends on k + kt, R and chi only; measure into macroslip")
+    reasons = {k: why for k in ("k", "kt", "fy_N") + (("beta",) if model == "segalman" else ())}
+    mv = msol.values
+    wf, Df = microslip_model(mv["K"], mv["R"], mv.get("chi", chi), mv["zeta"], m, A)
+    wf, Df = wf + defect[0], Df + defect[1]
+    values = {k: None for k in reasons}
+    values["zeta"] = mv["zeta"]
+    errors = {k: None for k in reasons}
+    errors["zeta"] = msol.errors["zeta"]
+    intervals = {k: None for k in reasons}
+    intervals["zeta"] = msol.intervals["zeta"]
+    if model == "segalman":
+        values["chi"], errors["chi"], intervals["chi"] = mv["chi"], msol.errors["chi"], msol.intervals["chi"]
+    for k in [k for k in ("chi", "zeta") if k in msol.open]:
+        reasons[k] = open_reason(msol.intervals[k])
+        values[k] = errors[k] = None
+    status, message = status_of(msol, reasons)
+    if refined is False:
+        status, message = FitStatus.REFINE_FAILED, FitStatus.REFINE_FAILED.message
+    r = np.concatenate(((wf - w) / w, (Df - D) / dscale))
+    names = tuple(p for p in ("k", "kt", "fy_N", "zeta", "chi", "beta") if p in values)
+    res = FitResult(kind="backbone", model=model, status=status, message=message, parameters=values,
+                    standard_errors=errors, names=names, correlation=np.full((len(names), len(names)), np.nan),
+                    not_identifiable=reasons, rms_residual=math.sqrt(float(np.mean(r * r))), law=law,
+                    measured={"amplitude_m": A, "omega_rad_s": w, "damping_ratio": D},
+                    fitted={"omega_rad_s": wf, "damping_ratio": Df}, evaluations=sol.evaluations + msol.evaluations,
+                    intervals=intervals, conditional_on=(), determined_combinations=combos)
+    return res, msol
+
+
+def _microslip_suffices(micro, sol, p) -> bool:
+    """Whether the microslip model (k + kt, R, chi, zeta) fits as well as the full one: its
+    extra sum of squares below the F test's level ``config.FIT_LEVEL`` for the parameters it
+    lacks. Then the data do not show the slip force, and kt, fy (beta) are not determined."""
+    from scipy.stats import f
+
+    msol = micro[1]
+    m = sol.residual.size
+    ssr, ssr_m = float(sol.residual @ sol.residual), float(msol.residual @ msol.residual)
+    q = p - len(msol.values)
+    dof = max(m - p, 1)
+    if ssr <= 0.0:
+        return ssr_m <= 0.0
+    return (ssr_m - ssr) / q <= float(f.ppf(config.FIT_LEVEL, q, dof)) * ssr / dof
 
 
 def fit_backbone(amplitude_m, omega_rad_s, damping_ratio, *, mass: float, model: str = config.MODEL,
@@ -253,20 +342,15 @@ def fit_backbone(amplitude_m, omega_rad_s, damping_ratio, *, mass: float, model:
     A, w, D, m = _check(amplitude_m, omega_rad_s, damping_ratio, mass)
     fixed = dict(law_params or {})
     make_law(model, kt=1.0, mu=1.0, n_ref=1.0, **fixed)
-    s0 = _start(model, A, w, D, m)
+    s_data = _start(model, A, w, D, m)
+    s0 = dict(s_data)
     for k, v in (start or {}).items():
         if k not in s0:
             raise ValueError(f"start has {k!r}, which model {model} does not fit (it fits {', '.join(s0)})")
         s0[k] = float(v)
-    params = [Param("k", s0["k"], True, 1e-6 * s0["k"], 1e3 * s0["k"]),
-              Param("kt", s0["kt"], True, 1e-4 * s0["kt"], 1e3 * s0["kt"]),
-              Param("fy", s0["fy"], True, 1e-4 * s0["fy"], 1e4 * s0["fy"]),
-              Param("zeta", s0["zeta"], True, 0.0, 1.0 / s0["zeta"])]
-    if "chi" in s0:
-        params.append(Param("chi", s0["chi"], False, CHI_MIN, CHI_MAX))
-    if "beta" in s0:
-        params.append(Param("beta", s0["beta"], False, 0.0, config.FIT_BETA_MAX))
+    params = _params(s0)
     dscale = float(np.max(D)) if np.max(D) > 0.0 else 1.0
+    weights = [1.0, 1.0]
 
     def law_of(v):
         shape = {k: v[k] for k in ("chi", "beta") if k in v}
@@ -274,30 +358,41 @@ def fit_backbone(amplitude_m, omega_rad_s, damping_ratio, *, mass: float, model:
 
     def fun(v, dw=0.0, dD=0.0):
         wf, Df = _model(law_of(v), v["k"], v["zeta"], m, A)
-        return np.concatenate(((wf + dw - w) / w, (Df + dD - D) / dscale))
+        return np.concatenate((weights[0] * (wf + dw - w) / w, weights[1] * (Df + dD - D) / dscale))
 
-    sol = solve(fun, params)
-    refined, defect = None, (0.0, 0.0)
+    sol = solve(fun, params, starts=[s_data] + _grid(s_data))
+    weights[:] = _weights(sol.residual, A.size, len(params))
+    refined, defect = None, (np.zeros(A.size), np.zeros(A.size))
     if refine_harmonics is not None:
         V.positive_int("refine_harmonics", refine_harmonics)
         sol, refined, defect = _refine(sol, params, fun, law_of, m, A, refine_harmonics, refine_samples)
+    law = law_of(sol.values)
+    if model in MICROSLIP_MODELS:
+        micro = _microslip_result(model, law, sol, m, A, w, D, dscale, weights, defect, refined)
+        if _microslip_suffices(micro, sol, len(params)):
+            return micro[0]
+    start_at = [replace(p, value=sol.values[p.name]) if (not p.positive or sol.values[p.name] > 0.0) else p
+                for p in params]
+    sol = solve(lambda v: fun(v, *defect), start_at, profile=True)
     reasons = {k: "the backbone depends too weakly on it (its standard error exceeds the limit): measure more "
                   "amplitudes, into macroslip for fy and kt, in microslip for chi" for k in sol.weak}
-    held = {**sol.values, **{k: s0[k] for k in sol.weak}}
-    law = law_of(held)
-    wf, Df = _model(law, held["k"], held["zeta"], m, A)
+    for k in sol.open:
+        reasons[k] = (reasons[k] + "; " if k in reasons else "") + open_reason(sol.intervals[k])
+    law = law_of(sol.values)
+    wf, Df = _model(law, sol.values["k"], sol.values["zeta"], m, A)
     wf, Df = wf + defect[0], Df + defect[1]  # EPMC's values when refined
     status, message = status_of(sol, reasons)
     if refined is False:
         status, message = FitStatus.REFINE_FAILED, FitStatus.REFINE_FAILED.message
-    values = {k: (None if k in reasons else v) for k, v in sol.values.items()}
-    errors = dict(sol.errors)
-    values["fy_N"], errors["fy_N"] = values.pop("fy"), errors.pop("fy")
-    r = sol.residual
+    ren = {"fy": "fy_N"}
+    values = {ren.get(k, k): (None if k in reasons else v) for k, v in sol.values.items()}
+    errors = {ren.get(k, k): (None if k in reasons else v) for k, v in sol.errors.items()}
+    r = np.concatenate(((wf - w) / w, (Df - D) / dscale))
     return FitResult(kind="backbone", model=model, status=status, message=message, parameters=values,
-                     standard_errors=errors, names=tuple("fy_N" if p.name == "fy" else p.name for p in params),
-                     correlation=sol.correlation, not_identifiable={("fy_N" if k == "fy" else k): v
-                                                                    for k, v in reasons.items()},
+                     standard_errors=errors, names=tuple(ren.get(p.name, p.name) for p in params),
+                     correlation=sol.correlation, not_identifiable={ren.get(k, k): v for k, v in reasons.items()},
                      rms_residual=math.sqrt(float(np.mean(r * r))), law=law,
                      measured={"amplitude_m": A, "omega_rad_s": w, "damping_ratio": D},
-                     fitted={"omega_rad_s": wf, "damping_ratio": Df}, evaluations=sol.evaluations)
+                     fitted={"omega_rad_s": wf, "damping_ratio": Df}, evaluations=sol.evaluations,
+                     intervals={ren.get(k, k): v for k, v in sol.intervals.items()},
+                     conditional_on=tuple(ren.get(k, k) for k in sol.weak))

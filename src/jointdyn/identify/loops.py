@@ -21,7 +21,7 @@ from .. import config
 from ..drivers import march
 from ..laws import MACROSLIP, law_parameters, make_law
 from ..laws.segalman import CHI_MAX, CHI_MIN
-from ._lsq import Param, solve, status_of
+from ._lsq import Param, open_reason, solve, status_of
 from .result import FitResult
 
 __all__ = ["fit_loops", "LOOP_MODELS"]
@@ -141,9 +141,77 @@ def _params(model, start) -> list:
     return out
 
 
-def _reasons(weak, law, x, N, T, T_fit):
+def _grid(s0) -> list:
+    """Further start points of a Segalman fit (a global start): a grid over chi, beta and the
+    slip force (mu) around the data's start values ``s0``."""
+    if "beta" not in s0:
+        return []
+    return [{**s0, "chi": c, "beta": b, "mu": f * s0["mu"]}
+            for c in config.FIT_GRID_CHI for b in config.FIT_GRID_BETA for f in config.FIT_GRID_SLIP]
+
+
+def _record_start(x, N, T, from_rest):
+    """(x and N to march, the mask of the record's samples fitted, a sentence saying how the
+    initial slip state was set). A record from rest (|T| at the first sample at most
+    ``config.FIT_REST_FORCE`` of max |T|, or ``from_rest``) is marched from the virgin state
+    at its first sample and fitted whole. Any other record (a steady cycle picked up
+    anywhere) is marched after a ramp from rest at x = 0 to its first sample, and its
+    samples before the second reversal (the first full stroke between its extremes, which
+    sets the state of every element that slips) only set the slip state: they are not
+    fitted."""
+    if from_rest is None:
+        from_rest = abs(float(T[0])) <= config.FIT_REST_FORCE * float(np.max(np.abs(T)))
+    if from_rest:
+        return x, N, np.ones(x.size, bool), "from rest: the virgin state at the first sample"
+    rev = _reversals(x)
+    if rev.size < 3:
+        raise ValueError("the record does not start from rest (T at the first sample is not 0) and has no full "
+                         "stroke between two reversals to set the slip state: record at least one full cycle")
+    ramp = np.linspace(0.0, float(x[0]), config.FIT_RAMP_SAMPLES, endpoint=False)
+    fitted = np.arange(x.size) >= rev[2]
+    return (np.concatenate((ramp, x)), np.concatenate((np.full(ramp.size, N[0]), N)), fitted,
+            f"mid-cycle: ramped from rest at x = 0 to the first sample; samples 0 to {int(rev[2]) - 1} (the first "
+            f"stroke) set the slip state and are not fitted")
+
+
+def _setup(model, x, N, T, n_ref, fixed, from_rest) -> dict:
+    """The pieces of a loop fit for one way of starting the record (:func:`_record_start`):
+    the law of a parameter dict, the force on the record's samples, the residual function,
+    the fitted-sample mask, the marched x and N and the sentence on the start."""
+    xm, Nm, fitted, record_start = _record_start(x, N, T, from_rest)
+    scale = float(np.max(np.abs(T)))
+
+    def law_of(v):
+        shape = {k: v[k] for k in SHAPE_PARAMS if k in v}
+        return make_law(model, kt=v["kt"], mu=v["mu"], n_ref=n_ref, **fixed, **shape)
+
+    def force(law):
+        return march(law, xm, Nm)[0][xm.size - x.size:]
+
+    def fun(v):
+        return (force(law_of(v))[fitted] - T[fitted]) / scale
+
+    return {"law_of": law_of, "force": force, "fun": fun, "fitted": fitted, "xm": xm, "Nm": Nm,
+            "record_start": record_start, "from_rest": xm.size == x.size}
+
+
+def _first_stroke_misfit(setup, values, x, T) -> bool:
+    """Whether a record taken to start from rest (|T| small at its first sample) is fitted on
+    its first stroke much worse than after it: then it was picked up in a steady cycle where
+    the force happened to cross zero, and its first stroke must only set the slip state."""
+    rev = _reversals(x)
+    if rev.size < 3 or rev[2] < 10 or x.size - rev[2] < 10:
+        return False
+    r = setup["force"](setup["law_of"](values)) - T
+    first, rest = r[: rev[2]], r[rev[2]:]
+    return math.sqrt(float(np.mean(first * first))) > config.FIT_FIRST_STROKE_MISFIT * math.sqrt(
+        float(np.mean(rest * rest)))
+
+
+def _reasons(weak, law, xm, Nm, T, T_fit, n):
     """Why each weak parameter is not determined, from the fitted model's motion states."""
-    code = march(law, x, N)[2]
+    code = march(law, xm, Nm)[2][xm.size - n:]
+    x, N = xm[xm.size - n:], Nm[Nm.size - n:]
     on = N > 0.0
     use = float(np.max(np.abs(T_fit[on]) / (law.mu * N[on]))) if law.mu > 0.0 else 0.0
     macro = int(np.count_nonzero(code == MACROSLIP))
@@ -163,7 +231,7 @@ def _reasons(weak, law, x, N, T, T_fit):
 
 
 def fit_loops(x, N, T, model: str = config.MODEL, *, t=None, n_ref: float | None = None,
-              law_params: dict | None = None, start: dict | None = None) -> FitResult:
+              law_params: dict | None = None, start: dict | None = None, from_rest: bool | None = None) -> FitResult:
     """Fit a contact law to measured loops: least squares of its force under the measured x, N.
 
     Parameters
@@ -185,7 +253,16 @@ def fit_loops(x, N, T, model: str = config.MODEL, *, t=None, n_ref: float | None
     law_params : dict, optional
         Law parameters held during the fit (e.g. ``n`` of ``discrete``, ``capacity``).
     start : dict, optional
-        Start values by name (``kt``, ``mu``, ``chi``, ``beta``) replacing those from the data.
+        Start values by name (``kt``, ``mu``, ``chi``, ``beta``); least squares begins at
+        the one of these, the data's own start values and (Segalman) a grid over chi, beta
+        and mu around them, whose sum of squares is least, so a poor start does not hold
+        the fit.
+    from_rest : bool, optional
+        Whether the record starts from rest (the virgin state at the first sample). Default:
+        when |T| at the first sample is at most ``config.FIT_REST_FORCE`` of max |T|.
+        Otherwise, or when the fit from rest leaves on the first stroke an rms residual above
+        ``config.FIT_FIRST_STROKE_MISFIT`` times that of the rest of the record, the first
+        stroke only sets the slip state (``FitResult.record_start`` says which).
 
     Returns
     -------
@@ -206,35 +283,41 @@ def fit_loops(x, N, T, model: str = config.MODEL, *, t=None, n_ref: float | None
             raise ValueError(f"law_params must not hold the fitted parameter {k}")
     make_law(model, kt=1.0, mu=1.0, n_ref=1.0, **fixed)  # validates the held law parameters
     n_ref = float(np.mean(N[N > 0.0])) if n_ref is None else V.positive("n_ref", n_ref)
-    s0 = _start(model, x, N, T, n_ref)
+    s_data = _start(model, x, N, T, n_ref)
+    s0 = dict(s_data)
     for k, v in (start or {}).items():
         if k not in s0:
             raise ValueError(f"start has {k!r}, which model {model} does not fit (it fits {', '.join(s0)})")
         s0[k] = float(v)
     params = _params(model, s0)
-    scale = float(np.max(np.abs(T)))
-
-    def law_of(v):
-        shape = {k: v[k] for k in SHAPE_PARAMS if k in v}
-        return make_law(model, kt=v["kt"], mu=v["mu"], n_ref=n_ref, **fixed, **shape)
-
-    def fun(v):
-        return (march(law_of(v), x, N)[0] - T) / scale
-
-    sol = solve(fun, params)
-    law = law_of({**sol.values, **{k: s0[k] for k in sol.weak}})
-    T_fit = march(law, x, N)[0]
-    reasons = _reasons(sol.weak, law, x, N, T, T_fit)
+    starts = [s_data] + _grid(s_data)
+    setup = _setup(model, x, N, T, n_ref, fixed, from_rest)
+    if from_rest is None and setup["from_rest"]:
+        first = solve(setup["fun"], params, starts=starts)
+        if _first_stroke_misfit(setup, first.values, x, T):
+            setup = _setup(model, x, N, T, n_ref, fixed, False)
+    law_of, force, fitted, xm, Nm = (setup[k] for k in ("law_of", "force", "fitted", "xm", "Nm"))
+    sol = solve(setup["fun"], params, profile=True, starts=starts)
+    law = law_of(sol.values)  # the optimum: one of the models that fit, also where some are not determined
+    T_fit = force(law)
+    weak = list(sol.weak) + [k for k in sol.open if k not in sol.weak]
+    reasons = _reasons(weak, law, xm, Nm, T, T_fit, x.size)
+    for k in sol.open:
+        reasons[k] = f"{reasons[k]}; {open_reason(sol.intervals[k])}"
     status, message = status_of(sol, reasons)
     values = {k: (None if k in reasons else v) for k, v in sol.values.items()}
-    errors = dict(sol.errors)
+    errors = {k: (None if k in reasons else v) for k, v in sol.errors.items()}
     values["fy_N"] = None if values["mu"] is None else values["mu"] * n_ref
     errors["fy_N"] = None if errors["mu"] is None else errors["mu"] * n_ref
-    r = T_fit - T
+    intervals = dict(sol.intervals)
+    iv = intervals["mu"]
+    intervals["fy_N"] = type(iv)(*(None if b is None else b * n_ref for b in (iv.low, iv.high)), iv.level)
+    r = (T_fit - T)[fitted]
     measured = {"x": x, "N": N, "T": T}
     if t is not None:
         measured["t"] = _array("t", t)
     return FitResult(kind="loops", model=model, status=status, message=message, parameters=values,
                      standard_errors=errors, names=tuple(p.name for p in params), correlation=sol.correlation,
                      not_identifiable=reasons, rms_residual=math.sqrt(float(np.mean(r * r))), n_ref=n_ref,
-                     law=law, measured=measured, fitted={"T": T_fit}, evaluations=sol.evaluations)
+                     law=law, measured=measured, fitted={"T": T_fit}, evaluations=sol.evaluations,
+                     intervals=intervals, conditional_on=tuple(sol.weak), record_start=setup["record_start"])

@@ -62,6 +62,22 @@ class FitResult:
         The data and the fitted model's values (arrays by column name).
     evaluations : int
         Model evaluations of the least squares.
+    intervals : dict
+        Name -> :class:`jointdyn.identify.Interval`: the profile-likelihood interval at ``config.FIT_LEVEL``
+        (95 %) of every fitted parameter, all the others refitted at each point (so not
+        conditional on any held value). ``low`` or ``high`` None: the data do not bound
+        the parameter on that side (it is then in ``not_identifiable``).
+    conditional_on : tuple of str
+        The parameters held at their fitted values when ``standard_errors`` were computed
+        (the linearised errors of the others are conditional on them; the intervals are
+        not).
+    determined_combinations : dict
+        Name -> {"value", "interval", "unit", "meaning"}: combinations of the parameters
+        the data determine when some parameters are not determined separately (a backbone
+        in microslip: ``k_plus_kt``, ``R``, ``chi``, ``zeta``).
+    record_start : str or None
+        Loops: how the initial slip state was set (from rest, or by the record's first
+        stroke, whose samples are then not fitted).
     """
 
     kind: str
@@ -79,10 +95,15 @@ class FitResult:
     measured: dict = field(default_factory=dict)
     fitted: dict = field(default_factory=dict)
     evaluations: int = 0
+    intervals: dict = field(default_factory=dict)
+    conditional_on: tuple = ()
+    determined_combinations: dict = field(default_factory=dict)
+    record_start: str | None = None
 
     def to_dict(self) -> dict:
         """The result as JSON-ready values (keys ``parameters``, ``standard_errors``,
-        ``rms_residual``, ``status`` and more)."""
+        ``rms_residual``, ``status`` and more; ``intervals``: name -> {low, high, level,
+        method} or None; ``standard_errors_conditional_on``; ``determined_combinations``)."""
         corr = [[None if not np.isfinite(v) else float(v) for v in row] for row in self.correlation]
         return {
             "kind": self.kind,
@@ -96,6 +117,10 @@ class FitResult:
             "rms_residual": float(self.rms_residual),
             "n_ref_N": self.n_ref,
             "evaluations": int(self.evaluations),
+            "intervals": {k: (None if v is None else v.to_dict()) for k, v in self.intervals.items()},
+            "standard_errors_conditional_on": list(self.conditional_on),
+            "determined_combinations": {k: dict(v) for k, v in self.determined_combinations.items()},
+            "record_start": self.record_start,
         }
 
 

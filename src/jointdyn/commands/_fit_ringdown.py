@@ -1,0 +1,70 @@
+"""``jointdyn fit --ringdown FILE.csv``: a ring-down to a backbone to a fitted model.
+
+The CSV has a header row and the columns ``t`` (s) and one of ``x`` (m),
+``v`` (m/s) or ``a`` (m/s^2), uniformly sampled. The backbone is extracted
+by :func:`jointdyn.backbone_from_ringdown` and fitted as ``--backbone`` would
+be (``--mass``, ``--model``); with ``--out DIR`` it is also written as
+``ringdown_backbone.csv`` with the ``--backbone`` columns.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+SIGNAL_COLUMNS = ("x", "v", "a")
+BACKBONE_FILE = "ringdown_backbone.csv"
+
+
+def _signal_column(path) -> str:
+    from .. import _validate as V
+
+    path = V.input_file("--ringdown", path)
+    try:
+        with open(path, encoding="utf-8") as fh:
+            header = [c.strip() for c in fh.readline().split(",")]
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"--ringdown {str(path)!r} cannot be read: {exc}") from None
+    found = [c for c in SIGNAL_COLUMNS if c in header]
+    if len(found) != 1:
+        raise ValueError(f"--ringdown {str(path)!r} must have the column t and exactly one of x (m), v (m/s), "
+                         f"a (m/s^2); header: {', '.join(header)}")
+    return found[0]
+
+
+def read_ringdown(path, read_columns) -> tuple:
+    """(t, signal, kind) of a ring-down CSV file (module docstring), read by ``read_columns``
+    (the reader of ``jointdyn fit``'s other files)."""
+    kind = _signal_column(path)
+    d = read_columns(path, ("t", kind), "--ringdown")
+    if not np.all(np.diff(d["t"]) > 0.0):
+        raise ValueError(f"--ringdown {str(path)!r}: t must increase strictly from row to row")
+    return d["t"], d[kind], kind
+
+
+def backbone_of(args, read_columns):
+    """The extracted :class:`~jointdyn.identify.RingdownBackbone` of ``args.ringdown``
+    (ValueError naming the file on bad data)."""
+    from ..identify import backbone_from_ringdown
+
+    t, y, kind = read_ringdown(args.ringdown, read_columns)
+    try:
+        return backbone_from_ringdown(t, y, kind)
+    except ValueError as exc:
+        raise ValueError(f"--ringdown {str(args.ringdown)!r}: {exc}") from None
+
+
+def backbone_csv(b) -> str:
+    """The backbone as CSV text with the ``--backbone`` columns."""
+    lines = ["amplitude_m,omega_rad_s,damping_ratio"]
+    for row in zip(b.amplitude_m, b.omega_rad_s, b.damping_ratio):
+        lines.append(",".join(f"{float(v):.17g}" for v in row))
+    return "\n".join(lines) + "\n"
+
+
+def write_backbone(out, b) -> None:
+    from .._io import atomic_path
+
+    with atomic_path(Path(out) / BACKBONE_FILE) as tmp:
+        Path(tmp).write_text(backbone_csv(b))

@@ -1,0 +1,99 @@
+"""``jointdyn fit --ringdown`` and ``--frc``: a free decay in a CSV file to a backbone (written with the
+``--backbone`` columns) to a fitted model; bad ring-downs refused with one line, exit 2, no
+file."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from jointdyn.cli import main
+
+W0 = 500.0
+T0 = 2.0 * math.pi / W0
+
+
+def _decay(path, per=64, periods=150, zeta=0.0025, column="x", steady=False):
+    t = np.arange(0.0, periods * T0, T0 / per)
+    env = np.ones(t.size) if steady else np.exp(-zeta * W0 * t)
+    y = 1e-4 * env * np.cos(W0 * math.sqrt(1 - zeta * zeta) * t)
+    np.savetxt(path, np.column_stack([t, y]), delimiter=",", header=f"t,{column}", comments="")
+    return path
+
+
+def test_a_linear_ringdown_is_written_as_a_backbone_and_fitted(tmp_path, capsys):
+    src = _decay(tmp_path / "decay.csv")
+    out = tmp_path / "out"
+    rc = main(["fit", "--ringdown", str(src), "--model", "iwan", "--mass", "2", "--json", "--out", str(out)])
+    d = json.loads(capsys.readouterr().out)
+    # a linear decay never slips: the fit names what it cannot determine (exit 3)
+    assert rc == 3 and d["status"] == "partly-identified"
+    assert d["determined_combinations"]["k_plus_kt"]["value"] == pytest.approx(2.0 * W0 ** 2, rel=1e-3)
+    assert d["determined_combinations"]["zeta"]["value"] == pytest.approx(0.0025, rel=0.01)
+    bb = (out / "ringdown_backbone.csv").read_text().splitlines()
+    assert bb[0] == "amplitude_m,omega_rad_s,damping_ratio" and len(bb) > 10
+    # the written backbone, fitted with --backbone, gives the same result
+    assert main(["fit", "--backbone", str(out / "ringdown_backbone.csv"), "--model", "iwan", "--mass", "2",
+                 "--json"]) == 3
+    again = json.loads(capsys.readouterr().out)
+    assert again["determined_combinations"]["k_plus_kt"]["value"] == pytest.approx(
+        d["determined_combinations"]["k_plus_kt"]["value"], rel=1e-9)
+
+
+@pytest.mark.parametrize("kw,word", [
+    (dict(periods=8), "shorter than"),
+    (dict(per=6), "aliased"),
+    (dict(steady=True), "no decay"),
+    (dict(column="displacement"), "exactly one of x"),
+])
+def test_bad_ringdowns_one_line_exit_2_no_file(tmp_path, capsys, kw, word):
+    src = _decay(tmp_path / "decay.csv", **kw)
+    out = tmp_path / "out"
+    rc = main(["fit", "--ringdown", str(src), "--model", "iwan", "--mass", "2", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 2 and word in err and len(err.strip().splitlines()) == 1 and "--ringdown" in err
+    assert not out.exists()
+
+
+def _curves(path, levels=(5.0, 15.0, 30.0), n=50):
+    import jointdyn as jd
+    from jointdyn.hb import frc_hb
+
+    law = jd.make_law("iwan", kt=1e5, mu=0.2, n_ref=100.0)
+    rows = []
+    for F in levels:
+        s = jd.System.sdof(m=2.0, k=4e5, law=law, f1=F, c=2 * 0.002 * math.sqrt(5e5 * 2.0), n0=100.0)
+        ds = frc_hb(s, 0.85, 1.1, harmonics=1)
+        g, A = np.asarray(ds["gamma"]), np.asarray(ds["amplitude_m"])
+        pick = np.linspace(0, g.size - 1, n).astype(int)
+        rows.append(np.column_stack([np.full(n, F), g[pick] * s.w0, A[pick]]))
+    np.savetxt(path, np.concatenate(rows), delimiter=",", header="force_N,omega_rad_s,amplitude_m", comments="")
+    return path
+
+
+def test_response_curves_from_a_file_are_fitted(tmp_path, capsys):
+    """``jointdyn fit --frc``: the plumbing (the accuracy is tests/test_identify_frc.py's): curves
+    made by HB without noise give the parameters to 1 %, the files are written."""
+    src = _curves(tmp_path / "curves.csv")
+    out = tmp_path / "out"
+    rc = main(["fit", "--frc", str(src), "--model", "iwan", "--mass", "2", "--json", "--out", str(out)])
+    d = json.loads(capsys.readouterr().out)
+    assert rc == 0 and d["kind"] == "frc" and d["status"] == "identified"
+    for name, true in (("k", 4e5), ("kt", 1e5), ("fy_N", 20.0), ("zeta", 0.002)):
+        assert d["parameters"][name] == pytest.approx(true, rel=0.01), name
+    assert {p.name for p in out.iterdir()} == {"fit.json", "fit.csv", "fit.png"}
+
+
+@pytest.mark.parametrize("content,extra,word", [
+    ("force_N,omega_rad_s\n1,2\n1,3\n1,4\n1,5\n", ["--mass", "2"], "missing column amplitude_m"),
+    ("force_N,omega_rad_s,amplitude_m\n1,2,3\n1,3,3\n1,4,3\n1,5,3\n1,6,3\n1,7,3\n", [], "--mass is required with --frc"),
+])
+def test_bad_response_curves_one_line_exit_2(tmp_path, capsys, content, extra, word):
+    src = tmp_path / "curves.csv"
+    src.write_text(content)
+    rc = main(["fit", "--frc", str(src), "--model", "iwan", *extra])
+    err = capsys.readouterr().err
+    assert rc == 2 and word in err and len(err.strip().splitlines()) == 1
