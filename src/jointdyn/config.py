@@ -209,6 +209,12 @@ CONT_SPARSE_FILL = 0.25
 #: 0.1 fill 0.25 in 0.68 s, 0.01 fill 0.20 in 0.58 s, all with residuals of
 #: 1e-11; at a lower amplitude 0.1 gave fill 0.010 where 1 gave 0.083
 CONT_SPARSE_PIVOTS = (0.0, 0.1)
+#: from CONT_KRYLOV_SOLVE unknowns, where the problem offers a structured
+#: preconditioner (harmonic balance: the blocks of its harmonics,
+#: jointdyn.hb._precond), GMRES with the factors of that preconditioner, made
+#: at the current matrix, runs this many iterations at most before the
+#: bordered matrix is factorised whole (the direct path, kept as the fallback)
+CONT_BLOCK_MAXITER = 40
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history
@@ -471,6 +477,13 @@ HB_CONDENSED_HILL_ROWS = 200
 #: rows on 2 cores): stability is not computed (growth NaN, the Dataset's
 #: ``stability`` attribute says so)
 HB_HILL_MAX_ROWS = 4000
+#: from config.CONT_KRYLOV_SOLVE unknowns, the Newton and tangent solves of HB
+#: branches and EPMC backbones are GMRES preconditioned by per-harmonic
+#: factorisations of the Jacobian's diagonal harmonic blocks
+#: (jointdyn.hb._precond); False: the direct path (one LU of the whole
+#: bordered matrix, reused through GMRES), kept as the reference of
+#: benchmarks/bench_hb_scale.py
+HB_BLOCK_PRECONDITIONER = True
 #: bytes of dense Jacobians a branch keeps at once: the continuation monitor
 #: keeps the evaluations of accepted points with their Jacobians while they fit
 #: (beyond, without: the point is evaluated again for its stability), and

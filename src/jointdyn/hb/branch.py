@@ -62,6 +62,7 @@ from ..continuation import (
     local_maxima,
     make_options,
     newton,
+    preconditioned_by,
     refine_maximum,
     turning_points,
 )
@@ -289,9 +290,11 @@ class _Tracker:
         #: True when the Jacobian stays sparse from the evaluation on (:meth:`HBProblem.evaluate_sparse`):
         #: interfaces on a sparse structure, from the size where the continuation's solves go large, where
         #: Hill's method (which needs the dense Jacobians) is beyond its size anyway
+        #: interfaces on a structure dense on its interface (a reduced model) too, where the harmonic blocks
+        #: precondition the solves (:meth:`HBProblem.block_preconditioner`)
         pat = problem.sparse_pattern() if problem.size >= config.CONT_KRYLOV_SOLVE else None
-        self.sparse = (pat is not None and pat.density <= config.CONT_SPARSE_DENSITY
-                       and not problem.hill_affordable())
+        self.sparse = (pat is not None and not problem.hill_affordable()
+                       and (pat.density <= config.CONT_SPARSE_DENSITY or config.HB_BLOCK_PRECONDITIONER))
 
     def residual(self, y, lam_s):
         xs, fs, ps = self.scales
@@ -504,6 +507,12 @@ def continued_branch(req: _Request, level, watch_for=None):
     (:class:`jointdyn.hb.discretisation._PeakWatch`)."""
     problem = make_problem(req.system, condense=req.condense, response_dofs=(req.dof,), harmonics=level[0],
                            samples=level[1], parameter=req.parameter, gamma=req.gamma)
+    with preconditioned_by(problem.block_preconditioner()):
+        return _continued(req, problem, watch_for)
+
+
+def _continued(req: _Request, problem: HBProblem, watch_for):
+    """:func:`continued_branch` of its problem."""
     tr = _Tracker(problem, _scales(problem, req.start), req.dof)
     opt = req.options
     if req.max_step is not None:

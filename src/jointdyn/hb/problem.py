@@ -479,6 +479,17 @@ class HBProblem:
             np.divide(ev.R, scl[0], out=scaled[1])
             np.multiply(ev.JX, scl[1], out=scaled[2])
 
+    def block_preconditioner(self, columns=()):
+        """The structured preconditioner of this problem's large solves (one factorisation per harmonic,
+        :class:`jointdyn.hb._precond.HarmonicBlocks`; ``columns``: those of the Jacobian it takes exactly),
+        or None where ``config.HB_BLOCK_PRECONDITIONER`` is off or the problem is below
+        ``config.CONT_KRYLOV_SOLVE`` unknowns (its solves are direct)."""
+        if not config.HB_BLOCK_PRECONDITIONER or self.size + 1 < config.CONT_KRYLOV_SOLVE:
+            return None
+        from ._precond import HarmonicBlocks
+
+        return HarmonicBlocks(self.n, self.H, columns)
+
     # --- sparse Jacobian ------------------------------------------------------
     def sparse_pattern(self):
         """The CSR pattern of dR/dX (:class:`jointdyn.hb._sparse.SparsePattern`; built once), or None

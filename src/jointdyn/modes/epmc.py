@@ -63,7 +63,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ..continuation import (ContinuationOptions, ContinuationStatus, ParameterProgress, continuation, make_options,
-                            newton)
+                            newton, preconditioned_by)
 from ..fourier import derivative_matrix
 from ..hb import HBProblem
 from ..hb._sparse import linear_entries
@@ -161,7 +161,9 @@ class EPMCProblem:
         # Jacobian stays sparse from the evaluation on (jointdyn.hb._sparse)
         pat = self.hb.sparse_pattern() if self.size >= config.CONT_KRYLOV_SOLVE else None
         #: True when the residual's Jacobian is a scipy.sparse matrix
-        self.sparse = pat is not None and pat.density <= config.CONT_SPARSE_DENSITY
+        #: (a structure dense on its interface too, where the harmonic blocks precondition the solves)
+        self.sparse = pat is not None and (pat.density <= config.CONT_SPARSE_DENSITY
+                                           or config.HB_BLOCK_PRECONDITIONER)
         self._A_M_sparse = _sparse_mass_damping(system.M, self.H) if self.sparse else None
         self.w_ref = self.linear.omega_rad_s
         self.k_ref = float(np.max(np.abs(np.diag(self.linear.stiffness))))
@@ -430,10 +432,16 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     problem = EPMCProblem(system, mode=mode, output_dof=output_dof, harmonics=harmonics, samples=samples)
     opt = _options(options, overrides)
     lam0, lam1 = math.log10(lo), math.log10(hi)
+    with preconditioned_by(problem.hb.block_preconditioner((problem.i_omega, problem.i_xi))):
+        return _walked(problem, lam0, lam1, opt, progress, reduction)
+
+
+def _walked(problem: EPMCProblem, lam0, lam1, opt, progress, reduction) -> Backbone:
+    """The backbone of :func:`epmc` from log10 amplitudes lam0 to lam1."""
     v0, ok, _ = newton(problem.residual, problem.linear_guess(), lam0, opt, max_iter=config.MODES_START_MAX_ITER)
     if not ok:
         return _backbone(problem, ModeStatus.NO_START, f"Newton did not converge at the smallest amplitude "
-                         f"{lo:.6g} m from linear stuck mode {problem.linear.index}", np.empty(0),
+                         f"{10.0 ** lam0:.6g} m from linear stuck mode {problem.linear.index}", np.empty(0),
                          np.empty((0, problem.size)), {}, {"points": 0}, reduction)
     stash = {}
 
