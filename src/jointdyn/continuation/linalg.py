@@ -298,31 +298,40 @@ class FactorReuse:
         f = self.blocks
         if f is not None and f.size == Jy.shape[0] and not self.stale:
             P = _Corrected.of(f, Jy, Jl, d)
-            x = None if P is None else self._krylov(times, P.solve, b)
+            x = None if P is None else self._krylov(times, P.solve, b, right=True)
             if x is not None:
                 return x
         self.stale = False
         self.blocks = f = self.structure.factor(Jy)
         self.counts["block_factorisations"] += 1
         P = None if f is None else _Corrected.of(f, Jy, Jl, d)
-        return None if P is None else self._krylov(times, P.solve, b, config.CONT_BLOCK_MAXITER)
+        return None if P is None else self._krylov(times, P.solve, b, config.CONT_BLOCK_MAXITER, right=True)
 
-    def _krylov(self, times, precondition, b, k=None):
+    def _krylov(self, times, precondition, b, k=None, right=False):
         """GMRES on ``times`` (the current matrix's product) preconditioned by ``precondition`` (a solve with
         the kept factors), at most ``k`` iterations (default ``config.CONT_KRYLOV_MAXITER``); the solution,
-        or None when not accurate enough."""
+        or None when not accurate enough. ``right``: preconditioned from the right, so that GMRES stops on
+        the true residual (an approximate preconditioner of a nearly singular matrix, as the harmonic
+        blocks at a resonance, has a large inverse: the left-preconditioned residual would stop it while
+        the true one is still far from the tolerance)."""
         import scipy.sparse.linalg as spla
 
-        A = spla.LinearOperator((b.size, b.size), matvec=times, dtype=np.float64)
-        P = spla.LinearOperator((b.size, b.size), matvec=precondition, dtype=np.float64)
         it = [0]
 
         def count(_):
             it[0] += 1
 
         k = config.CONT_KRYLOV_MAXITER if k is None else k
-        x, _ = spla.gmres(A, b, x0=P.matvec(b), M=P, rtol=0.1 * config.CONT_KRYLOV_RTOL, atol=0.0, restart=k,
-                          maxiter=1, callback=count, callback_type="pr_norm")
+        tol = dict(rtol=0.1 * config.CONT_KRYLOV_RTOL, atol=0.0, restart=k, maxiter=1, callback=count,
+                   callback_type="pr_norm")
+        if right:
+            AP = spla.LinearOperator((b.size, b.size), matvec=lambda y: times(precondition(y)), dtype=np.float64)
+            y, _ = spla.gmres(AP, b, x0=b.copy(), **tol)
+            x = precondition(y)
+        else:
+            A = spla.LinearOperator((b.size, b.size), matvec=times, dtype=np.float64)
+            P = spla.LinearOperator((b.size, b.size), matvec=precondition, dtype=np.float64)
+            x, _ = spla.gmres(A, b, x0=P.matvec(b), M=P, **tol)
         self.counts["krylov_iterations"] += it[0]
         nb = np.linalg.norm(b)
         if not np.isfinite(x).all() or np.linalg.norm(times(x) - b) > config.CONT_KRYLOV_RTOL * nb:
