@@ -150,3 +150,29 @@ def test_epmc_backbone_on_a_dense_reduced_model_equals_the_direct_path(monkeypat
         np.testing.assert_allclose(getattr(b, name), getattr(a, name), rtol=1e-8)
     # the damping grew from the modal value by the joint's slip: partial slip was crossed
     assert b.damping_ratio.max() > 2 * b.damping_ratio[0]
+
+
+@pytest.mark.parametrize("scale", [1e-3, 0.5, 5.0])
+def test_block_evaluation_equals_the_dense_one(scale):
+    """The Jacobian kept in its harmonic blocks (HBProblem.evaluate_blocks) against the dense evaluation:
+    residual, Jacobian, parameter derivative and pair outputs, from all stuck to slip and separation."""
+    s = _dense_reduced()
+    q = HBProblem(s, harmonics=3, samples=32)
+    kt, fy = reference_scales(s)
+    rng = np.random.default_rng(int(scale * 100))
+    X = rng.standard_normal(q.size) * scale * fy / kt
+    for p in (0.9, 1.2):
+        a, b = q.evaluate(X, p), q.evaluate_blocks(X, p)
+        for u, v in ((a.R, b.R), (a.JX, b.JX.toarray()), (a.Jp, b.Jp)):
+            assert np.max(np.abs(u - v)) <= 1e-13 * np.max(np.abs(u))
+        np.testing.assert_array_equal(a.pair_code, b.pair_code)
+        np.testing.assert_array_equal(a.pair_T, b.pair_T)
+        J = b.JX.scaled(0.5).with_columns({4: np.arange(q.size, dtype=float)})
+        D = 0.5 * a.JX
+        D[:, 4] = np.arange(q.size)
+        x = rng.standard_normal(q.size)
+        np.testing.assert_allclose(J @ x, D @ x, rtol=1e-12, atol=1e-12 * np.abs(D @ x).max())
+        np.testing.assert_allclose(J.toarray(), D, rtol=0, atol=1e-13 * np.abs(D).max())
+        for j in (0, 4, q.size - 1):
+            np.testing.assert_allclose(J.column(j), D[:, j], rtol=0, atol=1e-13 * np.abs(D).max())
+        np.testing.assert_allclose(J.block(1), D[18:54, 18:54], rtol=0, atol=1e-13 * np.abs(D).max())

@@ -229,8 +229,11 @@ class FactorReuse:
 
         n = Jy.shape[0]
         if self.sparse is None:
-            nnz = Jy.nnz if _is_sparse(Jy) else np.count_nonzero(Jy)
-            self.sparse = nnz <= config.CONT_SPARSE_DENSITY * n * n
+            if _is_structured(Jy):  # its caller chose the blocks for a dense structure
+                self.sparse = False
+            else:
+                nnz = Jy.nnz if _is_sparse(Jy) else np.count_nonzero(Jy)
+                self.sparse = nnz <= config.CONT_SPARSE_DENSITY * n * n
         if self.sparse:
             return self._sparse(Jy, Jl, d, b)
         if self.structure is not None:  # where SuperLU does not apply: a matrix dense in its blocks
@@ -406,7 +409,9 @@ def _unit(m, j):
 
 
 def _column(Jy, j):
-    """Column j of R_y (dense or sparse) as a 1-D array."""
+    """Column j of R_y (dense, sparse or structured) as a 1-D array."""
+    if _is_structured(Jy):
+        return Jy.column(j)
     if _is_sparse(Jy):
         return np.asarray(Jy[:, [j]].toarray()).ravel()
     return np.array(Jy[:, j])
@@ -494,9 +499,15 @@ def _is_sparse(Jy) -> bool:
     return type(Jy) is not np.ndarray and hasattr(Jy, "tocsc")
 
 
+def _is_structured(Jy) -> bool:
+    """True for a Jacobian that is neither an array nor a sparse matrix but its caller's structure (a
+    product ``@``, ``toarray()``, ``column(j)``; harmonic balance's blocks, ``jointdyn.hb._jacobian``)."""
+    return getattr(Jy, "structured", False) is True
+
+
 def _dense(Jy):
-    """R_y as a dense array (a sparse one converted)."""
-    return Jy.toarray() if _is_sparse(Jy) else Jy
+    """R_y as a dense array (a sparse or structured one converted)."""
+    return Jy.toarray() if _is_sparse(Jy) or _is_structured(Jy) else Jy
 
 
 def _newton_direction(Jy, Jl, d, R, v, u_pred):
@@ -511,9 +522,9 @@ def _tangent(Jy, Jl, t_prev):
     """Unit t with [R_y R_lam] t = 0, t_prev^T t = 1 (normalised), or None if singular."""
     f = np.float64
     Jl = np.ascontiguousarray(Jl, dtype=f).reshape(-1)
-    if _is_sparse(Jy) and _small(Jy):
+    if (_is_sparse(Jy) or _is_structured(Jy)) and _small(Jy):
         Jy = _dense(Jy)
-    if not _is_sparse(Jy):
+    if not (_is_sparse(Jy) or _is_structured(Jy)):
         Jy = np.ascontiguousarray(Jy, dtype=f).reshape(Jl.size, -1)
     t_prev = np.ascontiguousarray(t_prev, dtype=f)
     if _small(Jy):
@@ -531,7 +542,7 @@ def _as_arrays(R, Jy, Jl):
     """(R, R_y, R_lam) as C-contiguous float64 arrays of dims 1, 2, 1 (no copy when they are); a
     ``scipy.sparse`` R_y is passed on as it is (:func:`_is_sparse`)."""
     f = np.float64
-    if _is_sparse(Jy):
+    if _is_sparse(Jy) or _is_structured(Jy):
         R = np.ascontiguousarray(R, dtype=f).reshape(-1)
         return R, Jy, np.ascontiguousarray(Jl, dtype=f).reshape(-1)
     if (type(R) is np.ndarray and type(Jy) is np.ndarray and type(Jl) is np.ndarray and R.dtype == f

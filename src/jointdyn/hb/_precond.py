@@ -79,12 +79,16 @@ class HarmonicFactors:
     def of(cls, maker: HarmonicBlocks, J):
         import scipy.linalg as sla
 
-        sparse = type(J) is not np.ndarray and hasattr(J, "tocsr")
+        structured = getattr(J, "structured", False) is True  # jointdyn.hb._jacobian.HarmonicJacobian
+        sparse = not structured and type(J) is not np.ndarray and hasattr(J, "tocsr")
         if sparse:
             J = J.tocsr()
         blocks, factors = [], []
-        for lo, hi in maker.blocks:
-            B = J[lo:hi, lo:hi].toarray() if sparse else np.array(J[lo:hi, lo:hi])
+        for i, (lo, hi) in enumerate(maker.blocks):
+            if structured:
+                B = J.block(i)
+            else:
+                B = J[lo:hi, lo:hi].toarray() if sparse else np.array(J[lo:hi, lo:hi])
             if maker.columns:  # the exact columns are corrected as a whole: keep their in-block part out
                 own = [j - lo for j in maker.columns if lo <= j < hi]
                 B[:, own] = 0.0

@@ -287,20 +287,19 @@ class _Tracker:
         self._amps = {}
         #: the amplitudes of every accepted point (the branch's observable asks for them again)
         self._accepted_amps = {}
-        #: True when the Jacobian stays sparse from the evaluation on (:meth:`HBProblem.evaluate_sparse`):
-        #: interfaces on a sparse structure, from the size where the continuation's solves go large, where
-        #: Hill's method (which needs the dense Jacobians) is beyond its size anyway
-        #: interfaces on a structure dense on its interface (a reduced model) too, where the harmonic blocks
-        #: precondition the solves (:meth:`HBProblem.block_preconditioner`)
-        pat = problem.sparse_pattern() if problem.size >= config.CONT_KRYLOV_SOLVE else None
-        self.sparse = (pat is not None and not problem.hill_affordable()
-                       and (pat.density <= config.CONT_SPARSE_DENSITY or config.HB_BLOCK_PRECONDITIONER))
+        #: how the Jacobian is evaluated (:meth:`HBProblem.large_jacobian`): sparse or by harmonic blocks from
+        #: the size where the continuation's solves go large, where Hill's method (which needs the dense
+        #: Jacobians) is beyond its size anyway
+        self.kind = "dense" if problem.hill_affordable() else problem.large_jacobian()
 
     def residual(self, y, lam_s):
         xs, fs, ps = self.scales
-        if self.sparse:
+        if self.kind == "sparse":
             ev = self.problem.evaluate_sparse(y * xs, lam_s * ps)
             ev.scaled = (ev.R / fs, ev.JX * (xs / fs), ev.Jp * (ps / fs))
+        elif self.kind == "blocks":
+            ev = self.problem.evaluate_blocks(y * xs, lam_s * ps)
+            ev.scaled = (ev.R / fs, ev.JX.scaled(xs / fs), ev.Jp * (ps / fs))
         else:
             ev = self.problem.evaluate(y * xs, lam_s * ps, self.scales)
         self.last = ev

@@ -530,6 +530,80 @@ class HBProblem:
         ev.JX = pat.jacobian(lin_values, G)
         return ev
 
+    def large_jacobian(self) -> str:
+        """How the Jacobian is evaluated from ``config.CONT_KRYLOV_SOLVE`` unknowns: ``"sparse"``
+        (:meth:`evaluate_sparse`: at most ``config.CONT_SPARSE_DENSITY`` of its entries nonzero),
+        ``"blocks"`` (:meth:`evaluate_blocks`: a structure dense on its DOFs, with
+        ``config.HB_BLOCK_PRECONDITIONER``) or ``"dense"`` (:meth:`evaluate`: smaller problems, scalar
+        contacts, condensed problems, a SystemParameter)."""
+        if (self.size < config.CONT_KRYLOV_SOLVE or self.contacts or not self.has_interfaces or self.condensed
+                or isinstance(self.parameter, SystemParameter)):
+            return "dense"
+        sys_ = self.system
+        # an upper bound of the pattern's density without building it (np.unique of millions of keys for a
+        # reduced model, only to find it dense)
+        nd = 3 * self.nh
+        bound = (np.count_nonzero((sys_.K != 0.0) | (sys_.M != 0.0)) * self.nh
+                 + 2 * self.H * np.count_nonzero(sys_.C) + 4 * self.pair_positions.shape[0] * nd * nd)
+        if bound <= 4 * config.CONT_SPARSE_DENSITY * float(self.size) ** 2:
+            if self.sparse_pattern().density <= config.CONT_SPARSE_DENSITY:
+                return "sparse"
+        return "blocks" if config.HB_BLOCK_PRECONDITIONER else "dense"
+
+    def evaluate_blocks(self, X, p) -> _Eval:
+        """:meth:`evaluate_sparse` with dR/dX as a :class:`jointdyn.hb._jacobian.HarmonicJacobian` (N/m): the
+        linear terms as one dense block per harmonic, the pairs' Jacobians as a sparse matrix; for a
+        structure dense on its DOFs (a reduced model), where summing the dense blocks into one sparse
+        matrix at every evaluation costs more than the rest of it. Same conditions and values."""
+        if self.contacts or not self.has_interfaces or self.condensed or isinstance(self.parameter, SystemParameter):
+            raise ValueError("evaluate_blocks: the system must have interfaces and no scalar contacts, and the "
+                             "parameter must not be a SystemParameter")
+        from ._jacobian import HarmonicJacobian
+        from ._precond import harmonic_blocks
+
+        X = np.ascontiguousarray(X, dtype=np.float64)
+        w, dwdp, Fe, Fp, _, _, _ = self._inputs(p)
+        spans = harmonic_blocks(self.n, self.H)
+        K, C, M = (np.asarray(a, dtype=np.float64) for a in (self.system.K, self.system.C, self.system.M))
+        n = self.n
+        R, Jp, blocks = -Fe.copy(), -np.asarray(Fp, dtype=np.float64).copy(), []
+        for k, (lo, hi) in enumerate(spans):
+            B = np.empty((hi - lo, hi - lo))
+            if k == 0:
+                B[:] = K
+            else:
+                np.multiply(M, -(k * w) ** 2, out=B[:n, :n])
+                B[:n, :n] += K
+                B[n:, n:] = B[:n, :n]
+                np.multiply(C, k * w, out=B[:n, n:])
+                np.negative(B[:n, n:], out=B[n:, :n])
+                if dwdp != 0.0:  # d(block)/dw X: -2 k^2 w M on the diagonal, +-k C off it
+                    MX, CX = M @ X[lo:hi].reshape(2, n).T, C @ X[lo:hi].reshape(2, n).T
+                    Jp[lo:lo + n] += dwdp * (-2.0 * k * k * w * MX[:, 0] + k * CX[:, 1])
+                    Jp[lo + n:hi] += dwdp * (-2.0 * k * k * w * MX[:, 1] - k * CX[:, 0])
+            R[lo:hi] += B @ X[lo:hi]
+            blocks.append(B)
+        npairs, ns, nd = self.pair_params.shape[0], self.Ns, 3 * self.nh
+        G = np.empty((npairs, nd, nd))
+        info = np.array([0.0, 0.0, PERIOD_ONE])
+        ev = _Eval(R, None, Jp, np.empty((0, ns)), np.empty((0, ns), dtype=np.int64), info, None, np.empty((0, ns)))
+        ev.pair_T, ev.pair_N = np.empty((npairs, ns, 2)), np.empty((npairs, ns))
+        ev.pair_code = np.empty((npairs, ns), dtype=np.int8)
+        pairs_aft_kernel()(self.pair_positions, self.pair_params, X, self.n, self.E, self.P, *self._pair_dirs,
+                           int(self.max_passes), float(config.HB_PERIODIC_RTOL), ev.R, self._dummy, G,
+                           ev.pair_T, ev.pair_N, ev.pair_code, ev.info)
+        ev.JX = HarmonicJacobian(spans, blocks, self._pairs_pattern().jacobian(np.empty(0), G))
+        return ev
+
+    def _pairs_pattern(self):
+        """The CSR pattern of the pairs' part of dR/dX alone (built once)."""
+        if getattr(self, "_pair_pattern", None) is None:
+            from ._sparse import SparsePattern
+
+            Z = np.zeros((self.n, self.n))
+            self._pair_pattern = SparsePattern((Z, Z, Z), self.H, self.pair_positions)
+        return self._pair_pattern
+
     def problem_at(self, p: float):
         """The harmonic-balance problem of the System that this problem's
         :class:`~jointdyn.hb.parameters.SystemParameter` builds at p, at this problem's fixed frequency
