@@ -118,6 +118,7 @@ def test_hb_branch_on_a_dense_reduced_model_equals_the_direct_path(monkeypatch):
         _large(monkeypatch, on)
         out[on] = continue_hb(s, 0.8, 1.25, **kw)
     a, b = out[False], out[True]
+    assert HBProblem(s, harmonics=3, samples=32).large_jacobian() == "blocks"  # (the flag is on here)
     assert a.status.ok and b.status.ok
     # the whole bordered matrix factorised only where fresh blocks did not reach the tolerance
     assert b.counters["block_factorisations"] > 0 and b.counters["factorisations"] < a.counters["factorisations"] / 4

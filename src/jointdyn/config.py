@@ -215,6 +215,12 @@ CONT_SPARSE_PIVOTS = (0.0, 0.1)
 #: at the current matrix, runs this many iterations at most before the
 #: bordered matrix is factorised whole (the direct path, kept as the fallback)
 CONT_BLOCK_MAXITER = 40
+#: the structured factors kept from an earlier matrix are made anew at the next
+#: solve after a solve that needed more than this many GMRES iterations with
+#: them: fresh ones need some iterations too (10-14 on the lap joint at H = 3
+#: with its pairs slipping), and one set of fresh factors (H + 1 LUs) costs
+#: about as much as 25 iterations there
+CONT_BLOCK_REFRESH = 25
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history

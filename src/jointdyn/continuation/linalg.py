@@ -299,16 +299,22 @@ class FactorReuse:
             return _bordered_times(Jy, Jl, d, x)
 
         f = self.blocks
+        k = config.CONT_BLOCK_MAXITER
         if f is not None and f.size == Jy.shape[0] and not self.stale:
             P = _Corrected.of(f, Jy, Jl, d)
-            x = None if P is None else self._krylov(times, P.solve, b, right=True)
+            before = self.counts["krylov_iterations"]
+            x = None if P is None else self._krylov(times, P.solve, b, k, right=True)
+            # fresh blocks need some iterations too (the harmonics' coupling): the kept ones are dropped only
+            # when they need many more (a fresh factorisation costs about as much as CONT_BLOCK_REFRESH iterations)
+            self.stale = self.counts["krylov_iterations"] - before > config.CONT_BLOCK_REFRESH
             if x is not None:
                 return x
-        self.stale = False
         self.blocks = f = self.structure.factor(Jy)
         self.counts["block_factorisations"] += 1
         P = None if f is None else _Corrected.of(f, Jy, Jl, d)
-        return None if P is None else self._krylov(times, P.solve, b, config.CONT_BLOCK_MAXITER, right=True)
+        x = None if P is None else self._krylov(times, P.solve, b, k, right=True)
+        self.stale = False
+        return x
 
     def _krylov(self, times, precondition, b, k=None, right=False):
         """GMRES on ``times`` (the current matrix's product) preconditioned by ``precondition`` (a solve with
