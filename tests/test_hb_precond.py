@@ -177,3 +177,12 @@ def test_block_evaluation_equals_the_dense_one(scale):
         for j in (0, 4, q.size - 1):
             np.testing.assert_allclose(J.column(j), D[:, j], rtol=0, atol=1e-13 * np.abs(D).max())
         np.testing.assert_allclose(J.block(1), D[18:54, 18:54], rtol=0, atol=1e-13 * np.abs(D).max())
+
+
+def test_linear_guess_by_harmonic_blocks_equals_the_whole_solve(monkeypatch):
+    s = _dense_reduced()
+    q = HBProblem(s, harmonics=3, samples=32)
+    a = q.linear_guess(1.1)
+    monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
+    b = q.linear_guess(1.1)
+    np.testing.assert_allclose(b, a, rtol=0, atol=1e-12 * np.abs(a).max())

@@ -385,14 +385,32 @@ class HBProblem:
         """
         q = self.problem_at(p) if isinstance(self.parameter, SystemParameter) else self
         w = self.omega(p)
-        A = q.linear_matrix(w)
         Kc = q.pair_stiffness(stuck) if q.has_interfaces else np.zeros((q.n, q.n))
         if stuck:
             for c, b, bn, kn in zip(q.contacts, q.B, q.Bn, q._Sp[:, 1]):
                 Kc += c.law.kt * np.outer(b, b) + kn * np.outer(bn, bn)
+        F = q.forcing(q.parameter.forcing(q, p)[0], w)
+        if type(q).linear_matrix is HBProblem.linear_matrix and q.size >= config.CONT_KRYLOV_SOLVE:
+            # block-diagonal over the harmonics: one solve per harmonic, no (2H+1) n square matrix
+            return self._linear_guess_blocks(w, Kc, F)
+        A = q.linear_matrix(w)
         for h in range(q.nh):
             A[h * q.n:(h + 1) * q.n, h * q.n:(h + 1) * q.n] += Kc
-        return np.linalg.solve(A, q.forcing(q.parameter.forcing(q, p)[0], w))
+        return np.linalg.solve(A, F)
+
+    def _linear_guess_blocks(self, w, Kc, F):
+        """The solution of (A(w) + blockdiag(Kc)) X = F by one solve per harmonic block."""
+        from ._precond import harmonic_blocks
+
+        K, C, M = (np.asarray(a, dtype=np.float64) for a in (self.system.K, self.system.C, self.system.M))
+        n, X = self.n, np.empty(self.size)
+        for k, (lo, hi) in enumerate(harmonic_blocks(n, self.H)):
+            if k == 0:
+                X[lo:hi] = np.linalg.solve(K + Kc, F[lo:hi])
+                continue
+            D = K + Kc - (k * w) ** 2 * M
+            X[lo:hi] = np.linalg.solve(np.block([[D, (k * w) * C], [-(k * w) * C, D]]), F[lo:hi])
+        return X
 
     def pair_stiffness(self, stuck: bool = True) -> np.ndarray:
         """Stiffness (n, n) N/m of the interfaces' pairs on the unknown DOFs: every pair closed at rest
