@@ -213,8 +213,13 @@ CONT_SPARSE_PIVOTS = (0.0, 0.1)
 #: preconditioner (harmonic balance: the blocks of its harmonics,
 #: jointdyn.hb._precond), GMRES with the factors of that preconditioner, made
 #: at the current matrix, runs this many iterations at most before the
-#: bordered matrix is factorised whole (the direct path, kept as the fallback)
-CONT_BLOCK_MAXITER = 40
+#: bordered matrix is factorised whole (the direct path, kept as the fallback).
+#: On the lap joint at H = 3 (5131 unknowns) the pairs' slip couples the
+#: harmonics more as the amplitude grows (22 iterations at 0.4 mm, 36 at the
+#: tenth point after it) and a bound of 40 fell back to the whole LU 9 times
+#: along the backbone; one iteration costs about 1/25 of the H + 1 block LUs,
+#: and the whole LU about 14 times those, so 100 iterations still cost less
+CONT_BLOCK_MAXITER = 100
 #: the structured factors kept from an earlier matrix are made anew at the next
 #: solve after a solve that needed more than this many GMRES iterations with
 #: them: fresh ones need some iterations too (10-14 on the lap joint at H = 3
