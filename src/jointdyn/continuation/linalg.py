@@ -26,10 +26,11 @@ stops on its own residual.
 
 Where the caller knows the structure of its Jacobian (harmonic balance: the
 linear terms couple one harmonic only; :func:`preconditioned_by`), the
-kept factors are those of that structured preconditioner instead, made at
-the current matrix whenever the kept ones fail (GMRES up to
-``config.CONT_BLOCK_MAXITER`` iterations with fresh ones), and the whole
-bordered matrix is factorised only when even fresh ones fail. The
+kept factors are those of that structured preconditioner instead (GMRES
+up to ``config.CONT_BLOCK_MAXITER`` iterations, made anew after a solve
+that needed more than ``config.CONT_BLOCK_REFRESH``), made at the current
+matrix whenever the kept ones fail, and the whole bordered matrix is
+factorised only when even fresh ones fail. The
 preconditioner's exact columns (``columns``: dense columns of the unknowns it
 does not describe, e.g. EPMC's frequency and damping) and the border row and
 column of the continuation enter it exactly by a low-rank (Woodbury)
