@@ -215,6 +215,23 @@ CONT_SPARSE_FILL = 0.25
 #: 0.1 fill 0.25 in 0.68 s, 0.01 fill 0.20 in 0.58 s, all with residuals of
 #: 1e-11; at a lower amplitude 0.1 gave fill 0.010 where 1 gave 0.083
 CONT_SPARSE_PIVOTS = (0.0, 0.1)
+#: from CONT_KRYLOV_SOLVE unknowns, where the problem offers a structured
+#: preconditioner (harmonic balance: the blocks of its harmonics,
+#: jointdyn.hb._precond), GMRES with the factors of that preconditioner, made
+#: at the current matrix, runs this many iterations at most before the
+#: bordered matrix is factorised whole (the direct path, kept as the fallback).
+#: On the lap joint at H = 3 (5131 unknowns) the pairs' slip couples the
+#: harmonics more as the amplitude grows (22 iterations at 0.4 mm, 36 at the
+#: tenth point after it) and a bound of 40 fell back to the whole LU 9 times
+#: along the backbone; one iteration costs about 1/25 of the H + 1 block LUs,
+#: and the whole LU about 14 times those, so 100 iterations still cost less
+CONT_BLOCK_MAXITER = 100
+#: the structured factors kept from an earlier matrix are made anew at the next
+#: solve after a solve that needed more than this many GMRES iterations with
+#: them: fresh ones need some iterations too (10-14 on the lap joint at H = 3
+#: with its pairs slipping), and one set of fresh factors (H + 1 LUs) costs
+#: about as much as 25 iterations there
+CONT_BLOCK_REFRESH = 25
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history
@@ -475,6 +492,13 @@ HB_CONDENSED_HILL_ROWS = 200
 #: rows on 2 cores): stability is not computed (growth NaN, the Dataset's
 #: ``stability`` attribute says so)
 HB_HILL_MAX_ROWS = 4000
+#: from config.CONT_KRYLOV_SOLVE unknowns, the Newton and tangent solves of HB
+#: branches and EPMC backbones are GMRES preconditioned by per-harmonic
+#: factorisations of the Jacobian's diagonal harmonic blocks
+#: (jointdyn.hb._precond); False: the direct path (one LU of the whole
+#: bordered matrix, reused through GMRES), kept as the reference of
+#: benchmarks/bench_hb_scale.py
+HB_BLOCK_PRECONDITIONER = True
 #: bytes of dense Jacobians a branch keeps at once: the continuation monitor
 #: keeps the evaluations of accepted points with their Jacobians while they fit
 #: (beyond, without: the point is evaluated again for its stability), and

@@ -66,6 +66,7 @@ their refinement on a computed branch); :mod:`~jointdyn.continuation.progress`
 holds a progress bar over the parameter's range.
 """
 
+from .linalg import preconditioned_by
 from .newton import newton
 from .options import ContinuationOptions, ContinuationResult, ContinuationStatus, make_options
 from .post import local_maxima, refine_maximum, turning_points
@@ -73,4 +74,4 @@ from .progress import ParameterProgress
 from .walk import continuation
 
 __all__ = ["ContinuationOptions", "ContinuationStatus", "ContinuationResult", "continuation", "newton",
-           "turning_points", "make_options", "local_maxima", "refine_maximum", "ParameterProgress"]
+           "preconditioned_by", "turning_points", "make_options", "local_maxima", "refine_maximum", "ParameterProgress"]

@@ -23,6 +23,18 @@ K, M and C: each pair couples only its own DOFs; R_y may come as a
 reused in the same way, while they stay sparse. The preconditioner changes
 the work, not the answer beyond that tolerance: the Newton corrector still
 stops on its own residual.
+
+Where the caller knows the structure of its Jacobian (harmonic balance: the
+linear terms couple one harmonic only; :func:`preconditioned_by`), the
+kept factors are those of that structured preconditioner instead (GMRES
+up to ``config.CONT_BLOCK_MAXITER`` iterations, made anew after a solve
+that needed more than ``config.CONT_BLOCK_REFRESH``), made at the current
+matrix whenever the kept ones fail, and the whole bordered matrix is
+factorised only when even fresh ones fail. The
+preconditioner's exact columns (``columns``: dense columns of the unknowns it
+does not describe, e.g. EPMC's frequency and damping) and the border row and
+column of the continuation enter it exactly by a low-rank (Woodbury)
+correction (:class:`_Corrected`).
 """
 
 from __future__ import annotations
@@ -36,7 +48,7 @@ import numpy as np
 from .. import config
 from .._jit import jit
 
-__all__ = ["FactorReuse", "lu_solve", "reusing_factors"]
+__all__ = ["FactorReuse", "lu_solve", "preconditioned_by", "reusing_factors"]
 
 
 @jit
@@ -200,12 +212,17 @@ class FactorReuse:
     and sparse), the solves accepted from GMRES and its iterations.
     """
 
-    def __init__(self):
+    def __init__(self, structure=None):
+        #: maker of a structured preconditioner (:func:`preconditioned_by`), or None
+        self.structure = structure
+        self.blocks = None  # its kept factors
         self.lu = None
         self.splu = None  # the kept sparse factors (scipy.sparse.linalg.SuperLU)
         self.stale = False
         self.sparse = None  # decided at the first factorisation of the walk
         self.counts = {"factorisations": 0, "krylov_solves": 0, "krylov_iterations": 0, "sparse_factorisations": 0}
+        if structure is not None:
+            self.counts.update(block_factorisations=0, block_fallbacks=0)
 
     def solve(self, Jy, Jl, d, b):
         """``(x, ok)``: the solution of the bordered system (R_y alone when ``d`` is empty)."""
@@ -213,10 +230,18 @@ class FactorReuse:
 
         n = Jy.shape[0]
         if self.sparse is None:
-            nnz = Jy.nnz if _is_sparse(Jy) else np.count_nonzero(Jy)
-            self.sparse = nnz <= config.CONT_SPARSE_DENSITY * n * n
+            if _is_structured(Jy):  # its caller chose the blocks for a dense structure
+                self.sparse = False
+            else:
+                nnz = Jy.nnz if _is_sparse(Jy) else np.count_nonzero(Jy)
+                self.sparse = nnz <= config.CONT_SPARSE_DENSITY * n * n
         if self.sparse:
             return self._sparse(Jy, Jl, d, b)
+        if self.structure is not None:  # where SuperLU does not apply: a matrix dense in its blocks
+            x = self._structured(Jy, Jl, d, b)
+            if x is not None:
+                return x, True
+            self.counts["block_fallbacks"] += 1
         Jy = _dense(Jy)  # a sparse R_y whose factors filled in: dense from then on
         if self.lu is not None and self.lu[0].shape[0] == b.size and not self.stale:
             lu = self.lu
@@ -268,21 +293,55 @@ class FactorReuse:
             self.sparse, self.splu = False, None
         return x, bool(np.isfinite(x).all())
 
-    def _krylov(self, times, precondition, b):
+    def _structured(self, Jy, Jl, d, b):
+        """x by GMRES preconditioned with the structured factors (the kept ones, else fresh ones of this
+        matrix), or None when even fresh ones do not reach the tolerance (the caller solves directly)."""
+        def times(x):
+            return _bordered_times(Jy, Jl, d, x)
+
+        f = self.blocks
+        k = config.CONT_BLOCK_MAXITER
+        if f is not None and f.size == Jy.shape[0] and not self.stale:
+            P = _Corrected.of(f, Jy, Jl, d)
+            before = self.counts["krylov_iterations"]
+            x = None if P is None else self._krylov(times, P.solve, b, k, right=True)
+            # fresh blocks need some iterations too (the harmonics' coupling): the kept ones are dropped only
+            # when they need many more (a fresh factorisation costs about as much as CONT_BLOCK_REFRESH iterations)
+            self.stale = self.counts["krylov_iterations"] - before > config.CONT_BLOCK_REFRESH
+            if x is not None:
+                return x
+        self.blocks = f = self.structure.factor(Jy)
+        self.counts["block_factorisations"] += 1
+        P = None if f is None else _Corrected.of(f, Jy, Jl, d)
+        x = None if P is None else self._krylov(times, P.solve, b, k, right=True)
+        self.stale = False
+        return x
+
+    def _krylov(self, times, precondition, b, k=None, right=False):
         """GMRES on ``times`` (the current matrix's product) preconditioned by ``precondition`` (a solve with
-        the kept factors); the solution, or None when not accurate enough."""
+        the kept factors), at most ``k`` iterations (default ``config.CONT_KRYLOV_MAXITER``); the solution,
+        or None when not accurate enough. ``right``: preconditioned from the right, so that GMRES stops on
+        the true residual (an approximate preconditioner of a nearly singular matrix, as the harmonic
+        blocks at a resonance, has a large inverse: the left-preconditioned residual would stop it while
+        the true one is still far from the tolerance)."""
         import scipy.sparse.linalg as spla
 
-        A = spla.LinearOperator((b.size, b.size), matvec=times, dtype=np.float64)
-        P = spla.LinearOperator((b.size, b.size), matvec=precondition, dtype=np.float64)
         it = [0]
 
         def count(_):
             it[0] += 1
 
-        k = config.CONT_KRYLOV_MAXITER
-        x, _ = spla.gmres(A, b, x0=P.matvec(b), M=P, rtol=0.1 * config.CONT_KRYLOV_RTOL, atol=0.0, restart=k,
-                          maxiter=1, callback=count, callback_type="pr_norm")
+        k = config.CONT_KRYLOV_MAXITER if k is None else k
+        tol = dict(rtol=0.1 * config.CONT_KRYLOV_RTOL, atol=0.0, restart=k, maxiter=1, callback=count,
+                   callback_type="pr_norm")
+        if right:
+            AP = spla.LinearOperator((b.size, b.size), matvec=lambda y: times(precondition(y)), dtype=np.float64)
+            y, _ = spla.gmres(AP, b, x0=b.copy(), **tol)
+            x = precondition(y)
+        else:
+            A = spla.LinearOperator((b.size, b.size), matvec=times, dtype=np.float64)
+            P = spla.LinearOperator((b.size, b.size), matvec=precondition, dtype=np.float64)
+            x, _ = spla.gmres(A, b, x0=P.matvec(b), M=P, **tol)
         self.counts["krylov_iterations"] += it[0]
         nb = np.linalg.norm(b)
         if not np.isfinite(x).all() or np.linalg.norm(times(x) - b) > config.CONT_KRYLOV_RTOL * nb:
@@ -292,6 +351,77 @@ class FactorReuse:
         # spending GMRES iterations on a preconditioner that is likely to fail
         self.stale = it[0] > config.CONT_KRYLOV_REFRESH
         return x
+
+
+class _Corrected:
+    """Solves with the bordered matrix of :func:`_bordered` in which R_y is replaced by a structured
+    approximation ``f`` (its factors: ``f.solve``, ``f.column``), except on the columns ``f.columns``,
+    which are R_y's own, and on the border (exact): ``P = D + W Z^T`` with D = diag(f, 1) and a correction
+    of rank ``len(f.columns)`` (+ 2 with a border), solved by the Woodbury identity (r + 1 solves with f
+    to set it up, one per application)."""
+
+    def __init__(self, f, W, Z):
+        self.f, self.Z = f, Z
+        self.n = f.size
+        self.Y = self._base(W)
+        cap = np.eye(Z.shape[1]) + Z.T @ self.Y
+        self.cap = np.linalg.inv(cap)  # r x r, r <= 4
+
+    @classmethod
+    def of(cls, f, Jy, Jl, d):
+        """The corrected preconditioner, or None where its small capacitance matrix is singular."""
+        n = Jy.shape[0]
+        m = n + (1 if d.shape[0] else 0)
+        cols = [int(j) for j in f.columns]
+        Ws, Zs = [], []
+        for j in cols:
+            c = np.zeros(m)
+            c[:n] = _column(Jy, j) - f.column(j)
+            if m > n:
+                c[n] = d[j]
+            Ws.append(c)
+            Zs.append(_unit(m, j))
+        if m > n:
+            Ws.append(np.append(Jl, d[n] - 1.0))
+            Zs.append(_unit(m, n))
+            row = np.array(d, dtype=np.float64)
+            row[cols] = 0.0
+            row[n] = 0.0
+            Ws.append(_unit(m, n))
+            Zs.append(row)
+        if not Ws:
+            return cls(f, np.zeros((m, 0)), np.zeros((m, 0)))
+        try:
+            return cls(f, np.stack(Ws, axis=1), np.stack(Zs, axis=1))
+        except np.linalg.LinAlgError:
+            return None
+
+    def _base(self, r):
+        """D^-1 r (one vector or columns)."""
+        out = np.array(r, dtype=np.float64)
+        out[:self.n] = self.f.solve(out[:self.n])
+        return out
+
+    def solve(self, r):
+        y = self._base(r)
+        if self.Z.shape[1]:
+            y -= self.Y @ (self.cap @ (self.Z.T @ y))
+        return y
+
+
+def _unit(m, j):
+    e = np.zeros(m)
+    e[j] = 1.0
+    return e
+
+
+def _column(Jy, j):
+    """Column j of R_y (dense, sparse or structured) as a 1-D array."""
+    if _is_structured(Jy):
+        return Jy.column(j)
+    if _is_sparse(Jy):
+        return np.asarray(Jy[:, [j]].toarray()).ravel()
+    return np.array(Jy[:, j])
 
 
 def _bordered_times(Jy, Jl, d, x):
@@ -323,6 +453,25 @@ def _sparse_bordered(Jy, Jl, d):
 
 
 _REUSE: contextvars.ContextVar[FactorReuse | None] = contextvars.ContextVar("jointdyn_factor_reuse", default=None)
+_STRUCTURE = contextvars.ContextVar("jointdyn_structured_preconditioner", default=None)
+
+
+@contextlib.contextmanager
+def preconditioned_by(structure):
+    """Within the block, the large solves of new walks (:func:`reusing_factors`) are preconditioned by
+    ``structure`` (None: the direct path).
+
+    ``structure.factor(R_y)`` returns factors of an approximation of R_y
+    (or None where one is singular) with ``size`` (rows of R_y),
+    ``solve(r)`` (one vector or columns), ``column(j)`` (column j of the
+    approximation) and ``columns`` (the columns of R_y that it does not
+    describe: they are taken from R_y exactly, :class:`_Corrected`).
+    """
+    token = _STRUCTURE.set(structure)
+    try:
+        yield
+    finally:
+        _STRUCTURE.reset(token)
 
 
 @contextlib.contextmanager
@@ -335,7 +484,7 @@ def reusing_factors():
     if outer is not None:
         yield outer
         return
-    fr = FactorReuse()
+    fr = FactorReuse(_STRUCTURE.get())
     token = _REUSE.set(fr)
     try:
         yield fr
@@ -357,9 +506,15 @@ def _is_sparse(Jy) -> bool:
     return type(Jy) is not np.ndarray and hasattr(Jy, "tocsc")
 
 
+def _is_structured(Jy) -> bool:
+    """True for a Jacobian that is neither an array nor a sparse matrix but its caller's structure (a
+    product ``@``, ``toarray()``, ``column(j)``; harmonic balance's blocks, ``jointdyn.hb._jacobian``)."""
+    return getattr(Jy, "structured", False) is True
+
+
 def _dense(Jy):
-    """R_y as a dense array (a sparse one converted)."""
-    return Jy.toarray() if _is_sparse(Jy) else Jy
+    """R_y as a dense array (a sparse or structured one converted)."""
+    return Jy.toarray() if _is_sparse(Jy) or _is_structured(Jy) else Jy
 
 
 def _newton_direction(Jy, Jl, d, R, v, u_pred):
@@ -374,9 +529,9 @@ def _tangent(Jy, Jl, t_prev):
     """Unit t with [R_y R_lam] t = 0, t_prev^T t = 1 (normalised), or None if singular."""
     f = np.float64
     Jl = np.ascontiguousarray(Jl, dtype=f).reshape(-1)
-    if _is_sparse(Jy) and _small(Jy):
+    if (_is_sparse(Jy) or _is_structured(Jy)) and _small(Jy):
         Jy = _dense(Jy)
-    if not _is_sparse(Jy):
+    if not (_is_sparse(Jy) or _is_structured(Jy)):
         Jy = np.ascontiguousarray(Jy, dtype=f).reshape(Jl.size, -1)
     t_prev = np.ascontiguousarray(t_prev, dtype=f)
     if _small(Jy):
@@ -394,7 +549,7 @@ def _as_arrays(R, Jy, Jl):
     """(R, R_y, R_lam) as C-contiguous float64 arrays of dims 1, 2, 1 (no copy when they are); a
     ``scipy.sparse`` R_y is passed on as it is (:func:`_is_sparse`)."""
     f = np.float64
-    if _is_sparse(Jy):
+    if _is_sparse(Jy) or _is_structured(Jy):
         R = np.ascontiguousarray(R, dtype=f).reshape(-1)
         return R, Jy, np.ascontiguousarray(Jl, dtype=f).reshape(-1)
     if (type(R) is np.ndarray and type(Jy) is np.ndarray and type(Jl) is np.ndarray and R.dtype == f

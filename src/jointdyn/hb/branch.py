@@ -62,6 +62,7 @@ from ..continuation import (
     local_maxima,
     make_options,
     newton,
+    preconditioned_by,
     refine_maximum,
     turning_points,
 )
@@ -287,18 +288,19 @@ class _Tracker:
         self._amps = {}
         #: the amplitudes of every accepted point (the branch's observable asks for them again)
         self._accepted_amps = {}
-        #: True when the Jacobian stays sparse from the evaluation on (:meth:`HBProblem.evaluate_sparse`):
-        #: interfaces on a sparse structure, from the size where the continuation's solves go large, where
-        #: Hill's method (which needs the dense Jacobians) is beyond its size anyway
-        pat = problem.sparse_pattern() if problem.size >= config.CONT_KRYLOV_SOLVE else None
-        self.sparse = (pat is not None and pat.density <= config.CONT_SPARSE_DENSITY
-                       and not problem.hill_affordable())
+        #: how the Jacobian is evaluated (:meth:`HBProblem.large_jacobian`): sparse or by harmonic blocks from
+        #: the size where the continuation's solves go large, where Hill's method (which needs the dense
+        #: Jacobians) is beyond its size anyway
+        self.kind = "dense" if problem.hill_affordable() else problem.large_jacobian()
 
     def residual(self, y, lam_s):
         xs, fs, ps = self.scales
-        if self.sparse:
+        if self.kind == "sparse":
             ev = self.problem.evaluate_sparse(y * xs, lam_s * ps)
             ev.scaled = (ev.R / fs, ev.JX * (xs / fs), ev.Jp * (ps / fs))
+        elif self.kind == "blocks":
+            ev = self.problem.evaluate_blocks(y * xs, lam_s * ps)
+            ev.scaled = (ev.R / fs, ev.JX.scaled(xs / fs), ev.Jp * (ps / fs))
         else:
             ev = self.problem.evaluate(y * xs, lam_s * ps, self.scales)
         self.last = ev
@@ -505,6 +507,12 @@ def continued_branch(req: _Request, level: Level, watch_for=None):
     (:class:`jointdyn.hb.discretisation._PeakWatch`)."""
     problem = make_problem(req.system, condense=req.condense, response_dofs=(req.dof,), harmonics=level.harmonics,
                            samples=level.samples, parameter=req.parameter, gamma=req.gamma)
+    with preconditioned_by(problem.block_preconditioner()):
+        return _continued(req, problem, watch_for)
+
+
+def _continued(req: _Request, problem: HBProblem, watch_for):
+    """:func:`continued_branch` of its problem."""
     tr = _Tracker(problem, _scales(problem, req.start), req.dof)
     opt = req.options
     if req.max_step is not None:

@@ -385,14 +385,32 @@ class HBProblem:
         """
         q = self.problem_at(p) if isinstance(self.parameter, SystemParameter) else self
         w = self.omega(p)
-        A = q.linear_matrix(w)
         Kc = q.pair_stiffness(stuck) if q.has_interfaces else np.zeros((q.n, q.n))
         if stuck:
             for c, b, bn, kn in zip(q.contacts, q.B, q.Bn, q._Sp[:, 1]):
                 Kc += c.law.kt * np.outer(b, b) + kn * np.outer(bn, bn)
+        F = q.forcing(q.parameter.forcing(q, p)[0], w)
+        if type(q).linear_matrix is HBProblem.linear_matrix and q.size >= config.CONT_KRYLOV_SOLVE:
+            # block-diagonal over the harmonics: one solve per harmonic, no (2H+1) n square matrix
+            return self._linear_guess_blocks(w, Kc, F)
+        A = q.linear_matrix(w)
         for h in range(q.nh):
             A[h * q.n:(h + 1) * q.n, h * q.n:(h + 1) * q.n] += Kc
-        return np.linalg.solve(A, q.forcing(q.parameter.forcing(q, p)[0], w))
+        return np.linalg.solve(A, F)
+
+    def _linear_guess_blocks(self, w, Kc, F):
+        """The solution of (A(w) + blockdiag(Kc)) X = F by one solve per harmonic block."""
+        from ._precond import harmonic_blocks
+
+        K, C, M = (np.asarray(a, dtype=np.float64) for a in (self.system.K, self.system.C, self.system.M))
+        n, X = self.n, np.empty(self.size)
+        for k, (lo, hi) in enumerate(harmonic_blocks(n, self.H)):
+            if k == 0:
+                X[lo:hi] = np.linalg.solve(K + Kc, F[lo:hi])
+                continue
+            D = K + Kc - (k * w) ** 2 * M
+            X[lo:hi] = np.linalg.solve(np.block([[D, (k * w) * C], [-(k * w) * C, D]]), F[lo:hi])
+        return X
 
     def pair_stiffness(self, stuck: bool = True) -> np.ndarray:
         """Stiffness (n, n) N/m of the interfaces' pairs on the unknown DOFs: every pair closed at rest
@@ -479,6 +497,17 @@ class HBProblem:
             np.divide(ev.R, scl[0], out=scaled[1])
             np.multiply(ev.JX, scl[1], out=scaled[2])
 
+    def block_preconditioner(self, columns=()):
+        """The structured preconditioner of this problem's large solves (one factorisation per harmonic,
+        :class:`jointdyn.hb._precond.HarmonicBlocks`; ``columns``: those of the Jacobian it takes exactly),
+        or None where ``config.HB_BLOCK_PRECONDITIONER`` is off or the problem is below
+        ``config.CONT_KRYLOV_SOLVE`` unknowns (its solves are direct)."""
+        if not config.HB_BLOCK_PRECONDITIONER or self.size + 1 < config.CONT_KRYLOV_SOLVE:
+            return None
+        from ._precond import HarmonicBlocks
+
+        return HarmonicBlocks(self.n, self.H, columns)
+
     # --- sparse Jacobian ------------------------------------------------------
     def sparse_pattern(self):
         """The CSR pattern of dR/dX (:class:`jointdyn.hb._sparse.SparsePattern`; built once), or None
@@ -518,6 +547,80 @@ class HBProblem:
                            ev.pair_T, ev.pair_N, ev.pair_code, ev.info)
         ev.JX = pat.jacobian(lin_values, G)
         return ev
+
+    def large_jacobian(self) -> str:
+        """How the Jacobian is evaluated from ``config.CONT_KRYLOV_SOLVE`` unknowns: ``"sparse"``
+        (:meth:`evaluate_sparse`: at most ``config.CONT_SPARSE_DENSITY`` of its entries nonzero),
+        ``"blocks"`` (:meth:`evaluate_blocks`: a structure dense on its DOFs, with
+        ``config.HB_BLOCK_PRECONDITIONER``) or ``"dense"`` (:meth:`evaluate`: smaller problems, scalar
+        contacts, condensed problems, a SystemParameter)."""
+        if (self.size < config.CONT_KRYLOV_SOLVE or self.contacts or not self.has_interfaces or self.condensed
+                or isinstance(self.parameter, SystemParameter)):
+            return "dense"
+        sys_ = self.system
+        # an upper bound of the pattern's density without building it (np.unique of millions of keys for a
+        # reduced model, only to find it dense)
+        nd = 3 * self.nh
+        bound = (np.count_nonzero((sys_.K != 0.0) | (sys_.M != 0.0)) * self.nh
+                 + 2 * self.H * np.count_nonzero(sys_.C) + 4 * self.pair_positions.shape[0] * nd * nd)
+        if bound <= 4 * config.CONT_SPARSE_DENSITY * float(self.size) ** 2:
+            if self.sparse_pattern().density <= config.CONT_SPARSE_DENSITY:
+                return "sparse"
+        return "blocks" if config.HB_BLOCK_PRECONDITIONER else "dense"
+
+    def evaluate_blocks(self, X, p) -> _Eval:
+        """:meth:`evaluate_sparse` with dR/dX as a :class:`jointdyn.hb._jacobian.HarmonicJacobian` (N/m): the
+        linear terms as one dense block per harmonic, the pairs' Jacobians as a sparse matrix; for a
+        structure dense on its DOFs (a reduced model), where summing the dense blocks into one sparse
+        matrix at every evaluation costs more than the rest of it. Same conditions and values."""
+        if self.contacts or not self.has_interfaces or self.condensed or isinstance(self.parameter, SystemParameter):
+            raise ValueError("evaluate_blocks: the system must have interfaces and no scalar contacts, and the "
+                             "parameter must not be a SystemParameter")
+        from ._jacobian import HarmonicJacobian
+        from ._precond import harmonic_blocks
+
+        X = np.ascontiguousarray(X, dtype=np.float64)
+        w, dwdp, Fe, Fp, _, _, _ = self._inputs(p)
+        spans = harmonic_blocks(self.n, self.H)
+        K, C, M = (np.asarray(a, dtype=np.float64) for a in (self.system.K, self.system.C, self.system.M))
+        n = self.n
+        R, Jp, blocks = -Fe.copy(), -np.asarray(Fp, dtype=np.float64).copy(), []
+        for k, (lo, hi) in enumerate(spans):
+            B = np.empty((hi - lo, hi - lo))
+            if k == 0:
+                B[:] = K
+            else:
+                np.multiply(M, -(k * w) ** 2, out=B[:n, :n])
+                B[:n, :n] += K
+                B[n:, n:] = B[:n, :n]
+                np.multiply(C, k * w, out=B[:n, n:])
+                np.negative(B[:n, n:], out=B[n:, :n])
+                if dwdp != 0.0:  # d(block)/dw X: -2 k^2 w M on the diagonal, +-k C off it
+                    MX, CX = M @ X[lo:hi].reshape(2, n).T, C @ X[lo:hi].reshape(2, n).T
+                    Jp[lo:lo + n] += dwdp * (-2.0 * k * k * w * MX[:, 0] + k * CX[:, 1])
+                    Jp[lo + n:hi] += dwdp * (-2.0 * k * k * w * MX[:, 1] - k * CX[:, 0])
+            R[lo:hi] += B @ X[lo:hi]
+            blocks.append(B)
+        npairs, ns, nd = self.pair_params.shape[0], self.Ns, 3 * self.nh
+        G = np.empty((npairs, nd, nd))
+        info = np.array([0.0, 0.0, PERIOD_ONE])
+        ev = _Eval(R, None, Jp, np.empty((0, ns)), np.empty((0, ns), dtype=np.int64), info, None, np.empty((0, ns)))
+        ev.pair_T, ev.pair_N = np.empty((npairs, ns, 2)), np.empty((npairs, ns))
+        ev.pair_code = np.empty((npairs, ns), dtype=np.int8)
+        pairs_aft_kernel()(self.pair_positions, self.pair_params, X, self.n, self.E, self.P, *self._pair_dirs,
+                           int(self.max_passes), float(config.HB_PERIODIC_RTOL), ev.R, self._dummy, G,
+                           ev.pair_T, ev.pair_N, ev.pair_code, ev.info)
+        ev.JX = HarmonicJacobian(spans, blocks, self._pairs_pattern().jacobian(np.empty(0), G))
+        return ev
+
+    def _pairs_pattern(self):
+        """The CSR pattern of the pairs' part of dR/dX alone (built once)."""
+        if getattr(self, "_pair_pattern", None) is None:
+            from ._sparse import SparsePattern
+
+            Z = np.zeros((self.n, self.n))
+            self._pair_pattern = SparsePattern((Z, Z, Z), self.H, self.pair_positions)
+        return self._pair_pattern
 
     def problem_at(self, p: float):
         """The harmonic-balance problem of the System that this problem's

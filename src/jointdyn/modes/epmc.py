@@ -63,7 +63,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ..continuation import (ContinuationOptions, ContinuationStatus, ParameterProgress, continuation, make_options,
-                            newton)
+                            newton, preconditioned_by)
 from ..fourier import derivative_matrix
 from ..hb import HBProblem
 from ..hb._sparse import linear_entries
@@ -158,11 +158,13 @@ class EPMCProblem:
                               slice(2 * k * n, (2 * k + 1) * n)) for k in range(1, self.H + 1)]
         self.i_omega = n + self.output_dof
         self.i_xi = 2 * n + self.output_dof
-        # interfaces on a sparse structure, from the size where the continuation's solves go large: the
-        # Jacobian stays sparse from the evaluation on (jointdyn.hb._sparse)
-        pat = self.hb.sparse_pattern() if self.size >= config.CONT_KRYLOV_SOLVE else None
+        # interfaces from the size where the continuation's solves go large: the Jacobian stays sparse (a sparse
+        # structure, jointdyn.hb._sparse) or in its harmonic blocks (a dense one, jointdyn.hb._jacobian) from
+        # the evaluation on
+        #: how the residual's Jacobian is evaluated (:meth:`jointdyn.hb.HBProblem.large_jacobian`)
+        self.kind = self.hb.large_jacobian()
         #: True when the residual's Jacobian is a scipy.sparse matrix
-        self.sparse = pat is not None and pat.density <= config.CONT_SPARSE_DENSITY
+        self.sparse = self.kind == "sparse"
         self._A_M_sparse = _sparse_mass_damping(system.M, self.H) if self.sparse else None
         self.w_ref = self.linear.omega_rad_s
         self.k_ref = float(np.max(np.abs(np.diag(self.linear.stiffness))))
@@ -202,6 +204,8 @@ class EPMCProblem:
         Jacobian sparse where :attr:`sparse`."""
         if self.sparse:
             return self.hb.evaluate_sparse(X, omega / self.hb.w0)
+        if self.kind == "blocks":
+            return self.hb.evaluate_blocks(X, omega / self.hb.w0)
         return self.hb.evaluate(X, omega / self.hb.w0)
 
     def residual(self, v, lam):
@@ -216,6 +220,12 @@ class EPMCProblem:
         R = ev.R - (xi * w) * cx
         if self.sparse:
             J = ev.JX - (xi * w) * self._A_M_sparse
+        elif self.kind == "blocks":
+            J = ev.JX
+            for k, (lo, hi) in enumerate(J.spans[1:], start=1):  # -xi w A_M on the harmonics' blocks, in place
+                n = self.n
+                J.blocks[k][:n, n:] -= (xi * w * k) * self.system.M
+                J.blocks[k][n:, :n] += (xi * w * k) * self.system.M
         else:
             # in place on the evaluation's own Jacobian (nothing reads it afterwards): at thousands of unknowns
             # every copy of an N x N array costs as much as the AFT of hundreds of node pairs
@@ -231,6 +241,8 @@ class EPMCProblem:
 
     def _scaled_jacobian(self, J, c_omega, c_xi):
         """dR_s/dv: J / k_ref with the columns of omega and xi replaced (in place on a dense J)."""
+        if self.kind == "blocks":
+            return J.scaled(1.0 / self.k_ref).with_columns({self.i_omega: c_omega, self.i_xi: c_xi})
         if not self.sparse:
             J /= self.k_ref
             J[:, self.i_omega] = c_omega
@@ -432,10 +444,16 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     problem = EPMCProblem(system, mode=mode, output_dof=output_dof, harmonics=harmonics, samples=samples)
     opt = _options(options, overrides)
     lam0, lam1 = math.log10(lo), math.log10(hi)
+    with preconditioned_by(problem.hb.block_preconditioner((problem.i_omega, problem.i_xi))):
+        return _walked(problem, lam0, lam1, opt, progress, reduction)
+
+
+def _walked(problem: EPMCProblem, lam0, lam1, opt, progress, reduction) -> Backbone:
+    """The backbone of :func:`epmc` from log10 amplitudes lam0 to lam1."""
     v0, ok, _ = newton(problem.residual, problem.linear_guess(), lam0, opt, max_iter=config.MODES_START_MAX_ITER)
     if not ok:
         return _backbone(problem, ModeStatus.NO_START, f"Newton did not converge at the smallest amplitude "
-                         f"{lo:.6g} m from linear stuck mode {problem.linear.index}", np.empty(0),
+                         f"{10.0 ** lam0:.6g} m from linear stuck mode {problem.linear.index}", np.empty(0),
                          np.empty((0, problem.size)), {}, {"points": 0}, reduction)
     stash = {}
 

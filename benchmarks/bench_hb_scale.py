@@ -1,0 +1,131 @@
+"""Harmonic balance of a reduced model dense on its interface (issue 31): harmonic blocks against the direct path.
+
+The model, fixed before measuring: the shipped lap joint
+(:func:`jointdyn.fe.lap_joint`: Craig-Bampton model of 733 DOFs, every
+interface DOF coupled to every other, 120 loaded node pairs), with the
+figure's modal damping (``config.LAP_ZETA`` of every mode of the stuck
+structure: a dense C) and force (``config.LAP_FORCE_N`` at the output DOF),
+as :func:`jointdyn.figures.lap.lap_joint_system` builds it. Measured at
+``SAMPLES`` AFT samples:
+
+- the EPMC backbone of mode 1 over three decades of amplitude
+  (``AMPLITUDE_M``), at most ``MAX_POINTS`` points;
+- the HB forced-response branch across the first resonance (``BAND_HZ``).
+
+Each with the Newton and tangent solves preconditioned by the harmonic
+blocks (``config.HB_BLOCK_PRECONDITIONER``, :mod:`jointdyn.hb._precond`)
+and, in the same run, by today's direct path (one LU of the whole bordered
+matrix, reused through GMRES: the reference), the two sides alternated
+(block, direct for the backbone; direct, block for the branch). Each side
+runs in a child process of its own, so that its peak resident memory is
+its own (``ru_maxrss``). Quick: H = 1 (2199 unknowns, the figure's
+harmonics), the backbone only; full: H = 3 (5131 unknowns) and H = 5 (8063),
+backbone and branch. Stability: Hill's method is beyond
+``config.HB_HILL_MAX_ROWS`` at these sizes (the branches say
+``not-computed``).
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing
+import resource
+import time
+
+import numpy as np
+
+SAMPLES = 32
+AMPLITUDE_M = (2e-6, 2e-3)
+MAX_POINTS = 400
+BAND_HZ = (750.0, 805.0)
+
+
+def _system():
+    from jointdyn import config
+    from jointdyn.figures.lap import lap_joint_system
+
+    return lap_joint_system(config.LAP_FORCE_N, config.LAP_ZETA)[0]
+
+
+def _backbone(H: int, blocks: bool) -> dict:
+    from jointdyn import config
+    from jointdyn.modes import epmc
+
+    config.HB_BLOCK_PRECONDITIONER = blocks
+    s = _system()
+    t0 = time.perf_counter()
+    b = epmc(s, AMPLITUDE_M, harmonics=H, samples=SAMPLES, max_points=MAX_POINTS, ds_max=config.LAP_DS_MAX,
+             progress=False)
+    return {"s": time.perf_counter() - t0, "status": b.status.value, "points": int(b.points),
+            "counters": {k: int(v) for k, v in b.counters.items() if isinstance(v, (int, np.integer))},
+            "amplitude_m": b.amplitude_m.tolist(), "omega_rad_s": b.omega_rad_s.tolist(),
+            "damping_ratio": b.damping_ratio.tolist()}
+
+
+def _branch(H: int, blocks: bool) -> dict:
+    from jointdyn import config
+    from jointdyn.hb import continue_hb
+
+    config.HB_BLOCK_PRECONDITIONER = blocks
+    s = _system()
+    g0, g1 = (2.0 * math.pi * f / s.w0 for f in BAND_HZ)
+    t0 = time.perf_counter()
+    br = continue_hb(s, g0, g1, harmonics=H, samples=SAMPLES, condense=False, progress=False)
+    peak = max(br.peaks, key=lambda p: p.amplitude_m) if br.peaks else None
+    return {"s": time.perf_counter() - t0, "status": br.status.value, "points": int(br.lam.size),
+            "counters": {k: int(v) for k, v in br.counters.items() if isinstance(v, (int, np.integer))},
+            "stability": "not-computed" if np.all(np.isnan(br.growth)) else "computed",
+            "peak_hz": None if peak is None else peak.gamma * s.w0 / (2.0 * math.pi),
+            "peak_m": None if peak is None else peak.amplitude_m}
+
+
+def _child(conn, fn, args):
+    out = fn(*args)
+    out["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    conn.send(out)
+    conn.close()
+
+
+def _isolated(fn, *args) -> dict:
+    """fn(*args) in a child process (its own peak memory); the parent waits."""
+    ctx = multiprocessing.get_context("fork")
+    a, b = ctx.Pipe(duplex=False)
+    p = ctx.Process(target=_child, args=(b, fn, args))
+    p.start()
+    out = a.recv()
+    p.join()
+    return out
+
+
+def _compare_backbones(a: dict, b: dict) -> float:
+    """max relative difference of omega and damping of b's points against a's curve (interpolated in log a)."""
+    la, lb = np.log(a["amplitude_m"]), np.log(b["amplitude_m"])
+    worst = 0.0
+    for name in ("omega_rad_s", "damping_ratio"):
+        ya = np.interp(lb, la, a[name])
+        worst = max(worst, float(np.max(np.abs(np.asarray(b[name]) - ya) / np.abs(ya))))
+    return worst
+
+
+def run(quick: bool) -> dict:
+    out = {"model": "lap joint (733 DOFs, 120 pairs, modal damping)", "samples": SAMPLES}
+    for H in ((1,) if quick else (3, 5)):
+        blk = _isolated(_backbone, H, True)
+        ref = _isolated(_backbone, H, False)
+        for name, r in (("blocks", blk), ("direct", ref)):
+            out[f"H{H}_epmc_{name}"] = {k: v for k, v in r.items() if k not in ("amplitude_m", "omega_rad_s",
+                                                                                  "damping_ratio")}
+        out[f"H{H}_epmc_max_rel_diff"] = _compare_backbones(ref, blk) if ref["points"] and blk["points"] else None
+        if quick:
+            continue
+        ref = _isolated(_branch, H, False)
+        blk = _isolated(_branch, H, True)
+        out[f"H{H}_hb_direct"], out[f"H{H}_hb_blocks"] = ref, blk
+    return out
+
+
+if __name__ == "__main__":
+    import json
+    import sys
+
+    print(json.dumps(run("--full" not in sys.argv), indent=1))
