@@ -634,3 +634,31 @@ def modal_damping(M, K, zeta) -> np.ndarray:
     w = np.sqrt(np.maximum(lam, 0.0))
     MP = M @ phi
     return (MP * (2.0 * z * w)) @ MP.T
+
+
+def static_springs(system, open_pairs: bool = False) -> list:
+    """The springs that hold a System at rest with every contact stuck and every normal spring
+    closed, beside its K: ``(key, stiffness N/m, selection vector)`` each, the key as a system
+    file names it (``contact[i].kt``, ``contact[i].normal.kn``, ``interface[i].kt`` or ``.kn``,
+    pairs counted from 0). Pairs open at rest (preload 0) hold nothing: with ``open_pairs`` they are
+    the only ones listed (the springs they would add once closed)."""
+    n = system.ndof
+    out = []
+    for i, c in enumerate(() if open_pairs else system.contacts):
+        out.append((f"contact[{i}].kt", float(c.law.kt), _dense(c.dof, c.dof2, c.direction, n)))
+        kn = getattr(c.normal, "kn", None)
+        if kn is not None:
+            nm = c.normal
+            out.append((f"contact[{i}].normal.kn", float(kn), _dense(nm.dof, nm.dof2, nm.direction, n)))
+    for i, itf in enumerate(system.interfaces):
+        for j, row in enumerate(itf.pairs):
+            if (itf.preload[j] > 0.0) == open_pairs:
+                continue
+            for k, (name, value) in enumerate((("kt", itf.kt[j]), ("kt", itf.kt[j]), ("kn", itf.kn[j]))):
+                b = np.zeros(n)
+                if row[k] >= 0:
+                    b[row[k]] += 1.0
+                if row[k + 3] >= 0:
+                    b[row[k + 3]] -= 1.0
+                out.append((f"interface[{i}].{name}" + (f" (pair {j})" if itf.npairs > 1 else ""), float(value), b))
+    return out

@@ -42,8 +42,7 @@ def check_mean_position(system: System) -> None:
     stiffnesses are named instead, and a DOF held only by pairs open at rest
     (preload 0) names such a pair.
     """
-    from ..interfaces import static_springs
-    from ..systems import rigid_mode_dof
+    from ..systems import rigid_mode_dof, static_springs
 
     K = stuck_stiffness(system)  # with the normal springs of the contacts and pairs closed at rest
     dof = rigid_mode_dof(K)

@@ -536,6 +536,13 @@ class HBProblem:
         X = np.ascontiguousarray(X, dtype=np.float64)
         w, dwdp, Fe, Fp, _, _, _ = self._inputs(p)
         R, Jp, lin_values = pat.linear(X, w, dwdp, Fe, Fp)
+        ev, G = self._pairs_eval(X, R, Jp)
+        ev.JX = pat.jacobian(lin_values, G)
+        return ev
+
+    def _pairs_eval(self, X, R, Jp):
+        """The pairs' AFT added to the linear residual ``R`` (in place): the evaluation (without dR/dX)
+        and the pairs' Jacobian blocks ``G`` (npairs, 3 nh, 3 nh), N/m."""
         npairs, ns, nd = self.pair_params.shape[0], self.Ns, 3 * self.nh
         G = np.empty((npairs, nd, nd))
         info = np.array([0.0, 0.0, PERIOD_ONE])
@@ -545,8 +552,7 @@ class HBProblem:
         pairs_aft_kernel()(self.pair_positions, self.pair_params, X, self.n, self.E, self.P, *self._pair_dirs,
                            int(self.max_passes), float(config.HB_PERIODIC_RTOL), ev.R, self._dummy, G,
                            ev.pair_T, ev.pair_N, ev.pair_code, ev.info)
-        ev.JX = pat.jacobian(lin_values, G)
-        return ev
+        return ev, G
 
     def large_jacobian(self) -> str:
         """How the Jacobian is evaluated from ``config.CONT_KRYLOV_SOLVE`` unknowns: ``"sparse"``
@@ -601,15 +607,7 @@ class HBProblem:
                     Jp[lo + n:hi] += dwdp * (-2.0 * k * k * w * MX[:, 1] - k * CX[:, 0])
             R[lo:hi] += B @ X[lo:hi]
             blocks.append(B)
-        npairs, ns, nd = self.pair_params.shape[0], self.Ns, 3 * self.nh
-        G = np.empty((npairs, nd, nd))
-        info = np.array([0.0, 0.0, PERIOD_ONE])
-        ev = _Eval(R, None, Jp, np.empty((0, ns)), np.empty((0, ns), dtype=np.int64), info, None, np.empty((0, ns)))
-        ev.pair_T, ev.pair_N = np.empty((npairs, ns, 2)), np.empty((npairs, ns))
-        ev.pair_code = np.empty((npairs, ns), dtype=np.int8)
-        pairs_aft_kernel()(self.pair_positions, self.pair_params, X, self.n, self.E, self.P, *self._pair_dirs,
-                           int(self.max_passes), float(config.HB_PERIODIC_RTOL), ev.R, self._dummy, G,
-                           ev.pair_T, ev.pair_N, ev.pair_code, ev.info)
+        ev, G = self._pairs_eval(X, R, Jp)
         ev.JX = HarmonicJacobian(spans, blocks, self._pairs_pattern().jacobian(np.empty(0), G))
         return ev
 
