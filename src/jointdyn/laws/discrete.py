@@ -252,14 +252,7 @@ class DiscreteIwan(ContactLaw):
 
     n: int = law_param(config.LAW_DISCRETE_N, low=1, help="number of Jenkins elements")
     name: ClassVar[str] = "discrete"
-
-    @property
-    def step(self):
-        return discrete_step
-
-    @property
-    def step_jvp(self):
-        return discrete_step_jvp
+    kernels: ClassVar[tuple] = (discrete_step, discrete_step_jvp, discrete_init, discrete_init_jvp)
 
     @property
     def params(self) -> np.ndarray:
@@ -270,14 +263,6 @@ class DiscreteIwan(ContactLaw):
     @property
     def state_size(self) -> int:
         return _S_HEAD + self.n
-
-    @property
-    def init(self):
-        return discrete_init
-
-    @property
-    def init_jvp(self):
-        return discrete_init_jvp
 
     @property
     def x_slip(self) -> float:
@@ -298,14 +283,7 @@ class Jenkins(DiscreteIwan):
 
     n: int = 1
     name: ClassVar[str] = "jenkins"
-
-    @property
-    def step(self):
-        return jenkins_step
-
-    @property
-    def step_jvp(self):
-        return jenkins_step_jvp
+    kernels: ClassVar[tuple] = (jenkins_step, jenkins_step_jvp, discrete_init, discrete_init_jvp)
 
     def __post_init__(self) -> None:
         if isinstance(self.n, bool) or self.n != 1:
@@ -408,6 +386,7 @@ class DiscreteElements(ContactLaw):
     stiffnesses: tuple = ()
     slip_forces: tuple = ()
     name: ClassVar[str] = "discrete-elements"
+    kernels: ClassVar[tuple] = (elements_step, elements_step_jvp, discrete_init, discrete_init_jvp)
 
     @classmethod
     def from_elements(cls, stiffnesses, slip_forces, n_ref: float) -> "DiscreteElements":
@@ -442,28 +421,12 @@ class DiscreteElements(ContactLaw):
         return len(self.stiffnesses)
 
     @property
-    def step(self):
-        return elements_step
-
-    @property
-    def step_jvp(self):
-        return elements_step_jvp
-
-    @property
     def params(self) -> np.ndarray:
         return np.concatenate(([self.kt, self.fy, self.n_ref, float(self.n)], self.slip_forces, self.stiffnesses))
 
     @property
     def state_size(self) -> int:
         return _S_HEAD + self.n
-
-    @property
-    def init(self):
-        return discrete_init
-
-    @property
-    def init_jvp(self):
-        return discrete_init_jvp
 
     @property
     def x_slip(self) -> float:

@@ -508,14 +508,7 @@ class IwanClosedForm(ContactLaw):
         help="capacity of the reversal-point stack (the innermost pair is forgotten when full)",
     )
     name: ClassVar[str] = "iwan-closed"
-
-    @property
-    def step(self):
-        return closed_step
-
-    @property
-    def step_jvp(self):
-        return closed_step_jvp
+    kernels: ClassVar[tuple] = (closed_step, closed_step_jvp, closed_init, closed_init_jvp)
 
     @property
     def params(self) -> np.ndarray:
@@ -526,14 +519,6 @@ class IwanClosedForm(ContactLaw):
     @property
     def state_size(self) -> int:
         return _HEAD + 3 * self.max_depth
-
-    @property
-    def init(self):
-        return closed_init
-
-    @property
-    def init_jvp(self):
-        return closed_init_jvp
 
     @property
     def passive(self) -> bool:
