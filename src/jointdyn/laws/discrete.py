@@ -157,31 +157,15 @@ def _single_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
 
 @jit
 def discrete_step(params, s_old, s_new, x, N):
-    """Trial step of n Jenkins elements with load-scaled slip forces.
+    """Trial step of n Jenkins elements with load-scaled slip forces: the kernel
+    contract's ``step`` (:mod:`jointdyn.laws._base`: arguments, returns, units).
 
     Implements docs/model.md section 5: for each element, trial force
     ``p_i + (kt/n) dx``, clipped to ``alpha f_i / n`` with
     ``alpha = N / N_ref``; all ``p_i = 0`` when ``alpha <= 0``.
-
-    Parameters
-    ----------
-    params : float64[:]
-        ``[kt (N/m), fy (N), N_ref (N), n, f_1..f_n (N)]``.
-    s_old, s_new : float64[:]
-        ``[x_prev (m), p_1..p_n (N)]``; ``s_old`` is not written.
-    x : float
-        Tangential displacement, m.
-    N : float
-        Normal load, N.
-
-    Returns
-    -------
-    T : float
-        Tangential force, N.
-    kT : float
-        Tangent stiffness dT/dx, N/m (sum over sticking elements).
-    code : int
-        STICK_SLIP, MACROSLIP (every element slipping) or SEPARATION.
+    ``params = [kt (N/m), fy (N), N_ref (N), n, f_1..f_n (N)]``, states
+    ``[x_prev (m), p_1..p_n (N)]``; kT sums the sticking elements' kt / n;
+    MACROSLIP when every element slips.
     """
     return _discrete_core(params, s_old, s_new, x, N, None, None, None, None, None)
 

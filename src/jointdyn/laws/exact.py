@@ -177,28 +177,13 @@ def _exact_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
 # integrators), where a call passing three arrays costs as much as the law
 @jit(inline="always")
 def exact_step(params, s_old, s_new, x, N):
-    """Trial step of the exact Iwan law (see module docstring).
+    """Trial step of the exact Iwan law: the kernel contract's ``step``
+    (:mod:`jointdyn.laws._base`: arguments, returns, units), with
 
-    Parameters
-    ----------
-    params : float64[:]
-        ``[kt (N/m), fy (N), N_ref (N), K, kt / fy (1/m), 1 / N_ref (1/N)]``.
-    s_old, s_new : float64[:]
-        Committed (not written) and trial state, ``[x_prev (m), m,
-        (hi_k, a_k, b_k) * 3 K]`` (module docstring).
-    x : float
-        Tangential displacement, m.
-    N : float
-        Normal load, N.
-
-    Returns
-    -------
-    T : float
-        Tangential force, N: fy / 2 times the integral of P over [0, 2].
-    kT : float
-        Tangent dT/dx at fixed N, N/m: kt times the stuck fraction.
-    code : int
-        SEPARATION (N <= 0), MACROSLIP (no element stuck) or STICK_SLIP.
+    ``params = [kt (N/m), fy (N), N_ref (N), K, kt / fy (1/m), 1 / N_ref (1/N)]``,
+    states ``[x_prev (m), m, (hi_k, a_k, b_k) * 3 K]`` (module docstring);
+    T = fy / 2 times the integral of P over [0, 2] (N), kT = kt times the
+    stuck fraction of the slip strengths (N/m).
     """
     return _exact_core(params, s_old, s_new, x, N, None, None, None, None, None)
 

@@ -407,28 +407,11 @@ def _force(params, s_new, m, alpha, total, stuck, end_stuck):
 
 @jit(inline="always")
 def segalman_step(params, s_old, s_new, x, N):
-    """Trial step of the Segalman law (see module docstring).
-
-    Parameters
-    ----------
-    params : float64[:]
-        ``[kt (N/m), fy (N), N_ref (N), K, kt / fy (1/m), 1 / N_ref (1/N), chi, u_max, c_R, c_S]``.
-    s_old, s_new : float64[:]
-        Committed (not written) and trial state (layout of :mod:`jointdyn.laws.exact`,
-        last breakpoint at u_max).
-    x : float
-        Tangential displacement, m.
-    N : float
-        Normal load, N.
-
-    Returns
-    -------
-    T : float
-        Tangential force, N.
-    kT : float
-        Tangent dT/dx at fixed N, N/m.
-    code : int
-        SEPARATION (N <= 0), MACROSLIP (no element stuck) or STICK_SLIP.
+    """Trial step of the Segalman law: the kernel contract's ``step``
+    (:mod:`jointdyn.laws._base`: arguments, returns, units), with the
+    parameters and state of the module docstring (the pieces as in
+    :mod:`jointdyn.laws.exact`, the last breakpoint at u_max, then the power
+    cache); T and kT weigh the pieces by u^chi and add the delta at u_max.
     """
     return _segalman_core(params, s_old, s_new, x, N, None, None, None, None, None)
 
