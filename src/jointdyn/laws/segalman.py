@@ -246,7 +246,7 @@ def _wmerge_jvp(s, ds, j, uw, pw, hw, clamp, lines, alpha, ia, dN, chi):
 @jit(inline="always")
 def _wcapacity(s, ds, m, cap, alpha, ia, dN, chi):
     """Merge three adjacent pieces into two until at most ``cap`` pieces remain: the
-    triple the uniform law would merge (:func:`jointdyn.laws.exact._least_triple`,
+    triple the uniform law would merge (:func:`jointdyn.laws._density_march._least_triple`,
     no powers to compute) when its weighted vertex lies within the limits, else the
     least cost by the weighted vertices (:func:`_wcost`; the first triple, clamped,
     when none does). Keeps the power cache (rows from ``3 cap``) and returns the piece
@@ -291,7 +291,7 @@ def _wcapacity(s, ds, m, cap, alpha, ia, dN, chi):
 
 @jit(inline="always")
 def _ucapacity(s, ds, m, cap, alpha, total, stuck, ia, dN):
-    """chi = 0: the uniform law's merges (:func:`jointdyn.laws.exact._enforce_capacity`,
+    """chi = 0: the uniform law's merges (:func:`jointdyn.laws._density_march._enforce_capacity`,
     the same operations and bits); the power cache (u^1) follows."""
     m, total, stuck = _enforce_capacity(s, ds, m, cap, alpha, total, stuck, ia, dN)
     base = _HEAD + 9 * cap
