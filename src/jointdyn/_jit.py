@@ -23,7 +23,7 @@ import sys
 
 import numba
 from numba.core import environment as _environment
-from numba.core.caching import FunctionCache
+from numba.core.caching import CompileResultCacheImpl, FunctionCache, _CacheLocator
 from numba.core.runtime import nrt
 
 __all__ = ["jit", "specialize", "ANNOUNCE_ENV", "COMPILING_NOTE"]
@@ -52,6 +52,115 @@ def _note_compiling() -> None:
     print(COMPILING_NOTE, file=sys.stderr, flush=True)
 
 
+#: environment variable naming the folder of jointdyn's compiled kernels (default: a per-version folder
+#: of the user's cache directory, :func:`cache_root`)
+CACHE_ENV = "JOINTDYN_CACHE_DIR"
+_PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
+_STAMPS: dict = {}
+
+
+def _user_cache_home() -> str:
+    """The platform's per-user cache directory (XDG on Linux, ~/Library/Caches, %LOCALAPPDATA%)."""
+    if sys.platform == "win32":
+        return os.environ.get("LOCALAPPDATA") or os.path.join(os.path.expanduser("~"), "AppData", "Local")
+    if sys.platform == "darwin":
+        return os.path.join(os.path.expanduser("~"), "Library", "Caches")
+    return os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+
+
+def cache_root() -> str:
+    """Folder of jointdyn's compiled kernels: ``$JOINTDYN_CACHE_DIR``, else ``$NUMBA_CACHE_DIR/jointdyn``,
+    else ``jointdyn`` in the user's cache directory; then a subfolder per jointdyn version and Python.
+
+    Outside the installed package, so that reinstalling the same version (a new virtual
+    environment, ``pip install --force-reinstall``, an unwritable site-packages) finds the
+    kernels compiled before; one folder per version, which the user may delete.
+    """
+    # the package is imported before any of its modules (no import here: the package imports this one)
+    version = getattr(sys.modules.get(__package__), "__version__", "unknown")
+    root = os.environ.get(CACHE_ENV)
+    if not root:
+        numba_dir = os.environ.get("NUMBA_CACHE_DIR")
+        root = os.path.join(numba_dir, "jointdyn") if numba_dir else os.path.join(_user_cache_home(), "jointdyn")
+    return os.path.join(root, f"{version}-py{sys.version_info[0]}{sys.version_info[1]}")
+
+
+def _module_files(modname: str, seen: set) -> None:
+    """Source files of jointdyn module ``modname`` and of the jointdyn modules whose compiled
+    functions it references at module level (what Numba may inline into its kernels), recursively."""
+    if modname in seen:
+        return
+    mod = sys.modules.get(modname)
+    path = getattr(mod, "__file__", None)
+    if not path:
+        return
+    seen.add(modname)
+    for value in list(vars(mod).values()):
+        other = getattr(getattr(value, "py_func", value), "__module__", None)
+        if isinstance(other, str) and other.startswith("jointdyn.") and callable(value):
+            _module_files(other, seen)
+
+
+def source_stamp(modname: str) -> str:
+    """Hash of the source of jointdyn module ``modname`` and of every jointdyn module whose compiled
+    functions it may inline (:func:`_module_files`): changing a shared helper recompiles every kernel
+    that inlines it, and a reinstall with the same sources keeps the compiled kernels."""
+    hit = _STAMPS.get(modname)
+    if hit is not None:
+        return hit
+    import hashlib
+
+    seen: set = set()
+    _module_files(modname, seen)
+    h = hashlib.sha1()
+    for name in sorted(seen):
+        h.update(name.encode())
+        try:
+            with open(sys.modules[name].__file__, "rb") as fh:
+                h.update(fh.read())
+        except OSError:
+            h.update(b"?")
+    _STAMPS[modname] = stamp = h.hexdigest()[:16]
+    return stamp
+
+
+class _PackageLocator(_CacheLocator):
+    """Numba cache locator of jointdyn's functions: :func:`cache_root`, the module's path inside
+    the package as subfolder, files named by the source stamp (:func:`source_stamp`), so that
+    several source trees of one version (developers' worktrees) keep their own kernels side by side."""
+
+    def __init__(self, py_func, py_file):
+        rel = os.path.relpath(os.path.dirname(os.path.abspath(py_file)), _PACKAGE_DIR)
+        self._cache_path = os.path.normpath(os.path.join(cache_root(), rel))
+        self._lineno = py_func.__code__.co_firstlineno
+        self._stamp = source_stamp(py_func.__module__)
+
+    def get_cache_path(self):
+        return self._cache_path
+
+    def get_source_stamp(self):
+        return self._stamp
+
+    def get_disambiguator(self):
+        return f"{self._lineno}-{self._stamp}"
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        inside = os.path.abspath(py_file).startswith(_PACKAGE_DIR + os.sep)
+        if not inside or not str(getattr(py_func, "__module__", "")).startswith("jointdyn."):
+            return None
+        self = cls(py_func, py_file)
+        try:
+            self.ensure_cache_path()
+        except OSError:  # not writable: Numba's own locators (next to the sources, or its user-wide folder)
+            return None
+        return self
+
+
+class _PackageCacheImpl(CompileResultCacheImpl):
+    _locator_classes = [_PackageLocator, *CompileResultCacheImpl._locator_classes]
+
+
 class _LoadingCache(FunctionCache):
     """Numba's disk cache of one function, loading with the runtime only.
 
@@ -61,8 +170,10 @@ class _LoadingCache(FunctionCache):
     Numba's runtime (NRT) and C helpers only, and the environments it
     rebuilds import their own modules. The compiler refreshes both contexts
     before it compiles (``numba.core.compiler.CompilerBase``), so a cache
-    miss compiles as before.
+    miss compiles as before. Files go to :func:`cache_root` (:class:`_PackageLocator`).
     """
+
+    _impl_class = _PackageCacheImpl
 
     def load_overload(self, sig, target_context):
         nrt.rtsys.initialize(target_context)
@@ -176,11 +287,16 @@ _SPECIALIZED: dict = {}
 
 
 def _source_tag(obj) -> str:
-    """Hash of the source file defining a bound kernel (cache invalidation)."""
+    """Hash of the source a bound kernel is compiled from (cache invalidation): for a jointdyn
+    kernel its module and the modules it may inline (:func:`source_stamp`), for a plug-in the
+    file defining it."""
     import hashlib
     import inspect
 
     fn = getattr(obj, "py_func", obj)
+    mod = getattr(fn, "__module__", None)
+    if isinstance(mod, str) and mod.startswith("jointdyn.") and mod in sys.modules:
+        return source_stamp(mod)[:10]
     try:
         with open(inspect.getfile(fn), "rb") as fh:
             data = fh.read()

@@ -51,4 +51,20 @@ def run(args) -> int:
     for n in tqdm(todo, desc="figures", unit="fig", disable=None):
         paths = make_figure(n, out)
         tqdm.write(_summary(n, [Path(p) for p in paths]))
+    if not args.only:
+        _compile_fit_kernels()
     return 0
+
+
+def _compile_fit_kernels() -> None:
+    """Compile (or load) the march of every law ``jointdyn fit`` can fit, so that a first
+    ``fit`` after ``figures`` (the README's first command) does not compile: the figures
+    march most of these laws, but not ``segalman``. Instant when the cache holds them."""
+    import numpy as np
+
+    from ..drivers import march
+    from ..identify.loops import LOOP_MODELS
+    from ..laws import make_law
+
+    for model in LOOP_MODELS:
+        march(make_law(model, kt=1.0, mu=1.0, n_ref=1.0), np.array([0.0, 1.0]), np.ones(2))

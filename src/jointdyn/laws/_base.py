@@ -334,25 +334,36 @@ class ContactLaw:
             raise ValueError(f"kt must be larger: x_slip of {type(self).__name__} overflows with kt = {kt!r} N/m")
 
     # --- what subclasses provide ------------------------------------------
+    #: the law's compiled kernels ``(step, step_jvp, init, init_jvp)`` (a law
+    #: without derivative kernels gives two: ``(step, None, init, None)`` or
+    #: leaves them out); a law may instead override the four properties
+    kernels: ClassVar[tuple] = ()
+
+    def _kernel(self, i: int, what: str):
+        k = self.kernels[i] if i < len(self.kernels) else None
+        if k is None:
+            raise NotImplementedError(f"{type(self).__name__} has no {what} kernel")
+        return k
+
     @property
     def step(self):
         """The compiled trial-step kernel (see module docstring)."""
-        raise NotImplementedError
+        return self._kernel(0, "step")
 
     @property
     def step_jvp(self):
         """The compiled forward-mode kernel (see module docstring)."""
-        raise NotImplementedError
+        return self._kernel(1, "step_jvp")
 
     @property
     def init(self):
         """The compiled virgin-state kernel ``init(params, x0, n0, s)`` (see module docstring)."""
-        raise NotImplementedError
+        return self._kernel(2, "init")
 
     @property
     def init_jvp(self):
         """The compiled kernel ``init_jvp(params, x0, dx0, n0, dn0, s, ds)`` (see module docstring)."""
-        raise NotImplementedError
+        return self._kernel(3, "init_jvp")
 
     @property
     def params(self) -> np.ndarray:

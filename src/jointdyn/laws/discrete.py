@@ -157,31 +157,15 @@ def _single_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
 
 @jit
 def discrete_step(params, s_old, s_new, x, N):
-    """Trial step of n Jenkins elements with load-scaled slip forces.
+    """Trial step of n Jenkins elements with load-scaled slip forces: the kernel
+    contract's ``step`` (:mod:`jointdyn.laws._base`: arguments, returns, units).
 
     Implements docs/model.md section 5: for each element, trial force
     ``p_i + (kt/n) dx``, clipped to ``alpha f_i / n`` with
     ``alpha = N / N_ref``; all ``p_i = 0`` when ``alpha <= 0``.
-
-    Parameters
-    ----------
-    params : float64[:]
-        ``[kt (N/m), fy (N), N_ref (N), n, f_1..f_n (N)]``.
-    s_old, s_new : float64[:]
-        ``[x_prev (m), p_1..p_n (N)]``; ``s_old`` is not written.
-    x : float
-        Tangential displacement, m.
-    N : float
-        Normal load, N.
-
-    Returns
-    -------
-    T : float
-        Tangential force, N.
-    kT : float
-        Tangent stiffness dT/dx, N/m (sum over sticking elements).
-    code : int
-        STICK_SLIP, MACROSLIP (every element slipping) or SEPARATION.
+    ``params = [kt (N/m), fy (N), N_ref (N), n, f_1..f_n (N)]``, states
+    ``[x_prev (m), p_1..p_n (N)]``; kT sums the sticking elements' kt / n;
+    MACROSLIP when every element slips.
     """
     return _discrete_core(params, s_old, s_new, x, N, None, None, None, None, None)
 
@@ -252,14 +236,7 @@ class DiscreteIwan(ContactLaw):
 
     n: int = law_param(config.LAW_DISCRETE_N, low=1, help="number of Jenkins elements")
     name: ClassVar[str] = "discrete"
-
-    @property
-    def step(self):
-        return discrete_step
-
-    @property
-    def step_jvp(self):
-        return discrete_step_jvp
+    kernels: ClassVar[tuple] = (discrete_step, discrete_step_jvp, discrete_init, discrete_init_jvp)
 
     @property
     def params(self) -> np.ndarray:
@@ -270,14 +247,6 @@ class DiscreteIwan(ContactLaw):
     @property
     def state_size(self) -> int:
         return _S_HEAD + self.n
-
-    @property
-    def init(self):
-        return discrete_init
-
-    @property
-    def init_jvp(self):
-        return discrete_init_jvp
 
     @property
     def x_slip(self) -> float:
@@ -298,14 +267,7 @@ class Jenkins(DiscreteIwan):
 
     n: int = 1
     name: ClassVar[str] = "jenkins"
-
-    @property
-    def step(self):
-        return jenkins_step
-
-    @property
-    def step_jvp(self):
-        return jenkins_step_jvp
+    kernels: ClassVar[tuple] = (jenkins_step, jenkins_step_jvp, discrete_init, discrete_init_jvp)
 
     def __post_init__(self) -> None:
         if isinstance(self.n, bool) or self.n != 1:
@@ -408,6 +370,7 @@ class DiscreteElements(ContactLaw):
     stiffnesses: tuple = ()
     slip_forces: tuple = ()
     name: ClassVar[str] = "discrete-elements"
+    kernels: ClassVar[tuple] = (elements_step, elements_step_jvp, discrete_init, discrete_init_jvp)
 
     @classmethod
     def from_elements(cls, stiffnesses, slip_forces, n_ref: float) -> "DiscreteElements":
@@ -442,28 +405,12 @@ class DiscreteElements(ContactLaw):
         return len(self.stiffnesses)
 
     @property
-    def step(self):
-        return elements_step
-
-    @property
-    def step_jvp(self):
-        return elements_step_jvp
-
-    @property
     def params(self) -> np.ndarray:
         return np.concatenate(([self.kt, self.fy, self.n_ref, float(self.n)], self.slip_forces, self.stiffnesses))
 
     @property
     def state_size(self) -> int:
         return _S_HEAD + self.n
-
-    @property
-    def init(self):
-        return discrete_init
-
-    @property
-    def init_jvp(self):
-        return discrete_init_jvp
 
     @property
     def x_slip(self) -> float:

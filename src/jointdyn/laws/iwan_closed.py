@@ -403,27 +403,11 @@ def _closed_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
 # arrays field by field cost about half of the step time
 @jit(inline="always")
 def closed_step(params, s_old, s_new, x, N):
-    """Trial step of the closed-form Iwan law (see module docstring).
-
-    Parameters
-    ----------
-    params : float64[:]
-        ``[kt (N/m), fy (N), N_ref (N), memory (0 full / 1 last), max_depth]``.
-    s_old, s_new : float64[:]
-        Committed (not written) and trial state, length ``9 + 3 max_depth``.
-    x : float
-        Tangential displacement, m.
-    N : float
-        Normal load, N.
-
-    Returns
-    -------
-    T : float
-        Tangential force, N (paper eq. for T-> / T<-, docs/model.md section 3).
-    kT : float
-        Tangent dT/dx at fixed N, N/m.
-    code : int
-        STICK_SLIP, MACROSLIP or SEPARATION.
+    """Trial step of the closed-form Iwan law: the kernel contract's ``step``
+    (:mod:`jointdyn.laws._base`: arguments, returns, units), with
+    ``params = [kt (N/m), fy (N), N_ref (N), memory (0 full / 1 last), max_depth]``
+    and states of length ``9 + 3 max_depth`` (module docstring); T from the
+    paper's T-> / T<- (docs/model.md section 3).
     """
     return _closed_core(params, s_old, s_new, x, N, None, None, None, None, None)
 
@@ -508,14 +492,7 @@ class IwanClosedForm(ContactLaw):
         help="capacity of the reversal-point stack (the innermost pair is forgotten when full)",
     )
     name: ClassVar[str] = "iwan-closed"
-
-    @property
-    def step(self):
-        return closed_step
-
-    @property
-    def step_jvp(self):
-        return closed_step_jvp
+    kernels: ClassVar[tuple] = (closed_step, closed_step_jvp, closed_init, closed_init_jvp)
 
     @property
     def params(self) -> np.ndarray:
@@ -526,14 +503,6 @@ class IwanClosedForm(ContactLaw):
     @property
     def state_size(self) -> int:
         return _HEAD + 3 * self.max_depth
-
-    @property
-    def init(self):
-        return closed_init
-
-    @property
-    def init_jvp(self):
-        return closed_init_jvp
 
     @property
     def passive(self) -> bool:

@@ -57,9 +57,8 @@ import numpy as np
 from .. import config
 from .._jit import jit
 from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, law_param, register
-from .exact import (
+from ._density_march import (
     _END_HI,
-    _END_LO,
     _HEAD,
     _M,
     _P_CAP,
@@ -67,24 +66,25 @@ from .exact import (
     _P_INV_NREF,
     _P_KT,
     _P_QS,
-    _STUCK,
     _X,
     _ZERO,
     MIN_CAPACITY,
-    _coeffs,
-    _end_kind,
     _enforce_capacity,
     _least_triple,
-    _held,
     _integral,
     _line,
     _line_jvp,
-    _segment,
+    _pow1,
     _shift_down,
-    _split,
     _stuck_part,
     _write,
     _write_jvp,
+    clear_rows,
+    density_params,
+    finish_state,
+    march_pieces,
+    pieces_error,
+    stale_top,
 )
 
 __all__ = ["Segalman", "segalman_step", "segalman_step_jvp", "segalman_init", "segalman_init_jvp",
@@ -124,14 +124,6 @@ def segalman_constants(chi: float, beta: float) -> tuple:
 
 
 # --- weighted moments ----------------------------------------------------------------
-
-
-@jit(inline="always")
-def _pow1(u, chi):
-    """u^(chi + 1) (u itself when chi = 0, so that the uniform law's bits are kept)."""
-    if chi == 0.0:
-        return u
-    return u ** (chi + 1.0)
 
 
 @jit(inline="always")
@@ -254,7 +246,7 @@ def _wmerge_jvp(s, ds, j, uw, pw, hw, clamp, lines, alpha, ia, dN, chi):
 @jit(inline="always")
 def _wcapacity(s, ds, m, cap, alpha, ia, dN, chi):
     """Merge three adjacent pieces into two until at most ``cap`` pieces remain: the
-    triple the uniform law would merge (:func:`jointdyn.laws.exact._least_triple`,
+    triple the uniform law would merge (:func:`jointdyn.laws._density_march._least_triple`,
     no powers to compute) when its weighted vertex lies within the limits, else the
     least cost by the weighted vertices (:func:`_wcost`; the first triple, clamped,
     when none does). Keeps the power cache (rows from ``3 cap``) and returns the piece
@@ -299,7 +291,7 @@ def _wcapacity(s, ds, m, cap, alpha, ia, dN, chi):
 
 @jit(inline="always")
 def _ucapacity(s, ds, m, cap, alpha, total, stuck, ia, dN):
-    """chi = 0: the uniform law's merges (:func:`jointdyn.laws.exact._enforce_capacity`,
+    """chi = 0: the uniform law's merges (:func:`jointdyn.laws._density_march._enforce_capacity`,
     the same operations and bits); the power cache (u^1) follows."""
     m, total, stuck = _enforce_capacity(s, ds, m, cap, alpha, total, stuck, ia, dN)
     base = _HEAD + 9 * cap
@@ -365,22 +357,9 @@ def _jvp_force(s, ds, m, params, dT, base):
 
 
 @jit(inline="always")
-def _right_power(end, right, chi, p_hi, p_lo):
-    """right^(chi+1) of a written segment: the cached power ``p_hi`` of the old piece's
-    upper (end code _END_HI) or ``p_lo`` of its lower (_END_LO) breakpoint, computed for
-    a cut. Scalars only: an array argument of an inlined function with branches costs
-    reference-count updates at every call (see jointdyn.laws.exact)."""
-    if end == _END_HI:
-        return p_hi
-    if end == _END_LO:
-        return p_lo
-    return _pow1(right, chi)
-
-
-@jit(inline="always")
 def _segalman_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
-    # the uniform law's core (exact._exact_core) with weighted integrals and the delta;
-    # derivative arguments all arrays or all None (pruned at compile time)
+    # the uniform law's march (jointdyn.laws._density_march) with weighted integrals and
+    # the delta; derivative arguments all arrays or all None (pruned at compile time)
     fy = params[_P_FY]
     chi = params[_P_CHI]
     cap = int(params[_P_CAP])
@@ -388,124 +367,51 @@ def _segalman_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
     alpha = N * params[_P_INV_NREF]
     contact = alpha > 0.0 and fy > 0.0
     inc = params[_P_QS] * (x - s_old[_X])
-    m = 0
-    total = 0.0  # weighted integral of P over [0, u_max]
-    stuck = 0.0  # weighted measure of the stuck elements
-    tot_a = tot_b = st_a = 0.0
-    end_stuck = 0.0
-    pa = pb = np.nan
-    lo = 0.0
-    pleft = 0.0  # left^(chi + 1) of the next segment
-    k_lo = _end_kind(s_old[_HEAD + 1] + inc, 0.0)
-    pl_old = 0.0  # cached power of the old piece's lower breakpoint
-    for k in range(int(s_old[_M]) if contact else 0):
-        r = _HEAD + 3 * k
-        hi = s_old[r]
-        ph_old = s_old[base + k]
-        a = s_old[r + 1] + inc
-        b = s_old[r + 2]
-        k_hi = _end_kind(a + b * hi, alpha * hi)
-        c1 = c2 = hi
-        e1 = e2 = _END_HI
-        if k_lo != k_hi:
-            c1, c2, e1, e2 = _split(lo, hi, a, b, alpha, k_lo, k_hi)
-        left = lo
-        for seg in range(1 if k_lo == k_hi else 3):
-            right, kind, end = _segment(seg, c1, c2, hi, k_lo, k_hi, e1, e2)
-            if right > left:
-                a2, b2, kind = _coeffs(kind, a, b, alpha)
-                if kind == _STUCK or a2 != pa or b2 != pb:
-                    m += 1
-                _write(s_new, m - 1, right, a2, b2)
-                if ds_new is not None:
-                    _write_jvp(ds_new, ds_old, dx, dN, m - 1, r, kind, params[_P_QS], params[_P_INV_NREF], end, right,
-                               b, alpha)
-                pright = _right_power(end, right, chi, ph_old, pl_old)
-                s_new[base + m - 1] = pright
-                if chi == 0.0:  # the uniform law's operations
-                    total += _integral(left, right, a2, b2)
-                    if kind == _STUCK:
-                        stuck += right - left
-                else:  # the moments' numerators; multiplied by 1/(chi+1), 1/(chi+2) after the loop
-                    tot_a += a2 * (pright - pleft)
-                    tot_b += b2 * (right * pright - left * pleft)
-                    if kind == _STUCK:
-                        st_a += pright - pleft
-                end_stuck = 0.0  # whether the last segment (the element at u_max) is stuck
-                if kind == _STUCK:
-                    end_stuck = 1.0
-                pa, pb = a2, b2
-                left, pleft = right, pright
-        lo = hi
-        pl_old = ph_old
-        k_lo = k_hi
+    m, total, stuck, tot_a, tot_b, st_a, end_stuck = march_pieces(params, s_old, s_new, alpha, inc, contact, ds_old,
+                                                                  ds_new, dx, dN, (chi, base))
     # unconditional (a conditional reassignment cost 20 ns a step); 0 numerators when chi = 0
     total = total + (tot_a * params[_P_INV1] + tot_b * params[_P_INV2])
     stuck = stuck + st_a * params[_P_INV1]
     written = m
     if m > cap:
         m, total, stuck, end_stuck = _merges(s_new, ds_new, m, cap, alpha, total, stuck, params, dN, chi, base)
-    umax = params[_P_UMAX]
     if not contact:
-        _write(s_new, 0, umax, 0.0, 0.0)
+        _write(s_new, 0, params[_P_UMAX], 0.0, 0.0)
         s_new[base] = params[_P_UMAXP]
         m = 1
-    top = max(written, _held(s_new[_M], 3 * cap))
-    for rr in range(_HEAD + 3 * m, _HEAD + 3 * top):
-        s_new[rr] = 0.0
-        if ds_new is not None:
-            for j in range(ds_new.shape[1]):
-                ds_new[rr, j] = 0.0
-    for rr in range(base + m, base + top):
-        s_new[rr] = 0.0
-        if ds_new is not None:
-            for j in range(ds_new.shape[1]):
-                ds_new[rr, j] = 0.0
-    s_new[_X] = x
-    s_new[_M] = m
+    top = stale_top(s_new, written, 3 * cap)
+    clear_rows(s_new, ds_new, _HEAD + 3 * m, _HEAD + 3 * top)
+    clear_rows(s_new, ds_new, base + m, base + top)
     if ds_new is not None:
         if not contact:
-            _write_jvp(ds_new, ds_old, dx, dN, 0, _HEAD, _ZERO, 0.0, 0.0, _END_HI, umax, 0.0, 0.0)
+            _write_jvp(ds_new, ds_old, dx, dN, 0, _HEAD, _ZERO, 0.0, 0.0, _END_HI, params[_P_UMAX], 0.0, 0.0)
         _jvp_force(s_new, ds_new, m, params, dT, base)
-        for j in range(dx.shape[0]):
-            ds_new[_X, j] = dx[j]
-            ds_new[_M, j] = 0.0
-    # the delta at u_max: the last piece's end value (end_stuck tracked while writing: from
-    # the state here it cost 40 ns a step); a stuck last piece makes stuck > 0
+    finish_state(s_new, ds_new, dx, x, m)
+    return _force(params, s_new, m, alpha, total, stuck, end_stuck)
+
+
+@jit(inline="always")
+def _force(params, s_new, m, alpha, total, stuck, end_stuck):
+    """Force, tangent and code from the weighted integrals and the delta at u_max: the
+    last piece's end value (end_stuck tracked while writing: from the state here it cost
+    40 ns a step); a stuck last piece makes stuck > 0."""
     rl = _HEAD + 3 * (m - 1)
-    p_end = s_new[rl + 1] + s_new[rl + 2] * umax
+    p_end = s_new[rl + 1] + s_new[rl + 2] * params[_P_UMAX]
     code = STICK_SLIP if stuck > 0.0 else MACROSLIP
     if alpha <= 0.0:
         code = SEPARATION
     c_r = params[_P_CR]
     c_s = params[_P_CS]
-    return fy * (c_r * total + c_s * p_end), params[_P_KT] * (c_r * stuck + c_s * end_stuck), code
+    return params[_P_FY] * (c_r * total + c_s * p_end), params[_P_KT] * (c_r * stuck + c_s * end_stuck), code
 
 
 @jit(inline="always")
 def segalman_step(params, s_old, s_new, x, N):
-    """Trial step of the Segalman law (see module docstring).
-
-    Parameters
-    ----------
-    params : float64[:]
-        ``[kt (N/m), fy (N), N_ref (N), K, kt / fy (1/m), 1 / N_ref (1/N), chi, u_max, c_R, c_S]``.
-    s_old, s_new : float64[:]
-        Committed (not written) and trial state (layout of :mod:`jointdyn.laws.exact`,
-        last breakpoint at u_max).
-    x : float
-        Tangential displacement, m.
-    N : float
-        Normal load, N.
-
-    Returns
-    -------
-    T : float
-        Tangential force, N.
-    kT : float
-        Tangent dT/dx at fixed N, N/m.
-    code : int
-        SEPARATION (N <= 0), MACROSLIP (no element stuck) or STICK_SLIP.
+    """Trial step of the Segalman law: the kernel contract's ``step``
+    (:mod:`jointdyn.laws._base`: arguments, returns, units), with the
+    parameters and state of the module docstring (the pieces as in
+    :mod:`jointdyn.laws.exact`, the last breakpoint at u_max, then the power
+    cache); T and kT weigh the pieces by u^chi and add the delta at u_max.
     """
     return _segalman_core(params, s_old, s_new, x, N, None, None, None, None, None)
 
@@ -572,28 +478,13 @@ class Segalman(ContactLaw):
         help="linear pieces kept after a step (above it, three adjacent pieces are merged into two)",
     )
     name: ClassVar[str] = "segalman"
+    kernels: ClassVar[tuple] = (segalman_step, segalman_step_jvp, segalman_init, segalman_init_jvp)
 
     @property
     def smooth_force(self) -> bool:
         """True without a delta: the force then has no kink at the onset of macroslip
         (with beta > 0 the elements at phi_max slip all at once)."""
         return self.beta == 0.0
-
-    @property
-    def step(self):
-        return segalman_step
-
-    @property
-    def step_jvp(self):
-        return segalman_step_jvp
-
-    @property
-    def init(self):
-        return segalman_init
-
-    @property
-    def init_jvp(self):
-        return segalman_init_jvp
 
     @property
     def constants(self) -> tuple:
@@ -607,11 +498,9 @@ class Segalman(ContactLaw):
 
     @property
     def params(self) -> np.ndarray:
-        qs = self.kt / self.fy if self.fy > 0.0 else 0.0
         umax, c_r, c_s = self.constants
-        return np.array([self.kt, self.fy, self.n_ref, float(self.capacity), qs, 1.0 / self.n_ref,
-                         self.chi, umax, c_r, c_s, umax ** (self.chi + 1.0), 1.0 / (self.chi + 1.0),
-                         1.0 / (self.chi + 2.0)])
+        return np.array(density_params(self) + [self.chi, umax, c_r, c_s, umax ** (self.chi + 1.0),
+                                                1.0 / (self.chi + 1.0), 1.0 / (self.chi + 2.0)])
 
     @property
     def state_size(self) -> int:
@@ -629,23 +518,13 @@ class Segalman(ContactLaw):
         return True
 
     def _state_error(self, s):
-        """As :class:`~jointdyn.Iwan`, with the last live breakpoint at u_max."""
-        if not np.all(np.isfinite(s[:_HEAD])):
-            return f"entries 0..{_HEAD - 1} (x_prev, piece count) must be finite, got {s[:_HEAD].tolist()}"
-        m = s[_M]
-        if not (m == int(m) and 1 <= m <= self.capacity):
-            return f"entry {_M} (piece count) must be an integer in [1, {self.capacity}], got {float(m)!r}"
-        m = int(m)
-        live = s[_HEAD : _HEAD + 3 * m]
-        if not np.all(np.isfinite(live)):
-            return f"the {m} live pieces (entries {_HEAD}..{_HEAD + 3 * m - 1}) must be finite"
-        hi = live[0::3]
+        """As :class:`~jointdyn.Iwan` (last live breakpoint at u_max), and the power cache."""
         umax = self.constants[0]
-        if not (hi[0] > 0.0 and np.all(np.diff(hi) > 0.0) and hi[-1] == umax):
-            return (
-                f"the breakpoints (entries {_HEAD}, {_HEAD + 3}, ...) must increase strictly from above 0 "
-                f"and the last live one must be u_max = {umax!r}, got {hi.tolist()}"
-            )
+        err = pieces_error(s, self.capacity, umax, f"u_max = {umax!r}")
+        if err is not None:
+            return err
+        m = int(s[_M])
+        hi = s[_HEAD : _HEAD + 3 * m : 3]
         base = _HEAD + 9 * self.capacity
         cache = s[base : base + m]
         want = hi ** (self.chi + 1.0)
