@@ -155,3 +155,20 @@ def status_of(sol: Solution, reasons: dict) -> tuple:
     if reasons:
         return FitStatus.PARTLY_IDENTIFIED, "; ".join(f"{k} not identifiable: {v}" for k, v in reasons.items())
     return FitStatus.IDENTIFIED, FitStatus.IDENTIFIED.message
+
+
+def start_values(model: str, s_data: dict, start) -> dict:
+    """The data's start values ``s_data`` of a fit of ``model``, with those of ``start`` (a
+    mapping of fitted parameter names to values) put in their place.
+
+    Raises
+    ------
+    ValueError
+        ``start`` names a parameter that ``model`` does not fit.
+    """
+    s0 = dict(s_data)
+    for k, v in (start or {}).items():
+        if k not in s0:
+            raise ValueError(f"start has {k!r}, which model {model} does not fit (it fits {', '.join(s0)})")
+        s0[k] = float(v)
+    return s0

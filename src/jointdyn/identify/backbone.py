@@ -29,7 +29,7 @@ from .. import _validate as V
 from .. import config
 from ..laws import law_parameters, make_law
 from ..laws.segalman import CHI_MAX, CHI_MIN, segalman_constants
-from ._lsq import Param, open_reason, solve, status_of
+from ._lsq import Param, open_reason, solve, start_values, status_of
 from ._microslip import MICROSLIP_MODELS, microslip_backbone, microslip_constants, microslip_model
 from .result import FitResult, FitStatus
 
@@ -343,11 +343,7 @@ def fit_backbone(amplitude_m, omega_rad_s, damping_ratio, *, mass: float, model:
     fixed = dict(law_params or {})
     make_law(model, kt=1.0, mu=1.0, n_ref=1.0, **fixed)
     s_data = _start(model, A, w, D, m)
-    s0 = dict(s_data)
-    for k, v in (start or {}).items():
-        if k not in s0:
-            raise ValueError(f"start has {k!r}, which model {model} does not fit (it fits {', '.join(s0)})")
-        s0[k] = float(v)
+    s0 = start_values(model, s_data, start)
     params = _params(s0)
     dscale = float(np.max(D)) if np.max(D) > 0.0 else 1.0
     weights = [1.0, 1.0]

@@ -26,7 +26,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ..laws import make_law
-from ._lsq import open_reason, solve, status_of
+from ._lsq import open_reason, solve, start_values, status_of
 from .backbone import BACKBONE_MODELS, _grid, _params, describing_function
 from .result import FitResult
 
@@ -109,11 +109,7 @@ def fit_frc(force_N, omega_rad_s, amplitude_m, *, mass: float, model: str = conf
     fixed = dict(law_params or {})
     make_law(model, kt=1.0, mu=1.0, n_ref=1.0, **fixed)
     s_data = _start(model, F, w, A, m)
-    s0 = dict(s_data)
-    for k, v in (start or {}).items():
-        if k not in s0:
-            raise ValueError(f"start has {k!r}, which model {model} does not fit (it fits {', '.join(s0)})")
-        s0[k] = float(v)
+    s0 = start_values(model, s_data, start)
     params = _params(s0)
 
     def law_of(v):

@@ -21,7 +21,7 @@ from .. import config
 from ..drivers import march
 from ..laws import MACROSLIP, law_parameters, make_law
 from ..laws.segalman import CHI_MAX, CHI_MIN
-from ._lsq import Param, open_reason, solve, status_of
+from ._lsq import Param, open_reason, solve, start_values, status_of
 from .result import FitResult
 
 __all__ = ["fit_loops", "LOOP_MODELS"]
@@ -284,11 +284,7 @@ def fit_loops(x, N, T, model: str = config.MODEL, *, t=None, n_ref: float | None
     make_law(model, kt=1.0, mu=1.0, n_ref=1.0, **fixed)  # validates the held law parameters
     n_ref = float(np.mean(N[N > 0.0])) if n_ref is None else V.positive("n_ref", n_ref)
     s_data = _start(model, x, N, T, n_ref)
-    s0 = dict(s_data)
-    for k, v in (start or {}).items():
-        if k not in s0:
-            raise ValueError(f"start has {k!r}, which model {model} does not fit (it fits {', '.join(s0)})")
-        s0[k] = float(v)
+    s0 = start_values(model, s_data, start)
     params = _params(model, s0)
     starts = [s_data] + _grid(s_data)
     setup = _setup(model, x, N, T, n_ref, fixed, from_rest)
