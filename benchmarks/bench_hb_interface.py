@@ -83,7 +83,7 @@ def _time(q, X, count):
     kernel = pairs_aft_kernel()
     t0 = time.thread_time()
     kernel(q.pair_positions, q.pair_params, X, q.n, q.E, q.P, *q._pair_dirs, int(q.max_passes),
-           float(config.HB_PERIODIC_RTOL), R, JX, T, N, code, info)
+           float(config.HB_PERIODIC_RTOL), R, JX, q._no_blocks, T, N, code, info)
     t = (time.thread_time() - t0) / count * 1e6
     return t, type("Ev", (), {"info": info, "pair_code": code})
 
