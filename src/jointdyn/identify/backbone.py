@@ -20,6 +20,8 @@ omega_0 (what a modal dashpot gives, and what EPMC computes).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import math
 from dataclasses import replace
 
@@ -296,6 +298,25 @@ def _microslip_suffices(micro, sol, p) -> bool:
     return (ssr_m - ssr) / q <= float(f.ppf(config.FIT_LEVEL, q, dof)) * ssr / dof
 
 
+def modal_law(model: str, law_params) -> Callable:
+    """The joint law of a modal fit (backbone, response curves) from fitted values ``v`` (kt N/m, fy N,
+    and chi, beta where fitted), the held ``law_params`` validated once here.
+
+    Raises
+    ------
+    ValueError
+        ``law_params`` that ``model`` does not take or allow.
+    """
+    fixed = dict(law_params or {})
+    make_law(model, kt=1.0, mu=1.0, n_ref=1.0, **fixed)
+
+    def law_of(v):
+        shape = {k: v[k] for k in ("chi", "beta") if k in v}
+        return make_law(model, kt=v["kt"], mu=v["fy"], n_ref=1.0, **fixed, **shape)
+
+    return law_of
+
+
 def fit_backbone(amplitude_m, omega_rad_s, damping_ratio, *, mass: float, model: str = config.MODEL,
                  law_params: dict | None = None, start: dict | None = None, refine_harmonics: int | None = None,
                  refine_samples: int = config.HB_SAMPLES) -> FitResult:
@@ -340,17 +361,12 @@ def fit_backbone(amplitude_m, omega_rad_s, damping_ratio, *, mass: float, model:
     """
     V.choice("model", model, BACKBONE_MODELS)
     A, w, D, m = _check(amplitude_m, omega_rad_s, damping_ratio, mass)
-    fixed = dict(law_params or {})
-    make_law(model, kt=1.0, mu=1.0, n_ref=1.0, **fixed)
+    law_of = modal_law(model, law_params)
     s_data = _start(model, A, w, D, m)
     s0 = start_values(model, s_data, start)
     params = _params(s0)
     dscale = float(np.max(D)) if np.max(D) > 0.0 else 1.0
     weights = [1.0, 1.0]
-
-    def law_of(v):
-        shape = {k: v[k] for k in ("chi", "beta") if k in v}
-        return make_law(model, kt=v["kt"], mu=v["fy"], n_ref=1.0, **fixed, **shape)
 
     def fun(v, dw=0.0, dD=0.0):
         wf, Df = _model(law_of(v), v["k"], v["zeta"], m, A)

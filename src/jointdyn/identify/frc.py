@@ -25,9 +25,8 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ..laws import make_law
 from ._lsq import open_reason, solve, start_values, status_of
-from .backbone import BACKBONE_MODELS, _grid, _params, describing_function
+from .backbone import BACKBONE_MODELS, _grid, _params, describing_function, modal_law
 from .result import FitResult
 
 __all__ = ["fit_frc", "FRC_COLUMNS"]
@@ -106,15 +105,10 @@ def fit_frc(force_N, omega_rad_s, amplitude_m, *, mass: float, model: str = conf
     """
     V.choice("model", model, BACKBONE_MODELS)
     F, w, A, m = _check(force_N, omega_rad_s, amplitude_m, mass)
-    fixed = dict(law_params or {})
-    make_law(model, kt=1.0, mu=1.0, n_ref=1.0, **fixed)
+    law_of = modal_law(model, law_params)
     s_data = _start(model, F, w, A, m)
     s0 = start_values(model, s_data, start)
     params = _params(s0)
-
-    def law_of(v):
-        shape = {k: v[k] for k in ("chi", "beta") if k in v}
-        return make_law(model, kt=v["kt"], mu=v["fy"], n_ref=1.0, **fixed, **shape)
 
     def ratio(v, law, a):
         k1, en = describing_function(law, a)
