@@ -55,12 +55,18 @@ with tempfile.TemporaryDirectory() as d:
 """
 
 
-def _one(models: str, cache: str) -> float:
+def _env(cache: str) -> dict:
+    """Environment of a fresh process running this tree's jointdyn with the kernel cache under ``cache``."""
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src")] + [p for p in [env.get("PYTHONPATH")] if p])
     env["NUMBA_CACHE_DIR"] = cache
     env.pop("JOINTDYN_CACHE_DIR", None)
     env["MPLBACKEND"] = "Agg"
+    return env
+
+
+def _one(models: str, cache: str) -> float:
+    env = _env(cache)
     t0 = time.perf_counter()
     subprocess.run([sys.executable, "-c", _SCRIPT, models], env=env, check=True,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -76,11 +82,7 @@ README_COMMANDS = {
 
 def _command(args: list, cache: str) -> float:
     """Wall time of ``jointdyn ARGS`` in a fresh process with the Numba cache ``cache``."""
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src")] + [p for p in [env.get("PYTHONPATH")] if p])
-    env["NUMBA_CACHE_DIR"] = cache
-    env.pop("JOINTDYN_CACHE_DIR", None)
-    env["MPLBACKEND"] = "Agg"
+    env = _env(cache)
     t0 = time.perf_counter()
     subprocess.run([sys.executable, "-m", "jointdyn", *args], env=env, check=True, stdout=subprocess.DEVNULL,
                    stderr=subprocess.DEVNULL)
