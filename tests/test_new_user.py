@@ -135,3 +135,28 @@ def test_the_lap_joint_maps_label_each_row_once():
     labels = [axes[r, 0].get_ylabel() for r in range(2)]
     plt.close(fig)
     assert labels[0].startswith("(d) ") and labels[1].startswith("(e) ")
+
+
+def test_epmc_from_a_repeated_linear_mode_says_why_it_cannot_start(tmp_path, capsys):
+    """Two DOFs of equal stiffness and an open pair: mode 1's frequency is repeated, the start singular."""
+    f = tmp_path / "s.toml"
+    f.write_text(SYSTEM.format(preload="0.0").replace("[0.0, 2.0e3, 0.0]", "[0.0, 1.0e3, 0.0]"))
+    rc = run_cli(["modes", "--system", str(f), "--amplitude", "1e-6:1e-3", "--harmonics", "3", "--samples", "32",
+                  "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 3 and "no-start" in err and "repeated (mode 2 too)" in err and "detune" in err, err
+    f.write_text(SYSTEM.format(preload="0.0").replace("[0.0, 2.0e3, 0.0]", "[0.0, 1.0001e3, 0.0]"))
+    rc = run_cli(["modes", "--system", str(f), "--amplitude", "1e-6:1e-3", "--harmonics", "3", "--samples", "32",
+                  "--out", str(tmp_path / "o2")])
+    assert rc == 0, capsys.readouterr().err
+
+
+def test_a_linear_mode_knows_its_repeated_partners():
+    from jointdyn.modes._free import linear_stuck_mode
+
+    M = np.eye(3)
+    s = jd.System(M, np.zeros((3, 3)), np.diag([4.0, 4.0, 9.0]))
+    assert linear_stuck_mode(s, 1, 0).repeated == (2,)
+    assert linear_stuck_mode(s, 3, 2).repeated == ()
+    s = jd.System(M, np.zeros((3, 3)), np.diag([4.0, 4.0 * (1 + 1e-6), 9.0]))
+    assert linear_stuck_mode(s, 1, 0).repeated == ()

@@ -48,6 +48,10 @@ class LinearMode:
         The same shape with phi^T M phi = 1, kg^-1/2.
     stiffness : ndarray (n, n)
         The stuck stiffness K_reference + sum_c kt_c b_c b_c^T, N/m.
+    repeated : tuple of int
+        The other modes (1-based) with the same frequency to a relative
+        ``REPEATED_RTOL``: a repeated eigenvalue, whose mode shape is any
+        combination of theirs (empty for an isolated mode).
     """
 
     index: int
@@ -55,6 +59,12 @@ class LinearMode:
     shape: np.ndarray
     mass_normalised: np.ndarray
     stiffness: np.ndarray
+    repeated: tuple[int, ...] = ()
+
+
+#: Relative difference of two squared natural frequencies below which the eigenvalue is repeated: a few
+#: thousand times the rounding of a symmetric eigensolver, far below any physical detuning.
+REPEATED_RTOL = 1e-10
 
 
 def _constant(load) -> bool:
@@ -149,8 +159,11 @@ def linear_stuck_mode(system: System, mode: int, output_dof: int) -> LinearMode:
                          f"(|phi| = {abs(v[output_dof]):.3g} of {big:.3g}); choose a DOF that moves in it")
     if v[output_dof] < 0:
         v = -v
+    scale = max(abs(lam[k - 1]), float(np.max(np.abs(lam))) * np.finfo(float).eps)
+    repeated = tuple(int(j) + 1 for j in np.flatnonzero(np.abs(lam - lam[k - 1]) <= REPEATED_RTOL * scale)
+                     if j != k - 1)
     return LinearMode(index=k, omega_rad_s=math.sqrt(max(lam[k - 1], 0.0)), shape=v / v[output_dof],
-                      mass_normalised=v, stiffness=Ks)
+                      mass_normalised=v, stiffness=Ks, repeated=repeated)
 
 
 def contact_scale(system: System) -> float:

@@ -310,6 +310,16 @@ class EPMCProblem:
         return math.sqrt(float(Xm[1] @ M @ Xm[1] + Xm[2] @ M @ Xm[2]))
 
 
+def _repeated_note(linear) -> str:
+    """Why a start from a repeated eigenvalue fails, or ''."""
+    if not linear.repeated:
+        return ""
+    others = " and ".join(str(j) for j in linear.repeated)
+    return (f": its frequency {linear.omega_rad_s:.6g} rad/s is repeated (mode {others} too), so the mode shape "
+            "at small amplitude is any combination of theirs and the start is singular; detune the structure "
+            "slightly (e.g. the stiffness of one of the symmetric DOFs by 1e-4 of its value)")
+
+
 def _options(options, overrides) -> ContinuationOptions:
     """The step control of EPMC: modes defaults from config, then ``options``, then ``overrides``."""
     if options is None:
@@ -453,7 +463,8 @@ def _walked(problem: EPMCProblem, lam0, lam1, opt, progress, reduction) -> Backb
     v0, ok, _ = newton(problem.residual, problem.linear_guess(), lam0, opt, max_iter=config.MODES_START_MAX_ITER)
     if not ok:
         return _backbone(problem, ModeStatus.NO_START, f"Newton did not converge at the smallest amplitude "
-                         f"{10.0 ** lam0:.6g} m from linear stuck mode {problem.linear.index}", np.empty(0),
+                         f"{10.0 ** lam0:.6g} m from linear stuck mode {problem.linear.index}"
+                         f"{_repeated_note(problem.linear)}", np.empty(0),
                          np.empty((0, problem.size)), {}, {"points": 0}, reduction)
     stash = {}
 
