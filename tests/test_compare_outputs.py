@@ -74,7 +74,7 @@ def test_removed_number_is_reported(tmp_path):
 
 
 def test_netcdf_variables_attributes_and_nan(tmp_path):
-    xr = pytest.importorskip("xarray")
+    import xarray as xr
 
     def write(path, ds):
         ds.to_netcdf(path)

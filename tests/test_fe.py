@@ -7,6 +7,7 @@ of small meshes written by meshio (Abaqus NSETs, Gmsh 2 and 4 physical
 groups) are paired with the nodes at the same place.
 """
 
+import meshio
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -14,7 +15,6 @@ from hypothesis import strategies as st
 
 from jointdyn.fe import interface_from_mesh, interface_from_triplets, match_nodes, pair_frames, read_node_sets
 
-meshio = pytest.importorskip("meshio")
 
 
 def _spd(n, rng):
