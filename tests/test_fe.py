@@ -16,7 +16,6 @@ from hypothesis import strategies as st
 from jointdyn.fe import interface_from_mesh, interface_from_triplets, match_nodes, pair_frames, read_node_sets
 
 
-
 def _spd(n, rng):
     A = rng.normal(size=(n, n))
     return A @ A.T + n * np.eye(n)
