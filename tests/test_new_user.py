@@ -160,3 +160,48 @@ def test_a_linear_mode_knows_its_repeated_partners():
     assert linear_stuck_mode(s, 3, 2).repeated == ()
     s = jd.System(M, np.zeros((3, 3)), np.diag([4.0, 4.0 * (1 + 1e-6), 9.0]))
     assert linear_stuck_mode(s, 1, 0).repeated == ()
+
+
+HELD_BY_FRICTION = """
+[structure]
+M = [[1.0, 0.0], [0.0, 0.5]]
+K = [[1.0e4, 0.0], [0.0, 0.0]]
+
+[[force]]
+dof = 0
+amplitude = 2.0
+
+[[contact]]
+law = "jenkins"
+kt = 2.0e4
+mu = 0.5
+tangential = { dof = 0, dof2 = 1 }
+normal = { n0 = 10.0 }
+"""
+
+
+def test_hb_refuses_a_dof_held_only_by_friction_and_says_why(tmp_path, capsys):
+    """DOF 1 hangs on DOF 0 through a friction contact only: stuck, the structure is held, but harmonic
+    balance restarts the law at the mean of the motion, so friction holds no mean position; the solver
+    (and so the command line) says so instead of failing in Newton at the start."""
+    from jointdyn.hb import check_mean_position, frc_hb
+
+    f = tmp_path / "s.toml"
+    f.write_text(HELD_BY_FRICTION)
+    s = jd.read_system(f)
+    with pytest.raises(ValueError, match=r"DOF 1 is held only by friction \(by contact\[0\]\.kt\)"):
+        check_mean_position(s)
+    with pytest.raises(ValueError, match="held only by friction"):
+        frc_hb(s, 0.5, 1.5, harmonics=1, samples=16)
+    out = tmp_path / "o"
+    rc = run_cli(["frc", "--system", str(f), "--method", "hb", "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and "held only by friction" in err and "--method time" in err
+    assert not out.exists()
+    held = f.read_text().replace("[0.0, 0.0]]", "[0.0, 1.0e2]]")  # a soft spring to ground fixes the offset
+    check_mean_position(jd.read_system(_write_text(tmp_path / "h.toml", held)))
+
+
+def _write_text(path, text):
+    path.write_text(text)
+    return path
