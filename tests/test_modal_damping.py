@@ -248,3 +248,30 @@ def test_reduced_dense_model_with_modal_damping_through_both_paths():
     b = continue_hb(r2, 0.7, 1.3, harmonics=2, samples=32, condense=False)
     assert a.status.ok and b.status.ok
     assert b.response()[0].max() == pytest.approx(a.response()[0].max(), rel=1e-8)
+
+
+def test_condensation_takes_the_modes_of_the_operator():
+    """Ratios on the modes of (M, K) itself (no normal springs: K_reference is K): the condensed receptance
+    takes the operator's modes instead of decomposing (M, K) again, and equals the receptance of the dense
+    C at frequencies across the modes; an HB solution through the condensation is the same to 1e-8."""
+    from jointdyn.hb import harmonic_balance
+    from jointdyn.hb.condense import receptance
+    from jointdyn.laws.discrete import Jenkins
+
+    M, K = _pencil(12, seed=8)
+    op = jd.modal_damping(M, K, np.linspace(0.01, 0.04, 12), form="operator")
+    law = Jenkins(kt=float(np.mean(np.diag(K))), mu=0.3, n_ref=1.0)
+    f = np.zeros(12)
+    f[0] = 0.2
+    kw = dict(M=M, K=K, contacts=(jd.Contact(law, dof=3),), force=f, output_dof=3)
+    sa, so = jd.System(C=op.toarray(), **kw), jd.System(C=op, **kw)
+    ra, ro = receptance(sa), receptance(so)
+    np.testing.assert_array_equal(ro.vectors, op.phi)
+    cols = np.array([0, 3, 7])
+    for W in np.sqrt(op.lam[[0, 5, 11]]) * 1.01:
+        Ha, Ho = ra.block(W, np.arange(12), cols), ro.block(W, np.arange(12), cols)
+        np.testing.assert_allclose(Ho, Ha, rtol=0, atol=1e-10 * np.abs(Ha).max())
+    xa = harmonic_balance(sa, 1.05, harmonics=3, samples=32, condense=True)
+    xo = harmonic_balance(so, 1.05, harmonics=3, samples=32, condense=True)
+    assert xa.status.ok and xo.status.ok
+    np.testing.assert_allclose(xo.X, xa.X, rtol=0, atol=1e-8 * np.abs(xa.X).max())

@@ -25,8 +25,12 @@ Diagonal in the modes: when Phi holds all n modes of (M, K), the linear
 terms of harmonic k in the modal coordinates q (x = Phi q) are the 2 x 2
 blocks ``[[w_r^2 - (k w)^2, k w d_r], [-k w d_r, w_r^2 - (k w)^2]]`` per
 mode, so that ``(K - (k w)^2 M + i k w C)^-1 = Phi diag(1 / (w_r^2 - (k w)^2
-+ i k w d_r)) Phi^T``: :meth:`ModalDamping.harmonic_solve` (no
-factorisation; used by the linear start of harmonic balance).
++ i k w d_r)) Phi^T`` (:meth:`ModalDamping.harmonic_solve`: no
+factorisation). The condensation of harmonic balance onto the contacts
+(:mod:`jointdyn.hb.condense`), whose receptance is this expansion, takes
+the modes from the operator when they are those of the structure's K
+(:meth:`ModalDamping.modes_of`: the ratios given for (M, K) itself), instead
+of decomposing (M, K) and projecting C again (two O(n^3) steps).
 """
 
 from __future__ import annotations
@@ -56,6 +60,9 @@ class ModalDamping:
     lam : array_like (m,), optional
         Eigenvalues w^2 of (M, K) of the modes (rad^2/s^2; default w^2): with all n modes,
         :meth:`harmonic_solve` uses them.
+    stiffness : ndarray (n, n), optional
+        The K (N/m) whose modes these are (kept as given, not copied: a solver whose structure has this
+        K takes the modes from here instead of decomposing (M, K) again).
 
     Notes
     -----
@@ -66,7 +73,7 @@ class ModalDamping:
     #: numpy defers its binary operators to this class (C * 2.0 is refused, not broadcast element-wise)
     __array_priority__ = 100.0
 
-    def __init__(self, M, phi, zeta, w, lam=None):
+    def __init__(self, M, phi, zeta, w, lam=None, stiffness=None):
         M = V.finite_array("M", np.atleast_2d(M), 2)
         phi = V.finite_array("phi", np.atleast_2d(np.asarray(phi, dtype=np.float64)), 2)
         n, m = phi.shape
@@ -83,6 +90,8 @@ class ModalDamping:
         lam = w * w if lam is None else np.broadcast_to(np.asarray(lam, dtype=np.float64), (m,)).copy()
         self.phi = phi
         self.zeta, self.w, self.lam = z, w, lam
+        #: the K of the modes (N/m) when given, else None
+        self.stiffness = stiffness
         #: B = M Phi (n, m), kg
         self.B = np.ascontiguousarray(M @ phi)
         #: d = 2 zeta w (m,), 1/s
@@ -168,6 +177,11 @@ class ModalDamping:
             if best is None or err < best[0]:
                 best = (err, (c, 0.0) if col == 0 else (0.0, c))
         return best[1]
+
+    def modes_of(self, K) -> bool:
+        """True when all n modes are kept and they are those of (M, ``K``) (the ``stiffness`` given is K)."""
+        return self.complete and self.stiffness is not None and (
+            self.stiffness is K or np.array_equal(self.stiffness, K))
 
     def harmonic_solve(self, kw: float, r) -> np.ndarray:
         """x of (K - kw^2 M + i kw C) x = r for complex r (n,) or (n, k), with all n modes kept

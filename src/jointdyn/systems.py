@@ -652,7 +652,7 @@ def modal_damping(M, K, zeta, *, form: str = "array"):
         raise ValueError(f"zeta must be a number >= 0 or {n} numbers >= 0 (one per mode), got {zeta!r}")
     lam, phi = eigh(K, M)
     w = np.sqrt(np.maximum(lam, 0.0))
-    op = ModalDamping(M, phi, z, w, lam=lam)
+    op = ModalDamping(M, phi, z, w, lam=lam, stiffness=K)
     return op if form == "operator" else op.toarray()
 
 

@@ -71,7 +71,7 @@ import numpy as np
 from .. import config
 from .._cache import by_identity
 from .._jit import jit
-from ..damping import dense_damping
+from ..damping import dense_damping, is_operator
 from ..kinematics import contact_kinematics, selection_matrix
 from ..systems import System
 from .problem import HBProblem, _linear_blocks, contacts_only
@@ -385,10 +385,14 @@ def _expansion(system: System):
     """(kind, vectors, a, b, basis) of the receptance expansion and the undamped w_r^2 (module docstring).
 
     Rayleigh (or no) damping keeps Psi factored (:func:`_tridiagonal_modes`);
-    other damping needs the dense modes for Phi^T C Phi.
+    other damping needs the dense modes for Phi^T C Phi, except modal damping kept as an operator on the
+    modes of (M, K) (:class:`jointdyn.damping.ModalDamping`), whose modes are taken as they are.
     """
     from scipy.linalg import eigh
 
+    if is_operator(system.C) and system.C.modes_of(system.K):  # modal damping on the modes of (M, K)
+        op = system.C
+        return (MODAL, np.array(op.phi), np.array(op.lam), np.array(op.d), None), np.array(op.lam)
     M, C, K = system.M, dense_damping(system.C), system.K
     ab = _rayleigh(M, C, K)
     if ab is not None and system.ndof > 1:
