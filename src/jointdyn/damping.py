@@ -70,7 +70,7 @@ class ModalDamping:
     and :meth:`toarray` give the dense matrix (made once).
     """
 
-    #: numpy defers its binary operators to this class (C * 2.0 is refused, not broadcast element-wise)
+    #: numpy defers its binary operators to the reflected ones of this class (``A @ C`` is ``__rmatmul__``)
     __array_priority__ = 100.0
 
     def __init__(self, M, phi, zeta, w, lam=None, stiffness=None):
