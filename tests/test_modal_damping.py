@@ -275,3 +275,13 @@ def test_condensation_takes_the_modes_of_the_operator():
     xo = harmonic_balance(so, 1.05, harmonics=3, samples=32, condense=True)
     assert xa.status.ok and xo.status.ok
     np.testing.assert_allclose(xo.X, xa.X, rtol=0, atol=1e-8 * np.abs(xa.X).max())
+
+
+def test_resume_key_of_a_system_with_the_operator():
+    """A sweep's resume key describes the operator by its factors: the same damping gives the same key,
+    other ratios another one."""
+    from jointdyn.sweeps._family import fingerprint
+
+    M, K = _pencil(5, seed=9)
+    keys = [fingerprint(jd.System(M=M, K=K, C=jd.modal_damping(M, K, z, form="operator"))) for z in (0.01, 0.01, 0.02)]
+    assert keys[0] == keys[1] != keys[2]
