@@ -158,6 +158,25 @@ def test_large_solves_with_the_operator_equal_the_direct_dense_solve(monkeypatch
     assert "approximation_fallbacks" not in fr.counts
 
 
+def test_large_solve_falls_back_to_the_dense_solve(monkeypatch):
+    """Where GMRES with the sparse part's factors does not reach the tolerance (here: one nobody reaches), the
+    solve is LAPACK's on the dense matrix, and counted."""
+    from jointdyn.continuation.linalg import FactorReuse, _bordered
+
+    monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
+    monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
+    _, so = _pair(3)
+    q = HBProblem(so, harmonics=2, samples=32)
+    rng = np.random.default_rng(5)
+    ev = q.evaluate_sparse(1e-4 * rng.standard_normal(q.size), 1.0)
+    d, b = rng.standard_normal(q.size + 1), rng.standard_normal(q.size + 1)
+    monkeypatch.setattr(config, "CONT_KRYLOV_RTOL", 0.0)
+    fr = FactorReuse()
+    x, ok = fr.solve(ev.JX, ev.Jp, d, b)
+    assert ok and fr.counts["approximation_fallbacks"] == 1
+    np.testing.assert_array_equal(x, np.linalg.solve(_bordered(ev.JX.toarray(), ev.Jp, d), b))
+
+
 def test_hb_branch_and_solution_with_the_operator_equal_those_with_dense_c(monkeypatch):
     """A branch through the sparse evaluation with the operator (and its solves) against the dense path with
     the dense C: the same peak; one solution at a fixed frequency equal to 1e-8."""
