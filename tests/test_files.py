@@ -156,6 +156,26 @@ def test_modal_damping_and_w0_override(tmp_path):
     np.testing.assert_allclose(modal - np.diag(np.diag(modal)), 0.0, atol=1e-12 * np.abs(modal).max())
     scalar = jd.read_system(_write(tmp_path, BASE.replace("[[force]]", "zeta = 0.02\n\n[[force]]"), "c.toml"))
     np.testing.assert_allclose(scalar.C, jd.modal_damping(s.M, s.K_reference, 0.02), rtol=1e-14)
+    assert isinstance(scalar.C, jd.ModalDamping)  # kept as an operator: no n x n C for a large structure
+
+
+def test_zeta_basis_stuck_gives_the_ratios_of_the_stuck_modes(tmp_path):
+    """zeta_basis = "stuck": the ratios are those of the modes of (M, K + every contact's kt and closed
+    normal spring), the structure a modal test excites at low level; "slipping" is the default."""
+    from scipy.linalg import eigh
+
+    text = BASE.replace("[[force]]", 'zeta = [0.01, 0.03]\nzeta_basis = "stuck"\n\n[[force]]')
+    s = jd.read_system(_write(tmp_path, text))
+    Ks = s.K + s.contacts[0].law.kt * np.outer([1.0, 0.0], [1.0, 0.0])  # the contact on DOF 0 against ground
+    np.testing.assert_allclose(jd.stuck_stiffness(s), Ks, rtol=1e-15)
+    lam, phi = eigh(Ks, s.M)
+    modal = phi.T @ (s.C @ phi)
+    np.testing.assert_allclose(np.diag(modal), 2 * np.array([0.01, 0.03]) * np.sqrt(lam), rtol=1e-12)
+    np.testing.assert_allclose(modal - np.diag(np.diag(modal)), 0.0, atol=1e-12 * np.abs(modal).max())
+    slipping = jd.read_system(_write(tmp_path, text.replace('"stuck"', '"slipping"'), "d.toml"))
+    default = jd.read_system(_write(tmp_path, text.replace('zeta_basis = "stuck"\n', ""), "e.toml"))
+    np.testing.assert_array_equal(slipping.C.toarray(), default.C.toarray())
+    assert np.max(np.abs(slipping.C.toarray() - s.C.toarray())) > 1e-3 * np.max(np.abs(s.C.toarray()))
 
 
 def test_w0_skips_rigid_body_modes(tmp_path):
@@ -272,6 +292,10 @@ BAD = [
     ("zeta and C", _add("[structure]", "C = [[0.0, 0.0], [0.0, 0.0]]\nzeta = 0.01"),
      "structure.zeta cannot be combined with a damping matrix C"),
     ("negative zeta", _add("[structure]", "zeta = -0.01"), "structure.zeta must be >= 0"),
+    ("zeta_basis without zeta", _add("[structure]", 'zeta_basis = "stuck"'),
+     "structure.zeta_basis needs structure.zeta"),
+    ("unknown zeta_basis", _add("[structure]", 'zeta = 0.01\nzeta_basis = "free"'),
+     "structure.zeta_basis must be one of 'slipping', 'stuck'"),
     ("zeta per mode of the wrong length", _add("[structure]", "zeta = [0.01]"), "structure.zeta must have 2 entries"),
     ("w0 zero", _add("[structure]", "w0 = 0.0"), "structure.w0 must be > 0"),
     ("no stiffness and no w0", _sub("K = [[3.0e5, -1.0e5], [-1.0e5, 1.0e5]]", "K = [[0.0, 0.0], [0.0, 0.0]]"),

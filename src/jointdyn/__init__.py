@@ -40,7 +40,8 @@ from .drivers import LoopResult, harmonic_history, harmonic_loop, march, quasist
 from .drivers import InterfaceLoopResult, interface_loop
 from .interfaces import Interface
 from .kinematics import ConstantLoad, HarmonicLoad, NormalSpring, SampledLoad
-from .systems import PAPER, Contact, System, modal_damping
+from .damping import ModalDamping
+from .systems import PAPER, Contact, System, modal_damping, stuck_stiffness
 from .files import read_matrices, read_system
 
 __version__ = "0.1.0"
@@ -120,6 +121,8 @@ __all__ = [
     "Contact",
     "PAPER",
     "modal_damping",
+    "ModalDamping",
+    "stuck_stiffness",
     "read_system",
     "read_matrices",
     *_LAZY,

@@ -33,6 +33,7 @@ import numpy as np
 
 from . import _validate as V
 from . import config
+from .damping import dense_damping
 from .kinematics import NormalSpring
 from .systems import Contact, System
 
@@ -415,7 +416,8 @@ def reduce_system(system: System, n_modes: int, boundary_dofs=None) -> tuple[Sys
     if not isinstance(system, System):
         raise ValueError(f"system must be a System, got {type(system).__name__}")
     b = default_boundary(system) if boundary_dofs is None else boundary_dofs
-    cb = craig_bampton(system.M, system.K, b, n_modes, C=system.C, K_modes=system.K_reference)
+    # modal damping made dense: T^T C T of a reduced model is dense whatever C is
+    cb = craig_bampton(system.M, system.K, b, n_modes, C=dense_damping(system.C), K_modes=system.K_reference)
     out = int(system.response_dof)
     if out not in cb.boundary:
         raise ValueError(f"boundary_dofs must contain the response DOF {out}")

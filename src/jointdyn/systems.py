@@ -25,11 +25,12 @@ import numpy as np
 
 from . import _validate as V
 from . import config
+from .damping import ModalDamping
 from .interfaces import Interface
 from .kinematics import ConstantLoad, HarmonicLoad, NormalLoad, NormalSpring, _selection
 from .laws import ContactLaw, make_law
 
-__all__ = ["Contact", "System", "PAPER", "PAPER_NORMAL_DOF", "modal_damping"]
+__all__ = ["Contact", "System", "PAPER", "PAPER_NORMAL_DOF", "modal_damping", "stuck_stiffness"]
 
 #: the paper's section-3 damper (docs/model.md section 6)
 PAPER = dict(m=10.0, k=3.9e5, kt=3.0e5, kn=3.0e5, mu=0.5, n0=100.0)
@@ -164,7 +165,11 @@ class System:
     M, C, K : array_like
         Mass (kg, symmetric positive definite), viscous damping (N s/m; None
         for none; :func:`modal_damping` builds one from modal ratios) and
-        stiffness (N/m, symmetric) matrices, n x n.
+        stiffness (N/m, symmetric) matrices, n x n. C may also be a
+        :class:`~jointdyn.damping.ModalDamping` (modal damping kept as an
+        operator, ``modal_damping(..., form="operator")``): the solvers apply
+        it without an n x n array where the structure is sparse
+        (:mod:`jointdyn.damping` lists where it is made dense).
     contacts : tuple of Contact
         The frictional contacts (each with its own law and normal load).
     force : array_like
@@ -205,7 +210,12 @@ class System:
             raise ValueError("M must be symmetric positive definite (eigenvalues in (0, inf))")
         K = _square("K", self.K, n)
         _symmetric("K", K)
-        C = np.zeros((n, n)) if self.C is None else _square("C", self.C, n)
+        if isinstance(self.C, ModalDamping):
+            C = self.C
+            if C.shape != (n, n):
+                raise ValueError(f"C must be {n} x {n}, got a ModalDamping of shape {C.shape}")
+        else:
+            C = np.zeros((n, n)) if self.C is None else _square("C", self.C, n)
         contacts = tuple(self.contacts)
         for i, c in enumerate(contacts):
             if not isinstance(c, Contact):
@@ -601,13 +611,16 @@ def _dense(dof: int, dof2: int, direction, n: int) -> np.ndarray:
     return b
 
 
-def modal_damping(M, K, zeta) -> np.ndarray:
-    """Viscous damping matrix with modal damping ratios, N s/m.
+def modal_damping(M, K, zeta, *, form: str = "array"):
+    """Viscous damping with modal damping ratios, N s/m.
 
     ``C = M Phi diag(2 zeta_r w_r) Phi^T M`` with the mass-normalised modes
     Phi and natural frequencies w_r (rad/s) of (M, K), so that mode r of the
-    undamped structure has damping ratio zeta_r. Pass the stiffness the
-    ratios refer to (e.g. ``System.K_reference``, with the normal springs).
+    undamped structure (M, K) has damping ratio zeta_r. Pass the stiffness the
+    ratios refer to: :func:`stuck_stiffness` of a System (every contact and
+    interface pair stuck, normal springs closed: the structure a modal test
+    measures at low level) or ``System.K_reference`` (normal springs in place,
+    tangential contacts free).
 
     Parameters
     ----------
@@ -616,9 +629,16 @@ def modal_damping(M, K, zeta) -> np.ndarray:
     zeta : float or array_like (n,)
         Damping ratio of every mode, or one per mode in increasing frequency
         (>= 0). Rigid-body modes (w_r = 0) get no damping.
+    form : {"array", "operator"}
+        ``"array"`` (default): the dense n x n ndarray. ``"operator"``: a
+        :class:`~jointdyn.damping.ModalDamping` that applies C in O(n^2)
+        without forming it, which :class:`System` takes as its C (harmonic
+        balance and EPMC of a sparse structure then keep their Jacobians
+        sparse); ``.toarray()`` gives the same array as ``"array"``.
     """
     from scipy.linalg import eigh
 
+    V.choice("form", form, ("array", "operator"))
     M = V.finite_array("M", np.atleast_2d(M), 2)
     K = V.finite_array("K", np.atleast_2d(K), 2)
     n = M.shape[0]
@@ -632,8 +652,18 @@ def modal_damping(M, K, zeta) -> np.ndarray:
         raise ValueError(f"zeta must be a number >= 0 or {n} numbers >= 0 (one per mode), got {zeta!r}")
     lam, phi = eigh(K, M)
     w = np.sqrt(np.maximum(lam, 0.0))
-    MP = M @ phi
-    return (MP * (2.0 * z * w)) @ MP.T
+    op = ModalDamping(M, phi, z, w, lam=lam, stiffness=K)
+    return op if form == "operator" else op.toarray()
+
+
+def stuck_stiffness(system) -> np.ndarray:
+    """Stiffness (n, n) N/m of ``system`` at rest with every contact and every interface pair closed at
+    rest stuck (their kt, kn in place: :func:`static_springs`): the structure whose modes a modal test
+    measures at low amplitude."""
+    K = np.array(system.K, dtype=np.float64)
+    for _, k, b in static_springs(system):
+        K += k * np.outer(b, b)
+    return K
 
 
 def static_springs(system, open_pairs: bool = False) -> list:

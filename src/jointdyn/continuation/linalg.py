@@ -229,6 +229,12 @@ class FactorReuse:
         import scipy.linalg as sla  # here: small problems never need it, and the CLI starts without it
 
         n = Jy.shape[0]
+        if getattr(Jy, "approximation", None) is not None:  # a sparse matrix plus an operator
+            x = self._approximated(Jy, Jl, d, b)
+            if x is not None:
+                return x, True
+            self.counts["approximation_fallbacks"] = self.counts.get("approximation_fallbacks", 0) + 1
+            return _lapack_solve(_bordered(Jy.toarray(), Jl, d), b)
         if self.sparse is None:
             if _is_structured(Jy):  # its caller chose the blocks for a dense structure
                 self.sparse = False
@@ -292,6 +298,35 @@ class FactorReuse:
         if f.L.nnz + f.U.nnz > config.CONT_SPARSE_FILL * A.shape[0] ** 2:
             self.sparse, self.splu = False, None
         return x, bool(np.isfinite(x).all())
+
+    def _approximated(self, Jy, Jl, d, b):
+        """x by GMRES on the exact product of ``Jy`` preconditioned by the SuperLU factors of its sparse
+        ``approximation()`` (the kept ones, else fresh ones of this matrix), or None when even fresh ones do not
+        reach the tolerance (the caller solves directly). Harmonic balance with modal damping as an operator:
+        :mod:`jointdyn.hb._damped`."""
+        import scipy.sparse.linalg as spla
+
+        def times(x):
+            return _bordered_times(Jy, Jl, d, x)
+
+        A = _sparse_bordered(Jy.approximation(), Jl, d)
+        f = self.splu
+        if f is not None and f.shape == A.shape and not self.stale:
+            x = self._krylov(times, f.solve, b, config.CONT_BLOCK_MAXITER, right=True)
+            if x is not None:
+                return x
+        self.stale, self.splu = False, None
+        for thresh in config.CONT_SPARSE_PIVOTS:  # the diagonal pivots first (least fill), then safer ones
+            try:
+                f = spla.splu(A, diag_pivot_thresh=thresh)
+            except RuntimeError:  # exactly singular with these pivots
+                continue
+            self.counts["sparse_factorisations"] += 1
+            x = self._krylov(times, f.solve, b, config.CONT_BLOCK_MAXITER, right=True)
+            if x is not None:
+                self.splu = f
+                return x
+        return None
 
     def _structured(self, Jy, Jl, d, b):
         """x by GMRES preconditioned with the structured factors (the kept ones, else fresh ones of this

@@ -16,6 +16,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from .._cache import by_identity
+from ..damping import dense_damping
 from ..kinematics import (
     NORMAL_HARMONIC,
     NORMAL_SAMPLED,
@@ -125,7 +126,7 @@ def pack_system(system) -> PackedSystem:
     M = np.ascontiguousarray(system.M, dtype=np.float64)
     Minv = np.ascontiguousarray(np.linalg.inv(system.M))
     K = np.ascontiguousarray(system.K, dtype=np.float64)
-    C = np.ascontiguousarray(system.C, dtype=np.float64)
+    C = np.ascontiguousarray(dense_damping(system.C))  # the march's K and inverse mass are dense too
     fvec = np.ascontiguousarray(system.force, dtype=np.float64)
     phi = np.radians(system.force_phase_deg)
     fsin = np.ascontiguousarray(fvec * np.cos(phi))

@@ -34,7 +34,10 @@ __all__ = ["SystemFile", "read_system", "read_system_file", "read_matrices"]
 
 #: top-level keys of a system file
 _TOP_KEYS = ("title", "structure", "force", "contact", "interface", "output")
-_STRUCTURE_KEYS = ("M", "K", "C", "zeta", "file", "w0")
+_STRUCTURE_KEYS = ("M", "K", "C", "zeta", "zeta_basis", "file", "w0")
+#: what the modal ratios ``zeta`` refer to (``zeta_basis``): the modes with the contacts slipping (tangential
+#: springs out, normal springs closed: ``System.K_reference``), the default, or stuck (``stuck_stiffness``)
+ZETA_BASES = ("slipping", "stuck")
 _FORCE_KEYS = ("dof", "amplitude", "phase_deg")
 #: keys of a contact beside its law's own parameters
 _CONTACT_KEYS = ("law", "kt", "mu", "n_ref", "tangential", "normal")
@@ -369,7 +372,14 @@ def _structure(where: _Where, s, folder: Path) -> dict:
     _check_matrices(where, mats)
     if "C" in mats and "zeta" in s:
         raise where.error("structure.zeta", "cannot be combined with a damping matrix C; give one")
-    out = {"mats": mats, "zeta": None, "w0": None}
+    out = {"mats": mats, "zeta": None, "w0": None, "zeta_basis": ZETA_BASES[0]}
+    if "zeta_basis" in s:
+        if "zeta" not in s:
+            raise where.error("structure.zeta_basis", "needs structure.zeta (the ratios it refers to)")
+        if s["zeta_basis"] not in ZETA_BASES:
+            raise where.error("structure.zeta_basis", f"must be one of {', '.join(map(repr, ZETA_BASES))}, "
+                              f"got {s['zeta_basis']!r:.60}")
+        out["zeta_basis"] = s["zeta_basis"]
     if "zeta" in s:
         z = s["zeta"]
         n = mats["M"].shape[0]
@@ -583,7 +593,7 @@ def read_system_file(path) -> SystemFile:
     """
     import tomllib
 
-    from ..systems import System, modal_damping
+    from ..systems import System, modal_damping, stuck_stiffness
 
     p = Path(os.fspath(path))
     where = _Where(p)
@@ -622,8 +632,9 @@ def read_system_file(path) -> SystemFile:
               interfaces=interfaces)
     try:
         system = System(M, st["mats"].get("C"), K, **kw)
-        if st["zeta"] is not None:
-            system = System(M, modal_damping(M, system.K_reference, st["zeta"]), K, **kw)
+        if st["zeta"] is not None:  # an operator: no n x n C for a large sparse structure (jointdyn.damping)
+            Kz = system.K_reference if st["zeta_basis"] == "slipping" else stuck_stiffness(system)
+            system = System(M, modal_damping(M, Kz, st["zeta"], form="operator"), K, **kw)
     except ValueError as exc:
         raise ValueError(" ".join(f"{p}: {exc}".split())) from None
     if st["w0"] is None and not math.isfinite(system.w0):

@@ -66,6 +66,7 @@ from ..continuation import (
     refine_maximum,
     turning_points,
 )
+from ..damping import has_damping
 from ..fourier import derivative_matrix
 from ..laws import MACROSLIP, SEPARATION
 from ..systems import System
@@ -242,7 +243,7 @@ def _scales(problem: HBProblem, start: float):
 
 def _saturation_test(problem: HBProblem, ev, X, q, lam):
     """Describing-function saturation test (module docstring); None or reason."""
-    if q < config.HB_SATURATION_Q or np.any(problem.system.C != 0.0) or problem.system.ndof != 1:
+    if q < config.HB_SATURATION_Q or has_damping(problem.system.C) or problem.system.ndof != 1:
         return None
     for code in ev.code:
         slip = np.mean((code == MACROSLIP) | (code == SEPARATION))

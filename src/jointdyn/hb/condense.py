@@ -71,6 +71,7 @@ import numpy as np
 from .. import config
 from .._cache import by_identity
 from .._jit import jit
+from ..damping import dense_damping, is_operator
 from ..kinematics import contact_kinematics, selection_matrix
 from ..systems import System
 from .problem import HBProblem, _linear_blocks, contacts_only
@@ -384,11 +385,15 @@ def _expansion(system: System):
     """(kind, vectors, a, b, basis) of the receptance expansion and the undamped w_r^2 (module docstring).
 
     Rayleigh (or no) damping keeps Psi factored (:func:`_tridiagonal_modes`);
-    other damping needs the dense modes for Phi^T C Phi.
+    other damping needs the dense modes for Phi^T C Phi, except modal damping kept as an operator on the
+    modes of (M, K) (:class:`jointdyn.damping.ModalDamping`), whose modes are taken as they are.
     """
     from scipy.linalg import eigh
 
-    M, C, K = system.M, system.C, system.K
+    if is_operator(system.C) and system.C.modes_of(system.K):  # modal damping on the modes of (M, K)
+        op = system.C
+        return (MODAL, np.array(op.phi), np.array(op.lam), np.array(op.d), None), np.array(op.lam)
+    M, C, K = system.M, dense_damping(system.C), system.K
     ab = _rayleigh(M, C, K)
     if ab is not None and system.ndof > 1:
         w2, basis = _tridiagonal_modes(M, K)
@@ -445,9 +450,10 @@ def _check(system: System, rec: Receptance, w2) -> None:
     cols = np.unique(np.linspace(0, n - 1, min(n, 4)).astype(int))
     Zr = system.K - W * W * system.M
     Hb = rec.block(W, np.arange(n), cols)
-    ZH = _real_times(Zr, Hb) + 1j * W * _real_times(system.C, Hb)
+    C = dense_damping(system.C)
+    ZH = _real_times(Zr, Hb) + 1j * W * _real_times(C, Hb)
     err = float(np.max(np.abs(ZH - np.eye(n)[:, cols])))
-    zmax = float(np.max(np.abs(Zr) + W * np.abs(system.C)))
+    zmax = float(np.max(np.abs(Zr) + W * np.abs(C)))
     bound = config.HB_CONDENSE_CHECK_RTOL * zmax * float(np.max(np.abs(Hb)))
     if not err <= bound:
         raise ValueError(f"condense: the {rec.kind} expansion of the receptance misses Z(W) H(W) = I by "
@@ -718,13 +724,14 @@ class CondensedHBProblem(HBProblem):
         if not self.hill_affordable():
             return np.full(len(ws), np.nan)
         full = np.array([self.full_jacobian(J, w) for J, w in zip(JXs, ws)])
-        return hill_growth(full, self.system.M, self.system.C, ws, self.H)
+        return hill_growth(full, self.system.M, dense_damping(self.system.C), ws, self.H)
 
     def hill_stability(self, JX, w):
         """(stable, growth, multipliers) by Hill's method on the full Jacobian, or (False, NaN, empty)."""
         if not self.hill_affordable():
             return False, math.nan, np.empty(0, dtype=complex)
-        return hill_stability(self.full_jacobian(JX, w), self.system.M, self.system.C, w, self.H)
+        return hill_stability(self.full_jacobian(JX, w), self.system.M, dense_damping(self.system.C), w,
+                              self.H)
 
 
 def use_condensed(system: System, condense=None, response_dofs=()) -> bool:

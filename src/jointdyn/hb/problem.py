@@ -39,6 +39,7 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from .._cache import by_identity, by_value
+from ..damping import dense_damping, is_operator
 from ..fourier import STARTS, STOPS, derivative_matrix, extrema, fourier_matrices, phases, separation_grid
 from ..kinematics import NORMAL_SPRING, contact_kinematics, no_contact_init_jvp, no_contact_step_jvp, selection_matrix
 from ..laws import law_dispatch
@@ -117,7 +118,7 @@ def _linear_blocks(system: System, H: int):
     """(AK, AC, AM) with A(w) = AK + w AC + w^2 AM the linear terms of harmonics 0..H (dense; their entries
     per harmonic block: :func:`jointdyn.hb._sparse.linear_entries`)."""
     size = system.ndof * (2 * H + 1)
-    rows, cols, *values = linear_entries(system.K, system.C, system.M, H)
+    rows, cols, *values = linear_entries(system.K, dense_damping(system.C), system.M, H)
     out = []
     for v in values:
         # into zeroed arrays by the blocks' entries (np.kron writes every entry: seconds at thousands of unknowns)
@@ -521,14 +522,29 @@ class HBProblem:
             from ._sparse import SparsePattern
 
             sys_ = self.system
-            self._pattern = SparsePattern((sys_.K, sys_.C, sys_.M), self.H, self.pair_positions)
+            split = self.damping_split()
+            C = sys_.C if split is None else split.rayleigh
+            self._pattern = SparsePattern((sys_.K, C, sys_.M), self.H, self.pair_positions)
         return self._pattern
+
+    def damping_split(self):
+        """The split of a modal damping operator into its Rayleigh part and the rest
+        (:class:`jointdyn.hb._damped.DampingSplit`; built once), or None where C is an array."""
+        if not is_operator(self.system.C):
+            return None
+        if getattr(self, "_damping", None) is None:
+            from ._damped import DampingSplit
+
+            self._damping = DampingSplit(self.system.C, self.system.M, self.system.K)
+        return self._damping
 
     def evaluate_sparse(self, X, p) -> _Eval:
         """:meth:`evaluate` with dR/dX as a ``scipy.sparse.csr_matrix`` (N/m), for a system whose only
         nonlinear elements are interfaces (:meth:`sparse_pattern`), not condensed; no scaled copies. The linear terms
         are summed by their nonzeros and the pairs' Jacobians assembled into the pattern: the values are
-        those of :meth:`evaluate` up to the order of the sums."""
+        those of :meth:`evaluate` up to the order of the sums. With modal damping as an operator
+        (:meth:`damping_split`), dR/dX is a :class:`jointdyn.hb._damped.DampedJacobian`: the sparse matrix with
+        the Rayleigh part of C, and the rest of C as an operator."""
         pat = self.sparse_pattern()
         if pat is None:
             raise ValueError("evaluate_sparse: the system must have interfaces and no scalar contacts, and the "
@@ -536,8 +552,17 @@ class HBProblem:
         X = np.ascontiguousarray(X, dtype=np.float64)
         w, dwdp, Fe, Fp, _, _, _ = self._inputs(p)
         R, Jp, lin_values = pat.linear(X, w, dwdp, Fe, Fp)
+        split = self.damping_split()
+        if split is not None:  # the damping beyond its Rayleigh part, as an operator (jointdyn.hb._damped)
+            Y, dY = split.harmonics(X, self.n, self.H, w)
+            R += Y
+            Jp += dwdp * dY
         ev, G = self._pairs_eval(X, R, Jp)
         ev.JX = pat.jacobian(lin_values, G)
+        if split is not None:
+            from ._damped import DampedJacobian
+
+            ev.JX = DampedJacobian(ev.JX, split, self.n, self.H, w)
         return ev
 
     def _pairs_eval(self, X, R, Jp):
@@ -565,10 +590,12 @@ class HBProblem:
             return "dense"
         sys_ = self.system
         # an upper bound of the pattern's density without building it (np.unique of millions of keys for a
-        # reduced model, only to find it dense)
+        # reduced model, only to find it dense); modal damping enters the pattern by its Rayleigh part
         nd = 3 * self.nh
+        split = self.damping_split()
+        C = sys_.C if split is None else split.rayleigh
         bound = (np.count_nonzero((sys_.K != 0.0) | (sys_.M != 0.0)) * self.nh
-                 + 2 * self.H * np.count_nonzero(sys_.C) + 4 * self.pair_positions.shape[0] * nd * nd)
+                 + 2 * self.H * np.count_nonzero(C) + 4 * self.pair_positions.shape[0] * nd * nd)
         if bound <= 4 * config.CONT_SPARSE_DENSITY * float(self.size) ** 2:
             if self.sparse_pattern().density <= config.CONT_SPARSE_DENSITY:
                 return "sparse"
@@ -710,14 +737,14 @@ class HBProblem:
         (:func:`~jointdyn.hb.stability.hill_growth`); NaN when not :meth:`hill_affordable`."""
         if not self.hill_affordable():
             return np.full(len(ws), np.nan)
-        return hill_growth(JXs, self.system.M, self.system.C, ws, self.H)
+        return hill_growth(JXs, self.system.M, dense_damping(self.system.C), ws, self.H)
 
     def hill_stability(self, JX, w):
         """(stable, growth, multipliers) of one solution (:func:`~jointdyn.hb.stability.hill_stability`), or
         (False, NaN, empty) when not :meth:`hill_affordable`."""
         if not self.hill_affordable():
             return False, math.nan, np.empty(0, dtype=complex)
-        return hill_stability(JX, self.system.M, self.system.C, w, self.H)
+        return hill_stability(JX, self.system.M, dense_damping(self.system.C), w, self.H)
 
 
 def contacts_only(system: System) -> System:

@@ -193,7 +193,7 @@ class EPMCProblem:
     def linear_guess(self):
         """Scaled unknowns of the linear stuck mode: shape, frequency and the viscous modal damping of C."""
         phi = self.linear.mass_normalised
-        xi0 = float(phi @ self.system.C @ phi)  # phi^T C phi / phi^T M phi, 1/s
+        xi0 = float(phi @ (self.system.C @ phi))  # phi^T C phi / phi^T M phi, 1/s
         X = np.zeros(self.size)
         X[self.n:2 * self.n] = self.linear.shape
         return self.pack(X, self.linear.omega_rad_s, xi0)
@@ -218,7 +218,9 @@ class EPMCProblem:
         self.last = (X, w, xi, ev)
         cx = self._times_mass_damping(X)
         R = ev.R - (xi * w) * cx
-        if self.sparse:
+        if self.sparse and getattr(ev.JX, "structured", False):  # modal damping as an operator
+            J = ev.JX.plus_sparse(-(xi * w) * self._A_M_sparse)
+        elif self.sparse:
             J = ev.JX - (xi * w) * self._A_M_sparse
         elif self.kind == "blocks":
             J = ev.JX
@@ -241,7 +243,7 @@ class EPMCProblem:
 
     def _scaled_jacobian(self, J, c_omega, c_xi):
         """dR_s/dv: J / k_ref with the columns of omega and xi replaced (in place on a dense J)."""
-        if self.kind == "blocks":
+        if self.kind == "blocks" or getattr(J, "structured", False):
             return J.scaled(1.0 / self.k_ref).with_columns({self.i_omega: c_omega, self.i_xi: c_xi})
         if not self.sparse:
             J /= self.k_ref
@@ -297,7 +299,7 @@ class EPMCProblem:
         DX = derivative_matrix(self.H) @ Xm  # d/dtau, m
         M, C = self.system.M, self.system.C
         kin = omega * math.pi * float(np.einsum("ri,ij,rj->", DX, M, DX))
-        visc = omega * math.pi * float(np.einsum("ri,ij,rj->", DX, C, DX))
+        visc = omega * math.pi * float(np.einsum("ri,ir->", DX, C @ DX.T))  # C may be an operator
         du = hb.E @ (DX @ self.B.T)  # (Ns, contacts): du_c/dtau at the samples, m
         contact = np.einsum("cj,jc->c", ev.T, du) * (2.0 * math.pi / hb.Ns)
         pairs = hb.pair_results(X, ev)

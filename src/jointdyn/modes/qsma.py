@@ -269,7 +269,7 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     M, C = system.M, system.C
     q = x @ (M @ phi)
     w = np.sqrt(alpha / q)
-    xCx = np.einsum("pi,ij,pj->p", x, C, x)
+    xCx = np.einsum("pi,ip->p", x, C @ x.T)  # C may be an operator (jointdyn.damping)
     xMx = np.einsum("pi,ij,pj->p", x, M, x)
     Dc = E.sum(axis=1) / (2.0 * np.pi * alpha * q)
     Dv = w * xCx / (2.0 * alpha * q)

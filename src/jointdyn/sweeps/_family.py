@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate as V
+from ..damping import ModalDamping
 
 __all__ = ["LineSpec", "Family", "fingerprint", "system_family", "paper_family"]
 
@@ -38,6 +39,8 @@ def _canon(obj):
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         t = type(obj)
         return [f"{t.__module__}.{t.__qualname__}", {f.name: _canon(getattr(obj, f.name)) for f in dataclasses.fields(obj)}]
+    if isinstance(obj, ModalDamping):  # by its factors (M Phi, 2 zeta w): no n x n matrix to hash
+        return ["ModalDamping", _canon(np.asarray(obj.B)), _canon(np.asarray(obj.d))]
     if isinstance(obj, np.ndarray):
         a = np.ascontiguousarray(obj)
         return ["ndarray", a.dtype.str, list(a.shape), hashlib.sha1(a.tobytes()).hexdigest()]
