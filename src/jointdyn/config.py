@@ -84,154 +84,23 @@ FE_TANGENT_RTOL = 1e-8
 REDUCTION_SPARSE_ERROR_MODES = 12
 
 # --- continuation (jointdyn.continuation; unknowns, parameter and residual scaled) ----
+# The step control and the linear solves have their numbers in ContinuationOptions and
+# LinearSolveOptions (jointdyn.continuation.options); here only those the solvers share with it.
 #: Newton converged when max|R| <= this (scaled residual; harmonic balance
-#: scales R by max(F1, fy))
+#: scales R by max(F1, fy)): ContinuationOptions.tol, and harmonic balance's single solutions
 CONT_TOL = 1e-9
-#: Newton iterations per correction
-CONT_MAX_ITER = 12
-#: arc-length step: first, smallest, largest
-CONT_DS_START = 0.05
-CONT_DS_MIN = 1e-6
-CONT_DS_MAX = 0.1
-#: ... or this fraction of the norm of the unknowns where that is larger
-#: (a flank growing without bound: as many points per decade as a small one)
-CONT_DS_MAX_REL = 0.02
-#: bound on the points of a branch
-CONT_MAX_POINTS = 2000
-#: predictor direction: "tangent" or "secant"
-CONT_PREDICTOR = "tangent"
-#: where a solver asks for it (harmonic balance, when every contact law has a smooth force:
-#: ContactLaw.smooth_force), the corrector starts from the cubic Hermite extrapolation of the
-#: last two points and their tangents (moved onto the corrector's hyperplane, so that the point
-#: it converges to is the same) when the step is at most this many times the last one. On the
-#: paper damper's branch with the default law (eta 0.5, beta 2) it saves 14 % of the residual
-#: evaluations, 17 % at eta 1.5, beta 5 (a start about 10x closer to the curve: one Newton
-#: iteration less at many points). Laws with kinks or jumps at the onset of slip (Jenkins, the
-#: discrete model, the closed forms) do not use it: there Newton from the extrapolation lands
-#: on other points of the piecewise-smooth residual, and the step control follows another path
-CONT_START_EXTRAPOLATION = 2.0
-#: Newton iterations aimed at per correction; the step grows by CONT_GROW
-#: after a correction in fewer, shrinks by CONT_SHRINK after one in more
-CONT_TARGET_ITER = 4
-CONT_GROW = 1.6
-CONT_SHRINK = 0.6
-#: the step is multiplied by CONT_TURN_SHRINK after the unit tangent turned
-#: by more than ~10 degrees (cosine below CONT_TURN_COS): folds are resolved
-CONT_TURN_COS = 0.985
-CONT_TURN_SHRINK = 0.5
-#: step factor after a rejected step (corrector failed)
-CONT_REJECT_SHRINK = 0.5
-#: trial steps of the damped Newton line search (the full step, then
-#: halved each time) before the iteration counts as failed
-CONT_LINE_SEARCH_STEPS = 9
-#: above CONT_CORNER_DS, a corrector is stopped after this many times
-#: CONT_TARGET_ITER residual evaluations (retrying smaller is cheaper)
-CONT_MAX_EVALS_FACTOR = 2
-#: below this step a sharp turn or a long correction is a corner of a
-#: piecewise-smooth branch, not a jump to another branch
-CONT_CORNER_DS = 2e-3
-#: step factor after a rejection for a sharp turn or a far-away correction
-#: (a step accepted only at corner size, reached in fewer rejections)
-CONT_CORNER_SHRINK = 0.25
-#: above CONT_CORNER_DS a step is rejected when the new unit tangent's dot
-#: product with the previous one is below this (a turn by more than 60 deg)
-CONT_MIN_TANGENT_DOT = 0.5
-#: ... or when the corrector moved farther than this many steps from the
-#: predicted point
-CONT_MAX_DISTANCE = 2.0
-#: jumps over a discontinuity of the residual (corrector failed at the
-#: smallest step): Newton at fixed parameter tried this far beyond the last
-#: point (fractions of the parameter range), at most CONT_MAX_JUMPS times
-CONT_JUMP_FRACTIONS = (1e-4, 1e-3, 1e-2)
-CONT_MAX_JUMPS = 5
-#: a branch that goes back and forth without getting anywhere (the corrector keeps accepting
-#: points that alternate between the same states at a jump of a piecewise-smooth residual):
-#: over the last CONT_STALL_POINTS points, the distance from the first to the last (scaled
-#: unknowns and parameter) is below CONT_STALL_RATIO times the path through them; the branch
-#: stops there as failed, without those points. Such a stall measures about 1e-14 (Jenkins at
-#: eta 10, beta 1000, 7 x 128 samples); the zigzags at the non-smooth corners of branches that
-#: do get through stay above 6e-4 (Jenkins with separation on the grid of docs/hb-robustness.md)
-CONT_STALL_POINTS = 100
-CONT_STALL_RATIO = 1e-6
-#: a jump's guess follows the tangent when its parameter component exceeds
-#: this (else the last point's unknowns)
-CONT_JUMP_TANGENT_MIN = 1e-3
-#: largest deviation between the straight line joining consecutive points of
-#: a branch and the curve, in the plane (parameter, observable) (harmonic
-#: balance: gamma and the logarithm of the norm of the response DOF's
-#: harmonics, so 0.005 is half a percent of the amplitude or 0.005 in gamma;
-#: measured against the reported amplitude the chords stay within 1 %,
-#: tests/test_hb_trust.py)
-CONT_CHORD_TOL = 0.005
-#: refinement of a maximum along a branch (peaks): at most this many
-#: corrections, until the bracket is this fraction of its first width or the
-#: observable varies by at most CONT_REFINE_GTOL across it (harmonic
-#: balance: log q, so 1e-7 is a relative 1e-7 of the amplitude)
-CONT_REFINE_ITER = 20
-CONT_REFINE_STOL = 1e-4
-CONT_REFINE_GTOL = 1e-7
-#: bordered linear systems (Newton corrections, tangents) of at most this
-#: many unknowns are solved by the compiled elimination of
-#: jointdyn.continuation, larger ones by LAPACK (benchmarks/bench_linalg.py:
-#: the compiled elimination is 1.2-3.5x faster at 16 to 751 unknowns with
-#: single-threaded BLAS; beyond the sizes measured, LAPACK)
-CONT_SMALL_SOLVE = 800
 #: from this many unknowns, a walk's bordered systems are solved by GMRES
 #: preconditioned with the LU factors of an earlier matrix of the walk, and
 #: factorised anew only when that fails (jointdyn.continuation.linalg): a
-#: factorisation costs seconds there (benchmarks/bench_linalg.py)
+#: factorisation costs seconds there (benchmarks/bench_linalg.py); harmonic balance and EPMC
+#: choose the form of their Jacobians (sparse, blocks, dense) by the same bound
 CONT_KRYLOV_SOLVE = 2000
-#: a GMRES solution is accepted when |A x - b| <= this |b| (true residual)
-CONT_KRYLOV_RTOL = 1e-9
-#: GMRES iterations (one cycle, no restart) before the matrix is factorised;
-#: at 5500 unknowns an iteration (a product with the matrix and a solve with
-#: the kept factors) costs about 1/20 of a factorisation. Measured on the
-#: 167-pair chain of benchmarks/bench_hb_interface_chain.py (HB branch, 23
-#: points): 20 instead of 12 saved no factorisation (21 either way; the
-#: factors of the previous point do not reach the tolerance at the next) and
-#: cost 372 instead of 245 iterations
-CONT_KRYLOV_MAXITER = 12
-#: a solve that needed more iterations than this has the next matrix factorised
-#: at once (the kept factors have drifted from the walk's matrices)
-CONT_KRYLOV_REFRESH = 8
 #: from CONT_KRYLOV_SOLVE unknowns, a walk whose first matrix has at most this
 #: fraction of nonzero entries factorises by SuperLU (scipy.sparse.linalg.splu)
 #: at every solve (the 60-node chain of benchmarks/bench_hb_interface_chain.py,
-#: 1980 unknowns, 0.7 % nonzero: 4 ms against 227 ms for dense LAPACK), ...
+#: 1980 unknowns, 0.7 % nonzero: 4 ms against 227 ms for dense LAPACK); harmonic balance
+#: evaluates its Jacobian as a sparse matrix below the same density
 CONT_SPARSE_DENSITY = 0.02
-#: ... while its factors hold at most this fraction of N^2 entries (else dense
-#: from then on: SuperLU on a matrix that fills in completely costs about 5x
-#: dense LAPACK). The bound sits above the fill of the walks where SuperLU
-#: still wins: as the pairs of the 167-node chain slip, their blocks couple
-#: all harmonics and the fill grows; at 5512 unknowns fill 0.17 takes 0.24 s
-#: against 2.7-8.7 s for dense LAPACK, fill 0.083 0.10-0.18 s, so a bound
-#: below 0.17 would send that walk to the slower dense solve
-CONT_SPARSE_FILL = 0.25
-#: SuperLU's thresholds for preferring the diagonal pivot, tried in turn until
-#: the solution's true residual is at most CONT_KRYLOV_RTOL |b| (0: the
-#: diagonal unless it is zero, least fill; 0.1: the usual threshold pivoting;
-#: SuperLU's default 1 is partial pivoting). On the slipping 167-node chain's
-#: bordered matrix (5512 unknowns, 0.6 % nonzero): 0 fill 0.010 in 0.04 s,
-#: 0.1 fill 0.25 in 0.68 s, 0.01 fill 0.20 in 0.58 s, all with residuals of
-#: 1e-11; at a lower amplitude 0.1 gave fill 0.010 where 1 gave 0.083
-CONT_SPARSE_PIVOTS = (0.0, 0.1)
-#: from CONT_KRYLOV_SOLVE unknowns, where the problem offers a structured
-#: preconditioner (harmonic balance: the blocks of its harmonics,
-#: jointdyn.hb._precond), GMRES with the factors of that preconditioner, made
-#: at the current matrix, runs this many iterations at most before the
-#: bordered matrix is factorised whole (the direct path, kept as the fallback).
-#: On the lap joint at H = 3 (5131 unknowns) the pairs' slip couples the
-#: harmonics more as the amplitude grows (22 iterations at 0.4 mm, 36 at the
-#: tenth point after it) and a bound of 40 fell back to the whole LU 9 times
-#: along the backbone; one iteration costs about 1/25 of the H + 1 block LUs,
-#: and the whole LU about 14 times those, so 100 iterations still cost less
-CONT_BLOCK_MAXITER = 100
-#: the structured factors kept from an earlier matrix are made anew at the next
-#: solve after a solve that needed more than this many GMRES iterations with
-#: them: fresh ones need some iterations too (10-14 on the lap joint at H = 3
-#: with its pairs slipping), and one set of fresh factors (H + 1 LUs) costs
-#: about as much as 25 iterations there
-CONT_BLOCK_REFRESH = 25
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history

@@ -279,7 +279,7 @@ class ContactLaw:
     #: True when the force has no jump and no kink at the onset of slip (a distribution of
     #: slip thresholds, as the exact Iwan law): harmonic balance then starts each Newton
     #: correction of its continuation from an extrapolation of the branch
-    #: (``config.CONT_START_EXTRAPOLATION``); False (the safe default of a new law) starts it
+    #: (``continuation.START_EXTRAPOLATION``); False (the safe default of a new law) starts it
     #: from the tangent prediction
     smooth_force: ClassVar[bool] = False
 
