@@ -505,49 +505,8 @@ RINGDOWN_RATE_LIMIT = 0.1
 RINGDOWN_MAX_CYCLES = 32
 
 # --- sweeps --------------------------------------------------------------------------
-#: gamma grid START:STOP:STEP (the paper's Fig 6 range)
-SWEEP_GAMMA_DEFAULT = (0.6, 1.8, 0.01)
-#: most points of a gamma grid given as START:STOP:STEP
-SWEEP_MAX_GAMMA_POINTS = 100_000
-#: seconds to wait for a Dask scheduler to answer (--scheduler)
-SWEEP_SCHEDULER_TIMEOUT_S = 5.0
-#: local pool for sweep lines when no Dask client is given: "process" or
-#: "thread" (the compiled kernels release the GIL)
-SWEEP_POOL = "process"
 #: why a swept point is not-settled (``not_settled_reason``; index = code, 0
 #: for every other point): still converging at the period budget, stalled
 #: (quasi-periodic or chaotic), or repeating only after more than
 #: SS_MAX_MULTIPLE periods
 SWEEP_NOT_SETTLED_REASONS = ("none", "slowly-converging", "quasi-periodic-or-chaotic", "long-period")
-#: consecutive points of a line solved as one task and saved as one resume
-#: checkpoint (an interrupt stops a task after its current point, so this
-#: bounds what a killed run loses, not what an interrupted one loses)
-SWEEP_CHUNK_POINTS = 8
-#: tasks kept queued per worker (lines in progress at once), so that no
-#: worker waits for the next chunk of a line
-SWEEP_TASKS_PER_WORKER = 2
-#: seconds between refreshes of the progress bar while chunks run
-SWEEP_PROGRESS_POLL_S = 0.2
-#: seconds between checks of a worker process that its parent is alive (the
-#: fallback where the kernel's parent-death signal is not available)
-SWEEP_PARENT_POLL_S = 0.5
-
-# --- figures: the bolted lap joint (jointdyn.figures.lap) ----------------------------
-#: harmonics and AFT samples per period of its backbone. The reduced model has
-#: 733 DOFs, so an HB or EPMC Newton step solves 733 (2H + 1) unknowns with a dense LU: with
-#: H = 1 a backbone point costs about 1 s here. Against H = 3 (64 samples), H = 1 gives the first
-#: bending frequency within 0.1 % and its damping ratio within 2 % at the onset of slip (3e-5 m)
-#: and to three digits at the largest damping (3e-4 m) (docs/lap-joint.md)
-LAP_HARMONICS = 1
-LAP_SAMPLES = 32
-#: backbone range: first-harmonic amplitude of the output DOF, m (stuck below 4.5e-6 m)
-LAP_AMPLITUDE_M = (1e-6, 2e-3)
-#: largest arc-length step of the backbone (47 points over the range, most of them between 4.5e-6
-#: and 3e-4 m, where the pairs start to slip one after another)
-LAP_DS_MAX = 0.04
-#: amplitudes of the three slip maps, m: the onset of slip, the largest damping, deep slip
-LAP_SLIP_MAP_M = (3e-5, 3e-4, 1.5e-3)
-#: modal damping ratio of every mode of the plates (material damping)
-LAP_ZETA = 1e-3
-#: forced response (synthesised from the backbone): force amplitude at the output DOF, N
-LAP_FORCE_N = 30.0
