@@ -43,7 +43,7 @@ PAGE = Path(__file__).resolve().parents[1] / "exact-iwan.md"
 START, END = "<!-- tables:start -->", "<!-- tables:end -->"
 #: capacity treated as "no merge" (checked: the piece counts stay below it)
 K_REF = 2048
-K_DEFAULT = config.IWAN_CAPACITY
+K_DEFAULT = Iwan.__dataclass_fields__["capacity"].default  # the law's default capacity
 CAPACITIES = (8, 12, 16, 24, 32, 48, 64)
 DISCRETE_N = (50, 200, 1000, 4000)
 

@@ -15,24 +15,11 @@ from __future__ import annotations
 #: given (CLI ``--model``, ``System.paper_damper``, sweeps, figures): the
 #: exact Iwan model with varying normal load
 MODEL = "iwan"
-#: linear pieces kept by the exact Iwan law (``iwan``) after a step; beyond,
-#: three adjacent pieces are merged into two (results within 0.1 % of the
-#: converged limit, measured 3e-3 % at most on the Fig 6 grid:
-#: docs/exact-iwan.md)
-IWAN_CAPACITY = 32
 #: Jenkins elements of the discrete Iwan model
 LAW_DISCRETE_N = 1000
-#: capacity of the reversal-point stack of the closed-form Iwan law
-IWAN_CLOSED_MAX_DEPTH = 64
-#: a branch of the closed-form Iwan law closer than this to an earlier
-#: reversal point (normalised displacement kt x / fy) has reached it (Masing
-#: rejoin); the force error is of the same order in units of fy
-IWAN_CLOSED_WIPE_TOL = 1e-9
 #: microslip exponent chi of Segalman's four-parameter Iwan law (``segalman``)
 #: when none is given: the slip-displacement density grows as phi^chi
 SEGALMAN_CHI = -0.5
-#: weight beta of the final delta of the ``segalman`` density when none is given
-SEGALMAN_BETA = 0.0
 
 # --- systems (jointdyn.systems) ---------------------------------------------------------
 #: eigenvalues of (M, K_reference) below this fraction of the largest are
@@ -65,9 +52,6 @@ INTERFACE_MAX_PAIRS = 5_000
 MEMORY_LIMIT_BYTES = None
 #: share of the available memory a computation may take when MEMORY_LIMIT_BYTES is None
 MEMORY_FRACTION = 0.5
-#: copies of a contact law's state a solver holds at once (trial and committed states, their
-#: forward-mode derivatives): a law whose state times this exceeds the bound is refused
-LAW_STATE_COPIES = 16
 
 # --- FE interfaces and reduction (jointdyn.fe, jointdyn.reduction) ---------------------
 #: two mesh nodes are the same point (a node pair) when their distance is
