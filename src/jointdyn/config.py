@@ -54,15 +54,6 @@ MEMORY_LIMIT_BYTES = None
 MEMORY_FRACTION = 0.5
 
 # --- FE interfaces and reduction (jointdyn.fe, jointdyn.reduction) ---------------------
-#: two mesh nodes are the same point (a node pair) when their distance is
-#: within this fraction of the diagonal of the two node sets' bounding box
-FE_MATCH_RTOL = 1e-6
-#: a node in two pairs must get the same frame from both: rows t1, t2, n
-#: equal to this (unit vectors)
-FE_FRAME_ATOL = 1e-9
-#: a given tangent is along the normal when its part normal to n is below
-#: this fraction of its length
-FE_TANGENT_RTOL = 1e-8
 #: linear modes compared by the error report of a sparse Craig-Bampton
 #: reduction (the lowest ones; a dense reduction compares all of its size)
 REDUCTION_SPARSE_ERROR_MODES = 12
