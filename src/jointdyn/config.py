@@ -54,9 +54,6 @@ MEMORY_LIMIT_BYTES = None
 MEMORY_FRACTION = 0.5
 
 # --- FE interfaces and reduction (jointdyn.fe, jointdyn.reduction) ---------------------
-#: linear modes compared by the error report of a sparse Craig-Bampton
-#: reduction (the lowest ones; a dense reduction compares all of its size)
-REDUCTION_SPARSE_ERROR_MODES = 12
 
 # --- continuation (jointdyn.continuation; unknowns, parameter and residual scaled) ----
 # The step control and the linear solves have their numbers in ContinuationOptions and
