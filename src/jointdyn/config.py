@@ -30,9 +30,6 @@ SYSTEM_RIGID_MODE_RTOL = 1e-10
 #: Cholesky factorisation (shifted by the semi-definiteness tolerance) and Lanczos iterations
 #: for the extreme eigenvalues (scipy.sparse.linalg.eigsh), which scale to config.FILES_MAX_DOF
 SYSTEM_DENSE_CHECK_MAX_DOF = 1000
-#: a matrix is positive semi-definite when its smallest eigenvalue is at least -this times
-#: its largest (rounding of an assembled singular matrix)
-SYSTEM_SEMIDEFINITE_RTOL = 1e-10
 
 # --- system files (jointdyn.files) ------------------------------------------------------
 #: most degrees of freedom of a matrix read from a system file (its dense
