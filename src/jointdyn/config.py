@@ -79,17 +79,10 @@ QS_CYCLES = 2
 #: most samples of a harmonic history (cycles x steps per cycle); bounds the
 #: memory of one loop (about 100 bytes per sample with its CSV output)
 QS_MAX_SAMPLES = 10_000_000
-#: a cycle of a sampled history spans at least this many sample intervals on
-#: average (fewer is not a sampled loop); bounds the cycles of --period
-QS_MIN_INTERVALS_PER_CYCLE = 2
 #: a time within this fraction of a step (harmonic grid) or of the history
 #: duration (cycle windows) is the same instant: crossing instants and cycle
 #: boundaries snap onto existing samples instead of creating tiny steps
 QS_SNAP_RTOL = 1e-9
-#: load (as a fraction of n_ref) at which a law is evaluated at a re-contact
-#: instant (N = 0 followed by N > 0), so that the virgin curve starts exactly
-#: there; the sample is reported as separated with T = 0
-QS_RECONTACT_LOAD = 1e-300
 
 # --- time integration (explicit RK4 with events) --------------------------------
 #: RK4 steps per forcing period (before events and reversal splits)
