@@ -205,28 +205,6 @@ HB_AUTO_EARLY_DROP = 0.5
 #: the samples decide, H = 7 already within 2e-4 of H = 15 on the paper's grid
 HB_AUTO_MAX_HARMONICS = 15
 HB_AUTO_MAX_SAMPLES = 2048
-#: a contact force is zero while the contact is open and continuous at separation and re-contact: where a
-#: prescribed normal load changes sign, the AFT projects the force with the corners there taken into
-#: account (jointdyn.fourier.event_projection): one-sided polynomials of this degree through the corner
-#: and the nearest samples (error O(h^4) for a force smooth on either side, against O(h^2) uniform) ...
-HB_EVENT_ORDER = 3
-#: ... skipping samples nearer to the corner than this fraction of the sampling interval (nearly zero)
-HB_EVENT_MIN_OFFSET = 0.25
-#: before a separation the friction bound mu N falls to zero and a stuck contact slips only in the last
-#: ~|T| / (mu |dN/dtau|) rad, a near-jump of the force inside one sampling interval at large mu N0 / F1: the
-#: AFT marches the law also at phases graded towards each separation (jointdyn.fourier.separation_grid),
-#: over this many uniform samples before it (a slip stretch as wide as a few samples, eta = 10 and beta
-#: = 1-10, needs 4: with 2 its peaks at 7 x 128 are up to 1.4e-3 off the converged ones, with 4 within 4e-4) ...
-HB_SEPARATION_SPAN = 4
-#: ... each phase's distance to the separation this fraction of the one before (spacing 20 % of the
-#: distance) ...
-HB_SEPARATION_RATIO = 0.8
-#: ... down to this distance (rad): a slip stretch shorter than it costs at most its own width times the
-#: stuck force in the force's integral (with 4 samples, 0.8 and 1e-4: 32 phases more than the 128 samples)
-HB_SEPARATION_FINEST = 1e-4
-#: uniform samples per period of the fine grid on which amplitudes and
-#: extrema of a harmonic-balance response are located
-HB_FINE_SAMPLES = 1024
 #: bound on the periods marched per AFT evaluation (two normally suffice
 #: for Masing-type laws; the force must repeat to HB_PERIODIC_RTOL)
 HB_MAX_PASSES = 8
