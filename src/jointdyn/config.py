@@ -392,9 +392,6 @@ FIT_MAX_LOOP_SAMPLES = 1_000_000
 #: most points of a backbone fit (``fit --backbone``): every point costs a describing function per
 #: evaluation, 4 ms of CPU time per point for the whole fit (1000 points took 3.8 s, measured 2026-12)
 FIT_MAX_BACKBONE_POINTS = 1_000
-#: largest magnitude of a measured value a fit computes with: its squares, products and sums over
-#: every sample must stay finite in double precision (1e100 squared is 1e200)
-FIT_MAX_MAGNITUDE = 1e100
 #: confidence level of the intervals a fit reports (profile likelihood)
 FIT_LEVEL = 0.95
 #: profile likelihood: a scale parameter whose sum of squares stays below the threshold
@@ -418,10 +415,6 @@ FIT_RAMP_SAMPLES = 200
 #: loop fits: a record fitted from rest whose first stroke leaves an rms residual above this
 #: many times that of the rest was picked up mid-cycle (its first stroke then sets the state)
 FIT_FIRST_STROKE_MISFIT = 3.0
-#: jointdyn fit: largest plausible joint displacement of a loop record and modal amplitude of
-#: a backbone, m (beyond them the file is taken to be in other units, e.g. mm)
-FIT_PLAUSIBLE_DISPLACEMENT_M = 0.01
-FIT_PLAUSIBLE_AMPLITUDE_M = 0.1
 #: ring-downs (identify.ringdown): the mode's band is where the spectrum stays above this
 #: fraction of its peak, widened by this fraction on each side; a second spectral peak in it
 #: more prominent than this fraction of the peak is a second mode
