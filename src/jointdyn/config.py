@@ -1,10 +1,12 @@
-"""Numerical defaults of jointdyn, one section per package in the order of the layers, bottom up:
-contact laws; systems and system files; continuation and the quasi-static driver; the time march and
-its steady states; harmonic balance; nonlinear modes; sweeps.
+"""The numbers jointdyn's packages share, one section per package in the order of the layers, bottom up:
+contact laws; systems and system files; memory bounds; continuation and the quasi-static driver; the time
+march and its steady states; harmonic balance; nonlinear modes; identification; sweeps.
 
-Solvers and front ends (CLI, sweeps, figures) read their defaults from here
-and nowhere else, so that a change of accuracy policy is one edit. Test
-tolerances live with the tests (``tests/tolerances.py``). Units are given
+A number that one solver or package alone reads belongs in that solver's options object
+(``ContinuationOptions``, ``LinearSolveOptions``, ``SweepOptions``) or in its module, with its default
+documented there; ``tests/test_architecture.py`` fails on a number here that one package alone reads,
+except those it lists as still to move (the time march and steady states, harmonic balance, nonlinear
+modes, identification). Test tolerances live with the tests (``tests/tolerances.py``). Units are given
 where a number has one; "relative" numbers are fractions of the scale named.
 """
 
@@ -49,8 +51,6 @@ INTERFACE_MAX_PAIRS = 5_000
 MEMORY_LIMIT_BYTES = None
 #: share of the available memory a computation may take when MEMORY_LIMIT_BYTES is None
 MEMORY_FRACTION = 0.5
-
-# --- FE interfaces and reduction (jointdyn.fe, jointdyn.reduction) ---------------------
 
 # --- continuation (jointdyn.continuation; unknowns, parameter and residual scaled) ----
 # The step control and the linear solves have their numbers in ContinuationOptions and
