@@ -393,7 +393,7 @@ def test_the_energy_check_finds_a_name_outside_the_rule(tmp_path):
 
 # --- configuration by layer: config keeps only the numbers several packages share ---------------------------
 #: numbers read by one package only that are still in config, to move into that package's options object or
-#: module (as the continuation's, the sweeps', the laws' and the figures' were): the list only shrinks
+#: module (as the continuation's, the sweeps', the laws', the modes' and the figures' were): the list only shrinks
 PENDING_OWNED = {
     # dynamics
     "MONODROMY_FD_STEP", "SS_AMP_RTOL", "SS_BALANCE_RTOL", "SS_CHECK_PERIODS", "SS_CHUNK", "SS_DETECT_MULTIPLE",
@@ -420,10 +420,6 @@ PENDING_OWNED = {
     "RINGDOWN_FILTER_ORDER", "RINGDOWN_MAX_CYCLES", "RINGDOWN_MIN_DECAY", "RINGDOWN_MIN_SAMPLES_PER_PERIOD",
     "RINGDOWN_PAD_PERIODS", "RINGDOWN_RATE_LIMIT", "RINGDOWN_RATE_RTOL", "RINGDOWN_SECOND_PEAK",
     "RINGDOWN_TRIM_DECAYS",
-    # modes
-    "MODES_AUTO_CHECK_POINTS", "MODES_DS_MAX", "MODES_DS_START", "MODES_MIN_EIGENVALUE_RATIO",
-    "MODES_MIN_PARTICIPATION", "MODES_START_MAX_ITER", "MODES_TOL", "QSMA_DECADES_BELOW", "QSMA_MAX_ITER",
-    "QSMA_STEPS_PER_DECADE", "QSMA_SUBSTEPS", "QSMA_TOL", "SYNTHESIS_PEAK_RTOL",
 }
 #: bounds on the size of an input, kept in config beside the other input bounds whatever reads them
 INPUT_BOUNDS = {"FILES_MAX_DOF"}

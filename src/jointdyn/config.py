@@ -5,8 +5,8 @@ march and its steady states; harmonic balance; nonlinear modes; identification; 
 A number that one solver or package alone reads belongs in that solver's options object
 (``ContinuationOptions``, ``LinearSolveOptions``, ``SweepOptions``) or in its module, with its default
 documented there; ``tests/test_architecture.py`` fails on a number here that one package alone reads,
-except those it lists as still to move (the time march and steady states, harmonic balance, nonlinear
-modes, identification). Test tolerances live with the tests (``tests/tolerances.py``). Units are given
+except those it lists as still to move (the time march and steady states, harmonic balance,
+identification). Test tolerances live with the tests (``tests/tolerances.py``). Units are given
 where a number has one; "relative" numbers are fractions of the scale named.
 """
 
@@ -319,44 +319,6 @@ HB_JACOBIAN_BUDGET_BYTES = 2**28
 #: output DOF), in units of fy / kt of the first contact: from deep in the
 #: stuck regime to well into macroslip (four decades)
 MODES_AMPLITUDE_Q = (1e-2, 1e2)
-#: EPMC continuation in log10 of the amplitude (unknowns scaled by the
-#: amplitude, frequency and self-excitation by the linear frequency, residual
-#: by the stiffness times the amplitude): first and largest arc-length step
-#: (the largest bounds the spacing to 1/16 decade: at least 16 points per decade)
-MODES_DS_START = 0.02
-MODES_DS_MAX = 0.0625
-#: Newton tolerance of an EPMC point on that scaled residual; tight because
-#: the energy balance of a point (self-excitation against dissipation) holds
-#: to the residual relative to the damping ratio, which is small at small
-#: amplitudes
-MODES_TOL = 1e-12
-#: Newton iterations of the first EPMC point (from the linear stuck mode)
-MODES_START_MAX_ITER = 30
-#: points of an EPMC backbone (spread over it, plus its largest damping) where
-#: harmonics="auto" / samples="auto" check the discretisation (jointdyn.modes._auto)
-MODES_AUTO_CHECK_POINTS = 12
-#: a DOF moves in a linear mode when |phi_dof| exceeds this fraction of max |phi|
-MODES_MIN_PARTICIPATION = 1e-8
-#: K (tangential contacts free) is positive definite for nonlinear modes when
-#: its smallest eigenvalue of (M, K) exceeds this fraction of the largest
-MODES_MIN_EIGENVALUE_RATIO = 1e-12
-#: QSMA static push: steps per decade of the output-DOF displacement, and
-#: decades pushed below the smallest requested amplitude (the work integral
-#: starts at zero displacement)
-QSMA_STEPS_PER_DECADE = 40
-QSMA_DECADES_BELOW = 3
-#: push steps per backbone point: the work integrals use every step (their
-#: error at a kink of a law, e.g. the onset of slip of a Jenkins element,
-#: falls as the square of the step), the backbone reports every
-#: QSMA_SUBSTEPS-th
-QSMA_SUBSTEPS = 4
-#: QSMA equilibrium: Newton converged when max |residual| <= this times the
-#: largest elastic or applied force; iterations per step
-QSMA_TOL = 1e-12
-QSMA_MAX_ITER = 50
-#: single-nonlinear-mode synthesis: the resonance peak is located on the
-#: backbone to this relative tolerance in amplitude
-SYNTHESIS_PEAK_RTOL = 1e-10
 
 # --- identification (jointdyn.identify) -------------------------------------------
 #: most evaluations of the model (marches, describing functions) of one least-squares fit
