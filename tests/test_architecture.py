@@ -393,16 +393,8 @@ def test_the_energy_check_finds_a_name_outside_the_rule(tmp_path):
 
 # --- configuration by layer: config keeps only the numbers several packages share ---------------------------
 #: numbers read by one package only that are still in config, to move into that package's options object or
-#: module (as the continuation's, the sweeps', the laws', the modes' and the figures' were): the list only shrinks
+#: module (as the continuation's, the sweeps', the time march's, the laws', the modes' and the figures' were): the list only shrinks
 PENDING_OWNED = {
-    # dynamics
-    "MONODROMY_FD_STEP", "SS_AMP_RTOL", "SS_BALANCE_RTOL", "SS_CHECK_PERIODS", "SS_CHUNK", "SS_DETECT_MULTIPLE",
-    "SS_DISSIPATION_FLOOR", "SS_ENERGY_RTOL", "SS_FLOQUET_TOL", "SS_GROWTH_PERIODS", "SS_GROWTH_RATIO",
-    "SS_LINEAR_ITERS", "SS_LINEAR_RTOL", "SS_MAX_MULTIPLE", "SS_MAX_PERIODS", "SS_MAX_SHOTS", "SS_MULTIPLE_DECAY",
-    "SS_SHOOT_AFTER", "SS_SHOOT_CLEAN_STATE", "SS_SHOOT_FD", "SS_SHOOT_HALVINGS", "SS_SHOOT_MAXIT",
-    "SS_SHOOT_MAXSTEP", "SS_STALL_PERIODS", "SS_STALL_RATIO", "SS_UNBOUNDED_Q", "TI_BLOWUP_FACTOR",
-    "TI_EVENT_MERGE", "TI_MAX_OMEGA_H", "TI_MAX_SPLITS", "TI_RECONTACT_ALPHA", "TI_SPRING_OMEGA_H",
-    "TI_STEPS_PER_PERIOD",
     # hb
     "HB_AUTO_EARLY_DROP", "HB_AUTO_MAX_HARMONICS", "HB_AUTO_MAX_SAMPLES", "HB_BLOCK_PRECONDITIONER",
     "HB_CONDENSED_HILL_ROWS", "HB_CONDENSE_CHECK_RTOL", "HB_CONDENSE_MAX_FRACTION", "HB_CONDENSE_MIN_DOFS",

@@ -29,6 +29,7 @@ from jointdyn import config
 from jointdyn.cli import main
 from jointdyn.files import read_matrices, read_system
 from jointdyn.sweeps import _points
+from jointdyn.dynamics._model import TI_MAX_OMEGA_H
 from test_bad_input import _Reached, _boom, _cli, _tree, no_compute, refused  # noqa: F401 (no_compute: a fixture)
 
 SRC = str(Path(__file__).resolve().parents[1] / "src")
@@ -479,7 +480,7 @@ def test_period_steps_unchanged_where_memory_allows():
     pack = pack_system(s)
     w = 0.5 * s.w0
     J = period_steps(pack, w, 64)
-    assert J == max(64, int(math.ceil(2 * math.pi * pack.w_max / (w * config.TI_MAX_OMEGA_H))))
+    assert J == max(64, int(math.ceil(2 * math.pi * pack.w_max / (w * TI_MAX_OMEGA_H))))
     assert make_model(s, w, 64).J == J
 
 

@@ -5,8 +5,7 @@ march and its steady states; harmonic balance; nonlinear modes; identification; 
 A number that one solver or package alone reads belongs in that solver's options object
 (``ContinuationOptions``, ``LinearSolveOptions``, ``SweepOptions``) or in its module, with its default
 documented there; ``tests/test_architecture.py`` fails on a number here that one package alone reads,
-except those it lists as still to move (the time march and steady states, harmonic balance,
-identification). Test tolerances live with the tests (``tests/tolerances.py``). Units are given
+except those it lists as still to move (harmonic balance, identification). Test tolerances live with the tests (``tests/tolerances.py``). Units are given
 where a number has one; "relative" numbers are fractions of the scale named.
 """
 
@@ -85,106 +84,19 @@ QS_MAX_SAMPLES = 10_000_000
 QS_SNAP_RTOL = 1e-9
 
 # --- time integration (explicit RK4 with events) --------------------------------
-#: RK4 steps per forcing period (before events and reversal splits)
-TI_STEPS_PER_PERIOD = 256
-#: steps per period are raised so that w_max * h <= this (w_max: stiffest
-#: linear mode with every contact stuck); RK4 is stable up to ~2.8
-TI_MAX_OMEGA_H = 1.0
-#: once a normal spring opens, the steps are refined so that w_max * h <=
-#: this (w_max with the springs closed): every re-contact sets the normal
-#: DOFs ringing at their own frequency, and RK4 at w h = 1 damps that
-#: ringing numerically by about 0.3 % of its energy per step, which shows in
-#: the energy balance (measured on the coupled paper damper, eta 1.5: 6e-3
-#: at w h = 0.85, 2e-6 at 0.21)
-TI_SPRING_OMEGA_H = 0.3
-#: at most this many reversal splits inside one grid step
-TI_MAX_SPLITS = 4
-#: an event closer than this fraction of a step to a grid point moves it
-TI_EVENT_MERGE = 1e-6
-#: normal load put at a re-contact instant, as a fraction of n0 (> 0 so that
-#: the committed law state is "in contact, virgin at the re-contact point")
-TI_RECONTACT_ALPHA = 1e-12
-#: a state larger than this factor times (|f|/k_min + fy/kt) is a blow-up
-TI_BLOWUP_FACTOR = 1e8
 
 # --- steady state: periodicity checks ----------------------------------------------
-#: relative tolerance on the half peak-to-peak amplitude and on the
-#: period-boundary state (Poincare points)
-SS_AMP_RTOL = 1e-4
-#: relative tolerance on the energy per period
-SS_ENERGY_RTOL = 1e-3
-#: work of the forcing = dissipation per period to this (relative; the
-#: energy integrals carry the discretisation error)
-SS_BALANCE_RTOL = 1e-2
-#: windows (of p periods) that must agree
-SS_CHECK_PERIODS = 3
-#: largest period multiple p accepted as a periodic steady state
-SS_MAX_MULTIPLE = 4
-#: longer multiples (up to this) are detected and reported as
-#: "not-settled", detail "period-P", instead of running to max_periods
-SS_DETECT_MULTIPLE = 12
-#: a multiple p > 1 is accepted only when the largest one-period mismatch
-#: over the last K p periods is at least this fraction of that over the
-#: K p periods before (no decaying beat)
-SS_MULTIPLE_DECAY = 0.97
-#: after shooting, stop as "quasi-periodic-or-chaotic" when the largest
-#: one-period mismatch over the last SS_STALL_PERIODS/2 periods is >=
-#: SS_STALL_RATIO times that over the half before
-SS_STALL_PERIODS = 240
-SS_STALL_RATIO = 0.9
-#: cap on integrated periods
-SS_MAX_PERIODS = 1500
-#: periods integrated between two checks
-SS_CHUNK = 8
 
-#: rounding floor of the contact-dissipation check of a periodic state: the
-#: contact's energy per period may fall below zero by the period's
-#: energy-balance residual |W - E_contact - E_viscous| plus this fraction of
-#: |W| + |E_contact| + |E_viscous| before it is flagged as energy created
-SS_DISSIPATION_FLOOR = 1e-12
 
 # --- steady state: start and shooting ------------------------------------------------
-#: describing-function iterations of the linear start
-SS_LINEAR_ITERS = 30
-#: relative change of the describing-function amplitude that ends that
-#: iteration (it only seeds the integration, which does the rest)
-SS_LINEAR_RTOL = 1e-2
-#: shooting (Newton on the period map) when the estimated number of
-#: periods to converge exceeds this
-SS_SHOOT_AFTER = 40
-#: Newton iterations of one shooting attempt
-SS_SHOOT_MAXIT = 12
-#: largest Newton step (relative to the amplitude) and step halvings of the
-#: line search
-SS_SHOOT_MAXSTEP = 1.0
-SS_SHOOT_HALVINGS = 8
-#: before shooting (section at phase 0), rebuild the law states from the
-#: last period alone (forget the transient's memory)
-SS_SHOOT_CLEAN_STATE = True
-#: shooting attempts per run
-SS_MAX_SHOTS = 3
-#: relative finite-difference step of the monodromy matrix
-SS_SHOOT_FD = 1e-6
-#: a Floquet multiplier above 1 + this marks an unstable orbit
-SS_FLOQUET_TOL = 1e-3
 
 # --- monodromy (finite-difference Floquet multipliers of the period map) --------------
-#: relative central-difference step of the monodromy check of harmonic-balance
-#: solutions (of the amplitude for displacements, of w times it for velocities)
-MONODROMY_FD_STEP = 1e-6
 #: periods, and samples per period, of the harmonic-balance displacement over
 #: which each contact law is marched to obtain its state at the section
 MONODROMY_WARM_PERIODS = 3
 MONODROMY_WARM_SAMPLES = 4096
 
 # --- steady state: unbounded response ----------------------------------------------
-#: amplitude increasing over this many consecutive periods ...
-SS_GROWTH_PERIODS = 40
-#: ... with increments of the second half >= this fraction of the first
-SS_GROWTH_RATIO = 0.9
-#: ... and with the amplitude of x[response_dof] above this many fy/kt of
-#: the first contact (friction saturated: only then can friction lose)
-SS_UNBOUNDED_Q = 20.0
 
 # --- harmonic balance: discretisation and AFT ------------------------------------------
 #: harmonics 0..H of the unknowns
