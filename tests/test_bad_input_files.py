@@ -426,6 +426,7 @@ def test_memory_bound_from_config(monkeypatch, no_compute, capsys, tmp_path):
     """With config.MEMORY_LIMIT_BYTES the bound is exact: the largest size it names fits, one more does not."""
     from jointdyn.hb import hb_bytes
 
+    # the memory bound every solver shares (config), lowered to make the case small
     monkeypatch.setattr(config, "MEMORY_LIMIT_BYTES", 20 << 20)
     assert V.memory_budget() == 20 << 20
     line = refused(capsys, tmp_path, ["modes", "--harmonics", "200", "--out", "o"], "--harmonics 200",
@@ -549,6 +550,7 @@ def test_large_path_agrees_with_the_dense_path(sparse, rigid, monkeypatch):
     rng = np.random.default_rng(7)
     M, K = _chain(60, rng, rigid=rigid, sparse=sparse)
     dense = jd.System(M, None, K).w0
+    # shared by systems, files and harmonic balance (config): the large-structure path at this size
     monkeypatch.setattr(config, "SYSTEM_DENSE_CHECK_MAX_DOF", 10)
     large = jd.System(M, None, K).w0
     assert large == pytest.approx(dense, rel=1e-8)
@@ -569,6 +571,7 @@ def test_large_file_refusals_name_the_matrix(name, monkeypatch, tmp_path):
     mats[name] = mats[name] - 2.0 * np.max(np.abs(mats[name])) * np.eye(30)
     np.savez(tmp_path / "m.npz", **mats)
     toml = _toml(tmp_path, structure='file = "m.npz"', normal="{ n0 = 100.0 }")
+    # shared by systems, files and harmonic balance (config): the large-structure path at this size
     monkeypatch.setattr(config, "SYSTEM_DENSE_CHECK_MAX_DOF", 10)
     with pytest.raises(ValueError) as exc:
         read_system(toml)
@@ -619,6 +622,7 @@ def test_rigid_mode_dof_large_path_agrees(sparse, monkeypatch):
     Kr[7, :] = 0.0  # DOF 7 held by nothing
     expected = (rigid_mode_dof(K), rigid_mode_dof(Kr))
     assert expected[0] is None and (not sparse or expected[1] == 7)
+    # shared by systems, files and harmonic balance (config): the large-structure path at this size
     monkeypatch.setattr(config, "SYSTEM_DENSE_CHECK_MAX_DOF", 10)
     assert (rigid_mode_dof(K), rigid_mode_dof(Kr)) == expected
 
