@@ -178,10 +178,11 @@ def hb_branch(quick):
 
 def run(quick: bool = False) -> dict:
     from jointdyn import config
+    from jointdyn.laws.exact import IWAN_CAPACITY
 
     return {
         "default_model": config.MODEL,
-        "capacity": config.IWAN_CAPACITY,
+        "capacity": IWAN_CAPACITY,
         "kernel": kernel_rates(quick),
         "fig6_time_domain": fig6_time_domain(quick),
         "hb_branch_eta0.5_beta2": hb_branch(quick),

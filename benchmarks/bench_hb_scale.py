@@ -3,8 +3,8 @@
 The model, fixed before measuring: the shipped lap joint
 (:func:`jointdyn.fe.lap_joint`: Craig-Bampton model of 733 DOFs, every
 interface DOF coupled to every other, 120 loaded node pairs), with the
-figure's modal damping (``config.LAP_ZETA`` of every mode of the stuck
-structure: a dense C) and force (``config.LAP_FORCE_N`` at the output DOF),
+figure's modal damping (``jointdyn.figures.lap.LAP_ZETA`` of every mode of the stuck
+structure: a dense C) and force (``jointdyn.figures.lap.LAP_FORCE_N`` at the output DOF),
 as :func:`jointdyn.figures.lap.lap_joint_system` builds it. Measured at
 ``SAMPLES`` AFT samples:
 
@@ -41,20 +41,20 @@ BAND_HZ = (750.0, 805.0)
 
 
 def _system():
-    from jointdyn import config
-    from jointdyn.figures.lap import lap_joint_system
+    from jointdyn.figures import lap
 
-    return lap_joint_system(config.LAP_FORCE_N, config.LAP_ZETA)[0]
+    return lap.lap_joint_system(lap.LAP_FORCE_N, lap.LAP_ZETA)[0]
 
 
 def _backbone(H: int, blocks: bool) -> dict:
     from jointdyn import config
+    from jointdyn.figures import lap
     from jointdyn.modes import epmc
 
     config.HB_BLOCK_PRECONDITIONER = blocks
     s = _system()
     t0 = time.perf_counter()
-    b = epmc(s, AMPLITUDE_M, harmonics=H, samples=SAMPLES, max_points=MAX_POINTS, ds_max=config.LAP_DS_MAX,
+    b = epmc(s, AMPLITUDE_M, harmonics=H, samples=SAMPLES, max_points=MAX_POINTS, ds_max=lap.LAP_DS_MAX,
              progress=False)
     return {"s": time.perf_counter() - t0, "status": b.status.value, "points": int(b.points),
             "counters": {k: int(v) for k, v in b.counters.items() if isinstance(v, (int, np.integer))},

@@ -47,13 +47,18 @@ def _system(nodes: int, operator: bool):
                      output_dof=s.output_dof)
 
 
-def _lower(quick: bool) -> None:
+def _lower(quick: bool) -> dict:
+    """The large-solve paths at the quick model's size (where the dense C still makes it dense): the shared
+    thresholds set in config, the walk's own as its ``linear`` option (returned as keyword arguments)."""
     from jointdyn import config
+    from jointdyn.continuation import LinearSolveOptions
 
-    if quick:  # the large-solve paths at the quick model's size (where the dense C still makes it dense)
-        config.CONT_SMALL_SOLVE, config.CONT_KRYLOV_SOLVE = 0, 0
-        config.CONT_SPARSE_DENSITY = 0.1
-        config.HB_HILL_MAX_ROWS = 0
+    if not quick:
+        return {}
+    config.CONT_KRYLOV_SOLVE = 0
+    config.CONT_SPARSE_DENSITY = 0.1
+    config.HB_HILL_MAX_ROWS = 0
+    return {"linear": LinearSolveOptions(small_solve=0)}
 
 
 def _counters(c) -> dict:
@@ -63,10 +68,11 @@ def _counters(c) -> dict:
 def _branch(nodes: int, operator: bool, quick: bool) -> dict:
     from jointdyn.hb import continue_hb
 
-    _lower(quick)
+    extra = _lower(quick)
     s = _system(nodes, operator)
     t0 = time.perf_counter()
-    br = continue_hb(s, *BAND, harmonics=H, samples=NS, condense=False, progress=False, max_points=MAX_POINTS)
+    br = continue_hb(s, *BAND, harmonics=H, samples=NS, condense=False, progress=False, max_points=MAX_POINTS,
+                     **extra)
     return {"s": time.perf_counter() - t0, "status": br.status.value, "points": int(br.lam.size),
             "peak_m": float(br.response()[0].max()), "counters": _counters(br.counters)}
 
@@ -75,12 +81,12 @@ def _backbone(nodes: int, operator: bool, quick: bool) -> dict:
     from jointdyn.hb.problem import reference_scales
     from jointdyn.modes import epmc
 
-    _lower(quick)
+    extra = _lower(quick)
     s = _system(nodes, operator)
     kt, fy = reference_scales(s)
     t0 = time.perf_counter()
     b = epmc(s, tuple(a * fy / kt for a in AMPLITUDE), harmonics=H, samples=NS, max_points=MAX_POINTS,
-             progress=False)
+             progress=False, **extra)
     return {"s": time.perf_counter() - t0, "status": b.status.value, "points": int(b.points),
             "counters": _counters(b.counters), "amplitude_m": b.amplitude_m.tolist(),
             "omega_rad_s": b.omega_rad_s.tolist(), "damping_ratio": b.damping_ratio.tolist()}

@@ -13,6 +13,9 @@ own layer and the layers below it, never one above)::
 Helpers used everywhere (configuration, statuses, the jit helper, caches,
 validation, atomic file writing, exit codes) belong to no layer. No module
 imports itself back through others, at module level or inside a function.
+Configuration by layer: ``config`` keeps only numbers several packages (or
+the helpers) read; a number one package reads lives in that package's options
+object or module.
 """
 
 from __future__ import annotations
@@ -387,3 +390,90 @@ def test_the_energy_check_finds_a_name_outside_the_rule(tmp_path):
                               'e = {"energy_pair_total_J": 3.0}\n')
     assert energy_names_outside_the_rule(pkg) == ["a.py:2: energy_pair_total_J"]
 
+
+# --- configuration by layer: config keeps only the numbers several packages share ---------------------------
+#: numbers read by one package only that are still in config, to move into that package's options object or
+#: module (as the continuation's, the sweeps', the time march's, the laws', the modes' and the figures' were): the list only shrinks
+PENDING_OWNED = {
+    # hb
+    "HB_AUTO_EARLY_DROP", "HB_AUTO_MAX_HARMONICS", "HB_AUTO_MAX_SAMPLES", "HB_BLOCK_PRECONDITIONER",
+    "HB_CONDENSED_HILL_ROWS", "HB_CONDENSE_CHECK_RTOL", "HB_CONDENSE_MAX_FRACTION", "HB_CONDENSE_MIN_DOFS",
+    "HB_CONDENSE_MODAL_RTOL", "HB_CONDENSE_STATIC_RTOL", "HB_FOLD_WINDOW", "HB_HILL_MAX_ROWS", "HB_HOMOTOPY_START",
+    "HB_JACOBIAN_BUDGET_BYTES", "HB_MAX_GAMMA_STEP", "HB_PARAMETER_FD_STEP", "HB_PEAK_PROMINENCE",
+    "HB_PERIODIC_RTOL", "HB_RECONTACT_ALPHA", "HB_SATURATION_Q", "HB_SATURATION_SLIP_FRACTION", "HB_SMALL_EIG",
+    "HB_SOLVE_MAX_ITER", "HB_STABILITY_CONFIRM", "HB_STABILITY_RTOL", "HB_START_MAX_ITER", "HB_TURNING_BAND",
+    "HB_TURNING_BAND_LOG_Q", "HB_UNBOUNDED_FAIL_FRACTION", "HB_UNBOUNDED_Q",
+    # identify
+    "FIT_BETA_MAX", "FIT_BETA_START", "FIT_FIRST_STROKE_MISFIT", "FIT_FTOL", "FIT_GRID_BETA", "FIT_GRID_CHI",
+    "FIT_GRID_SLIP", "FIT_GTOL", "FIT_LEVEL", "FIT_MAX_NFEV", "FIT_MAX_RELATIVE_SE", "FIT_MAX_SHAPE_SE",
+    "FIT_MU_QUANTILE", "FIT_PROFILE_FTOL", "FIT_PROFILE_MAX_NFEV", "FIT_PROFILE_REFINE", "FIT_PROFILE_SPAN",
+    "FIT_PROFILE_STEPS", "FIT_QUAD_NODES", "FIT_RAMP_SAMPLES", "FIT_REFINE_ITERATIONS", "FIT_REFINE_RTOL",
+    "FIT_REST_FORCE", "FIT_SLOPE_WINDOW", "FIT_XTOL", "RINGDOWN_BAND_LEVEL", "RINGDOWN_BAND_MARGIN",
+    "RINGDOWN_FILTER_ORDER", "RINGDOWN_MAX_CYCLES", "RINGDOWN_MIN_DECAY", "RINGDOWN_MIN_SAMPLES_PER_PERIOD",
+    "RINGDOWN_PAD_PERIODS", "RINGDOWN_RATE_LIMIT", "RINGDOWN_RATE_RTOL", "RINGDOWN_SECOND_PEAK",
+    "RINGDOWN_TRIM_DECAYS",
+}
+#: bounds on the size of an input, kept in config beside the other input bounds whatever reads them
+INPUT_BOUNDS = {"FILES_MAX_DOF"}
+
+
+def config_constants(root: Path = SRC) -> set:
+    """The names config.py assigns (upper case)."""
+    tree = ast.parse((root / "config.py").read_text())
+    return {t.id for node in tree.body if isinstance(node, (ast.Assign, ast.AnnAssign))
+            for t in (node.targets if isinstance(node, ast.Assign) else [node.target])
+            if isinstance(t, ast.Name) and t.id.isupper()}
+
+
+def config_readers(root: Path = SRC) -> dict:
+    """Config name -> the top-level modules and packages of jointdyn whose code reads it (``config.NAME``, or
+    ``from ..config import NAME``)."""
+    out = {}
+    for path in sorted(q for q in root.rglob("*.py") if "__pycache__" not in q.parts and q != root / "config.py"):
+        tree = ast.parse(path.read_text(), str(path))
+        for node in ast.walk(tree):
+            names = []
+            if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "config":
+                names = [node.attr]
+            elif isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[-1] == "config":
+                names = [alias.name for alias in node.names]
+            top = path.relative_to(root).parts[0].removesuffix(".py")
+            for name in names:
+                out.setdefault(name, set()).add(top)
+    return out
+
+
+def owned_config_constants(root: Path = SRC) -> dict:
+    """Config name -> the one package that reads it, for every name read by one package of the layers and no
+    helper (``UTILITIES``: their numbers, such as the memory bound, apply to every solver), or by nothing
+    ("nobody": a number left behind)."""
+    readers = config_readers(root)
+    owned = {}
+    for name in sorted(config_constants(root)):
+        tops = readers.get(name, set())
+        if tops & (UTILITIES | {"__init__"}):
+            continue
+        if len(tops) <= 1:
+            owned[name] = next(iter(tops), "nobody")
+    return owned
+
+
+def test_config_keeps_only_shared_numbers():
+    owned = owned_config_constants()
+    crept = [f"config.{name}: read by {top} alone" for name, top in owned.items()
+             if name not in PENDING_OWNED | INPUT_BOUNDS]
+    assert not crept, ("numbers of one package belong in its options object (docs/architecture.md):\n"
+                       + "\n".join(crept))
+    stale = sorted((PENDING_OWNED | INPUT_BOUNDS) - set(owned) - (INPUT_BOUNDS & config_constants()))
+    assert not stale, f"moved out of config or now shared: remove from PENDING_OWNED: {stale}"
+
+
+def test_the_config_check_finds_an_owned_number(tmp_path):
+    pkg = tmp_path / "jointdyn"
+    (pkg / "hb").mkdir(parents=True)
+    (pkg / "modes").mkdir()
+    (pkg / "config.py").write_text("SHARED = 1\nOWNED = 2\nLEFT = 3\nHELPER = 4\n")
+    (pkg / "hb" / "a.py").write_text("from .. import config\nx = config.SHARED + config.OWNED\n")
+    (pkg / "modes" / "b.py").write_text("from ..config import SHARED\n")
+    (pkg / "_validate.py").write_text("from . import config\ny = config.HELPER\n")
+    assert owned_config_constants(pkg) == {"LEFT": "nobody", "OWNED": "hb"}

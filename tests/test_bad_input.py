@@ -27,6 +27,7 @@ import pytest
 import jointdyn
 from jointdyn import config
 from jointdyn.cli import main
+from jointdyn.commands import frc as frc_command
 from jointdyn.drivers import harmonic_history, quasistatic, read_history_csv
 from jointdyn.sweeps import _points, frc_sweep
 
@@ -284,7 +285,7 @@ SIZES = [
     (["loop", "--cycles", "100000", "--steps-per-cycle", "100000"], "--cycles x --steps-per-cycle"),
     (["loop", "--cycles", "1", "--steps-per-cycle", str(config.QS_MAX_SAMPLES + 1)], "--steps-per-cycle"),
     (["frc", "--gamma", "0.6:1.8:1e-9"], "at most"),
-    (["frc", "--gamma", f"1:2:{1 / config.SWEEP_MAX_GAMMA_POINTS}"], "--gamma"),
+    (["frc", "--gamma", f"1:2:{1 / frc_command.MAX_GAMMA_POINTS}"], "--gamma"),
 ]
 
 
@@ -490,7 +491,7 @@ def test_frc_refuses_options_of_the_other_method(argv, word, no_compute, capsys,
 
 # --- a Dask scheduler that does not answer -----------------------------------------------------
 def test_frc_unreachable_scheduler(no_compute, capsys, tmp_path, monkeypatch):
-    monkeypatch.setattr(config, "SWEEP_SCHEDULER_TIMEOUT_S", 0.5)
+    monkeypatch.setattr(frc_command, "SCHEDULER_TIMEOUT_S", 0.5)  # the command line's own wait, shortened
     refused(capsys, tmp_path, ["frc", "--gamma", "1:1.1:0.1", "--scheduler", "tcp://127.0.0.1:9", "--out", "o"],
             "--scheduler")
 

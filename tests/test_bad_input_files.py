@@ -29,6 +29,7 @@ from jointdyn import config
 from jointdyn.cli import main
 from jointdyn.files import read_matrices, read_system
 from jointdyn.sweeps import _points
+from jointdyn.dynamics._model import TI_MAX_OMEGA_H
 from test_bad_input import _Reached, _boom, _cli, _tree, no_compute, refused  # noqa: F401 (no_compute: a fixture)
 
 SRC = str(Path(__file__).resolve().parents[1] / "src")
@@ -425,6 +426,7 @@ def test_memory_bound_from_config(monkeypatch, no_compute, capsys, tmp_path):
     """With config.MEMORY_LIMIT_BYTES the bound is exact: the largest size it names fits, one more does not."""
     from jointdyn.hb import hb_bytes
 
+    # the memory bound every solver shares (config), lowered to make the case small
     monkeypatch.setattr(config, "MEMORY_LIMIT_BYTES", 20 << 20)
     assert V.memory_budget() == 20 << 20
     line = refused(capsys, tmp_path, ["modes", "--harmonics", "200", "--out", "o"], "--harmonics 200",
@@ -479,7 +481,7 @@ def test_period_steps_unchanged_where_memory_allows():
     pack = pack_system(s)
     w = 0.5 * s.w0
     J = period_steps(pack, w, 64)
-    assert J == max(64, int(math.ceil(2 * math.pi * pack.w_max / (w * config.TI_MAX_OMEGA_H))))
+    assert J == max(64, int(math.ceil(2 * math.pi * pack.w_max / (w * TI_MAX_OMEGA_H))))
     assert make_model(s, w, 64).J == J
 
 
@@ -548,6 +550,7 @@ def test_large_path_agrees_with_the_dense_path(sparse, rigid, monkeypatch):
     rng = np.random.default_rng(7)
     M, K = _chain(60, rng, rigid=rigid, sparse=sparse)
     dense = jd.System(M, None, K).w0
+    # shared by systems, files and harmonic balance (config): the large-structure path at this size
     monkeypatch.setattr(config, "SYSTEM_DENSE_CHECK_MAX_DOF", 10)
     large = jd.System(M, None, K).w0
     assert large == pytest.approx(dense, rel=1e-8)
@@ -568,6 +571,7 @@ def test_large_file_refusals_name_the_matrix(name, monkeypatch, tmp_path):
     mats[name] = mats[name] - 2.0 * np.max(np.abs(mats[name])) * np.eye(30)
     np.savez(tmp_path / "m.npz", **mats)
     toml = _toml(tmp_path, structure='file = "m.npz"', normal="{ n0 = 100.0 }")
+    # shared by systems, files and harmonic balance (config): the large-structure path at this size
     monkeypatch.setattr(config, "SYSTEM_DENSE_CHECK_MAX_DOF", 10)
     with pytest.raises(ValueError) as exc:
         read_system(toml)
@@ -618,6 +622,7 @@ def test_rigid_mode_dof_large_path_agrees(sparse, monkeypatch):
     Kr[7, :] = 0.0  # DOF 7 held by nothing
     expected = (rigid_mode_dof(K), rigid_mode_dof(Kr))
     assert expected[0] is None and (not sparse or expected[1] == 7)
+    # shared by systems, files and harmonic balance (config): the large-structure path at this size
     monkeypatch.setattr(config, "SYSTEM_DENSE_CHECK_MAX_DOF", 10)
     assert (rigid_mode_dof(K), rigid_mode_dof(Kr)) == expected
 

@@ -175,6 +175,7 @@ def test_a_fifo_or_device_is_not_a_regular_file(tmp_path, capsys, kind):
 # --- size bounds, the same for every way of giving the same thing ---------------------
 
 def test_inline_pairs_are_bounded_like_a_pairs_file(tmp_path, capsys, monkeypatch):
+    # an input-size bound shared by every command (config), lowered to make the case small
     monkeypatch.setattr(config, "INTERFACE_MAX_PAIRS", 5)
     row = "[0, 1, 2, -1, -1, -1]"
     inline = _system(tmp_path, pairs="[" + ", ".join([row] * 6) + "]")
@@ -378,6 +379,7 @@ def test_epmc_calls_a_tiny_normal_stiffness_ill_conditioned(tmp_path, capsys):
 def test_the_library_fits_keep_the_bounds_of_the_cli(monkeypatch):
     import jointdyn as jd
 
+    # input-size bounds shared by the fit command and the fits (config), lowered to make the case small
     monkeypatch.setattr(config, "FIT_MAX_BACKBONE_POINTS", 5)
     monkeypatch.setattr(config, "FIT_MAX_LOOP_SAMPLES", 300)
     A = np.logspace(-7, -4, 8)

@@ -8,7 +8,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import tolerances
-from jointdyn import config
 from jointdyn.drivers import march
 from jointdyn.kinematics import ConstantLoad, HarmonicLoad
 from jointdyn.laws import SEPARATION, make_law
@@ -25,6 +24,8 @@ from jointdyn.dynamics import (
 )
 from jointdyn.dynamics._core import LOADS_HARMONIC, RUN_BLOWUP, RUN_OK, RUN_OVERFLOW
 from jointdyn.dynamics._model import make_model, run
+from jointdyn.dynamics._model import TI_STEPS_PER_PERIOD
+from jointdyn.dynamics.steady import SS_AMP_RTOL, SS_CHECK_PERIODS, SS_CHUNK, SS_MAX_PERIODS
 
 M, K, KT = PAPER["m"], PAPER["k"], PAPER["kt"]
 
@@ -176,7 +177,7 @@ def test_energy_balance_at_steady_state(kw, gamma):
 def test_step_halving_changes_amplitude_little(eta, gamma):
     s = System.paper_damper(eta=eta, beta=2.0)
     a = steady_state(s, gamma, keep_loop=False)
-    b = steady_state(s, gamma, steps_per_period=2 * config.TI_STEPS_PER_PERIOD, start=a, keep_loop=False)
+    b = steady_state(s, gamma, steps_per_period=2 * TI_STEPS_PER_PERIOD, start=a, keep_loop=False)
     assert a.status == b.status == "periodic"
     assert b.amplitude_m == pytest.approx(a.amplitude_m, rel=tolerances.TEST_TI_STEP_HALVING_RTOL)
 
@@ -244,7 +245,7 @@ def test_event_at_the_period_boundary(delta):
     assert np.max(np.abs(T - tr.T[:, 0])) <= tolerances.TEST_TI_MARCH_ATOL_FY * law.fy
     assert 0.0 <= tr.N[0, 0] <= 1e-9 * law.n_ref
     a = steady_state(s, 1.1, keep_loop=False)
-    b = steady_state(s, 1.1, steps_per_period=2 * config.TI_STEPS_PER_PERIOD, keep_loop=False)
+    b = steady_state(s, 1.1, steps_per_period=2 * TI_STEPS_PER_PERIOD, keep_loop=False)
     assert a.status.ok and b.status.ok
     assert b.amplitude_m == pytest.approx(a.amplitude_m, rel=tolerances.TEST_TI_STEP_HALVING_RTOL)
 
@@ -312,11 +313,11 @@ def test_loop_is_one_closed_period_and_warm_start_is_cheap():
     assert lp.t[-1] == pytest.approx(2 * math.pi / w, rel=1e-12)
     X = 0.5 * (lp.x[:, 0].max() - lp.x[:, 0].min())
     assert X == pytest.approx(r.amplitude_m, rel=1e-6)
-    assert np.abs(lp.x[-1, 0] - lp.x[0, 0]) <= 10 * config.SS_AMP_RTOL * r.amplitude_m
+    assert np.abs(lp.x[-1, 0] - lp.x[0, 0]) <= 10 * SS_AMP_RTOL * r.amplitude_m
     assert isinstance(r.restart, Restart)
     r2 = steady_state(s, 1.2, start=r)
-    assert r2.status.ok and r2.periods <= config.SS_CHECK_PERIODS + config.SS_CHUNK + 1
-    assert r2.amplitude_m == pytest.approx(r.amplitude_m, rel=10 * config.SS_AMP_RTOL)
+    assert r2.status.ok and r2.periods <= SS_CHECK_PERIODS + SS_CHUNK + 1
+    assert r2.amplitude_m == pytest.approx(r.amplitude_m, rel=10 * SS_AMP_RTOL)
     r3 = steady_state(s, 1.3, start=r, keep_loop=False)
     assert r3.status.ok and r3.loop is None
 
@@ -330,7 +331,7 @@ def test_unsettled_response_is_not_reported_as_a_number():
     r = steady_state(s, 1.15)
     assert r.status == "not-settled"
     assert math.isnan(r.amplitude_q) and math.isnan(r.amplitude_m)
-    assert r.periods < config.SS_MAX_PERIODS
+    assert r.periods < SS_MAX_PERIODS
     assert steady_state(System.paper_damper(eta=0.5, beta=2.0), 1.15).status == "periodic"
 
 

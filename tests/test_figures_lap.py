@@ -10,8 +10,8 @@ import math
 import numpy as np
 import pytest
 
-from jointdyn import config
 from jointdyn.figures import FIGURES, figure_names
+from jointdyn.figures import lap
 from jointdyn.figures.lap import lap_joint_data, lap_joint_system
 
 
@@ -28,7 +28,7 @@ def test_stuck_backbone_is_the_linear_mode_with_the_loaded_pairs_stuck(stuck_tab
     assert (bb.status == "complete").all() and len(bb) >= 2
     f1 = lap_joint().frequencies_hz["stuck"][0]  # the script's number, stored with the model
     np.testing.assert_allclose(bb.frequency_hz, f1, rtol=1e-6)
-    np.testing.assert_allclose(bb.damping_ratio, config.LAP_ZETA, rtol=1e-6)
+    np.testing.assert_allclose(bb.damping_ratio, lap.LAP_ZETA, rtol=1e-6)
     np.testing.assert_allclose(bb.damping_ratio_contacts, 0.0, atol=1e-12)
     slip = stuck_tables["slip"]
     on = slip.in_interface.astype(bool)
@@ -49,10 +49,10 @@ def test_stuck_forced_response_is_the_linear_modes(stuck_tables):
     lam, phi = eigh(lj.linear_K("stuck"), lj.M, subset_by_index=[0, 0])
     w, v = math.sqrt(lam[0]), phi[:, 0]
     W = 2 * math.pi * frc.frequency_hz.to_numpy()
-    a = abs(v[lj.output_dof] * (v @ system.force)) / np.abs(w * w - W * W + 2j * config.LAP_ZETA * w * W)
+    a = abs(v[lj.output_dof] * (v @ system.force)) / np.abs(w * w - W * W + 2j * lap.LAP_ZETA * w * W)
     np.testing.assert_allclose(frc.amplitude_m, a, rtol=1e-6)
     peak = frc[frc.flank == 0]
-    assert float(peak.frequency_hz.iloc[0]) == pytest.approx(w * math.sqrt(1 - 2 * config.LAP_ZETA**2) / (2 * math.pi),
+    assert float(peak.frequency_hz.iloc[0]) == pytest.approx(w * math.sqrt(1 - 2 * lap.LAP_ZETA**2) / (2 * math.pi),
                                                              rel=1e-9)
 
 

@@ -246,6 +246,7 @@ def test_one_matrix_per_file_relative_to_the_system_file(tmp_path, monkeypatch):
 def test_size_bound_before_conversion(tmp_path, monkeypatch):
     from jointdyn import config
 
+    # an input-size bound kept with the others in config, lowered to make the case small
     monkeypatch.setattr(config, "FILES_MAX_DOF", 1)
     with pytest.raises(ValueError, match=r"structure\.M must have at most 1 rows and columns"):
         jd.read_system(_write(tmp_path, BASE))

@@ -12,6 +12,7 @@ from jointdyn.continuation import (
     ContinuationOptions,
     ContinuationResult,
     ContinuationStatus,
+    LinearSolveOptions,
     continuation,
     newton,
 )
@@ -23,13 +24,27 @@ def _cubic(y, lam):
     return np.array([y[0] ** 3 - y[0] + lam]), np.array([[3 * y[0] ** 2 - 1]]), np.array([1.0])
 
 
-def test_options_defaults_come_from_config():
-    opt = ContinuationOptions()
-    assert (opt.ds, opt.ds_min, opt.ds_max) == (config.CONT_DS_START, config.CONT_DS_MIN, config.CONT_DS_MAX)
-    assert (opt.tol, opt.max_iter, opt.max_points) == (config.CONT_TOL, config.CONT_MAX_ITER,
-                                                        config.CONT_MAX_POINTS)
-    assert opt.jump_fractions == config.CONT_JUMP_FRACTIONS and opt.corner_ds == config.CONT_CORNER_DS
-    assert opt.start_extrapolation is None  # the solver decides (harmonic balance: by the contact laws)
+def _documented_numbers(cls, field):
+    """The numbers written in the docstring paragraph of ``field`` of ``cls`` (numpydoc Attributes)."""
+    import re
+
+    doc = cls.__doc__.split("Attributes", 1)[1]
+    paragraphs = re.split(r"\n    (?=[a-z_][a-z_, ]*(?: : |\n))", doc)
+    text = next(p for p in paragraphs if re.match(rf"([a-z_]+, )*{field}\b", p.strip()))
+    return {float(x) for x in re.findall(r"(?<![\w.])-?\d+(?:\.\d+)?(?:e-?\d+)?(?![\w.])", text)}
+
+
+@pytest.mark.parametrize("cls", [ContinuationOptions, LinearSolveOptions])
+def test_every_default_of_the_options_is_written_in_their_docstring(cls):
+    """The numbers of the continuation live in its options objects, each default documented with it."""
+    for f in dataclasses.fields(cls):
+        default = f.default
+        values = default if isinstance(default, tuple) else (default,)
+        for v in values:
+            if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v):
+                assert float(v) in _documented_numbers(cls, f.name), (cls.__name__, f.name, v)
+    assert ContinuationOptions().start_extrapolation is None  # the solver decides (harmonic balance: by the laws)
+    assert ContinuationOptions().tol == config.CONT_TOL  # shared with harmonic balance's single solutions
 
 
 @pytest.mark.parametrize("field,value", [("ds", 0.0), ("ds_min", -1.0), ("max_points", 0), ("grow", -1.0),
@@ -93,9 +108,9 @@ def test_monitor_stops_with_its_status():
 
 
 def test_large_bordered_systems_go_through_lapack():
-    # a diagonal cubic of more unknowns than config.CONT_SMALL_SOLVE: the
+    # a diagonal cubic of more unknowns than LinearSolveOptions.small_solve: the
     # LAPACK path; every point must solve the equations
-    n = config.CONT_SMALL_SOLVE  # n + 1 unknowns with the arc-length constraint
+    n = LinearSolveOptions().small_solve  # n + 1 unknowns with the arc-length constraint
     c = np.linspace(0.5, 1.5, n)
 
     def res(y, lam):

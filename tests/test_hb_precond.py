@@ -14,7 +14,7 @@ import pytest
 
 import jointdyn as jd
 from jointdyn import config
-from jointdyn.continuation import linalg
+from jointdyn.continuation import LinearSolveOptions, linalg
 from jointdyn.hb._precond import HarmonicBlocks, harmonic_blocks
 from jointdyn.hb.problem import HBProblem, reference_scales
 from jointdyn.interfaces import Interface
@@ -90,7 +90,7 @@ def test_structured_solve_meets_the_tolerance_on_a_coupled_matrix(monkeypatch):
         x, ok = fr.solve(A, Jl, d, b)
         assert ok and fr.counts["block_factorisations"] == 1 and fr.counts["factorisations"] == 0
         np.testing.assert_allclose(x, exact, rtol=1e-7, atol=1e-9 * np.abs(exact).max())
-        assert fr.counts["krylov_iterations"] <= config.CONT_KRYLOV_REFRESH
+        assert fr.counts["krylov_iterations"] <= LinearSolveOptions().krylov_refresh
         A2 = A + 1e-3 * (sps.identity(size) if sps.issparse(A) else np.eye(size))
         x, ok = fr.solve(A2, Jl, d, b)
         np.testing.assert_allclose(x, np.linalg.solve(linalg._bordered(A2 if isinstance(A2, np.ndarray) else
@@ -100,11 +100,14 @@ def test_structured_solve_meets_the_tolerance_on_a_coupled_matrix(monkeypatch):
 
 
 def _large(monkeypatch, on: bool):
-    """The large-problem path at this small size: direct (on False) or preconditioned by the blocks."""
-    monkeypatch.setattr(config, "CONT_SMALL_SOLVE", 0)
+    """The large-problem path at this small size: direct (on False) or preconditioned by the blocks; returns
+    the linear-solve options of that path."""
+    # CONT_KRYLOV_SOLVE and CONT_SPARSE_DENSITY are shared (the walk's solves and the form harmonic balance and
+    # EPMC give their Jacobians): patched here so that both take the large path at this small size
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     monkeypatch.setattr(config, "HB_HILL_MAX_ROWS", 0)
     monkeypatch.setattr(config, "HB_BLOCK_PRECONDITIONER", on)
+    return LinearSolveOptions(small_solve=0)
 
 
 def test_hb_branch_on_a_dense_reduced_model_equals_the_direct_path(monkeypatch):
@@ -115,8 +118,7 @@ def test_hb_branch_on_a_dense_reduced_model_equals_the_direct_path(monkeypatch):
     kw = dict(harmonics=3, samples=32, condense=False)
     out = {}
     for on in (False, True):
-        _large(monkeypatch, on)
-        out[on] = continue_hb(s, 0.8, 1.25, **kw)
+        out[on] = continue_hb(s, 0.8, 1.25, linear=_large(monkeypatch, on), **kw)
     a, b = out[False], out[True]
     assert HBProblem(s, harmonics=3, samples=32).large_jacobian() == "blocks"  # (the flag is on here)
     assert a.status.ok and b.status.ok
@@ -141,8 +143,7 @@ def test_epmc_backbone_on_a_dense_reduced_model_equals_the_direct_path(monkeypat
     rng_a = (0.01 * fy / kt, 10.0 * fy / kt)
     out = {}
     for on in (False, True):
-        _large(monkeypatch, on)
-        out[on] = epmc(s, rng_a, harmonics=3, samples=32)
+        out[on] = epmc(s, rng_a, harmonics=3, samples=32, linear=_large(monkeypatch, on))
     a, b = out[False], out[True]
     assert a.status.ok and b.status.ok
     assert b.counters["block_factorisations"] > 0 and b.counters["factorisations"] < a.counters["factorisations"] / 4
@@ -183,6 +184,6 @@ def test_linear_guess_by_harmonic_blocks_equals_the_whole_solve(monkeypatch):
     s = _dense_reduced()
     q = HBProblem(s, harmonics=3, samples=32)
     a = q.linear_guess(1.1)
-    monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
+    monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)  # shared (config): the solves and the Jacobian's form
     b = q.linear_guess(1.1)
     np.testing.assert_allclose(b, a, rtol=0, atol=1e-12 * np.abs(a).max())

@@ -343,6 +343,7 @@ def test_a_stop_the_finished_branch_does_not_confirm_is_undone(monkeypatch):
     made = []
     real = hb_disc._fixed_branch
     monkeypatch.setattr(hb_disc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
+    # harmonic balance's number, still in config until hb's options take it (PENDING_OWNED in tests/test_architecture.py)
     monkeypatch.setattr(config, "HB_AUTO_EARLY_DROP", 1.0)
     every = frc_hb(system, 0.6, 1.8, max_step=0.01)
     assert isinstance(made[0], hb_disc._Refine) and made[0].peak.lam < 0.7

@@ -13,7 +13,7 @@ import pytest
 
 import jointdyn as jd
 from jointdyn import config
-from jointdyn.continuation import linalg
+from jointdyn.continuation import LinearSolveOptions, linalg
 
 
 def _bordered_case(rng, n):
@@ -105,7 +105,7 @@ def test_sparse_matrices_are_factorised_by_superlu_while_their_factors_stay_spar
 
 def test_superlu_takes_safer_pivots_where_the_diagonal_ones_are_inaccurate():
     """The diagonal pivots first (least fill); where the solve is then not accurate (tiny diagonal
-    entries), the next threshold of config.CONT_SPARSE_PIVOTS: the answer is LAPACK's either way."""
+    entries), the next threshold of LinearSolveOptions.sparse_pivots: the answer is LAPACK's either way."""
     rng = np.random.default_rng(10)
     n = 600  # 1.2 % nonzero: sparse (config.CONT_SPARSE_DENSITY)
     J = _banded(rng, n)
@@ -135,10 +135,9 @@ def test_a_sparse_jacobian_is_solved_as_its_dense_array():
     ref_t = linalg._tangent(J, Jl, d)
     for small, density in ((800, 1.0), (0, 1.0), (0, 0.0)):
         with pytest.MonkeyPatch.context() as mp:
-            mp.setattr(config, "CONT_SMALL_SOLVE", small)
-            mp.setattr(config, "CONT_KRYLOV_SOLVE", 0)
+            mp.setattr(config, "CONT_KRYLOV_SOLVE", 0)  # shared with the solvers (config): the large path
             mp.setattr(config, "CONT_SPARSE_DENSITY", density)
-            with linalg.reusing_factors():
+            with linalg.reusing_factors(LinearSolveOptions(small_solve=small)):
                 dv, ok = linalg._newton_direction(sps.csr_matrix(J), Jl, d, R, v, up)
                 t = linalg._tangent(sps.csr_matrix(J), Jl, d)
         assert ok
@@ -180,12 +179,14 @@ def _chain(nodes=4):
 
 
 def _reuse_everywhere(monkeypatch, path):
-    """Every bordered solve through FactorReuse: dense (GMRES with kept factors) or sparse (SuperLU)."""
-    monkeypatch.setattr(config, "CONT_SMALL_SOLVE", 0)
+    """Every bordered solve through FactorReuse: dense (GMRES with kept factors) or sparse (SuperLU).
+    Returns the counter that says so and the walk's linear-solve options."""
+    # CONT_KRYLOV_SOLVE and CONT_SPARSE_DENSITY are shared (the walk's solves and the form harmonic balance and
+    # EPMC give their Jacobians): patched here so that both take the large path at this small size
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0 if path == "sparse" else 0.0)
-    monkeypatch.setattr(config, "CONT_SPARSE_FILL", 1.0)
-    return "sparse_factorisations" if path == "sparse" else "krylov_solves"
+    key = "sparse_factorisations" if path == "sparse" else "krylov_solves"
+    return key, LinearSolveOptions(small_solve=0, sparse_fill=1.0)
 
 
 def test_epmc_in_place_jacobian_equals_the_dense_mass_block():
@@ -222,10 +223,10 @@ def test_epmc_points_with_reused_factors_equal_direct_solves(monkeypatch, path):
     kt, fy = reference_scales(s)
     amps = fy / kt * np.array([0.05, 0.3, 1.0, 3.0])
 
-    def points():
+    def points(linear=None):
         q = EPMCProblem(s, harmonics=3, samples=32)
         v, out = q.linear_guess(), []
-        with linalg.reusing_factors() as fr:
+        with linalg.reusing_factors(linear) as fr:
             for a in amps:
                 v, ok, _ = q.solve(a, v, tol=1e-11)
                 assert ok
@@ -234,8 +235,8 @@ def test_epmc_points_with_reused_factors_equal_direct_solves(monkeypatch, path):
 
     direct, counts = points()
     assert counts["factorisations"] == 0  # small: the compiled elimination, no reuse
-    key = _reuse_everywhere(monkeypatch, path)
-    reused, counts = points()
+    key, linear = _reuse_everywhere(monkeypatch, path)
+    reused, counts = points(linear)
     assert counts[key] > 0
     np.testing.assert_allclose(reused, direct, rtol=0, atol=1e-8 * np.abs(direct).max())
 
@@ -246,8 +247,8 @@ def test_hb_branch_with_reused_factors_has_the_same_peak(monkeypatch, path):
 
     s = _chain(3)
     a = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False)
-    key = _reuse_everywhere(monkeypatch, path)
-    b = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False)
+    key, linear = _reuse_everywhere(monkeypatch, path)
+    b = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False, linear=linear)
     assert a.status.ok and b.status.ok
     assert b.counters[key] > 0 and key not in a.counters
     pa, pb = a.response()[0].max(), b.response()[0].max()

@@ -13,6 +13,7 @@ import pytest
 
 import jointdyn as jd
 from jointdyn import config
+from jointdyn.continuation import LinearSolveOptions
 from jointdyn.hb.problem import HBProblem, reference_scales
 from test_sparse_jacobian import _two_bodies
 
@@ -185,11 +186,11 @@ def test_hb_branch_and_solution_with_the_operator_equal_those_with_dense_c(monke
     sa, so = _pair(3)
     a = continue_hb(sa, 0.7, 1.3, harmonics=2, samples=32, condense=False)
     xa = harmonic_balance(sa, 1.02, harmonics=2, samples=32, condense=False)
-    monkeypatch.setattr(config, "CONT_SMALL_SOLVE", 0)
+    # shared numbers: the size above which Krylov solves and the sparse evaluation are used
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
-    monkeypatch.setattr(config, "HB_HILL_MAX_ROWS", 0)
-    b = continue_hb(so, 0.7, 1.3, harmonics=2, samples=32, condense=False)
+    monkeypatch.setattr(config, "HB_HILL_MAX_ROWS", 0)  # an hb number still in config
+    b = continue_hb(so, 0.7, 1.3, harmonics=2, samples=32, condense=False, linear=LinearSolveOptions(small_solve=0))
     assert a.status.ok and b.status.ok
     assert b.counters["sparse_factorisations"] > 0 and b.counters["krylov_solves"] > 0
     assert b.response()[0].max() == pytest.approx(a.response()[0].max(), rel=1e-8)
@@ -215,7 +216,7 @@ def test_epmc_with_the_operator_equals_epmc_with_dense_c(monkeypatch):
     np.testing.assert_allclose(a2.omega_rad_s, a.omega_rad_s, rtol=1e-12)
     np.testing.assert_allclose(a2.damping_ratio, a.damping_ratio, rtol=1e-10)
     dense = EPMCProblem(sa, harmonics=3, samples=32)
-    monkeypatch.setattr(config, "CONT_SMALL_SOLVE", 0)
+    # shared numbers: the size above which Krylov solves and the sparse evaluation are used
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
     sparse = EPMCProblem(so, harmonics=3, samples=32)
@@ -231,7 +232,7 @@ def test_epmc_with_the_operator_equals_epmc_with_dense_c(monkeypatch):
         np.testing.assert_allclose(Rb, Ra, rtol=0, atol=1e-13 * np.abs(Ra).max())
         np.testing.assert_allclose(Jb.toarray(), Ja, rtol=0, atol=1e-13 * np.abs(Ja).max())
         np.testing.assert_allclose(Lb, La, rtol=0, atol=1e-13 * max(np.abs(La).max(), 1.0))
-    b = epmc(so, rng_a, harmonics=3, samples=32)
+    b = epmc(so, rng_a, harmonics=3, samples=32, linear=LinearSolveOptions(small_solve=0))
     assert a.status.ok and b.status.ok and b.counters["sparse_factorisations"] > 0
     for name in ("omega_rad_s", "damping_ratio"):
         ya = np.interp(np.log(b.amplitude_m), np.log(a.amplitude_m), getattr(a, name))

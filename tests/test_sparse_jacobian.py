@@ -13,6 +13,7 @@ import pytest
 
 import jointdyn as jd
 from jointdyn import config
+from jointdyn.continuation import LinearSolveOptions
 from jointdyn.hb.problem import HBProblem, reference_scales
 from jointdyn.interfaces import Interface
 
@@ -94,6 +95,8 @@ def test_epmc_residual_with_a_sparse_jacobian_equals_the_dense_one(monkeypatch):
     s = jd.System(M=s.M, C=s.C, K=s.K, interfaces=s.interfaces, output_dof=0)
     dense = EPMCProblem(s, harmonics=3, samples=32)
     assert not dense.sparse
+    # CONT_KRYLOV_SOLVE and CONT_SPARSE_DENSITY are shared (the walk's solves and the form harmonic balance and
+    # EPMC give their Jacobians): patched here so that both take the large path at this small size
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
     sparse = EPMCProblem(s, harmonics=3, samples=32)
@@ -122,10 +125,11 @@ def test_epmc_backbone_with_sparse_jacobians_equals_the_dense_one(monkeypatch):
     kt, fy = reference_scales(s)
     rng_a = (0.05 * fy / kt, 5.0 * fy / kt)
     a = epmc(s, rng_a, harmonics=3, samples=32)
-    monkeypatch.setattr(config, "CONT_SMALL_SOLVE", 0)
+    # CONT_KRYLOV_SOLVE and CONT_SPARSE_DENSITY are shared (the walk's solves and the form harmonic balance and
+    # EPMC give their Jacobians): patched here so that both take the large path at this small size
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
-    b = epmc(s, rng_a, harmonics=3, samples=32)
+    b = epmc(s, rng_a, harmonics=3, samples=32, linear=LinearSolveOptions(small_solve=0))
     assert a.status.ok and b.status.ok
     assert b.counters["sparse_factorisations"] > 0 and "sparse_factorisations" not in a.counters
     # the two walks may place their points differently: compare b's points with a's curve
@@ -141,7 +145,8 @@ def test_hb_branch_with_sparse_jacobians_has_the_same_peak(monkeypatch):
 
     s = _two_bodies(3)
     a = continue_hb(s, 0.7, 1.3, harmonics=2, samples=32, condense=False)
-    monkeypatch.setattr(config, "CONT_SMALL_SOLVE", 0)
+    # CONT_KRYLOV_SOLVE and CONT_SPARSE_DENSITY are shared (the walk's solves and the form harmonic balance and
+    # EPMC give their Jacobians): patched here so that both take the large path at this small size
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
     monkeypatch.setattr(config, "HB_HILL_MAX_ROWS", 0)
@@ -153,7 +158,8 @@ def test_hb_branch_with_sparse_jacobians_has_the_same_peak(monkeypatch):
         return orig(self, X, p)
 
     monkeypatch.setattr(HBProblem, "evaluate_sparse", counted)
-    b = continue_hb(s, 0.7, 1.3, harmonics=2, samples=32, condense=False)
+    b = continue_hb(s, 0.7, 1.3, harmonics=2, samples=32, condense=False,
+                    linear=LinearSolveOptions(small_solve=0))
     assert a.status.ok and b.status.ok and calls
     assert b.counters["sparse_factorisations"] > 0
     pa, pb = a.response()[0].max(), b.response()[0].max()

@@ -9,7 +9,7 @@ import xarray as xr
 
 import jointdyn as jd
 from jointdyn.interfaces import Interface
-from jointdyn.sweeps import _frc, frc_sweep, to_frame
+from jointdyn.sweeps import SweepOptions, frc_sweep, to_frame
 
 M4 = np.diag([1.0, 1.0, 1.0, 2.0])
 K4 = np.diag([1e3, 1.2e3, 2e3, 4e3])
@@ -61,8 +61,6 @@ def test_systems_without_interfaces_get_no_pair_dimension():
 def test_family_with_and_without_interfaces_pool_and_dask_equal_serial():
     """A family of Systems with different numbers of pairs (the narrower padded with NaN): serial ==
     local process pool == Dask (2 workers), with chunks of 2 points continuing across workers."""
-    from unittest import mock
-
     from distributed import Client, LocalCluster
 
     one_pair = _system()
@@ -76,18 +74,16 @@ def test_family_with_and_without_interfaces_pool_and_dask_equal_serial():
     assert serial.pair_energy_J.dims == ("system", "direction", "gamma", "pair")
     assert np.isnan(serial.pair_energy_J.sel(system="one pair", pair=1)).all()
     assert np.isfinite(serial.pair_energy_J.sel(system="one pair", pair=0)).all()
-    with mock.patch.object(_frc.config, "SWEEP_CHUNK_POINTS", 2):
-        pooled = frc_sweep(family, GAMMAS, **kw, n_workers=2)
-        with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
-            with Client(lc) as client:
-                dist = frc_sweep(family, GAMMAS, **kw, client=client)
+    pooled = frc_sweep(family, GAMMAS, **kw, options=SweepOptions(chunk_points=2), n_workers=2)
+    with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
+        with Client(lc) as client:
+            dist = frc_sweep(family, GAMMAS, **kw, options=SweepOptions(chunk_points=2), client=client)
     xr.testing.assert_identical(serial, pooled)
     xr.testing.assert_identical(serial, dist)
 
 
 def test_resumed_sweep_keeps_the_pair_results(tmp_path, monkeypatch):
-    monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", 2)
-    kw = dict(directions=("up",), n_workers=1, progress=False, out=tmp_path)
+    kw = dict(options=SweepOptions(chunk_points=2), directions=("up",), n_workers=1, progress=False, out=tmp_path)
     full = frc_sweep(_system(), GAMMAS, **kw)
     again = frc_sweep(_system(), GAMMAS, **kw)
     assert again.attrs["reused_points"] == len(GAMMAS)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 import xarray as xr
 
-from jointdyn.sweeps import _frc, _points, frc_sweep
+from jointdyn.sweeps import SweepOptions, _points, frc_sweep
 from jointdyn.sweeps._family import LineSpec
 from test_sweeps import GAMMAS, _Fake, _results
 
@@ -25,8 +25,8 @@ def swap(monkeypatch):
 
 @pytest.mark.parametrize("chunk", [2, 8])
 def test_one_more_point_reuses_every_point_before_it(swap, tmp_path, monkeypatch, chunk):
-    monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", chunk)
-    kw = dict(etas=[0.5], betas=[1.0], n_workers=1, progress=False, out=tmp_path)
+    kw = dict(options=SweepOptions(chunk_points=chunk), etas=[0.5], betas=[1.0], n_workers=1, progress=False,
+              out=tmp_path)
     swap()
     frc_sweep(GAMMAS, **kw)
     longer = [*GAMMAS, 1.4]  # one more point at the top of the grid
@@ -51,8 +51,8 @@ def test_one_more_point_reuses_every_point_before_it(swap, tmp_path, monkeypatch
 
 
 def test_a_point_inserted_inside_the_grid_reuses_the_points_before_it(swap, tmp_path, monkeypatch):
-    monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", 1)
-    kw = dict(etas=[0.5], betas=[1.0], directions=("up",), n_workers=1, progress=False, out=tmp_path)
+    kw = dict(options=SweepOptions(chunk_points=1), etas=[0.5], betas=[1.0], directions=("up",), n_workers=1,
+              progress=False, out=tmp_path)
     swap()
     frc_sweep(GAMMAS, **kw)  # 0.8 ... 1.3
     finer = sorted([*GAMMAS, 0.95])

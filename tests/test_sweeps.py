@@ -23,7 +23,7 @@ from hypothesis import strategies as st
 
 import jointdyn as jd
 from jointdyn.dynamics import Restart
-from jointdyn.sweeps import STATUS_CODES, LineSpec, frc_sweep, status_name, to_frame
+from jointdyn.sweeps import STATUS_CODES, LineSpec, SweepOptions, frc_sweep, status_name, to_frame
 from jointdyn.sweeps import _frc, _points
 from tolerances import (
     TEST_SWEEP_CONTACT_ENERGY_RTOL,
@@ -123,9 +123,8 @@ def test_chain_and_restart_after_unbounded(fake):
 def test_chunking_does_not_change_results(chunk, fake, monkeypatch):
     """A line run as chunks of any size continues each chunk from the
     previous chunk's last state: the same result as one plain loop."""
-    monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", chunk)
     g = [0.5 + 0.05 * i for i in range(20)]
-    ds = frc_sweep(g, etas=[0.5], betas=[2.0], n_workers=1, progress=False)
+    ds = frc_sweep(g, etas=[0.5], betas=[2.0], n_workers=1, progress=False, options=SweepOptions(chunk_points=chunk))
     for d in ("up", "down"):
         got = ds.amplitude_q.sel(eta=0.5, beta=2.0, delta=0.0, direction=d).values
         np.testing.assert_array_equal(got, _expected_line(g, d))
@@ -154,8 +153,7 @@ def test_interrupt_keeps_finished_points_and_resume_reuses_them(monkeypatch, tmp
     """Ctrl-C at the 10th point of a serial sweep: the 9 finished points are
     saved (across chunk boundaries), the rerun reuses exactly them, says so,
     computes only the rest and equals the uninterrupted sweep."""
-    monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", 4)
-    kw = dict(etas=[0.5, 1.5], betas=[1.0], n_workers=1, progress=False)
+    kw = dict(options=SweepOptions(chunk_points=4), etas=[0.5, 1.5], betas=[1.0], n_workers=1, progress=False)
     ref = _Fake()
     monkeypatch.setattr(_points, "_steady_state_fn", lambda: ref)
     full = frc_sweep(GAMMAS, **kw)
@@ -187,9 +185,10 @@ def test_resume_from_any_interruption(k, chunk):
     from pathlib import Path
     from unittest import mock
 
-    kw = dict(etas=[0.5, 1.5], betas=[1.0, 2.0], directions=("up",), n_workers=1, progress=False)
+    kw = dict(etas=[0.5, 1.5], betas=[1.0, 2.0], directions=("up",), n_workers=1, progress=False,
+              options=SweepOptions(chunk_points=chunk))
     total = 4 * len(GAMMAS)
-    with mock.patch.object(_frc.config, "SWEEP_CHUNK_POINTS", chunk), tempfile.TemporaryDirectory() as d:
+    with tempfile.TemporaryDirectory() as d:
         with mock.patch.object(_points, "_steady_state_fn", lambda: _Fake()):
             full = frc_sweep(GAMMAS, **kw)
         stop = _Fake(interrupt_at=k)
@@ -308,7 +307,7 @@ def test_dask_progress_moves_per_point(monkeypatch):
     with LocalCluster(n_workers=1, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
         with Client(lc) as client:
             frc_sweep(gammas, directions=("up",), client=client)
-    assert len(gammas) <= _frc.config.SWEEP_CHUNK_POINTS
+    assert len(gammas) <= SweepOptions().chunk_points
     assert seen == [(k, k) for k in range(len(gammas))]
     assert bars[0].n == bars[0].total == len(gammas)
 
@@ -318,10 +317,7 @@ def test_threads_and_dask_equal_serial(fake, monkeypatch):
 
     kw = dict(etas=[0.5, 1.5], betas=[1.0, 2.0, 5.0], progress=False)
     serial = frc_sweep(GAMMAS, **kw, n_workers=1)
-    with monkeypatch.context() as mp:  # the local pool kind and chunking for this call only
-        mp.setattr(_frc.config, "SWEEP_POOL", "thread")
-        mp.setattr(_frc.config, "SWEEP_CHUNK_POINTS", 2)
-        threads = frc_sweep(GAMMAS, **kw, n_workers=2)
+    threads = frc_sweep(GAMMAS, **kw, n_workers=2, options=SweepOptions(pool="thread", chunk_points=2))
     xr.testing.assert_identical(serial, threads)
     with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
         with Client(lc) as client:
@@ -484,18 +480,15 @@ def test_linear_stuck_limit_real_solver():
 def test_real_solver_serial_equals_dask_and_pool():
     """Deterministic: serial == Dask LocalCluster == local process pool,
     with chunks of 2 points (lines continue across chunks on other workers)."""
-    from unittest import mock
-
     from distributed import Client, LocalCluster
 
     g = [0.9, 1.0, 1.1, 1.2, 1.3]
     kw = dict(etas=[0.5, 1.5], betas=[2.0], progress=False)
     serial = frc_sweep(g, **kw, n_workers=1)
-    with mock.patch.object(_frc.config, "SWEEP_CHUNK_POINTS", 2):
-        with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
-            with Client(lc) as client:
-                dist = frc_sweep(g, **kw, client=client)
-        pooled = frc_sweep(g, **kw, n_workers=2)  # local process pool (config.SWEEP_POOL)
+    with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
+        with Client(lc) as client:
+            dist = frc_sweep(g, **kw, options=SweepOptions(chunk_points=2), client=client)
+    pooled = frc_sweep(g, **kw, options=SweepOptions(chunk_points=2), n_workers=2)  # local process pool
     xr.testing.assert_identical(serial, dist)
     xr.testing.assert_identical(serial, pooled)
 
@@ -592,8 +585,6 @@ def test_system_family_pool_and_dask_equal_serial():
     """A mapping {label: System} with per-DOF and per-contact outputs: serial
     == local process pool == Dask, with chunks of 2 points (lines continue
     across chunks on other workers; the Systems travel by pickle)."""
-    from unittest import mock
-
     from distributed import Client, LocalCluster
 
     family = {"light": _two_dof(40.0), "separating": _two_dof(150.0, law="jenkins")}
@@ -601,11 +592,10 @@ def test_system_family_pool_and_dask_equal_serial():
     g = [0.8, 1.0, 1.2]
     serial = frc_sweep(family, g, **kw, n_workers=1)
     assert serial.sizes["system"] == 2 and list(serial.system.values) == ["light", "separating"]
-    with mock.patch.object(_frc.config, "SWEEP_CHUNK_POINTS", 2):
-        pooled = frc_sweep(family, g, **kw, n_workers=2)
-        with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
-            with Client(lc) as client:
-                dist = frc_sweep(family, g, **kw, client=client)
+    pooled = frc_sweep(family, g, **kw, options=SweepOptions(chunk_points=2), n_workers=2)
+    with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as lc:
+        with Client(lc) as client:
+            dist = frc_sweep(family, g, **kw, options=SweepOptions(chunk_points=2), client=client)
     xr.testing.assert_identical(serial, pooled)
     xr.testing.assert_identical(serial, dist)
 
@@ -614,8 +604,7 @@ def test_damaged_checkpoint_is_recomputed_from_there(fake, tmp_path, monkeypatch
     """A truncated chunk file (a full disk, a partial copy) and the
     temporary file a kill during an atomic write leaves behind: the chunks
     before the damage are reused, the rest recomputed, the result unchanged."""
-    monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", 2)
-    kw = dict(directions=("up",), n_workers=1, progress=False, out=tmp_path)
+    kw = dict(options=SweepOptions(chunk_points=2), directions=("up",), n_workers=1, progress=False, out=tmp_path)
     full = frc_sweep(GAMMAS, **kw)
     (line,) = (tmp_path / "lines").iterdir()
     chunks = sorted(line.glob("p*.npz"))
@@ -663,10 +652,9 @@ def test_refused_system_is_named_and_the_finished_points_kept(pool, tmp_path, mo
     the System by its label; the points finished before it (the other
     System's, and this one's first chunk) are saved and reused by a rerun,
     which equals the uninterrupted sweep."""
-    monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", 2)
-    monkeypatch.setattr(_frc.config, "SWEEP_POOL", "thread")
     family = {f"eta{e}": jd.System.paper_damper(eta=e, beta=2.0) for e in (0.5, 1.5)}
-    kw = dict(directions=("up",), loop_outputs=False, progress=False, n_workers=1 if pool == "serial" else 2)
+    kw = dict(options=SweepOptions(chunk_points=2, pool="thread"), directions=("up",), loop_outputs=False,
+              progress=False, n_workers=1 if pool == "serial" else 2)
     refusing = _Refusing()
     monkeypatch.setattr(_points, "_steady_state_fn", lambda: refusing)
     with pytest.raises(ValueError) as exc:
@@ -694,8 +682,8 @@ def test_interrupt_on_dask_keeps_every_finished_point(tmp_path, monkeypatch):
     uninterrupted sweep."""
     from distributed import Client, LocalCluster
 
-    monkeypatch.setattr(_frc.config, "SWEEP_CHUNK_POINTS", 4)
-    kw = dict(etas=[0.5, 1.5], betas=[1.0, 2.0], directions=("up",), progress=False)
+    kw = dict(options=SweepOptions(chunk_points=4), etas=[0.5, 1.5], betas=[1.0, 2.0], directions=("up",),
+              progress=False)
     monkeypatch.setattr(_points, "_steady_state_fn", lambda: _Fake())
     full = frc_sweep(GAMMAS, **kw, n_workers=1)
     stop = _Fake(interrupt_at=9)

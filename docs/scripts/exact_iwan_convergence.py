@@ -33,9 +33,10 @@ from pathlib import Path
 
 import numpy as np
 
-from jointdyn import DiscreteIwan, Iwan, IwanClosedForm, config, harmonic_loop
+from jointdyn import DiscreteIwan, Iwan, IwanClosedForm, harmonic_loop
 from jointdyn._io import atomic_write_text
 from jointdyn.dynamics import steady_state
+from jointdyn.dynamics.steady import SS_AMP_RTOL
 from jointdyn.laws.exact import piece_count
 from jointdyn.systems import PAPER, System
 
@@ -43,7 +44,7 @@ PAGE = Path(__file__).resolve().parents[1] / "exact-iwan.md"
 START, END = "<!-- tables:start -->", "<!-- tables:end -->"
 #: capacity treated as "no merge" (checked: the piece counts stay below it)
 K_REF = 2048
-K_DEFAULT = config.IWAN_CAPACITY
+K_DEFAULT = Iwan.__dataclass_fields__["capacity"].default  # the law's default capacity
 CAPACITIES = (8, 12, 16, 24, 32, 48, 64)
 DISCRETE_N = (50, 200, 1000, 4000)
 
@@ -271,7 +272,7 @@ def summary() -> str:
             f"{100 * SUMMARY['points']:.1e} % at the damper points")
     if "grid" in SUMMARY:
         text += (f" and by {100 * SUMMARY['grid']:.1e} % over the whole Fig 6 grid (there the periodicity "
-                 f"tolerance {config.SS_AMP_RTOL:g} of the steady states bounds the comparison)")
+                 f"tolerance {SS_AMP_RTOL:g} of the steady states bounds the comparison)")
     return text + "; the requirement is 0.1 %."
 
 

@@ -1,10 +1,11 @@
-"""Numerical defaults of jointdyn, one section per package in the order of the layers, bottom up:
-contact laws; systems and system files; continuation and the quasi-static driver; the time march and
-its steady states; harmonic balance; nonlinear modes; sweeps.
+"""The numbers jointdyn's packages share, one section per package in the order of the layers, bottom up:
+contact laws; systems and system files; memory bounds; continuation and the quasi-static driver; the time
+march and its steady states; harmonic balance; nonlinear modes; identification; sweeps.
 
-Solvers and front ends (CLI, sweeps, figures) read their defaults from here
-and nowhere else, so that a change of accuracy policy is one edit. Test
-tolerances live with the tests (``tests/tolerances.py``). Units are given
+A number that one solver or package alone reads belongs in that solver's options object
+(``ContinuationOptions``, ``LinearSolveOptions``, ``SweepOptions``) or in its module, with its default
+documented there; ``tests/test_architecture.py`` fails on a number here that one package alone reads,
+except those it lists as still to move (harmonic balance, identification). Test tolerances live with the tests (``tests/tolerances.py``). Units are given
 where a number has one; "relative" numbers are fractions of the scale named.
 """
 
@@ -15,24 +16,11 @@ from __future__ import annotations
 #: given (CLI ``--model``, ``System.paper_damper``, sweeps, figures): the
 #: exact Iwan model with varying normal load
 MODEL = "iwan"
-#: linear pieces kept by the exact Iwan law (``iwan``) after a step; beyond,
-#: three adjacent pieces are merged into two (results within 0.1 % of the
-#: converged limit, measured 3e-3 % at most on the Fig 6 grid:
-#: docs/exact-iwan.md)
-IWAN_CAPACITY = 32
 #: Jenkins elements of the discrete Iwan model
 LAW_DISCRETE_N = 1000
-#: capacity of the reversal-point stack of the closed-form Iwan law
-IWAN_CLOSED_MAX_DEPTH = 64
-#: a branch of the closed-form Iwan law closer than this to an earlier
-#: reversal point (normalised displacement kt x / fy) has reached it (Masing
-#: rejoin); the force error is of the same order in units of fy
-IWAN_CLOSED_WIPE_TOL = 1e-9
 #: microslip exponent chi of Segalman's four-parameter Iwan law (``segalman``)
 #: when none is given: the slip-displacement density grows as phi^chi
 SEGALMAN_CHI = -0.5
-#: weight beta of the final delta of the ``segalman`` density when none is given
-SEGALMAN_BETA = 0.0
 
 # --- systems (jointdyn.systems) ---------------------------------------------------------
 #: eigenvalues of (M, K_reference) below this fraction of the largest are
@@ -43,9 +31,6 @@ SYSTEM_RIGID_MODE_RTOL = 1e-10
 #: Cholesky factorisation (shifted by the semi-definiteness tolerance) and Lanczos iterations
 #: for the extreme eigenvalues (scipy.sparse.linalg.eigsh), which scale to config.FILES_MAX_DOF
 SYSTEM_DENSE_CHECK_MAX_DOF = 1000
-#: a matrix is positive semi-definite when its smallest eigenvalue is at least -this times
-#: its largest (rounding of an assembled singular matrix)
-SYSTEM_SEMIDEFINITE_RTOL = 1e-10
 
 # --- system files (jointdyn.files) ------------------------------------------------------
 #: most degrees of freedom of a matrix read from a system file (its dense
@@ -65,173 +50,25 @@ INTERFACE_MAX_PAIRS = 5_000
 MEMORY_LIMIT_BYTES = None
 #: share of the available memory a computation may take when MEMORY_LIMIT_BYTES is None
 MEMORY_FRACTION = 0.5
-#: copies of a contact law's state a solver holds at once (trial and committed states, their
-#: forward-mode derivatives): a law whose state times this exceeds the bound is refused
-LAW_STATE_COPIES = 16
-
-# --- FE interfaces and reduction (jointdyn.fe, jointdyn.reduction) ---------------------
-#: two mesh nodes are the same point (a node pair) when their distance is
-#: within this fraction of the diagonal of the two node sets' bounding box
-FE_MATCH_RTOL = 1e-6
-#: a node in two pairs must get the same frame from both: rows t1, t2, n
-#: equal to this (unit vectors)
-FE_FRAME_ATOL = 1e-9
-#: a given tangent is along the normal when its part normal to n is below
-#: this fraction of its length
-FE_TANGENT_RTOL = 1e-8
-#: linear modes compared by the error report of a sparse Craig-Bampton
-#: reduction (the lowest ones; a dense reduction compares all of its size)
-REDUCTION_SPARSE_ERROR_MODES = 12
 
 # --- continuation (jointdyn.continuation; unknowns, parameter and residual scaled) ----
+# The step control and the linear solves have their numbers in ContinuationOptions and
+# LinearSolveOptions (jointdyn.continuation.options); here only those the solvers share with it.
 #: Newton converged when max|R| <= this (scaled residual; harmonic balance
-#: scales R by max(F1, fy))
+#: scales R by max(F1, fy)): ContinuationOptions.tol, and harmonic balance's single solutions
 CONT_TOL = 1e-9
-#: Newton iterations per correction
-CONT_MAX_ITER = 12
-#: arc-length step: first, smallest, largest
-CONT_DS_START = 0.05
-CONT_DS_MIN = 1e-6
-CONT_DS_MAX = 0.1
-#: ... or this fraction of the norm of the unknowns where that is larger
-#: (a flank growing without bound: as many points per decade as a small one)
-CONT_DS_MAX_REL = 0.02
-#: bound on the points of a branch
-CONT_MAX_POINTS = 2000
-#: predictor direction: "tangent" or "secant"
-CONT_PREDICTOR = "tangent"
-#: where a solver asks for it (harmonic balance, when every contact law has a smooth force:
-#: ContactLaw.smooth_force), the corrector starts from the cubic Hermite extrapolation of the
-#: last two points and their tangents (moved onto the corrector's hyperplane, so that the point
-#: it converges to is the same) when the step is at most this many times the last one. On the
-#: paper damper's branch with the default law (eta 0.5, beta 2) it saves 14 % of the residual
-#: evaluations, 17 % at eta 1.5, beta 5 (a start about 10x closer to the curve: one Newton
-#: iteration less at many points). Laws with kinks or jumps at the onset of slip (Jenkins, the
-#: discrete model, the closed forms) do not use it: there Newton from the extrapolation lands
-#: on other points of the piecewise-smooth residual, and the step control follows another path
-CONT_START_EXTRAPOLATION = 2.0
-#: Newton iterations aimed at per correction; the step grows by CONT_GROW
-#: after a correction in fewer, shrinks by CONT_SHRINK after one in more
-CONT_TARGET_ITER = 4
-CONT_GROW = 1.6
-CONT_SHRINK = 0.6
-#: the step is multiplied by CONT_TURN_SHRINK after the unit tangent turned
-#: by more than ~10 degrees (cosine below CONT_TURN_COS): folds are resolved
-CONT_TURN_COS = 0.985
-CONT_TURN_SHRINK = 0.5
-#: step factor after a rejected step (corrector failed)
-CONT_REJECT_SHRINK = 0.5
-#: trial steps of the damped Newton line search (the full step, then
-#: halved each time) before the iteration counts as failed
-CONT_LINE_SEARCH_STEPS = 9
-#: above CONT_CORNER_DS, a corrector is stopped after this many times
-#: CONT_TARGET_ITER residual evaluations (retrying smaller is cheaper)
-CONT_MAX_EVALS_FACTOR = 2
-#: below this step a sharp turn or a long correction is a corner of a
-#: piecewise-smooth branch, not a jump to another branch
-CONT_CORNER_DS = 2e-3
-#: step factor after a rejection for a sharp turn or a far-away correction
-#: (a step accepted only at corner size, reached in fewer rejections)
-CONT_CORNER_SHRINK = 0.25
-#: above CONT_CORNER_DS a step is rejected when the new unit tangent's dot
-#: product with the previous one is below this (a turn by more than 60 deg)
-CONT_MIN_TANGENT_DOT = 0.5
-#: ... or when the corrector moved farther than this many steps from the
-#: predicted point
-CONT_MAX_DISTANCE = 2.0
-#: jumps over a discontinuity of the residual (corrector failed at the
-#: smallest step): Newton at fixed parameter tried this far beyond the last
-#: point (fractions of the parameter range), at most CONT_MAX_JUMPS times
-CONT_JUMP_FRACTIONS = (1e-4, 1e-3, 1e-2)
-CONT_MAX_JUMPS = 5
-#: a branch that goes back and forth without getting anywhere (the corrector keeps accepting
-#: points that alternate between the same states at a jump of a piecewise-smooth residual):
-#: over the last CONT_STALL_POINTS points, the distance from the first to the last (scaled
-#: unknowns and parameter) is below CONT_STALL_RATIO times the path through them; the branch
-#: stops there as failed, without those points. Such a stall measures about 1e-14 (Jenkins at
-#: eta 10, beta 1000, 7 x 128 samples); the zigzags at the non-smooth corners of branches that
-#: do get through stay above 6e-4 (Jenkins with separation on the grid of docs/hb-robustness.md)
-CONT_STALL_POINTS = 100
-CONT_STALL_RATIO = 1e-6
-#: a jump's guess follows the tangent when its parameter component exceeds
-#: this (else the last point's unknowns)
-CONT_JUMP_TANGENT_MIN = 1e-3
-#: largest deviation between the straight line joining consecutive points of
-#: a branch and the curve, in the plane (parameter, observable) (harmonic
-#: balance: gamma and the logarithm of the norm of the response DOF's
-#: harmonics, so 0.005 is half a percent of the amplitude or 0.005 in gamma;
-#: measured against the reported amplitude the chords stay within 1 %,
-#: tests/test_hb_trust.py)
-CONT_CHORD_TOL = 0.005
-#: refinement of a maximum along a branch (peaks): at most this many
-#: corrections, until the bracket is this fraction of its first width or the
-#: observable varies by at most CONT_REFINE_GTOL across it (harmonic
-#: balance: log q, so 1e-7 is a relative 1e-7 of the amplitude)
-CONT_REFINE_ITER = 20
-CONT_REFINE_STOL = 1e-4
-CONT_REFINE_GTOL = 1e-7
-#: bordered linear systems (Newton corrections, tangents) of at most this
-#: many unknowns are solved by the compiled elimination of
-#: jointdyn.continuation, larger ones by LAPACK (benchmarks/bench_linalg.py:
-#: the compiled elimination is 1.2-3.5x faster at 16 to 751 unknowns with
-#: single-threaded BLAS; beyond the sizes measured, LAPACK)
-CONT_SMALL_SOLVE = 800
 #: from this many unknowns, a walk's bordered systems are solved by GMRES
 #: preconditioned with the LU factors of an earlier matrix of the walk, and
 #: factorised anew only when that fails (jointdyn.continuation.linalg): a
-#: factorisation costs seconds there (benchmarks/bench_linalg.py)
+#: factorisation costs seconds there (benchmarks/bench_linalg.py); harmonic balance and EPMC
+#: choose the form of their Jacobians (sparse, blocks, dense) by the same bound
 CONT_KRYLOV_SOLVE = 2000
-#: a GMRES solution is accepted when |A x - b| <= this |b| (true residual)
-CONT_KRYLOV_RTOL = 1e-9
-#: GMRES iterations (one cycle, no restart) before the matrix is factorised;
-#: at 5500 unknowns an iteration (a product with the matrix and a solve with
-#: the kept factors) costs about 1/20 of a factorisation. Measured on the
-#: 167-pair chain of benchmarks/bench_hb_interface_chain.py (HB branch, 23
-#: points): 20 instead of 12 saved no factorisation (21 either way; the
-#: factors of the previous point do not reach the tolerance at the next) and
-#: cost 372 instead of 245 iterations
-CONT_KRYLOV_MAXITER = 12
-#: a solve that needed more iterations than this has the next matrix factorised
-#: at once (the kept factors have drifted from the walk's matrices)
-CONT_KRYLOV_REFRESH = 8
 #: from CONT_KRYLOV_SOLVE unknowns, a walk whose first matrix has at most this
 #: fraction of nonzero entries factorises by SuperLU (scipy.sparse.linalg.splu)
 #: at every solve (the 60-node chain of benchmarks/bench_hb_interface_chain.py,
-#: 1980 unknowns, 0.7 % nonzero: 4 ms against 227 ms for dense LAPACK), ...
+#: 1980 unknowns, 0.7 % nonzero: 4 ms against 227 ms for dense LAPACK); harmonic balance
+#: evaluates its Jacobian as a sparse matrix below the same density
 CONT_SPARSE_DENSITY = 0.02
-#: ... while its factors hold at most this fraction of N^2 entries (else dense
-#: from then on: SuperLU on a matrix that fills in completely costs about 5x
-#: dense LAPACK). The bound sits above the fill of the walks where SuperLU
-#: still wins: as the pairs of the 167-node chain slip, their blocks couple
-#: all harmonics and the fill grows; at 5512 unknowns fill 0.17 takes 0.24 s
-#: against 2.7-8.7 s for dense LAPACK, fill 0.083 0.10-0.18 s, so a bound
-#: below 0.17 would send that walk to the slower dense solve
-CONT_SPARSE_FILL = 0.25
-#: SuperLU's thresholds for preferring the diagonal pivot, tried in turn until
-#: the solution's true residual is at most CONT_KRYLOV_RTOL |b| (0: the
-#: diagonal unless it is zero, least fill; 0.1: the usual threshold pivoting;
-#: SuperLU's default 1 is partial pivoting). On the slipping 167-node chain's
-#: bordered matrix (5512 unknowns, 0.6 % nonzero): 0 fill 0.010 in 0.04 s,
-#: 0.1 fill 0.25 in 0.68 s, 0.01 fill 0.20 in 0.58 s, all with residuals of
-#: 1e-11; at a lower amplitude 0.1 gave fill 0.010 where 1 gave 0.083
-CONT_SPARSE_PIVOTS = (0.0, 0.1)
-#: from CONT_KRYLOV_SOLVE unknowns, where the problem offers a structured
-#: preconditioner (harmonic balance: the blocks of its harmonics,
-#: jointdyn.hb._precond), GMRES with the factors of that preconditioner, made
-#: at the current matrix, runs this many iterations at most before the
-#: bordered matrix is factorised whole (the direct path, kept as the fallback).
-#: On the lap joint at H = 3 (5131 unknowns) the pairs' slip couples the
-#: harmonics more as the amplitude grows (22 iterations at 0.4 mm, 36 at the
-#: tenth point after it) and a bound of 40 fell back to the whole LU 9 times
-#: along the backbone; one iteration costs about 1/25 of the H + 1 block LUs,
-#: and the whole LU about 14 times those, so 100 iterations still cost less
-CONT_BLOCK_MAXITER = 100
-#: the structured factors kept from an earlier matrix are made anew at the next
-#: solve after a solve that needed more than this many GMRES iterations with
-#: them: fresh ones need some iterations too (10-14 on the lap joint at H = 3
-#: with its pairs slipping), and one set of fresh factors (H + 1 LUs) costs
-#: about as much as 25 iterations there
-CONT_BLOCK_REFRESH = 25
 
 # --- quasi-static driver -------------------------------------------------------
 #: uniform samples per cycle of the harmonic history
@@ -241,119 +78,25 @@ QS_CYCLES = 2
 #: most samples of a harmonic history (cycles x steps per cycle); bounds the
 #: memory of one loop (about 100 bytes per sample with its CSV output)
 QS_MAX_SAMPLES = 10_000_000
-#: a cycle of a sampled history spans at least this many sample intervals on
-#: average (fewer is not a sampled loop); bounds the cycles of --period
-QS_MIN_INTERVALS_PER_CYCLE = 2
 #: a time within this fraction of a step (harmonic grid) or of the history
 #: duration (cycle windows) is the same instant: crossing instants and cycle
 #: boundaries snap onto existing samples instead of creating tiny steps
 QS_SNAP_RTOL = 1e-9
-#: load (as a fraction of n_ref) at which a law is evaluated at a re-contact
-#: instant (N = 0 followed by N > 0), so that the virgin curve starts exactly
-#: there; the sample is reported as separated with T = 0
-QS_RECONTACT_LOAD = 1e-300
 
 # --- time integration (explicit RK4 with events) --------------------------------
-#: RK4 steps per forcing period (before events and reversal splits)
-TI_STEPS_PER_PERIOD = 256
-#: steps per period are raised so that w_max * h <= this (w_max: stiffest
-#: linear mode with every contact stuck); RK4 is stable up to ~2.8
-TI_MAX_OMEGA_H = 1.0
-#: once a normal spring opens, the steps are refined so that w_max * h <=
-#: this (w_max with the springs closed): every re-contact sets the normal
-#: DOFs ringing at their own frequency, and RK4 at w h = 1 damps that
-#: ringing numerically by about 0.3 % of its energy per step, which shows in
-#: the energy balance (measured on the coupled paper damper, eta 1.5: 6e-3
-#: at w h = 0.85, 2e-6 at 0.21)
-TI_SPRING_OMEGA_H = 0.3
-#: at most this many reversal splits inside one grid step
-TI_MAX_SPLITS = 4
-#: an event closer than this fraction of a step to a grid point moves it
-TI_EVENT_MERGE = 1e-6
-#: normal load put at a re-contact instant, as a fraction of n0 (> 0 so that
-#: the committed law state is "in contact, virgin at the re-contact point")
-TI_RECONTACT_ALPHA = 1e-12
-#: a state larger than this factor times (|f|/k_min + fy/kt) is a blow-up
-TI_BLOWUP_FACTOR = 1e8
 
 # --- steady state: periodicity checks ----------------------------------------------
-#: relative tolerance on the half peak-to-peak amplitude and on the
-#: period-boundary state (Poincare points)
-SS_AMP_RTOL = 1e-4
-#: relative tolerance on the energy per period
-SS_ENERGY_RTOL = 1e-3
-#: work of the forcing = dissipation per period to this (relative; the
-#: energy integrals carry the discretisation error)
-SS_BALANCE_RTOL = 1e-2
-#: windows (of p periods) that must agree
-SS_CHECK_PERIODS = 3
-#: largest period multiple p accepted as a periodic steady state
-SS_MAX_MULTIPLE = 4
-#: longer multiples (up to this) are detected and reported as
-#: "not-settled", detail "period-P", instead of running to max_periods
-SS_DETECT_MULTIPLE = 12
-#: a multiple p > 1 is accepted only when the largest one-period mismatch
-#: over the last K p periods is at least this fraction of that over the
-#: K p periods before (no decaying beat)
-SS_MULTIPLE_DECAY = 0.97
-#: after shooting, stop as "quasi-periodic-or-chaotic" when the largest
-#: one-period mismatch over the last SS_STALL_PERIODS/2 periods is >=
-#: SS_STALL_RATIO times that over the half before
-SS_STALL_PERIODS = 240
-SS_STALL_RATIO = 0.9
-#: cap on integrated periods
-SS_MAX_PERIODS = 1500
-#: periods integrated between two checks
-SS_CHUNK = 8
 
-#: rounding floor of the contact-dissipation check of a periodic state: the
-#: contact's energy per period may fall below zero by the period's
-#: energy-balance residual |W - E_contact - E_viscous| plus this fraction of
-#: |W| + |E_contact| + |E_viscous| before it is flagged as energy created
-SS_DISSIPATION_FLOOR = 1e-12
 
 # --- steady state: start and shooting ------------------------------------------------
-#: describing-function iterations of the linear start
-SS_LINEAR_ITERS = 30
-#: relative change of the describing-function amplitude that ends that
-#: iteration (it only seeds the integration, which does the rest)
-SS_LINEAR_RTOL = 1e-2
-#: shooting (Newton on the period map) when the estimated number of
-#: periods to converge exceeds this
-SS_SHOOT_AFTER = 40
-#: Newton iterations of one shooting attempt
-SS_SHOOT_MAXIT = 12
-#: largest Newton step (relative to the amplitude) and step halvings of the
-#: line search
-SS_SHOOT_MAXSTEP = 1.0
-SS_SHOOT_HALVINGS = 8
-#: before shooting (section at phase 0), rebuild the law states from the
-#: last period alone (forget the transient's memory)
-SS_SHOOT_CLEAN_STATE = True
-#: shooting attempts per run
-SS_MAX_SHOTS = 3
-#: relative finite-difference step of the monodromy matrix
-SS_SHOOT_FD = 1e-6
-#: a Floquet multiplier above 1 + this marks an unstable orbit
-SS_FLOQUET_TOL = 1e-3
 
 # --- monodromy (finite-difference Floquet multipliers of the period map) --------------
-#: relative central-difference step of the monodromy check of harmonic-balance
-#: solutions (of the amplitude for displacements, of w times it for velocities)
-MONODROMY_FD_STEP = 1e-6
 #: periods, and samples per period, of the harmonic-balance displacement over
 #: which each contact law is marched to obtain its state at the section
 MONODROMY_WARM_PERIODS = 3
 MONODROMY_WARM_SAMPLES = 4096
 
 # --- steady state: unbounded response ----------------------------------------------
-#: amplitude increasing over this many consecutive periods ...
-SS_GROWTH_PERIODS = 40
-#: ... with increments of the second half >= this fraction of the first
-SS_GROWTH_RATIO = 0.9
-#: ... and with the amplitude of x[response_dof] above this many fy/kt of
-#: the first contact (friction saturated: only then can friction lose)
-SS_UNBOUNDED_Q = 20.0
 
 # --- harmonic balance: discretisation and AFT ------------------------------------------
 #: harmonics 0..H of the unknowns
@@ -374,28 +117,6 @@ HB_AUTO_EARLY_DROP = 0.5
 #: the samples decide, H = 7 already within 2e-4 of H = 15 on the paper's grid
 HB_AUTO_MAX_HARMONICS = 15
 HB_AUTO_MAX_SAMPLES = 2048
-#: a contact force is zero while the contact is open and continuous at separation and re-contact: where a
-#: prescribed normal load changes sign, the AFT projects the force with the corners there taken into
-#: account (jointdyn.fourier.event_projection): one-sided polynomials of this degree through the corner
-#: and the nearest samples (error O(h^4) for a force smooth on either side, against O(h^2) uniform) ...
-HB_EVENT_ORDER = 3
-#: ... skipping samples nearer to the corner than this fraction of the sampling interval (nearly zero)
-HB_EVENT_MIN_OFFSET = 0.25
-#: before a separation the friction bound mu N falls to zero and a stuck contact slips only in the last
-#: ~|T| / (mu |dN/dtau|) rad, a near-jump of the force inside one sampling interval at large mu N0 / F1: the
-#: AFT marches the law also at phases graded towards each separation (jointdyn.fourier.separation_grid),
-#: over this many uniform samples before it (a slip stretch as wide as a few samples, eta = 10 and beta
-#: = 1-10, needs 4: with 2 its peaks at 7 x 128 are up to 1.4e-3 off the converged ones, with 4 within 4e-4) ...
-HB_SEPARATION_SPAN = 4
-#: ... each phase's distance to the separation this fraction of the one before (spacing 20 % of the
-#: distance) ...
-HB_SEPARATION_RATIO = 0.8
-#: ... down to this distance (rad): a slip stretch shorter than it costs at most its own width times the
-#: stuck force in the force's integral (with 4 samples, 0.8 and 1e-4: 32 phases more than the 128 samples)
-HB_SEPARATION_FINEST = 1e-4
-#: uniform samples per period of the fine grid on which amplitudes and
-#: extrema of a harmonic-balance response are located
-HB_FINE_SAMPLES = 1024
 #: bound on the periods marched per AFT evaluation (two normally suffice
 #: for Masing-type laws; the force must repeat to HB_PERIODIC_RTOL)
 HB_MAX_PASSES = 8
@@ -510,44 +231,6 @@ HB_JACOBIAN_BUDGET_BYTES = 2**28
 #: output DOF), in units of fy / kt of the first contact: from deep in the
 #: stuck regime to well into macroslip (four decades)
 MODES_AMPLITUDE_Q = (1e-2, 1e2)
-#: EPMC continuation in log10 of the amplitude (unknowns scaled by the
-#: amplitude, frequency and self-excitation by the linear frequency, residual
-#: by the stiffness times the amplitude): first and largest arc-length step
-#: (the largest bounds the spacing to 1/16 decade: at least 16 points per decade)
-MODES_DS_START = 0.02
-MODES_DS_MAX = 0.0625
-#: Newton tolerance of an EPMC point on that scaled residual; tight because
-#: the energy balance of a point (self-excitation against dissipation) holds
-#: to the residual relative to the damping ratio, which is small at small
-#: amplitudes
-MODES_TOL = 1e-12
-#: Newton iterations of the first EPMC point (from the linear stuck mode)
-MODES_START_MAX_ITER = 30
-#: points of an EPMC backbone (spread over it, plus its largest damping) where
-#: harmonics="auto" / samples="auto" check the discretisation (jointdyn.modes._auto)
-MODES_AUTO_CHECK_POINTS = 12
-#: a DOF moves in a linear mode when |phi_dof| exceeds this fraction of max |phi|
-MODES_MIN_PARTICIPATION = 1e-8
-#: K (tangential contacts free) is positive definite for nonlinear modes when
-#: its smallest eigenvalue of (M, K) exceeds this fraction of the largest
-MODES_MIN_EIGENVALUE_RATIO = 1e-12
-#: QSMA static push: steps per decade of the output-DOF displacement, and
-#: decades pushed below the smallest requested amplitude (the work integral
-#: starts at zero displacement)
-QSMA_STEPS_PER_DECADE = 40
-QSMA_DECADES_BELOW = 3
-#: push steps per backbone point: the work integrals use every step (their
-#: error at a kink of a law, e.g. the onset of slip of a Jenkins element,
-#: falls as the square of the step), the backbone reports every
-#: QSMA_SUBSTEPS-th
-QSMA_SUBSTEPS = 4
-#: QSMA equilibrium: Newton converged when max |residual| <= this times the
-#: largest elastic or applied force; iterations per step
-QSMA_TOL = 1e-12
-QSMA_MAX_ITER = 50
-#: single-nonlinear-mode synthesis: the resonance peak is located on the
-#: backbone to this relative tolerance in amplitude
-SYNTHESIS_PEAK_RTOL = 1e-10
 
 # --- identification (jointdyn.identify) -------------------------------------------
 #: most evaluations of the model (marches, describing functions) of one least-squares fit
@@ -583,9 +266,6 @@ FIT_MAX_LOOP_SAMPLES = 1_000_000
 #: most points of a backbone fit (``fit --backbone``): every point costs a describing function per
 #: evaluation, 4 ms of CPU time per point for the whole fit (1000 points took 3.8 s, measured 2026-12)
 FIT_MAX_BACKBONE_POINTS = 1_000
-#: largest magnitude of a measured value a fit computes with: its squares, products and sums over
-#: every sample must stay finite in double precision (1e100 squared is 1e200)
-FIT_MAX_MAGNITUDE = 1e100
 #: confidence level of the intervals a fit reports (profile likelihood)
 FIT_LEVEL = 0.95
 #: profile likelihood: a scale parameter whose sum of squares stays below the threshold
@@ -609,10 +289,6 @@ FIT_RAMP_SAMPLES = 200
 #: loop fits: a record fitted from rest whose first stroke leaves an rms residual above this
 #: many times that of the rest was picked up mid-cycle (its first stroke then sets the state)
 FIT_FIRST_STROKE_MISFIT = 3.0
-#: jointdyn fit: largest plausible joint displacement of a loop record and modal amplitude of
-#: a backbone, m (beyond them the file is taken to be in other units, e.g. mm)
-FIT_PLAUSIBLE_DISPLACEMENT_M = 0.01
-FIT_PLAUSIBLE_AMPLITUDE_M = 0.1
 #: ring-downs (identify.ringdown): the mode's band is where the spectrum stays above this
 #: fraction of its peak, widened by this fraction on each side; a second spectral peak in it
 #: more prominent than this fraction of the peak is a second mode
@@ -636,49 +312,8 @@ RINGDOWN_RATE_LIMIT = 0.1
 RINGDOWN_MAX_CYCLES = 32
 
 # --- sweeps --------------------------------------------------------------------------
-#: gamma grid START:STOP:STEP (the paper's Fig 6 range)
-SWEEP_GAMMA_DEFAULT = (0.6, 1.8, 0.01)
-#: most points of a gamma grid given as START:STOP:STEP
-SWEEP_MAX_GAMMA_POINTS = 100_000
-#: seconds to wait for a Dask scheduler to answer (--scheduler)
-SWEEP_SCHEDULER_TIMEOUT_S = 5.0
-#: local pool for sweep lines when no Dask client is given: "process" or
-#: "thread" (the compiled kernels release the GIL)
-SWEEP_POOL = "process"
 #: why a swept point is not-settled (``not_settled_reason``; index = code, 0
 #: for every other point): still converging at the period budget, stalled
 #: (quasi-periodic or chaotic), or repeating only after more than
 #: SS_MAX_MULTIPLE periods
 SWEEP_NOT_SETTLED_REASONS = ("none", "slowly-converging", "quasi-periodic-or-chaotic", "long-period")
-#: consecutive points of a line solved as one task and saved as one resume
-#: checkpoint (an interrupt stops a task after its current point, so this
-#: bounds what a killed run loses, not what an interrupted one loses)
-SWEEP_CHUNK_POINTS = 8
-#: tasks kept queued per worker (lines in progress at once), so that no
-#: worker waits for the next chunk of a line
-SWEEP_TASKS_PER_WORKER = 2
-#: seconds between refreshes of the progress bar while chunks run
-SWEEP_PROGRESS_POLL_S = 0.2
-#: seconds between checks of a worker process that its parent is alive (the
-#: fallback where the kernel's parent-death signal is not available)
-SWEEP_PARENT_POLL_S = 0.5
-
-# --- figures: the bolted lap joint (jointdyn.figures.lap) ----------------------------
-#: harmonics and AFT samples per period of its backbone. The reduced model has
-#: 733 DOFs, so an HB or EPMC Newton step solves 733 (2H + 1) unknowns with a dense LU: with
-#: H = 1 a backbone point costs about 1 s here. Against H = 3 (64 samples), H = 1 gives the first
-#: bending frequency within 0.1 % and its damping ratio within 2 % at the onset of slip (3e-5 m)
-#: and to three digits at the largest damping (3e-4 m) (docs/lap-joint.md)
-LAP_HARMONICS = 1
-LAP_SAMPLES = 32
-#: backbone range: first-harmonic amplitude of the output DOF, m (stuck below 4.5e-6 m)
-LAP_AMPLITUDE_M = (1e-6, 2e-3)
-#: largest arc-length step of the backbone (47 points over the range, most of them between 4.5e-6
-#: and 3e-4 m, where the pairs start to slip one after another)
-LAP_DS_MAX = 0.04
-#: amplitudes of the three slip maps, m: the onset of slip, the largest damping, deep slip
-LAP_SLIP_MAP_M = (3e-5, 3e-4, 1.5e-3)
-#: modal damping ratio of every mode of the plates (material damping)
-LAP_ZETA = 1e-3
-#: forced response (synthesised from the backbone): force amplitude at the output DOF, N
-LAP_FORCE_N = 30.0

@@ -40,10 +40,19 @@ from pathlib import Path
 
 import numpy as np
 
-from . import config
 
 __all__ = ["LapJoint", "PairTable", "interface_from_mesh", "interface_from_triplets", "lap_joint", "match_nodes",
            "pair_frames", "pair_springs", "read_node_sets"]  # fmt: skip
+
+#: two mesh nodes are the same point (a node pair) when their distance is
+#: within this fraction of the diagonal of the two node sets' bounding box
+FE_MATCH_RTOL = 1e-6
+#: a node in two pairs must get the same frame from both: rows t1, t2, n
+#: equal to this (unit vectors)
+FE_FRAME_ATOL = 1e-9
+#: a given tangent is along the normal when its part normal to n is below
+#: this fraction of its length
+FE_TANGENT_RTOL = 1e-8
 
 
 @dataclass(frozen=True)
@@ -138,7 +147,7 @@ def pair_frames(normals, tangents=None) -> np.ndarray:
     given = np.linalg.norm(t, axis=1)
     t = t - np.sum(t * n, axis=1)[:, None] * n
     tl = np.linalg.norm(t, axis=1)
-    bad = ~(tl > config.FE_TANGENT_RTOL * given)
+    bad = ~(tl > FE_TANGENT_RTOL * given)
     if np.any(bad):
         raise ValueError(f"tangents must be finite, non-zero and not along the normal (pair {int(np.argmax(bad))})")
     t1 = t / tl[:, None]
@@ -184,7 +193,7 @@ def _rotation(trip: np.ndarray, frames: np.ndarray, pair_of: np.ndarray, ndof: i
                          "of one node")  # fmt: skip
     R = frames[pair_of]
     diff = np.max(np.abs(R - R[first][inv]), axis=(1, 2))
-    if np.any(diff > config.FE_FRAME_ATOL):
+    if np.any(diff > FE_FRAME_ATOL):
         k = int(np.argmax(diff))
         raise ValueError(f"normals: the node with DOFs {trip[k].tolist()} gets different frames from pairs "
                          f"{int(pair_of[first[inv[k]]])} and {int(pair_of[k])}")  # fmt: skip
@@ -254,7 +263,7 @@ def match_nodes(points, ids_a, ids_b, *, tol: float | None = None, where: str = 
     ids_a, ids_b : array_like of int
         The two node sets (same size, no node in both).
     tol : float, optional
-        Largest distance of a pair, m (default ``config.FE_MATCH_RTOL`` times
+        Largest distance of a pair, m (default ``FE_MATCH_RTOL`` times
         the diagonal of the two sets' bounding box).
     where, names : str, (str, str)
         File and set names for the error messages.
@@ -280,7 +289,7 @@ def match_nodes(points, ids_a, ids_b, *, tol: float | None = None, where: str = 
     if tol is None:
         both = np.concatenate([pa, pb])
         diag = float(np.linalg.norm(both.max(axis=0) - both.min(axis=0))) if both.size else 0.0
-        tol = config.FE_MATCH_RTOL * (diag if diag > 0.0 else 1.0)
+        tol = FE_MATCH_RTOL * (diag if diag > 0.0 else 1.0)
     dist, k = cKDTree(pb).query(pa)
     far = dist > tol
     if np.any(far):

@@ -22,12 +22,34 @@ import math
 
 import numpy as np
 
-from . import config
 from ._cache import by_value
 from ._jit import jit
 
 __all__ = ["phases", "basis", "fourier_matrices", "event_projection", "separation_grid", "derivative_matrix",
            "reconstruct", "extrema"]
+
+#: a contact force is zero while the contact is open and continuous at separation and re-contact: where a
+#: prescribed normal load changes sign, the AFT projects the force with the corners there taken into
+#: account (jointdyn.fourier.event_projection): one-sided polynomials of this degree through the corner
+#: and the nearest samples (error O(h^4) for a force smooth on either side, against O(h^2) uniform) ...
+HB_EVENT_ORDER = 3
+#: ... skipping samples nearer to the corner than this fraction of the sampling interval (nearly zero)
+HB_EVENT_MIN_OFFSET = 0.25
+#: before a separation the friction bound mu N falls to zero and a stuck contact slips only in the last
+#: ~|T| / (mu |dN/dtau|) rad, a near-jump of the force inside one sampling interval at large mu N0 / F1: the
+#: AFT marches the law also at phases graded towards each separation (jointdyn.fourier.separation_grid),
+#: over this many uniform samples before it (a slip stretch as wide as a few samples, eta = 10 and beta
+#: = 1-10, needs 4: with 2 its peaks at 7 x 128 are up to 1.4e-3 off the converged ones, with 4 within 4e-4) ...
+HB_SEPARATION_SPAN = 4
+#: ... each phase's distance to the separation this fraction of the one before (spacing 20 % of the
+#: distance) ...
+HB_SEPARATION_RATIO = 0.8
+#: ... down to this distance (rad): a slip stretch shorter than it costs at most its own width times the
+#: stuck force in the force's integral (with 4 samples, 0.8 and 1e-4: 32 phases more than the 128 samples)
+HB_SEPARATION_FINEST = 1e-4
+#: uniform samples per period of the fine grid on which amplitudes and
+#: extrema of a harmonic-balance response are located
+HB_FINE_SAMPLES = 1024
 
 #: one side of a zero stretch of a signal (:func:`event_projection`): the signal is zero before the phase
 #: (it starts there) or after it (it stops there)
@@ -110,8 +132,8 @@ def _one_sided_derivatives(tau_e: float, side: int, samples: int, order: int, mi
 
 
 @by_value()
-def event_projection(harmonics: int, samples: int, events: tuple, order: int = config.HB_EVENT_ORDER,
-                     min_offset: float = config.HB_EVENT_MIN_OFFSET) -> np.ndarray:
+def event_projection(harmonics: int, samples: int, events: tuple, order: int = HB_EVENT_ORDER,
+                     min_offset: float = HB_EVENT_MIN_OFFSET) -> np.ndarray:
     """Analysis matrix (2H+1, Ns) for a signal that is zero on stretches of the period, given their ends.
 
     The uniform projection (:func:`fourier_matrices`) is the trapezoidal
@@ -222,9 +244,9 @@ def _graded_nodes(tau_e: float, length: float, uniform: np.ndarray, ratio: float
 
 
 @by_value()
-def separation_grid(harmonics: int, samples: int, events: tuple, order: int = config.HB_EVENT_ORDER,
-                    min_offset: float = config.HB_EVENT_MIN_OFFSET, span: int = config.HB_SEPARATION_SPAN,
-                    ratio: float = config.HB_SEPARATION_RATIO, finest: float = config.HB_SEPARATION_FINEST):
+def separation_grid(harmonics: int, samples: int, events: tuple, order: int = HB_EVENT_ORDER,
+                    min_offset: float = HB_EVENT_MIN_OFFSET, span: int = HB_SEPARATION_SPAN,
+                    ratio: float = HB_SEPARATION_RATIO, finest: float = HB_SEPARATION_FINEST):
     """AFT phases and matrices for a contact force that stops at separations (``tau, E, P, uniform``).
 
     Before a separation the normal load N falls to zero and the friction
@@ -343,7 +365,7 @@ def derivative_matrix(harmonics: int) -> np.ndarray:
     return D
 
 
-def reconstruct(coefficients, harmonics: int, points: int = config.HB_FINE_SAMPLES) -> np.ndarray:
+def reconstruct(coefficients, harmonics: int, points: int = HB_FINE_SAMPLES) -> np.ndarray:
     """The signal at ``points`` uniform phases over one period.
 
     ``coefficients`` is (2H+1,) or (2H+1, m) (m signals); the result is
@@ -384,7 +406,7 @@ def _extrema(Ef, c):  # pragma: no cover - compiled
     return out[0], out[1]
 
 
-def extrema(coefficients, harmonics: int, points: int = config.HB_FINE_SAMPLES):
+def extrema(coefficients, harmonics: int, points: int = HB_FINE_SAMPLES):
     """(max, min) of one signal over a period, in the coefficients' unit.
 
     Located on ``points`` uniform samples and refined by the vertex of the

@@ -32,13 +32,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _validate as V
-from . import config
 from .damping import dense_damping
 from .kinematics import NormalSpring
 from .systems import Contact, System
 
 __all__ = ["CraigBampton", "InterfaceReduction", "ModeError", "craig_bampton", "default_boundary",
            "reduce_interface", "reduce_system"]
+
+#: linear modes compared by the error report of a sparse Craig-Bampton
+#: reduction (the lowest ones; a dense reduction compares all of its size)
+REDUCTION_SPARSE_ERROR_MODES = 12
 
 
 @dataclass(frozen=True)
@@ -250,7 +253,7 @@ def _craig_bampton_sparse(M, K, b, n_modes, C, K_modes, error_modes) -> CraigBam
     Mr, Kr = project(M), project(K)
     Cr = None if C is None else project(_sparse_matrix("C", C, n))
     Km = K if K_modes is None else _sparse_matrix("K_modes", K_modes, n)
-    count = config.REDUCTION_SPARSE_ERROR_MODES if error_modes is None else error_modes
+    count = REDUCTION_SPARSE_ERROR_MODES if error_modes is None else error_modes
     error = _mode_error(M, Km, T, Mr, project(Km), min(count, T.shape[1]))
     return CraigBampton(M=Mr, K=Kr, C=Cr, T=T, boundary=b, interior_w_rad_s=w_int, error=error)
 
@@ -277,7 +280,7 @@ def craig_bampton(M, K, boundary_dofs, n_modes: int, *, C=None, K_modes=None,
     error_modes : int, optional
         Modes the error report compares, the lowest ones (default: all of
         the reduced size for dense matrices,
-        ``config.REDUCTION_SPARSE_ERROR_MODES`` for sparse ones).
+        ``REDUCTION_SPARSE_ERROR_MODES`` for sparse ones).
 
     Returns
     -------

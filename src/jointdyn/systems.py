@@ -32,6 +32,10 @@ from .laws import ContactLaw, make_law
 
 __all__ = ["Contact", "System", "PAPER", "PAPER_NORMAL_DOF", "modal_damping", "stuck_stiffness"]
 
+#: a matrix is positive semi-definite when its smallest eigenvalue is at least -this times
+#: its largest (rounding of an assembled singular matrix)
+SYSTEM_SEMIDEFINITE_RTOL = 1e-10
+
 #: the paper's section-3 damper (docs/model.md section 6)
 PAPER = dict(m=10.0, k=3.9e5, kt=3.0e5, kn=3.0e5, mu=0.5, n0=100.0)
 #: the normal DOF of the coupled paper damper (``System.paper_damper(normal="spring")``):
@@ -522,7 +526,7 @@ def _positive_definite(A) -> bool:
 
 def definiteness_failure(A: np.ndarray, *, semi: bool) -> float | None:
     """None when the symmetric ``A`` is positive definite (``semi``: positive
-    semi-definite, its smallest eigenvalue at least -``config.SYSTEM_SEMIDEFINITE_RTOL``
+    semi-definite, its smallest eigenvalue at least -``SYSTEM_SEMIDEFINITE_RTOL``
     times its largest); else its smallest eigenvalue.
 
     Scales to large matrices: a Cholesky factorisation (of A shifted by the
@@ -536,7 +540,7 @@ def definiteness_failure(A: np.ndarray, *, semi: bool) -> float | None:
     op = _operator(A)
     shift = 0.0
     if semi:
-        shift = config.SYSTEM_SEMIDEFINITE_RTOL * max(abs(_largest_eigenvalue(op)) if n > 2 else
+        shift = SYSTEM_SEMIDEFINITE_RTOL * max(abs(_largest_eigenvalue(op)) if n > 2 else
                                                        float(np.max(np.abs(np.linalg.eigvalsh(A)))), 1e-300)
     if sp.issparse(op):
         B = op + shift * sp.identity(n, format="csc")

@@ -5,7 +5,7 @@ column and the line, so that a user finds the bad value in the file; the
 library's fits (:func:`jointdyn.fit_loops`, :func:`jointdyn.fit_backbone`)
 would name only their arguments. Sizes and magnitudes are bounded before
 any fitting (``config.FIT_MAX_LOOP_SAMPLES``,
-``config.FIT_MAX_BACKBONE_POINTS``, ``config.FIT_MAX_MAGNITUDE``).
+``config.FIT_MAX_BACKBONE_POINTS``, ``FIT_MAX_MAGNITUDE``).
 """
 
 from __future__ import annotations
@@ -16,6 +16,10 @@ from .. import config
 from ..files.tables import RowBound, Spec, data_line, read_table
 
 __all__ = ["LOOPS", "BACKBONE", "read_columns", "read_loops", "read_backbone", "plausibility"]
+
+#: largest magnitude of a measured value a fit computes with: its squares, products and sums over
+#: every sample must stay finite in double precision (1e100 squared is 1e200)
+FIT_MAX_MAGNITUDE = 1e100
 
 #: a fretting rig's record: time, tangential displacement, normal load, tangential force
 LOOPS = Spec(
@@ -52,7 +56,7 @@ def _where(name, path) -> str:
     return f"{name} {str(path)!r}"
 
 
-def _magnitudes(name, path, lay, cols: dict, *, top: float = config.FIT_MAX_MAGNITUDE) -> None:
+def _magnitudes(name, path, lay, cols: dict, *, top: float = FIT_MAX_MAGNITUDE) -> None:
     """Every value within ``top`` in magnitude, else the column and the line of the first beyond."""
     for key, v in cols.items():
         bad = np.flatnonzero(~(np.abs(v) <= top))
@@ -60,7 +64,7 @@ def _magnitudes(name, path, lay, cols: dict, *, top: float = config.FIT_MAX_MAGN
             i = int(bad[0])
             raise ValueError(f"{_where(name, path)} line {data_line(path, lay, name, i)}: {key} = {float(v[i])!r} "
                              f"is beyond the range a fit computes with (|{key}| <= {top:g}, "
-                             "config.FIT_MAX_MAGNITUDE: its squares and products must stay finite)")
+                             "FIT_MAX_MAGNITUDE: its squares and products must stay finite)")
 
 
 def _row_check(name, path, lay, key, v, ok, what: str) -> None:
@@ -91,7 +95,7 @@ def read_columns(path, columns, name: str) -> dict:
 
 def read_loops(path, name: str = "--input") -> dict:
     """Measured loops ``t, x, N, T`` (s, m, N, N), checked: at most ``config.FIT_MAX_LOOP_SAMPLES``
-    rows, values within ``config.FIT_MAX_MAGNITUDE``, x moving, some N > 0, some T != 0.
+    rows, values within ``FIT_MAX_MAGNITUDE``, x moving, some N > 0, some T != 0.
 
     Raises
     ------
@@ -118,7 +122,7 @@ def read_loops(path, name: str = "--input") -> dict:
 def read_backbone(path, name: str = "--backbone", mass: float | None = None) -> dict:
     """A measured backbone ``amplitude_m, omega_rad_s, damping_ratio``, checked: at most
     ``config.FIT_MAX_BACKBONE_POINTS`` rows, amplitude and omega > 0, damping >= 0, every value
-    within ``config.FIT_MAX_MAGNITUDE`` and the modal force ``--mass`` omega^2 amplitude too.
+    within ``FIT_MAX_MAGNITUDE`` and the modal force ``--mass`` omega^2 amplitude too.
 
     Raises
     ------
@@ -127,20 +131,20 @@ def read_backbone(path, name: str = "--backbone", mass: float | None = None) -> 
     """
     cols, lay = read_table(path, BACKBONE, name=name, bound=_BACKBONE_ROWS)
     d = dict(zip(BACKBONE.columns, cols))
-    top, low = config.FIT_MAX_MAGNITUDE, 1.0 / config.FIT_MAX_MAGNITUDE
+    top, low = FIT_MAX_MAGNITUDE, 1.0 / FIT_MAX_MAGNITUDE
     for key in ("amplitude_m", "omega_rad_s"):
         _row_check(name, path, lay, key, d[key], d[key] > 0.0, "> 0 (allowed range (0, inf))")
     _row_check(name, path, lay, "damping_ratio", d["damping_ratio"], d["damping_ratio"] >= 0.0,
                ">= 0 (allowed range [0, inf))")
     for key in ("amplitude_m", "omega_rad_s"):
         _row_check(name, path, lay, key, d[key], (d[key] >= low) & (d[key] <= top),
-                   f"in [{low:g}, {top:g}] (config.FIT_MAX_MAGNITUDE: the fit's products must stay finite)")
+                   f"in [{low:g}, {top:g}] (FIT_MAX_MAGNITUDE: the fit's products must stay finite)")
     _magnitudes(name, path, lay, {"damping_ratio": d["damping_ratio"]})
     if mass is not None:
         force = mass * d["omega_rad_s"] ** 2 * d["amplitude_m"]
         _row_check(name, path, lay, "amplitude_m", d["amplitude_m"], force <= top,
                    f"such that --mass x omega_rad_s^2 x amplitude_m (modal force, N) is at most {top:g} "
-                   f"(config.FIT_MAX_MAGNITUDE; --mass {mass:g} kg)")
+                   f"(FIT_MAX_MAGNITUDE; --mass {mass:g} kg)")
     return d
 
 

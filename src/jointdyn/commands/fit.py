@@ -47,6 +47,11 @@ from .. import config
 from .._exit import EXIT_INCOMPLETE
 from ._law_args import add_law_arguments, law_params
 
+#: jointdyn fit: largest plausible joint displacement of a loop record and modal amplitude of
+#: a backbone, m (beyond them the file is taken to be in other units, e.g. mm)
+FIT_PLAUSIBLE_DISPLACEMENT_M = 0.01
+FIT_PLAUSIBLE_AMPLITUDE_M = 0.1
+
 NAME = "fit"
 HELP = "identify a joint model (kt, mu, chi, beta, ...) from measured loops (t, x, N, T) or a backbone"
 
@@ -129,14 +134,14 @@ def _fit(args):
     held, start = _law_options(args)
     if args.input is not None:
         d = read_loops(args.input, "--input")
-        _plausible("--input", args.input, "x", d["x"], config.FIT_PLAUSIBLE_DISPLACEMENT_M, "m")
+        _plausible("--input", args.input, "x", d["x"], FIT_PLAUSIBLE_DISPLACEMENT_M, "m")
         return fit_loops(d["x"], d["N"], d["T"], args.model, t=d["t"], n_ref=args.n_ref, law_params=held,
                          start=start)
     if args.frc is not None:
         from ..identify.frc import FRC_COLUMNS, fit_frc
 
         d = read_columns(args.frc, FRC_COLUMNS, "--frc")
-        _plausible("--frc", args.frc, "amplitude_m", d["amplitude_m"], config.FIT_PLAUSIBLE_AMPLITUDE_M, "m")
+        _plausible("--frc", args.frc, "amplitude_m", d["amplitude_m"], FIT_PLAUSIBLE_AMPLITUDE_M, "m")
         return fit_frc(d["force_N"], d["omega_rad_s"], d["amplitude_m"], mass=args.mass, model=args.model,
                        law_params=held, start=start)
     if args.ringdown is not None:
@@ -145,12 +150,12 @@ def _fit(args):
         b = backbone_of(args, read_columns)
         args.ringdown_backbone = b
         d = {"amplitude_m": b.amplitude_m, "omega_rad_s": b.omega_rad_s, "damping_ratio": b.damping_ratio}
-        _plausible("--ringdown", args.ringdown, "x (amplitude)", d["amplitude_m"], config.FIT_PLAUSIBLE_AMPLITUDE_M,
+        _plausible("--ringdown", args.ringdown, "x (amplitude)", d["amplitude_m"], FIT_PLAUSIBLE_AMPLITUDE_M,
                    "m")
         return fit_backbone(d["amplitude_m"], d["omega_rad_s"], d["damping_ratio"], mass=args.mass,
                             model=args.model, law_params=held, start=start)
     d = read_backbone(args.backbone, "--backbone", mass=args.mass)
-    _plausible("--backbone", args.backbone, "amplitude_m", d["amplitude_m"], config.FIT_PLAUSIBLE_AMPLITUDE_M, "m")
+    _plausible("--backbone", args.backbone, "amplitude_m", d["amplitude_m"], FIT_PLAUSIBLE_AMPLITUDE_M, "m")
     return fit_backbone(d["amplitude_m"], d["omega_rad_s"], d["damping_ratio"], mass=args.mass, model=args.model,
                         law_params=held, start=start)
 

@@ -43,6 +43,12 @@ from ..systems import PAPER
 _HB_NAMES = ("--harmonics", "--samples")
 
 NAME = "frc"
+#: the gamma grid START:STOP:STEP when none is given (the paper's Fig 6 range)
+GAMMA_DEFAULT = (0.6, 1.8, 0.01)
+#: most points of a gamma grid given as START:STOP:STEP
+MAX_GAMMA_POINTS = 100_000
+#: seconds to wait for a Dask scheduler to answer (--scheduler)
+SCHEDULER_TIMEOUT_S = 5.0
 HELP = ("frequency-response curve (steady amplitude vs gamma) of the paper's friction damper or of a structure "
         "of your own (--system FILE.toml)")
 
@@ -52,7 +58,7 @@ PAPER_OPTIONS = {"eta": 0.5, "beta": None, "f1": None, "delta": 0.0, "model": co
 
 
 def add_arguments(p) -> None:
-    g0 = ":".join(f"{v:g}" for v in config.SWEEP_GAMMA_DEFAULT)
+    g0 = ":".join(f"{v:g}" for v in GAMMA_DEFAULT)
     d = PAPER_OPTIONS
     p.add_argument("--method", default="time", help="time (time-domain steady states, default) or hb (harmonic balance)")
     add_system_argument(p)
@@ -85,7 +91,7 @@ def add_arguments(p) -> None:
                    help="time: time steps per forcing period (solver default)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="time: run the sweep lines on the Dask scheduler at ADDRESS (e.g. tcp://host:8786; "
-                        f"connection timeout {config.SWEEP_SCHEDULER_TIMEOUT_S:g} s)")
+                        f"connection timeout {SCHEDULER_TIMEOUT_S:g} s)")
     p.add_argument("--workers", type=int, default=None,
                    help="time: local parallel workers (default: all cores; not with --scheduler)")
     p.add_argument("--harmonics", default=None, metavar="H|auto",
@@ -116,7 +122,7 @@ def parse_gamma(text: str, name: str = "--gamma") -> np.ndarray:
         raise ValueError(f"{name} STOP must be >= START ({start:g}), got {stop:g}")
     # a float until bounded: (STOP - START) / STEP may be huge or inf
     V.count_at_most(f"{name} START:STOP:STEP", (stop - start) / step + 1.0,
-                    config.SWEEP_MAX_GAMMA_POINTS, "points")
+                    MAX_GAMMA_POINTS, "points")
     count = int(math.floor((stop - start) / step + 1e-9)) + 1
     grid = start + step * np.arange(count)
     with np.errstate(over="ignore", invalid="ignore"):
@@ -127,7 +133,7 @@ def parse_gamma(text: str, name: str = "--gamma") -> np.ndarray:
 
 def config_gamma() -> str:
     """The default --gamma grid, as the option writes it."""
-    return ":".join(f"{v:g}" for v in config.SWEEP_GAMMA_DEFAULT)
+    return ":".join(f"{v:g}" for v in GAMMA_DEFAULT)
 
 
 def _frequency_gammas(args) -> np.ndarray:
@@ -296,7 +302,7 @@ def _connect(address):
     except ValueError as exc:
         raise ValueError(f"--scheduler must be a Dask scheduler address such as tcp://host:8786, got "
                          f"{address!r}: {exc}") from None
-    timeout = config.SWEEP_SCHEDULER_TIMEOUT_S
+    timeout = SCHEDULER_TIMEOUT_S
     try:
         return Client(address, timeout=timeout)
     except (OSError, TimeoutError, ValueError, TypeError) as exc:

@@ -31,6 +31,7 @@ from .. import _validate as V
 from .. import config
 from .._exit import EXIT_INCOMPLETE
 from .._io import jsonable as _jsonable
+from ..continuation import ContinuationOptions
 from ._law_args import add_law_arguments, law_params, model_help
 from ._system_args import load_system_file, option_names
 
@@ -63,7 +64,7 @@ def add_arguments(p) -> None:
                    help=f"epmc: AFT time samples per period, or auto (default: from {config.HB_SAMPLES}, doubled "
                         "while the backbone changes with more: where a contact separates)")
     p.add_argument("--max-points", type=int, default=None,
-                   help=f"epmc: bound on the points of the backbone (default {config.CONT_MAX_POINTS})")
+                   help=f"epmc: bound on the points of the backbone (default {ContinuationOptions.max_points})")
     p.add_argument("--out", default=None, metavar="DIR", help="write modes.nc, modes.csv, modes.png here")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
 
@@ -124,7 +125,7 @@ def _validate(args):
         check_memory(system, disc, names=names)
         args.harmonics = AUTO if disc.harmonics_auto else disc.first.harmonics
         args.samples = AUTO if disc.samples_auto else disc.first.samples
-        args.max_points = V.positive_int("--max-points", config.CONT_MAX_POINTS if args.max_points is None
+        args.max_points = V.positive_int("--max-points", ContinuationOptions.max_points if args.max_points is None
                                          else args.max_points, 2)
     if args.out is not None:
         V.output_dir("--out", args.out, files=("modes.nc", "modes.csv", "modes.png"))

@@ -51,8 +51,9 @@ computed branch between three points (peaks of response curves), and
 :func:`local_maxima` finds the points to start from.
 
 Every number of the step control is a field of :class:`ContinuationOptions`
-(defaults in :mod:`jointdyn.config`, group "continuation"). Bordered linear
-systems go through LAPACK, except small ones (``config.CONT_SMALL_SOLVE``
+(defaults documented there), those of its linear solves of
+:class:`LinearSolveOptions` (``ContinuationOptions.linear``). Bordered linear
+systems go through LAPACK, except small ones (``LinearSolveOptions.small_solve``
 unknowns or fewer), where a compiled Gaussian elimination is faster
 (``benchmarks/bench_linalg.py``).
 
@@ -68,10 +69,12 @@ holds a progress bar over the parameter's range.
 
 from .linalg import preconditioned_by
 from .newton import newton
-from .options import ContinuationOptions, ContinuationResult, ContinuationStatus, make_options
+from .options import (START_EXTRAPOLATION, ContinuationOptions, ContinuationResult, ContinuationStatus,
+                      LinearSolveOptions, make_options)
 from .post import local_maxima, refine_maximum, turning_points
 from .progress import ParameterProgress
 from .walk import continuation
 
-__all__ = ["ContinuationOptions", "ContinuationStatus", "ContinuationResult", "continuation", "newton",
+__all__ = ["ContinuationOptions", "LinearSolveOptions", "START_EXTRAPOLATION", "ContinuationStatus",
+           "ContinuationResult", "continuation", "newton",
            "preconditioned_by", "turning_points", "make_options", "local_maxima", "refine_maximum", "ParameterProgress"]

@@ -1,6 +1,6 @@
 """Linear algebra of the continuation: the bordered systems of the Newton step and of the tangent.
 
-LAPACK ``dgesv`` (through NumPy) for most sizes; below ``config.CONT_SMALL_SOLVE``
+LAPACK ``dgesv`` (through NumPy) for most sizes; up to ``LinearSolveOptions.small_solve``
 unknowns a compiled Gaussian elimination with partial pivoting
 (:func:`lu_solve`, also used by :mod:`jointdyn.modes.qsma`), faster there
 because NumPy's per-call overhead costs more than the arithmetic
@@ -13,10 +13,10 @@ There, within one walk (:func:`reusing_factors`), the LU factors of the last
 factorised bordered matrix precondition GMRES on the current one
 (:class:`FactorReuse`): a few products with the current matrix instead of a
 new factorisation. The solution is accepted only when its true residual
-``|A x - b| <= config.CONT_KRYLOV_RTOL |b|``; otherwise, or after
-``config.CONT_KRYLOV_MAXITER`` iterations, the current matrix is factorised
+``|A x - b| <= krylov_rtol |b|``; otherwise, or after
+``krylov_maxiter`` iterations, the current matrix is factorised
 and solved directly (and its factors kept for the next solves); after a
-solve that needed more than ``config.CONT_KRYLOV_REFRESH`` iterations, the
+solve that needed more than ``krylov_refresh`` iterations, the
 next matrix is factorised at once. A sparse matrix (structures with sparse
 K, M and C: each pair couples only its own DOFs; R_y may come as a
 ``scipy.sparse`` matrix) is factorised by SuperLU instead, its factors
@@ -27,14 +27,15 @@ stops on its own residual.
 Where the caller knows the structure of its Jacobian (harmonic balance: the
 linear terms couple one harmonic only; :func:`preconditioned_by`), the
 kept factors are those of that structured preconditioner instead (GMRES
-up to ``config.CONT_BLOCK_MAXITER`` iterations, made anew after a solve
-that needed more than ``config.CONT_BLOCK_REFRESH``), made at the current
+up to ``block_maxiter`` iterations, made anew after a solve
+that needed more than ``block_refresh``), made at the current
 matrix whenever the kept ones fail, and the whole bordered matrix is
 factorised only when even fresh ones fail. The
 preconditioner's exact columns (``columns``: dense columns of the unknowns it
 does not describe, e.g. EPMC's frequency and damping) and the border row and
 column of the continuation enter it exactly by a low-rank (Woodbury)
-correction (:class:`_Corrected`).
+correction (:class:`_Corrected`). The numbers named are the fields of the walk's
+:class:`~jointdyn.continuation.options.LinearSolveOptions` (``ContinuationOptions.linear``).
 """
 
 from __future__ import annotations
@@ -47,6 +48,7 @@ import numpy as np
 
 from .. import config
 from .._jit import jit
+from .options import LinearSolveOptions
 
 __all__ = ["FactorReuse", "lu_solve", "preconditioned_by", "reusing_factors"]
 
@@ -193,7 +195,8 @@ def _lapack_solve(A, b):
 
 def _small(Jy) -> bool:
     """True when the bordered system of R_y is solved by the compiled elimination (see the module docstring)."""
-    return Jy.shape[0] + 1 <= config.CONT_SMALL_SOLVE
+    fr = _REUSE.get()
+    return Jy.shape[0] + 1 <= (_DEFAULT_LINEAR if fr is None else fr.linear).small_solve
 
 
 class FactorReuse:
@@ -205,16 +208,18 @@ class FactorReuse:
     ``config.CONT_SPARSE_DENSITY`` of its entries nonzero: a structure with
     sparse K, M, C, whose pairs couple only their own DOFs) is factorised by
     SuperLU (``scipy.sparse.linalg.splu``, the pivot thresholds of
-    ``config.CONT_SPARSE_PIVOTS`` in turn until the solve is accurate)
+    ``linear.sparse_pivots`` in turn until the solve is accurate)
     instead, and its factors precondition GMRES in the same way, while they
-    stay sparse (at most ``config.CONT_SPARSE_FILL`` of N^2 entries; else
+    stay sparse (at most ``linear.sparse_fill`` of N^2 entries; else
     the walk goes on dense). ``counts`` holds the factorisations (dense
     and sparse), the solves accepted from GMRES and its iterations.
     """
 
-    def __init__(self, structure=None):
+    def __init__(self, structure=None, linear: LinearSolveOptions | None = None):
         #: maker of a structured preconditioner (:func:`preconditioned_by`), or None
         self.structure = structure
+        #: the numbers of the solves (default ``LinearSolveOptions()``)
+        self.linear = _DEFAULT_LINEAR if linear is None else linear
         self.blocks = None  # its kept factors
         self.lu = None
         self.splu = None  # the kept sparse factors (scipy.sparse.linalg.SuperLU)
@@ -282,7 +287,7 @@ class FactorReuse:
         self.stale = False
         f = x = None
         nb = np.linalg.norm(b)
-        for thresh in config.CONT_SPARSE_PIVOTS:  # the diagonal pivots first (least fill), then safer ones
+        for thresh in self.linear.sparse_pivots:  # the diagonal pivots first (least fill), then safer ones
             try:
                 f = spla.splu(A, diag_pivot_thresh=thresh)
             except RuntimeError:  # exactly singular with these pivots
@@ -290,12 +295,12 @@ class FactorReuse:
                 continue
             self.counts["sparse_factorisations"] += 1
             x = f.solve(b)
-            if np.isfinite(x).all() and np.linalg.norm(A @ x - b) <= config.CONT_KRYLOV_RTOL * nb:
+            if np.isfinite(x).all() and np.linalg.norm(A @ x - b) <= self.linear.krylov_rtol * nb:
                 break
         self.splu = f
         if f is None:
             return b, False
-        if f.L.nnz + f.U.nnz > config.CONT_SPARSE_FILL * A.shape[0] ** 2:
+        if f.L.nnz + f.U.nnz > self.linear.sparse_fill * A.shape[0] ** 2:
             self.sparse, self.splu = False, None
         return x, bool(np.isfinite(x).all())
 
@@ -312,17 +317,17 @@ class FactorReuse:
         A = _sparse_bordered(Jy.approximation(), Jl, d)
         f = self.splu
         if f is not None and f.shape == A.shape and not self.stale:
-            x = self._krylov(times, f.solve, b, config.CONT_BLOCK_MAXITER, right=True)
+            x = self._krylov(times, f.solve, b, self.linear.block_maxiter, right=True)
             if x is not None:
                 return x
         self.stale, self.splu = False, None
-        for thresh in config.CONT_SPARSE_PIVOTS:  # the diagonal pivots first (least fill), then safer ones
+        for thresh in self.linear.sparse_pivots:  # the diagonal pivots first (least fill), then safer ones
             try:
                 f = spla.splu(A, diag_pivot_thresh=thresh)
             except RuntimeError:  # exactly singular with these pivots
                 continue
             self.counts["sparse_factorisations"] += 1
-            x = self._krylov(times, f.solve, b, config.CONT_BLOCK_MAXITER, right=True)
+            x = self._krylov(times, f.solve, b, self.linear.block_maxiter, right=True)
             if x is not None:
                 self.splu = f
                 return x
@@ -335,14 +340,14 @@ class FactorReuse:
             return _bordered_times(Jy, Jl, d, x)
 
         f = self.blocks
-        k = config.CONT_BLOCK_MAXITER
+        k = self.linear.block_maxiter
         if f is not None and f.size == Jy.shape[0] and not self.stale:
             P = _Corrected.of(f, Jy, Jl, d)
             before = self.counts["krylov_iterations"]
             x = None if P is None else self._krylov(times, P.solve, b, k, right=True)
             # fresh blocks need some iterations too (the harmonics' coupling): the kept ones are dropped only
             # when they need many more (a fresh factorisation costs about as much as CONT_BLOCK_REFRESH iterations)
-            self.stale = self.counts["krylov_iterations"] - before > config.CONT_BLOCK_REFRESH
+            self.stale = self.counts["krylov_iterations"] - before > self.linear.block_refresh
             if x is not None:
                 return x
         self.blocks = f = self.structure.factor(Jy)
@@ -354,7 +359,7 @@ class FactorReuse:
 
     def _krylov(self, times, precondition, b, k=None, right=False):
         """GMRES on ``times`` (the current matrix's product) preconditioned by ``precondition`` (a solve with
-        the kept factors), at most ``k`` iterations (default ``config.CONT_KRYLOV_MAXITER``); the solution,
+        the kept factors), at most ``k`` iterations (default ``linear.krylov_maxiter``); the solution,
         or None when not accurate enough. ``right``: preconditioned from the right, so that GMRES stops on
         the true residual (an approximate preconditioner of a nearly singular matrix, as the harmonic
         blocks at a resonance, has a large inverse: the left-preconditioned residual would stop it while
@@ -366,8 +371,8 @@ class FactorReuse:
         def count(_):
             it[0] += 1
 
-        k = config.CONT_KRYLOV_MAXITER if k is None else k
-        tol = dict(rtol=0.1 * config.CONT_KRYLOV_RTOL, atol=0.0, restart=k, maxiter=1, callback=count,
+        k = self.linear.krylov_maxiter if k is None else k
+        tol = dict(rtol=0.1 * self.linear.krylov_rtol, atol=0.0, restart=k, maxiter=1, callback=count,
                    callback_type="pr_norm")
         if right:
             AP = spla.LinearOperator((b.size, b.size), matvec=lambda y: times(precondition(y)), dtype=np.float64)
@@ -379,12 +384,12 @@ class FactorReuse:
             x, _ = spla.gmres(A, b, x0=P.matvec(b), M=P, **tol)
         self.counts["krylov_iterations"] += it[0]
         nb = np.linalg.norm(b)
-        if not np.isfinite(x).all() or np.linalg.norm(times(x) - b) > config.CONT_KRYLOV_RTOL * nb:
+        if not np.isfinite(x).all() or np.linalg.norm(times(x) - b) > self.linear.krylov_rtol * nb:
             return None
         self.counts["krylov_solves"] += 1
         # the factors drift from the walk's matrices: factorise at the next solve instead of first
         # spending GMRES iterations on a preconditioner that is likely to fail
-        self.stale = it[0] > config.CONT_KRYLOV_REFRESH
+        self.stale = it[0] > self.linear.krylov_refresh
         return x
 
 
@@ -487,6 +492,8 @@ def _sparse_bordered(Jy, Jl, d):
     return sps.csc_matrix((np.concatenate((Jy.ravel()[idx], Jl, d)), (rows, cols)), shape=(n + 1, n + 1))
 
 
+#: the numbers of solves outside any walk
+_DEFAULT_LINEAR = LinearSolveOptions()
 _REUSE: contextvars.ContextVar[FactorReuse | None] = contextvars.ContextVar("jointdyn_factor_reuse", default=None)
 _STRUCTURE = contextvars.ContextVar("jointdyn_structured_preconditioner", default=None)
 
@@ -510,16 +517,17 @@ def preconditioned_by(structure):
 
 
 @contextlib.contextmanager
-def reusing_factors():
-    """Within the block, large bordered solves reuse factors (:class:`FactorReuse`); yields it.
+def reusing_factors(linear: LinearSolveOptions | None = None):
+    """Within the block, large bordered solves reuse factors (:class:`FactorReuse`, solving by the numbers
+    of ``linear``, default ``LinearSolveOptions()``); yields it.
 
-    Nested blocks share the outer one. The factors are dropped on exit.
+    Nested blocks share the outer one (and its numbers). The factors are dropped on exit.
     """
     outer = _REUSE.get()
     if outer is not None:
         yield outer
         return
-    fr = FactorReuse(_STRUCTURE.get())
+    fr = FactorReuse(_STRUCTURE.get(), linear)
     token = _REUSE.set(fr)
     try:
         yield fr
@@ -528,7 +536,7 @@ def reusing_factors():
 
 
 def _large_solve(Jy, Jl, d, b):
-    """A bordered solve above ``config.CONT_SMALL_SOLVE``: with reused factors where they pay, else ``dgesv``."""
+    """A bordered solve above ``small_solve`` unknowns: with reused factors where they pay, else ``dgesv``."""
     fr = _REUSE.get()
     if fr is not None and Jy.shape[0] + 1 >= config.CONT_KRYLOV_SOLVE:
         return fr.solve(Jy, Jl, d, b)

@@ -78,6 +78,6 @@ def newton(residual, y, lam, options: ContinuationOptions | None = None, *, coun
     """
     opt = make_options(options, overrides)
     cnt = counter if counter is not None else {"residual_evaluations": 0}
-    with reusing_factors():
+    with reusing_factors(opt.linear):
         y, ok, it, _ = _solve_damped(residual, np.asarray(y, dtype=float), lam, None, None, opt, cnt)
     return y, ok, it

@@ -9,7 +9,6 @@ from typing import Callable
 
 import numpy as np
 
-from .. import config
 from .newton import _solve_damped
 from .options import ContinuationOptions, make_options
 
@@ -124,14 +123,14 @@ def _interpolate(s, U, x):
     return w @ U, d / np.linalg.norm(d)
 
 
-def _bracketed(s, g, width0) -> bool:
+def _bracketed(s, g, width0, opt: ContinuationOptions) -> bool:
     """True when the bracket of :func:`refine_maximum` is narrow enough or flat enough (value converged)."""
-    return bool(s[2] - s[0] <= config.CONT_REFINE_STOL * width0
-                or g[1] - min(g[0], g[2]) <= config.CONT_REFINE_GTOL)
+    return bool(s[2] - s[0] <= opt.refine_stol * width0
+                or g[1] - min(g[0], g[2]) <= opt.refine_gtol)
 
 
 def refine_maximum(residual: Callable, observe: Callable, y, lam, options: ContinuationOptions | None = None,
-                   *, iterations: int = config.CONT_REFINE_ITER, **overrides):
+                   *, iterations: int | None = None, **overrides):
     """Maximum of an observable along the solution curve, refined between three branch points.
 
     ``y`` (3, n) and ``lam`` (3,) are consecutive points of a branch whose
@@ -142,12 +141,12 @@ def refine_maximum(residual: Callable, observe: Callable, y, lam, options: Conti
     by the arc-length corrector (predicted by the quadratic through the
     three points, constrained to the hyperplane orthogonal to its
     derivative), and the bracket shrunk around the best point; until the
-    bracket is ``config.CONT_REFINE_STOL`` of its first width, or the
-    observable varies by at most ``config.CONT_REFINE_GTOL`` across it
+    bracket is ``options.refine_stol`` of its first width, or the
+    observable varies by at most ``options.refine_gtol`` across it
     (the value has converged; a flat maximum's location is then known to
     the square root of that), or
-    ``iterations`` corrections were made (a maximum at a corner of a
-    piecewise-smooth branch converges linearly).
+    ``iterations`` corrections were made (default ``options.refine_iter``) (a maximum at a corner of a
+    ``iterations`` corrections were made (default ``options.refine_iter``; a maximum at a corner of a
 
     Returns
     -------
@@ -164,8 +163,8 @@ def refine_maximum(residual: Callable, observe: Callable, y, lam, options: Conti
     width0 = s[2] - s[0]
     cnt = {"residual_evaluations": 0}
     last_width = math.inf
-    for _ in range(iterations):
-        if _bracketed(s, g, width0):
+    for _ in range(opt.refine_iter if iterations is None else iterations):
+        if _bracketed(s, g, width0, opt):
             break
         x = _vertex(s, g)
         lo, hi = s[0] + GOLDEN_MARGIN * (s[1] - s[0]), s[2] - GOLDEN_MARGIN * (s[2] - s[1])
@@ -190,5 +189,5 @@ def refine_maximum(residual: Callable, observe: Callable, y, lam, options: Conti
             U[1], g[1], s[1] = v, gv, x
         else:
             U[k], g[k], s[k] = v, gv, x
-    converged = _bracketed(s, g, width0)
+    converged = _bracketed(s, g, width0, opt)
     return U[1, :n].copy(), float(U[1, n]), float(g[1]), bool(converged)

@@ -494,7 +494,7 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
     lam0, lam_stop : float
         Start and end of the parameter range (distinct).
     options : ContinuationOptions, optional
-        Step control (defaults from :mod:`jointdyn.config`); keyword
+        Step control (defaults documented there); keyword
         arguments override its fields (e.g. ``ds_max=0.05``).
     monitor : callable, optional
         ``monitor(y, lam) -> None | (status, message)`` called at every
@@ -523,7 +523,7 @@ def continuation(residual: Callable, y0, lam0: float, lam_stop: float, options: 
     lam_stop = V.finite("lam_stop", lam_stop)
     if lam_stop == lam0:
         raise ValueError("lam_stop must differ from lam0")
-    with reusing_factors() as fr:
+    with reusing_factors(opt.linear) as fr:
         res = _walk(residual, y0, lam0, lam_stop, opt, monitor, progress, observe, lam_name)
     if any(fr.counts.values()):  # large bordered systems (continuation.linalg): how they were solved
         res.counters.update(fr.counts)

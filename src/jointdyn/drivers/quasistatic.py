@@ -22,6 +22,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+#: a cycle of a sampled history spans at least this many sample intervals on
+#: average (fewer is not a sampled loop); bounds the cycles of --period
+QS_MIN_INTERVALS_PER_CYCLE = 2
+#: load (as a fraction of n_ref) at which a law is evaluated at a re-contact
+#: instant (N = 0 followed by N > 0), so that the virgin curve starts exactly
+#: there; the sample is reported as separated with T = 0
+QS_RECONTACT_LOAD = 1e-300
+
 if TYPE_CHECKING:
     import pandas as pd
 
@@ -403,7 +411,7 @@ def cycle_count(t, period, name: str = "period") -> int:
     """Number of full cycles of length ``period`` in the history sampled at ``t``.
 
     Bounded before anything is computed: at least one cycle, and at most one
-    per :data:`config.QS_MIN_INTERVALS_PER_CYCLE` sample intervals (a cycle
+    per :data:`QS_MIN_INTERVALS_PER_CYCLE` sample intervals (a cycle
     has to be sampled to be a loop; this also bounds the work by the size of
     the history, whatever ``period``).
 
@@ -428,12 +436,12 @@ def cycle_count(t, period, name: str = "period") -> int:
     """
     period = V.positive(name, period)
     duration = float(t[-1] - t[0])
-    most = max(1, (len(t) - 1) // config.QS_MIN_INTERVALS_PER_CYCLE)
+    most = max(1, (len(t) - 1) // QS_MIN_INTERVALS_PER_CYCLE)
     ratio = duration / period * (1.0 + config.QS_SNAP_RTOL)  # inf for a tiny period: compared as a float
     if not ratio < most + 1:
         raise ValueError(
             f"{name} must be at least {duration / most!r} s (at most {most} cycle{'s' if most > 1 else ''} of "
-            f">= {config.QS_MIN_INTERVALS_PER_CYCLE} sample intervals in {len(t)} samples over {duration!r} s), "
+            f">= {QS_MIN_INTERVALS_PER_CYCLE} sample intervals in {len(t)} samples over {duration!r} s), "
             f"got {period!r}"
         )
     if ratio < 1.0:
@@ -497,7 +505,7 @@ def quasistatic(law, t, x, N, *, period=None, state=None) -> LoopResult:
         Normal load, N (finite, same length; N <= 0 is separation).
     period : float, optional
         Cycle length, s (> 0, at most the duration of the history, and long
-        enough for :data:`config.QS_MIN_INTERVALS_PER_CYCLE` sample
+        enough for :data:`QS_MIN_INTERVALS_PER_CYCLE` sample
         intervals per cycle on average; see :func:`cycle_count`).
     state : ndarray, optional
         Committed law state to start from (default: virgin at x[0], N[0]).
@@ -531,7 +539,7 @@ def quasistatic(law, t, x, N, *, period=None, state=None) -> LoopResult:
     recontact = np.zeros(N.size, dtype=bool)
     recontact[:-1] = (N[:-1] == 0.0) & (N[1:] > 0.0)
     Nk = N.copy()
-    Nk[recontact] = config.QS_RECONTACT_LOAD * law.n_ref
+    Nk[recontact] = QS_RECONTACT_LOAD * law.n_ref
     T, kT, code, _ = march(law, x, Nk, state=state)
     open_ = N <= 0.0
     T[open_] = 0.0

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate as V
-from .. import config
 from .._cache import by_identity
 from ..damping import dense_damping
 from ..kinematics import (
@@ -40,6 +39,28 @@ from .status import RunStatus, run_status
 
 __all__ = ["PackedSystem", "pack_system", "check_period_steps", "Model", "make_model", "refine_if_opened", "Grid", "RunResult", "run",
            "recontact_load", "pair_relative", "sliders", "set_sliders"]  # fmt: skip
+
+#: RK4 steps per forcing period (before events and reversal splits)
+TI_STEPS_PER_PERIOD = 256
+#: steps per period are raised so that w_max * h <= this (w_max: stiffest
+#: linear mode with every contact stuck); RK4 is stable up to ~2.8
+TI_MAX_OMEGA_H = 1.0
+#: once a normal spring opens, the steps are refined so that w_max * h <=
+#: this (w_max with the springs closed): every re-contact sets the normal
+#: DOFs ringing at their own frequency, and RK4 at w h = 1 damps that
+#: ringing numerically by about 0.3 % of its energy per step, which shows in
+#: the energy balance (measured on the coupled paper damper, eta 1.5: 6e-3
+#: at w h = 0.85, 2e-6 at 0.21)
+TI_SPRING_OMEGA_H = 0.3
+#: at most this many reversal splits inside one grid step
+TI_MAX_SPLITS = 4
+#: an event closer than this fraction of a step to a grid point moves it
+TI_EVENT_MERGE = 1e-6
+#: normal load put at a re-contact instant, as a fraction of n0 (> 0 so that
+#: the committed law state is "in contact, virgin at the re-contact point")
+TI_RECONTACT_ALPHA = 1e-12
+#: a state larger than this factor times (|f|/k_min + fy/kt) is a blow-up
+TI_BLOWUP_FACTOR = 1e8
 
 
 @dataclass(frozen=True)
@@ -212,8 +233,8 @@ def recontact_load(kin: ContactKinematics, c: int) -> float:
     """Load (N) a prescribed load is snapped to at a re-contact instant:
     ``TI_RECONTACT_ALPHA`` times n0 (harmonic) or times the largest |sample| (sampled)."""
     if kin.normal_kind[c] == NORMAL_SAMPLED:
-        return config.TI_RECONTACT_ALPHA * float(np.max(np.abs(kin.normal_table[c])))
-    return config.TI_RECONTACT_ALPHA * kin.normal_par[c, 0]
+        return TI_RECONTACT_ALPHA * float(np.max(np.abs(kin.normal_table[c])))
+    return TI_RECONTACT_ALPHA * kin.normal_par[c, 0]
 
 
 def _period_grid(pack: PackedSystem, w: float, J: int, events: bool):
@@ -228,7 +249,7 @@ def _period_grid(pack: PackedSystem, w: float, J: int, events: bool):
     Tp = 2 * math.pi / w
     t = np.arange(J + 1) * (Tp / J)  # np.linspace(0, Tp, J + 1), bit for bit, cheaper
     t[J] = Tp
-    tol = config.TI_EVENT_MERGE * Tp / J
+    tol = TI_EVENT_MERGE * Tp / J
     tg = t
     ev_at = {}
     instants = list(load_events(pack.kin, w, Tp)) if events else []
@@ -295,10 +316,10 @@ class Model:
         """Blow-up caps, never below TI_BLOWUP_FACTOR times the starting state."""
         wv = max(self.pack.w_max, self.w, 1.0)
         xs = float(np.max(np.abs(x))) + float(np.max(np.abs(v))) / wv
-        if config.TI_BLOWUP_FACTOR * xs <= self.xcap0:
+        if TI_BLOWUP_FACTOR * xs <= self.xcap0:
             return self.xcap  # the usual case: the start is far below the caps
         n = self.n
-        return np.maximum(self.xcap, config.TI_BLOWUP_FACTOR * np.concatenate([np.full(n, xs), np.full(n, xs * wv)]))
+        return np.maximum(self.xcap, TI_BLOWUP_FACTOR * np.concatenate([np.full(n, xs), np.full(n, xs * wv)]))
 
     def segment_grid(self, ta: float, tb: float) -> Grid:
         """Grid for ta < t <= tb (0 <= ta < tb <= ta + period), from the period grid."""
@@ -397,7 +418,7 @@ def make_model(system, w: float, steps_per_period: int, *, events: bool = True,
     refined = bool(refined) and pack.springs
     J = period_steps(pack, w, steps_per_period, refined=refined)
     fs = pack.fmax if force_scale is None else force_scale
-    xcap0 = config.TI_BLOWUP_FACTOR * (fs / pack.kmin + pack.xlin + 1e-12)
+    xcap0 = TI_BLOWUP_FACTOR * (fs / pack.kmin + pack.xlin + 1e-12)
     xcap = np.empty(2 * pack.ndof)
     xcap[: pack.ndof] = xcap0
     xcap[pack.ndof :] = xcap0 * max(pack.w_max, w, 1.0)
@@ -406,7 +427,7 @@ def make_model(system, w: float, steps_per_period: int, *, events: bool = True,
         tg, Ng = _period_grid(pack, w, J, events)
         grid, period = _harmonic_tables(pack, tg, Ng, w), 2 * math.pi / w
     return Model(pack=pack, system=system, w=w, events=bool(events),
-                 max_split=config.TI_MAX_SPLITS if events else 0, J=J, xcap0=xcap0, xcap=xcap,
+                 max_split=TI_MAX_SPLITS if events else 0, J=J, xcap0=xcap0, xcap=xcap,
                  grid=grid, period=period, steps_per_period=int(steps_per_period), refined=refined)  # fmt: skip
 
 
@@ -426,7 +447,7 @@ def period_steps(pack: PackedSystem, w: float, steps_per_period: int, *, refined
     ``name`` for the first)."""
     J = float(steps_per_period)
     if w > 0:
-        wh = config.TI_SPRING_OMEGA_H if refined else config.TI_MAX_OMEGA_H
+        wh = TI_SPRING_OMEGA_H if refined else TI_MAX_OMEGA_H
         with np.errstate(over="ignore", divide="ignore"):
             need = float(np.ceil(np.float64(2 * math.pi) * pack.w_max / (np.float64(w) * wh)))
         J = max(J, need)
@@ -450,10 +471,10 @@ def check_period_steps(system, w: float, steps_per_period: int | None = None, *,
     """The steps of one forcing period of ``system`` at ``w`` (rad/s), refused before anything is computed
     (ValueError naming ``name`` where ``steps_per_period`` sets the step, else the stiffest mode) when
     ``lines`` runs at once would exceed the memory bound: :func:`period_steps` with the solver's default
-    steps (``config.TI_STEPS_PER_PERIOD``) where ``steps_per_period`` is None, refined where the system
+    steps (``TI_STEPS_PER_PERIOD``) where ``steps_per_period`` is None, refined where the system
     has normal springs. The lowest frequency of a sweep needs the most."""
     pack = pack_system(system)
-    spp = config.TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period
+    spp = TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period
     return period_steps(pack, w, spp, refined=pack.springs, lines=lines, name=name)
 
 
@@ -498,7 +519,7 @@ def run(model: Model, grid: Grid, mode: int, x, v, S, nper: int, *, rdof: int = 
     summ = np.zeros((nper, N_SUMMARY))
     zend = np.zeros((nper, 2 * pack.ndof))
     psum = np.zeros((nper, pack.npairs, 4))
-    control = (mode, nper, 0.0, model.w, rdof, model.max_split, record, config.TI_RECONTACT_ALPHA)
+    control = (mode, nper, 0.0, model.w, rdof, model.max_split, record, TI_RECONTACT_ALPHA)
     io = (x, v, S, model.cap(x, v))
     if record:
         x0, v0, S0 = x.copy(), v.copy(), S.copy()

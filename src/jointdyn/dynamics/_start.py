@@ -15,13 +15,18 @@ import math
 
 import numpy as np
 
-from .. import config
 from .._jit import jit, specialize
 from ..drivers import march
 from ..drivers._march import law_marcher
 from ..kinematics import load_table, tangential_history
 
 __all__ = ["linear_start", "clean_states"]
+
+#: describing-function iterations of the linear start
+SS_LINEAR_ITERS = 30
+#: relative change of the describing-function amplitude that ends that
+#: iteration (it only seeds the integration, which does the rest)
+SS_LINEAR_RTOL = 1e-2
 
 
 @jit
@@ -143,8 +148,8 @@ def linear_start(model):
     u = Im(U e^{i w t}) with the prescribed N_c(t), a spring contact at its
     preload, marched with the real law),
     started from the stuck stiffness kt and iterated with relaxation 1/2
-    until X changes by less than ``config.SS_LINEAR_RTOL`` (at most
-    ``config.SS_LINEAR_ITERS`` solves). Each iteration is a LAPACK solve
+    until X changes by less than ``SS_LINEAR_RTOL`` (at most
+    ``SS_LINEAR_ITERS`` solves). Each iteration is a LAPACK solve
     (:func:`_df_solve`) and one compiled call marching every contact
     (``_df_template``). Returns x, v (m, m/s) and law states at t = 0 (law
     marched over the last two cycles of the estimate), or None if the
@@ -160,7 +165,7 @@ def linear_start(model):
     X = np.zeros(pk.ndof, dtype=np.complex128)
     run = specialize(_df_template, INIT=pk.init, MARCH=law_marcher(pk.step))
     xmax = 1e3 * (pk.fmax / pk.kmin + pk.xlin)
-    iters = config.SS_LINEAR_ITERS if pk.ncontacts else 1
+    iters = SS_LINEAR_ITERS if pk.ncontacts else 1
     kc = pk.kt.astype(np.complex128)
     have, final, it = False, False, 0
     while True:
@@ -168,7 +173,7 @@ def linear_start(model):
             Xn = _df_solve(_df_matrix(Z0, pk.B, kc), f)
             if Xn is None:
                 return None
-            ok, conv = _df_accept(Xn, X, have, config.SS_LINEAR_RTOL, xmax)
+            ok, conv = _df_accept(Xn, X, have, SS_LINEAR_RTOL, xmax)
             if not ok:
                 return None
             have, it = True, it + 1

@@ -18,11 +18,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate as V
-from .. import config
 from ..kinematics import sampled_load_grid
 from ..systems import System
 from ._core import LOADS_SAMPLED
-from ._model import Model, make_model, refine_if_opened, run
+from ._model import (TI_MAX_OMEGA_H, TI_RECONTACT_ALPHA, TI_SPRING_OMEGA_H, TI_STEPS_PER_PERIOD, Model, make_model,
+                     refine_if_opened, run)
 from .status import RunStatus
 
 __all__ = ["Trajectory", "Restart", "integrate", "integrate_sampled"]
@@ -141,11 +141,11 @@ def integrate(
     periods : int
         Number of forcing periods (>= 1).
     steps_per_period : int, optional
-        Base steps per forcing period (default ``config.TI_STEPS_PER_PERIOD``);
-        raised automatically so that w_max h <= ``config.TI_MAX_OMEGA_H``
+        Base steps per forcing period (default ``TI_STEPS_PER_PERIOD``);
+        raised automatically so that w_max h <= ``TI_MAX_OMEGA_H``
         for the stiffest mode with every contact stuck and every normal
         spring closed, and (the run repeated) so that w_max h <=
-        ``config.TI_SPRING_OMEGA_H`` when a normal spring opens; events and
+        ``TI_SPRING_OMEGA_H`` when a normal spring opens; events and
         reversals add steps.
     x0, v0 : array_like, optional
         Initial displacements (m) and velocities (m/s); default rest.
@@ -162,7 +162,7 @@ def integrate(
     """
     if not isinstance(system, System):
         raise ValueError(f"system must be a System, got {type(system).__name__}")
-    spp = V.positive_int("steps_per_period", config.TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period, 4)
+    spp = V.positive_int("steps_per_period", TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period, 4)
     periods = V.positive_int("periods", periods)
     w = _omega(system, gamma)
     model = make_model(system, w, spp)
@@ -248,7 +248,7 @@ def integrate_sampled(
     N = N.copy()
     for c in model.pack.kin.springs:  # a spring's load comes from the state: its column is not read
         N[:, c] = model.pack.kin.normal_par[c, 0]
-    tg, Fg, Ng = sampled_load_grid(t, F, N, config.TI_RECONTACT_ALPHA)
+    tg, Fg, Ng = sampled_load_grid(t, F, N, TI_RECONTACT_ALPHA)
     if start is not None:
         x0, v0, states = start.x, start.v, start.states
     fresh = states is None

@@ -19,10 +19,13 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _validate as V
-from .. import config
-from ._model import Model, make_model
+from ._model import TI_STEPS_PER_PERIOD, Model, make_model
 
 __all__ = ["fd_monodromy", "period_map", "monodromy_matrix"]
+
+#: relative central-difference step of the monodromy check of harmonic-balance
+#: solutions (of the amplitude for displacements, of w times it for velocities)
+MONODROMY_FD_STEP = 1e-6
 
 
 def fd_monodromy(pmap, z, scale, eps: float, z1=None):
@@ -114,9 +117,9 @@ def monodromy_matrix(system, w: float, t0: float, x, v, states, *, amplitude: fl
         Displacement scale (m) of the perturbations: relative step ``eps``
         of ``amplitude`` for x and of ``w amplitude`` for v.
     eps : float, optional
-        Relative step of the central differences (default ``config.MONODROMY_FD_STEP``).
+        Relative step of the central differences (default ``MONODROMY_FD_STEP``).
     steps_per_period : int, optional
-        RK4 base steps per period (default ``config.TI_STEPS_PER_PERIOD``).
+        RK4 base steps per period (default ``TI_STEPS_PER_PERIOD``).
 
     Returns
     -------
@@ -131,8 +134,8 @@ def monodromy_matrix(system, w: float, t0: float, x, v, states, *, amplitude: fl
     """
     w = V.positive("w", w)
     amp = V.positive("amplitude", amplitude)
-    eps = V.positive("eps", config.MONODROMY_FD_STEP if eps is None else eps)
-    spp = config.TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period
+    eps = V.positive("eps", MONODROMY_FD_STEP if eps is None else eps)
+    spp = TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period
     spp = V.positive_int("steps_per_period", spp, 4)
     model = make_model(system, w, spp)
     n = model.n

@@ -12,6 +12,12 @@ from ._core import RUN_BLOWUP, RUN_OK, RUN_OVERFLOW
 
 __all__ = ["EnergyCheck", "RunStatus", "SteadyStatus", "run_status"]
 
+#: rounding floor of the contact-dissipation check of a periodic state: the
+#: contact's energy per period may fall below zero by the period's
+#: energy-balance residual |W - E_contact - E_viscous| plus this fraction of
+#: |W| + |E_contact| + |E_viscous| before it is flagged as energy created
+SS_DISSIPATION_FLOOR = 1e-12
+
 
 class RunStatus(Status):
     """Outcome of one call of the compiled RK4 runner (:attr:`Trajectory.status`).
@@ -50,7 +56,7 @@ class EnergyCheck(Status):
 
     Over a periodic orbit a passive contact dissipates ``energy_contact_J >=
     0``; a value below zero by more than the period's energy-balance residual
-    (plus a rounding floor, ``config.SS_DISSIPATION_FLOOR``) means that the
+    (plus a rounding floor, ``SS_DISSIPATION_FLOOR``) means that the
     contact law created energy (e.g. the paper's closed form at some points)
     or that the orbit is not accurate enough to tell.
     """

@@ -22,17 +22,70 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _validate as V
-from .. import config
 from .._jit import jit
 from ..systems import System
 from ._core import N_SUMMARY, S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
-from ._model import Model, make_model, pack_system, refine_if_opened
+from ._model import TI_STEPS_PER_PERIOD, Model, make_model, pack_system, refine_if_opened
 from ._start import clean_states, linear_start
 from .integrate import Restart, Trajectory, _omega, _trajectory
 from .monodromy import fd_monodromy
-from .status import EnergyCheck, SteadyStatus
+from .status import SS_DISSIPATION_FLOOR, EnergyCheck, SteadyStatus
 
 __all__ = ["SteadyState", "energy_check", "prepare_kernels", "steady_state"]
+
+#: relative tolerance on the half peak-to-peak amplitude and on the
+#: period-boundary state (Poincare points)
+SS_AMP_RTOL = 1e-4
+#: relative tolerance on the energy per period
+SS_ENERGY_RTOL = 1e-3
+#: work of the forcing = dissipation per period to this (relative; the
+#: energy integrals carry the discretisation error)
+SS_BALANCE_RTOL = 1e-2
+#: windows (of p periods) that must agree
+SS_CHECK_PERIODS = 3
+#: largest period multiple p accepted as a periodic steady state
+SS_MAX_MULTIPLE = 4
+#: longer multiples (up to this) are detected and reported as
+#: "not-settled", detail "period-P", instead of running to max_periods
+SS_DETECT_MULTIPLE = 12
+#: a multiple p > 1 is accepted only when the largest one-period mismatch
+#: over the last K p periods is at least this fraction of that over the
+#: K p periods before (no decaying beat)
+SS_MULTIPLE_DECAY = 0.97
+#: after shooting, stop as "quasi-periodic-or-chaotic" when the largest
+#: one-period mismatch over the last SS_STALL_PERIODS/2 periods is >=
+#: SS_STALL_RATIO times that over the half before
+SS_STALL_PERIODS = 240
+SS_STALL_RATIO = 0.9
+#: cap on integrated periods
+SS_MAX_PERIODS = 1500
+#: periods integrated between two checks
+SS_CHUNK = 8
+#: shooting (Newton on the period map) when the estimated number of
+#: periods to converge exceeds this
+SS_SHOOT_AFTER = 40
+#: Newton iterations of one shooting attempt
+SS_SHOOT_MAXIT = 12
+#: largest Newton step (relative to the amplitude) and step halvings of the
+#: line search
+SS_SHOOT_MAXSTEP = 1.0
+SS_SHOOT_HALVINGS = 8
+#: before shooting (section at phase 0), rebuild the law states from the
+#: last period alone (forget the transient's memory)
+SS_SHOOT_CLEAN_STATE = True
+#: shooting attempts per run
+SS_MAX_SHOTS = 3
+#: relative finite-difference step of the monodromy matrix
+SS_SHOOT_FD = 1e-6
+#: a Floquet multiplier above 1 + this marks an unstable orbit
+SS_FLOQUET_TOL = 1e-3
+#: amplitude increasing over this many consecutive periods ...
+SS_GROWTH_PERIODS = 40
+#: ... with increments of the second half >= this fraction of the first
+SS_GROWTH_RATIO = 0.9
+#: ... and with the amplitude of x[response_dof] above this many fy/kt of
+#: the first contact (friction saturated: only then can friction lose)
+SS_UNBOUNDED_Q = 20.0
 
 
 @dataclass(frozen=True)
@@ -257,12 +310,12 @@ def _check_periodic(h: _History, p: int, K: int, model, amp_rtol, energy_rtol):
     if h.size < K * p:
         return False
     return bool(_periodic_arrays(h.summ, h.Z, p, K, model.n, model.w, model.pack.K_stuck, model.pack.M,
-                                 _amplitude_scale(model, 0.0), amp_rtol, energy_rtol, config.SS_BALANCE_RTOL))  # fmt: skip
+                                 _amplitude_scale(model, 0.0), amp_rtol, energy_rtol, SS_BALANCE_RTOL))  # fmt: skip
 
 
 def _growing(h: _History, model, amp_rtol) -> bool:
     """Amplitude increasing over the last SS_GROWTH_PERIODS periods without slowing down."""
-    G = config.SS_GROWTH_PERIODS
+    G = SS_GROWTH_PERIODS
     if h.size < G + 1:
         return False
     S = np.asarray(h.summ[-(G + 1):])
@@ -271,28 +324,28 @@ def _growing(h: _History, model, amp_rtol) -> bool:
     if not np.all(d > 0):
         return False
     half = d.size // 2
-    if d[half:].mean() < config.SS_GROWTH_RATIO * d[:half].mean():
+    if d[half:].mean() < SS_GROWTH_RATIO * d[:half].mean():
         return False
     # energy surplus (W - E_c - E_v) / W per period: stays positive and does
     # not decay when the response is unbounded (Den Hartog: 1 - 4R/(pi F));
     # it decays to 0 on a (slow) approach to a bounded state
     sur = (S[1:, S_W] - S[1:, S_EC] - S[1:, S_EV]) / np.maximum(np.abs(S[1:, S_W]), 1e-300)
     q = max(sur.size // 4, 1)
-    if not np.all(sur > 0) or sur[-q:].mean() < config.SS_GROWTH_RATIO * sur[:q].mean():
+    if not np.all(sur > 0) or sur[-q:].mean() < SS_GROWTH_RATIO * sur[:q].mean():
         return False
     if d.mean() <= amp_rtol * A[-1]:
         return False
     # a contact in microslip dissipates ~A^3 (faster than the work ~A of the
     # forcing): growth can only be unbounded once the friction saturates
     laws = model.pack.laws
-    if laws and not A[-1] > config.SS_UNBOUNDED_Q * laws[0].fy / laws[0].kt:
+    if laws and not A[-1] > SS_UNBOUNDED_Q * laws[0].fy / laws[0].kt:
         return False
     return True
 
 
 def _long_period(h: _History, K: int, model, amp_rtol, energy_rtol) -> int:
     """Smallest multiple p in (SS_MAX_MULTIPLE, SS_DETECT_MULTIPLE] that repeats (0 if none)."""
-    for p in range(config.SS_MAX_MULTIPLE + 1, config.SS_DETECT_MULTIPLE + 1):
+    for p in range(SS_MAX_MULTIPLE + 1, SS_DETECT_MULTIPLE + 1):
         if h.size < K * p:
             break
         if _check_periodic(h, p, K, model, amp_rtol, energy_rtol) and not _one_period_decaying(h, K * p, model):
@@ -312,7 +365,7 @@ def _one_period_decaying(h: _History, m: int, model) -> bool:
     if h.size < 2 * m:
         return True
     d = _mismatches(h, 2 * m, model)
-    return d[m:].max() < config.SS_MULTIPLE_DECAY * d[:m].max()
+    return d[m:].max() < SS_MULTIPLE_DECAY * d[:m].max()
 
 
 def _mismatches(h: _History, count: int, model) -> np.ndarray:
@@ -329,11 +382,11 @@ def _stalled(h: _History, model) -> bool:
     Compares the largest mismatch over the last SS_STALL_PERIODS / 2 periods
     with that over the half before.
     """
-    m = config.SS_STALL_PERIODS // 2
+    m = SS_STALL_PERIODS // 2
     if h.size < 2 * m:
         return False
     d = _mismatches(h, 2 * m, model)
-    return d[m:].max() >= config.SS_STALL_RATIO * d[:m].max()
+    return d[m:].max() >= SS_STALL_RATIO * d[:m].max()
 
 
 def _contraction(h: _History, model):
@@ -367,7 +420,7 @@ def _section(model: Model, x, v, S, rdof, count):
     The section is at phase 0, or in the middle of a separation when every
     contact separates (law states reset there, so (x, v) is the whole state
     and the map is exact); at phase 0 the law states are first rebuilt from
-    the last period alone (``config.SS_SHOOT_CLEAN_STATE``).
+    the last period alone (``SS_SHOOT_CLEAN_STATE``).
     """
     ts = model.section_time()
     if ts > 0.0:
@@ -376,7 +429,7 @@ def _section(model: Model, x, v, S, rdof, count):
         if not res.status.ok:
             return None
         return x, v, S, model.segment_grid(ts, ts + model.period), ts
-    if config.SS_SHOOT_CLEAN_STATE and model.nc:
+    if SS_SHOOT_CLEAN_STATE and model.nc:
         cl = clean_states(model, x, v, S, rdof, count)
         if cl is None:
             return None
@@ -389,9 +442,9 @@ def _line_search(phi, z, dz, D, S1, rn):
     <= SS_SHOOT_MAXSTEP) whose residual is below ``rn``; None if none is."""
     lam = 1.0
     big = float(np.max(np.abs(dz)))
-    if big > config.SS_SHOOT_MAXSTEP:
-        lam = config.SS_SHOOT_MAXSTEP / big
-    for _ls in range(config.SS_SHOOT_HALVINGS):
+    if big > SS_SHOOT_MAXSTEP:
+        lam = SS_SHOOT_MAXSTEP / big
+    for _ls in range(SS_SHOOT_HALVINGS):
         zn = z + lam * dz * D
         zn1, Sn1, sn1 = phi(zn, S1)
         if zn1 is not None:
@@ -420,7 +473,7 @@ def _newton(model: Model, phi, z, S, tol, counters):
         return z, S, False, floq
     best = None  # (residual, z, S, first residual) in the fixed scale D0
     D0 = None
-    for _ in range(config.SS_SHOOT_MAXIT):
+    for _ in range(SS_SHOOT_MAXIT):
         A = 0.5 * (s1[S_XMAX] - s1[S_XMIN])
         xs = _amplitude_scale(model, max(A, np.max(np.abs(z[:n]))))
         D = np.concatenate([np.full(n, xs), np.full(n, xs * w)])
@@ -434,7 +487,7 @@ def _newton(model: Model, phi, z, S, tol, counters):
             return z, S, True, floq
         D = D0
         counters["shoot"] += 1
-        Jm = fd_monodromy(lambda zz: phi(zz, S)[0], z, D, config.SS_SHOOT_FD, z1)
+        Jm = fd_monodromy(lambda zz: phi(zz, S)[0], z, D, SS_SHOOT_FD, z1)
         if Jm is None:
             return z, S, False, floq
         floq = float(np.max(np.abs(np.linalg.eigvals(Jm))))
@@ -521,7 +574,7 @@ class _March:
         self.shots += 1
         xs_, vs_, Ss_, ok, self.floq = _shoot(model, self.x.copy(), self.v.copy(), self.S.copy(), rdof,
                                               0.1 * amp_rtol, self.counters)  # fmt: skip
-        if ok and not (self.floq > 1.0 + config.SS_FLOQUET_TOL):
+        if ok and not (self.floq > 1.0 + SS_FLOQUET_TOL):
             self.x, self.v, self.S = xs_, vs_, np.ascontiguousarray(Ss_)
             self.hist = _History(np.concatenate([self.x, self.v]))
             return True
@@ -531,7 +584,7 @@ class _March:
 def _period_multiple(hist, model, K, amp_rtol, energy_rtol) -> int:
     """Smallest p <= SS_MAX_MULTIPLE with which the history repeats (0 if none);
     a multiple p > 1 must not be a slowly alternating approach to period 1."""
-    for p in range(1, config.SS_MAX_MULTIPLE + 1):
+    for p in range(1, SS_MAX_MULTIPLE + 1):
         if _check_periodic(hist, p, K, model, amp_rtol, energy_rtol):
             if p > 1 and _one_period_decaying(hist, K * p, model):
                 continue
@@ -553,7 +606,7 @@ def _need_shoot(hist, model, growing, amp_rtol, chunk) -> bool:
     if rho >= 1.0:
         return hist.size >= 2 * chunk
     if dlast > target:
-        return math.log(target / dlast) / math.log(rho) > config.SS_SHOOT_AFTER
+        return math.log(target / dlast) / math.log(rho) > SS_SHOOT_AFTER
     return False
 
 
@@ -565,7 +618,7 @@ def _settle(model, st: _March, K, maxp, amp_rtol, energy_rtol, rdof, shooting):
     starts again. Returns (status or None when max_periods ran out, detail,
     p, the model in use).
     """
-    chunk = max(config.SS_CHUNK, K)
+    chunk = max(SS_CHUNK, K)
     while True:
         nrun = int(min(chunk, maxp - st.counters["periods"]))
         if nrun <= 0:
@@ -582,7 +635,7 @@ def _settle(model, st: _March, K, maxp, amp_rtol, energy_rtol, rdof, shooting):
         p_found = _period_multiple(st.hist, model, K, amp_rtol, energy_rtol)
         long_p = 0 if p_found else _long_period(st.hist, K, model, amp_rtol, energy_rtol)
         growing = False if (p_found or long_p) else _growing(st.hist, model, amp_rtol)
-        can_shoot = shooting and st.shots < config.SS_MAX_SHOTS
+        can_shoot = shooting and st.shots < SS_MAX_SHOTS
         # a multiple p > 1 may be a lightly damped transient whose free
         # frequency is commensurate with the forcing: first look for a
         # stable period-1 orbit by shooting (once per history)
@@ -647,7 +700,7 @@ def steady_state(
 
     Integrates M x'' + C x' + K x = f sin(w t) - sum_c B_c T_c(u_c, N_c(t))
     (docs/model.md section 6), w = gamma w0, until the response repeats with the
-    forcing period or a multiple p <= ``config.SS_MAX_MULTIPLE``: over the
+    forcing period or a multiple p <= ``SS_MAX_MULTIPLE``: over the
     last ``check_periods`` windows of p periods the half peak-to-peak
     amplitude of x[response_dof] and the period-boundary state agree within
     ``amp_rtol`` (relative to the amplitude) and the dissipated energy and
@@ -661,17 +714,17 @@ def steady_state(
     gamma : float
         w / w0 (> 0).
     steps_per_period : int, optional
-        Base RK4 steps per forcing period (default ``config.TI_STEPS_PER_PERIOD``).
+        Base RK4 steps per forcing period (default ``TI_STEPS_PER_PERIOD``).
     start : SteadyState or Restart, optional
         Warm start (state at a period boundary, e.g. the previous sweep
         point). Default: equivalent-linearisation estimate (stuck stiffness
         kt refined by the law's describing function).
     amp_rtol, energy_rtol : float, optional
-        Tolerances (defaults ``config.SS_AMP_RTOL``, ``config.SS_ENERGY_RTOL``).
+        Tolerances (defaults ``SS_AMP_RTOL``, ``SS_ENERGY_RTOL``).
     check_periods : int, optional
-        K, windows that must agree (default ``config.SS_CHECK_PERIODS``).
+        K, windows that must agree (default ``SS_CHECK_PERIODS``).
     max_periods : int, optional
-        Cap on integrated periods (default ``config.SS_MAX_PERIODS``).
+        Cap on integrated periods (default ``SS_MAX_PERIODS``).
     response_dof : int, optional
         DOF whose amplitude is reported (default: the system's response DOF,
         ``[output] dof`` of a system file, as :func:`jointdyn.frc_hb`,
@@ -690,12 +743,12 @@ def steady_state(
     if not isinstance(system, System):
         raise ValueError(f"system must be a System, got {type(system).__name__}")
     spp = V.positive_int(
-        "steps_per_period", config.TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period, 4
+        "steps_per_period", TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period, 4
     )
-    amp_rtol = V.positive("amp_rtol", config.SS_AMP_RTOL if amp_rtol is None else amp_rtol)
-    energy_rtol = V.positive("energy_rtol", config.SS_ENERGY_RTOL if energy_rtol is None else energy_rtol)
-    K = V.positive_int("check_periods", config.SS_CHECK_PERIODS if check_periods is None else check_periods, 2)
-    maxp = V.positive_int("max_periods", config.SS_MAX_PERIODS if max_periods is None else max_periods)
+    amp_rtol = V.positive("amp_rtol", SS_AMP_RTOL if amp_rtol is None else amp_rtol)
+    energy_rtol = V.positive("energy_rtol", SS_ENERGY_RTOL if energy_rtol is None else energy_rtol)
+    K = V.positive_int("check_periods", SS_CHECK_PERIODS if check_periods is None else check_periods, 2)
+    maxp = V.positive_int("max_periods", SS_MAX_PERIODS if max_periods is None else max_periods)
     rdof = V.positive_int("response_dof", system.response_dof if response_dof is None else response_dof, 0)
     if rdof >= system.ndof:
         raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {rdof}")
@@ -707,7 +760,7 @@ def steady_state(
     if status is None:
         # did not settle within max_periods: say why if we can
         status = SteadyStatus.NOT_SETTLED
-        stalled = st.hist.size >= config.SS_STALL_PERIODS and _stalled(st.hist, model)
+        stalled = st.hist.size >= SS_STALL_PERIODS and _stalled(st.hist, model)
         detail = "quasi-periodic-or-chaotic" if stalled else "slowly-converging"
     last = st.hist.summ[-1] if st.hist.size else None
     last_amp = 0.5 * (last[S_XMAX] - last[S_XMIN]) if last is not None else math.nan
@@ -737,7 +790,7 @@ def energy_check(work_force_J: float, energy_contact_J: float, energy_viscous_J:
     """Passivity of the contacts over a periodic orbit, from its energies per period (J).
 
     Flags ``energy_contact_J < -tol`` with ``tol = |W - E_contact -
-    E_viscous| + config.SS_DISSIPATION_FLOOR (|W| + |E_contact| +
+    E_viscous| + SS_DISSIPATION_FLOOR (|W| + |E_contact| +
     |E_viscous|)``: the period's energy-balance residual bounds the
     quadrature and transient error of the contact's integral, so a value
     beyond it is energy created by the contact law.
@@ -748,7 +801,7 @@ def energy_check(work_force_J: float, energy_contact_J: float, energy_viscous_J:
         ``PASSIVE`` or ``NEGATIVE_DISSIPATION``.
     """
     W, Ec, Ev = float(work_force_J), float(energy_contact_J), float(energy_viscous_J)
-    tol = abs(W - Ec - Ev) + config.SS_DISSIPATION_FLOOR * (abs(W) + abs(Ec) + abs(Ev))
+    tol = abs(W - Ec - Ev) + SS_DISSIPATION_FLOOR * (abs(W) + abs(Ec) + abs(Ev))
     return EnergyCheck.NEGATIVE_DISSIPATION if Ec < -tol else EnergyCheck.PASSIVE
 
 
@@ -772,14 +825,14 @@ def prepare_kernels(systems) -> None:
             continue
         seen.add((pack.runner, pack.init))
         try:
-            model = make_model(system, _omega(system, 1.0), config.TI_STEPS_PER_PERIOD)
+            model = make_model(system, _omega(system, 1.0), TI_STEPS_PER_PERIOD)
         except ValueError:
             continue
         x, v, S = _first_state(model, None)
         clean_states(model, x, v, S, 0, lambda res: None)
-        _periodic_arrays(np.empty((0, N_SUMMARY)), np.zeros((1, 2 * model.n)), 1, config.SS_CHECK_PERIODS, model.n,
-                         model.w, model.pack.K_stuck, model.pack.M, _amplitude_scale(model, 0.0), config.SS_AMP_RTOL,
-                         config.SS_ENERGY_RTOL, config.SS_BALANCE_RTOL)  # fmt: skip
+        _periodic_arrays(np.empty((0, N_SUMMARY)), np.zeros((1, 2 * model.n)), 1, SS_CHECK_PERIODS, model.n,
+                         model.w, model.pack.K_stuck, model.pack.M, _amplitude_scale(model, 0.0), SS_AMP_RTOL,
+                         SS_ENERGY_RTOL, SS_BALANCE_RTOL)  # fmt: skip
 
 
 def _first_state(model, start):

@@ -9,7 +9,7 @@
     the element has no initial gap: given to it, they would touch at zero
     load and clap in every cycle, so the model keeps their nodes as interior
     DOFs), and the plates' modal damping
-    (``config.LAP_ZETA``): (a) the first
+    (:data:`LAP_ZETA`): (a) the first
     bending mode's natural frequency and (b) its damping ratio against the
     first-harmonic amplitude of the output DOF (EPMC backbone,
     :func:`jointdyn.modes.epmc`); (c) the forced response near it to a force
@@ -20,7 +20,7 @@
     (d) and (e) maps of the patch at three amplitudes of the backbone: per
     pair the fraction of the period it slips (d) and the fraction it is open
     (e), with the energy the pairs dissipate per cycle above each column.
-    Settings: ``config.LAP_*``.
+    Settings: the ``LAP_*`` constants of this module.
 """
 
 from __future__ import annotations
@@ -30,13 +30,31 @@ import math
 import numpy as np
 import pandas as pd
 
-from .. import config
 from ._registry import pyplot, register_figure, save_figure
 
 __all__ = ["lap_joint_system", "lap_joint_data"]
 
+#: harmonics and AFT samples per period of its backbone. The reduced model has
+#: 733 DOFs, so an HB or EPMC Newton step solves 733 (2H + 1) unknowns with a dense LU: with
+#: H = 1 a backbone point costs about 1 s here. Against H = 3 (64 samples), H = 1 gives the first
+#: bending frequency within 0.1 % and its damping ratio within 2 % at the onset of slip (3e-5 m)
+#: and to three digits at the largest damping (3e-4 m) (docs/lap-joint.md)
+LAP_HARMONICS = 1
+LAP_SAMPLES = 32
+#: backbone range: first-harmonic amplitude of the output DOF, m (stuck below 4.5e-6 m)
+LAP_AMPLITUDE_M = (1e-6, 2e-3)
+#: largest arc-length step of the backbone (47 points over the range, most of them between 4.5e-6
+#: and 3e-4 m, where the pairs start to slip one after another)
+LAP_DS_MAX = 0.04
+#: amplitudes of the three slip maps, m: the onset of slip, the largest damping, deep slip
+LAP_SLIP_MAP_M = (3e-5, 3e-4, 1.5e-3)
+#: modal damping ratio of every mode of the plates (material damping)
+LAP_ZETA = 1e-3
+#: forced response (synthesised from the backbone): force amplitude at the output DOF, N
+LAP_FORCE_N = 30.0
 
-def lap_joint_system(force_n: float = config.LAP_FORCE_N, zeta: float = config.LAP_ZETA):
+
+def lap_joint_system(force_n: float = LAP_FORCE_N, zeta: float = LAP_ZETA):
     """``(system, lap_joint)``: the shipped lap joint (:func:`jointdyn.fe.lap_joint`) as a
     :class:`~jointdyn.systems.System`: its reduced M and K, modal damping ``zeta`` of every mode of the
     structure with its pairs stuck, one interface of its pairs (those loaded at rest: their kt, kn, mu and
@@ -100,13 +118,13 @@ def _frc_table(bb, system) -> pd.DataFrame:
                          "force_N": float(system.force[system.output_dof])})
 
 
-def lap_joint_data(harmonics=config.LAP_HARMONICS, samples=config.LAP_SAMPLES, amplitude=config.LAP_AMPLITUDE_M,
-                   maps=config.LAP_SLIP_MAP_M, force_n=config.LAP_FORCE_N):
+def lap_joint_data(harmonics=LAP_HARMONICS, samples=LAP_SAMPLES, amplitude=LAP_AMPLITUDE_M,
+                   maps=LAP_SLIP_MAP_M, force_n=LAP_FORCE_N):
     """The backbone, the forced response and the slip maps of the lap joint as three tables."""
     from ..modes import epmc
 
     system, lj = lap_joint_system(force_n)
-    bb = epmc(system, amplitude, harmonics=harmonics, samples=samples, ds_max=config.LAP_DS_MAX, progress=False)
+    bb = epmc(system, amplitude, harmonics=harmonics, samples=samples, ds_max=LAP_DS_MAX, progress=False)
     return {"backbone": _backbone_table(bb), "frc": _frc_table(bb, system), "slip": _slip_table(bb, maps, lj)}
 
 

@@ -54,6 +54,7 @@ import numpy as np
 
 from .. import config
 from ..continuation import (
+    START_EXTRAPOLATION,
     ContinuationOptions,
     ContinuationResult,
     ContinuationStatus,
@@ -433,7 +434,7 @@ def _homotopy(problem: HBProblem, gamma: float, tol: float):
     system, f1 = problem.system, problem.f1_ref
     opt = make_options(None, {"tol": tol})
     if opt.start_extrapolation is None and all(c.law.smooth_force for c in system.contacts):
-        opt = dataclasses.replace(opt, start_extrapolation=config.CONT_START_EXTRAPOLATION)
+        opt = dataclasses.replace(opt, start_extrapolation=START_EXTRAPOLATION)
     req = _Request(system=system, start=config.HB_HOMOTOPY_START * f1, stop=f1, parameter=F1, gamma=gamma,
                    max_step=None, dof=system.response_dof, options=opt, backward=False, progress=False,
                    condense=problem.condensed)

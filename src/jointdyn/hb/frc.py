@@ -18,7 +18,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ..continuation import ContinuationOptions, make_options
+from ..continuation import START_EXTRAPOLATION, ContinuationOptions, make_options
 from ..systems import System
 from .branch import _forcing_problem, _Request, solve_point
 from .discretisation import adaptive_branch
@@ -191,7 +191,7 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
     V.positive_int("max_points", opt.max_points, 2)
     if opt.start_extrapolation is None and all(c.law.smooth_force for c in system.contacts):
         # every force smooth at the onset of slip: the corrector starts from the branch's extrapolation
-        opt = dataclasses.replace(opt, start_extrapolation=config.CONT_START_EXTRAPOLATION)
+        opt = dataclasses.replace(opt, start_extrapolation=START_EXTRAPOLATION)
     if max_step is None and par is GAMMA:
         max_step = config.HB_MAX_GAMMA_STEP
     if max_step is not None:

@@ -62,12 +62,12 @@ def monodromy_multipliers(problem, X, p, *, steps_per_period: int | None = None,
     p : float
         Parameter value.
     steps_per_period : int, optional
-        RK4 base steps per period (default ``config.TI_STEPS_PER_PERIOD``;
+        RK4 base steps per period (default ``dynamics._model.TI_STEPS_PER_PERIOD``;
         events and reversals add steps).
     eps : float, optional
         Relative perturbation of positions (scaled by the amplitude) and
         velocities (scaled by w times the amplitude); default
-        ``config.MONODROMY_FD_STEP``.
+        ``dynamics.monodromy.MONODROMY_FD_STEP``.
     warm_periods, warm_samples : int, optional
         Periods of the HB displacement, and samples per period, marched
         through each contact law to obtain the contact state at the section

@@ -689,7 +689,7 @@ class HBProblem:
     def amplitudes(self, X, dof: int, p=None):
         """(half peak-to-peak, mean, max |x|) of x_dof(t), m.
 
-        Extrema located on ``config.HB_FINE_SAMPLES`` samples per period
+        Extrema located on ``fourier.HB_FINE_SAMPLES`` samples per period
         and refined by a parabola (:func:`jointdyn.fourier.extrema`). ``p``
         as in :meth:`dof_coefficients`.
         """

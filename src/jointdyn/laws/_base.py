@@ -125,6 +125,10 @@ __all__ = [
     "canonical_law_params",
 ]
 
+#: copies of a contact law's state a solver holds at once (trial and committed states, their
+#: forward-mode derivatives): a law whose state times this exceeds the bound is refused
+LAW_STATE_COPIES = 16
+
 #: part of the interface sticks while part slips (microslip); for a single
 #: Jenkins element: stuck
 STICK_SLIP = 0
@@ -279,7 +283,7 @@ class ContactLaw:
     #: True when the force has no jump and no kink at the onset of slip (a distribution of
     #: slip thresholds, as the exact Iwan law): harmonic balance then starts each Newton
     #: correction of its continuation from an extrapolation of the branch
-    #: (``config.CONT_START_EXTRAPOLATION``); False (the safe default of a new law) starts it
+    #: (``continuation.START_EXTRAPOLATION``); False (the safe default of a new law) starts it
     #: from the tangent prediction
     smooth_force: ClassVar[bool] = False
 
@@ -293,10 +297,10 @@ class ContactLaw:
         self._check_scales()
 
     def _check_state_size(self) -> None:
-        """The state, in the copies the solvers hold (``config.LAW_STATE_COPIES``),
+        """The state, in the copies the solvers hold (``LAW_STATE_COPIES``),
         fits the memory bound: ValueError naming the integer law parameter that
         sets its size (with the largest value that fits) otherwise."""
-        nbytes = 8.0 * self.state_size * config.LAW_STATE_COPIES
+        nbytes = 8.0 * self.state_size * LAW_STATE_COPIES
         budget = V.memory_budget()
         if nbytes <= budget:
             return
@@ -305,7 +309,7 @@ class ContactLaw:
                 v = getattr(self, p.name)
                 hi = max(int(p.low), int(v * budget // nbytes))
                 V.memory_fits(f"{p.name} = {v}", nbytes, hint=f"{p.name} must be at most {hi} "
-                              f"(a state of {self.state_size} numbers, {config.LAW_STATE_COPIES} copies)")
+                              f"(a state of {self.state_size} numbers, {LAW_STATE_COPIES} copies)")
         V.memory_fits(f"the state of {type(self).__name__} ({self.state_size} numbers)", nbytes)
 
     def _check_scales(self) -> None:

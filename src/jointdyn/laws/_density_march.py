@@ -37,6 +37,12 @@ from .._jit import jit
 __all__ = ["SNAP", "MIN_CAPACITY", "march_pieces", "clear_rows", "finish_state", "density_params",
            "pieces_error"]
 
+#: linear pieces kept by the exact Iwan law (``iwan``) after a step; beyond,
+#: three adjacent pieces are merged into two (results within 0.1 % of the
+#: converged limit, measured 3e-3 % at most on the Fig 6 grid:
+#: docs/exact-iwan.md)
+IWAN_CAPACITY = 32
+
 #: a cut of a piece by a clip line closer than this (units of u, the slip
 #: strength in fy; pieces live on [0, u_max]) to an end of the piece is dropped
 SNAP = 1e-9

@@ -76,10 +76,10 @@ from typing import ClassVar
 
 import numpy as np
 
-from .. import config
 from .._jit import jit
 from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, law_param, register
 from ._density_march import (
+    IWAN_CAPACITY,
     _END_HI,
     _HEAD,
     _M,
@@ -241,7 +241,7 @@ class Iwan(ContactLaw):
     """
 
     capacity: int = law_param(
-        config.IWAN_CAPACITY, low=MIN_CAPACITY,
+        IWAN_CAPACITY, low=MIN_CAPACITY,
         help="linear pieces kept after a step (above it, three adjacent pieces are merged into two)",
     )
     name: ClassVar[str] = "iwan"

@@ -48,11 +48,17 @@ from typing import ClassVar
 
 import numpy as np
 
-from .. import config
 from .._jit import jit
 from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, law_param, register
 
 __all__ = ["IwanClosedForm", "closed_step", "closed_step_jvp", "closed_init", "closed_init_jvp", "backbone"]
+
+#: capacity of the reversal-point stack of the closed-form Iwan law
+IWAN_CLOSED_MAX_DEPTH = 64
+#: a branch of the closed-form Iwan law closer than this to an earlier
+#: reversal point (normalised displacement kt x / fy) has reached it (Masing
+#: rejoin); the force error is of the same order in units of fy
+IWAN_CLOSED_WIPE_TOL = 1e-9
 
 # params: [kt, fy, n_ref, memory (0 full, 1 last), max_depth]
 # state : [q_prev, G_prev, a_prev, dir, base, base_q, base_a, m, base_G, (q_i, G_i, a_i) * max_depth]
@@ -66,7 +72,7 @@ _SAT_RTOL = 1e-12
 # reversal point has reached it: without it, rounding makes steady cycles
 # stop a hair short of their own earlier reversal points, and the stack
 # grows by one point every half cycle (memory of loops of size ~1e-16)
-_WIPE_TOL = config.IWAN_CLOSED_WIPE_TOL
+_WIPE_TOL = IWAN_CLOSED_WIPE_TOL
 
 
 @jit(inline="always")
@@ -488,7 +494,7 @@ class IwanClosedForm(ContactLaw):
         help="reversal memory: full (Masing's extended rules) or last (the paper's last-reversal rule)",
     )
     max_depth: int = law_param(
-        config.IWAN_CLOSED_MAX_DEPTH, low=2,
+        IWAN_CLOSED_MAX_DEPTH, low=2,
         help="capacity of the reversal-point stack (the innermost pair is forgotten when full)",
     )
     name: ClassVar[str] = "iwan-closed"

@@ -58,6 +58,7 @@ from .. import config
 from .._jit import jit
 from ._base import MACROSLIP, SEPARATION, STICK_SLIP, ContactLaw, law_param, register
 from ._density_march import (
+    IWAN_CAPACITY,
     _END_HI,
     _HEAD,
     _M,
@@ -89,6 +90,9 @@ from ._density_march import (
 
 __all__ = ["Segalman", "segalman_step", "segalman_step_jvp", "segalman_init", "segalman_init_jvp",
            "CHI_MIN", "CHI_MAX", "segalman_constants"]
+
+#: weight beta of the final delta of the ``segalman`` density when none is given
+SEGALMAN_BETA = 0.0
 
 #: smallest microslip exponent: the moments of u^chi lose about
 #: -log10(chi + 1) digits to cancellation as chi approaches -1
@@ -471,10 +475,10 @@ class Segalman(ContactLaw):
 
     chi: float = law_param(config.SEGALMAN_CHI, low=CHI_MIN, high=CHI_MAX,
                            help="microslip exponent: slip-displacement density R phi^chi (dissipation ~ A^(chi+3))")
-    beta: float = law_param(config.SEGALMAN_BETA, low=0.0,
+    beta: float = law_param(SEGALMAN_BETA, low=0.0,
                             help="weight of the delta of slip displacements at phi_max (0: none)")
     capacity: int = law_param(
-        config.IWAN_CAPACITY, low=MIN_CAPACITY,
+        IWAN_CAPACITY, low=MIN_CAPACITY,
         help="linear pieces kept after a step (above it, three adjacent pieces are merged into two)",
     )
     name: ClassVar[str] = "segalman"

@@ -29,13 +29,17 @@ from ..hb.levels import Discretisation
 
 __all__ = ["auto_backbone", "check_points", "level_changes"]
 
+#: points of an EPMC backbone (spread over it, plus its largest damping) where
+#: harmonics="auto" / samples="auto" check the discretisation (jointdyn.modes._auto)
+MODES_AUTO_CHECK_POINTS = 12
+
 
 def check_points(backbone) -> np.ndarray:
     """Indices of the points where a backbone's discretisation is checked:
-    ``config.MODES_AUTO_CHECK_POINTS`` spread evenly over its points, and
+    ``MODES_AUTO_CHECK_POINTS`` spread evenly over its points, and
     the point of largest damping ratio."""
     p = backbone.points
-    idx = np.round(np.linspace(0, p - 1, min(p, config.MODES_AUTO_CHECK_POINTS))).astype(int)
+    idx = np.round(np.linspace(0, p - 1, min(p, MODES_AUTO_CHECK_POINTS))).astype(int)
     zeta = np.where(np.isfinite(backbone.damping_ratio), backbone.damping_ratio, -np.inf)
     return np.unique(np.r_[idx, int(np.argmax(zeta))])
 

@@ -31,6 +31,12 @@ from ..systems import System
 __all__ = ["LinearMode", "check_free_vibration", "linear_stuck_mode", "output_dof_of", "amplitude_range",
            "contact_scale"]
 
+#: a DOF moves in a linear mode when |phi_dof| exceeds this fraction of max |phi|
+MODES_MIN_PARTICIPATION = 1e-8
+#: K (tangential contacts free) is positive definite for nonlinear modes when
+#: its smallest eigenvalue of (M, K) exceeds this fraction of the largest
+MODES_MIN_EIGENVALUE_RATIO = 1e-12
+
 
 @dataclass(frozen=True)
 class LinearMode:
@@ -113,11 +119,11 @@ def check_free_vibration(system, method: str, *, springs: bool = True) -> System
     from scipy.linalg import eigh
 
     lam = eigh(system.K_reference, system.M, eigvals_only=True)
-    if not lam[0] > config.MODES_MIN_EIGENVALUE_RATIO * abs(lam[-1]):
+    if not lam[0] > MODES_MIN_EIGENVALUE_RATIO * abs(lam[-1]):
         # a positive eigenvalue below the ratio is a stiffness too small beside the others, not a free DOF
         what = ("is ill-conditioned with the tangential contacts free: its smallest eigenvalue of (M, K), "
                 f"{lam[0]:.6g} (rad/s)^2, is {lam[0] / lam[-1]:.3g} of the largest, below the ratio "
-                f"{config.MODES_MIN_EIGENVALUE_RATIO:g} that double precision resolves (a normal stiffness kn many "
+                f"{MODES_MIN_EIGENVALUE_RATIO:g} that double precision resolves (a normal stiffness kn many "
                 "decades below the others?)" if lam[0] > 0.0 else
                 "must be positive definite with the tangential contacts free (smallest eigenvalue of (M, K) "
                 f"{lam[0]:.6g} (rad/s)^2)")
@@ -154,7 +160,7 @@ def linear_stuck_mode(system: System, mode: int, output_dof: int) -> LinearMode:
     lam, phi = eigh(Ks, system.M)
     v = phi[:, k - 1]
     big = float(np.max(np.abs(v)))
-    if not abs(v[output_dof]) > config.MODES_MIN_PARTICIPATION * big:
+    if not abs(v[output_dof]) > MODES_MIN_PARTICIPATION * big:
         raise ValueError(f"output_dof: DOF {output_dof} does not move in linear stuck mode {k} "
                          f"(|phi| = {abs(v[output_dof]):.3g} of {big:.3g}); choose a DOF that moves in it")
     if v[output_dof] < 0:

@@ -75,6 +75,20 @@ from .backbone import Backbone, ModeStatus
 
 __all__ = ["EPMCProblem", "epmc"]
 
+#: EPMC continuation in log10 of the amplitude (unknowns scaled by the
+#: amplitude, frequency and self-excitation by the linear frequency, residual
+#: by the stiffness times the amplitude): first and largest arc-length step
+#: (the largest bounds the spacing to 1/16 decade: at least 16 points per decade)
+MODES_DS_START = 0.02
+MODES_DS_MAX = 0.0625
+#: Newton tolerance of an EPMC point on that scaled residual; tight because
+#: the energy balance of a point (self-excitation against dissipation) holds
+#: to the residual relative to the damping ratio, which is small at small
+#: amplitudes
+MODES_TOL = 1e-12
+#: Newton iterations of the first EPMC point (from the linear stuck mode)
+MODES_START_MAX_ITER = 30
+
 _LN10 = math.log(10.0)
 
 
@@ -323,9 +337,9 @@ def _repeated_note(linear) -> str:
 
 
 def _options(options, overrides) -> ContinuationOptions:
-    """The step control of EPMC: modes defaults from config, then ``options``, then ``overrides``."""
+    """The step control of EPMC: the defaults of this module, then ``options``, then ``overrides``."""
     if options is None:
-        options = ContinuationOptions(ds=config.MODES_DS_START, ds_max=config.MODES_DS_MAX, tol=config.MODES_TOL)
+        options = ContinuationOptions(ds=MODES_DS_START, ds_max=MODES_DS_MAX, tol=MODES_TOL)
     return make_options(options, overrides)
 
 
@@ -415,8 +429,8 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         ripple).
     options : ContinuationOptions, optional
         Step control in the scaled unknowns (arc length in decades of
-        amplitude); default ``ds = config.MODES_DS_START``,
-        ``ds_max = config.MODES_DS_MAX``, ``tol = config.MODES_TOL``;
+        amplitude); default ``ds = MODES_DS_START``,
+        ``ds_max = MODES_DS_MAX``, ``tol = MODES_TOL``;
         keyword arguments override its fields (``ds_max``, ``max_points``,
         ``tol``, ...).
     progress : bool, optional
@@ -462,7 +476,7 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
 
 def _walked(problem: EPMCProblem, lam0, lam1, opt, progress, reduction) -> Backbone:
     """The backbone of :func:`epmc` from log10 amplitudes lam0 to lam1."""
-    v0, ok, _ = newton(problem.residual, problem.linear_guess(), lam0, opt, max_iter=config.MODES_START_MAX_ITER)
+    v0, ok, _ = newton(problem.residual, problem.linear_guess(), lam0, opt, max_iter=MODES_START_MAX_ITER)
     if not ok:
         return _backbone(problem, ModeStatus.NO_START, f"Newton did not converge at the smallest amplitude "
                          f"{10.0 ** lam0:.6g} m from linear stuck mode {problem.linear.index}"

@@ -45,6 +45,21 @@ from .backbone import Backbone, ModeStatus
 
 __all__ = ["qsma", "push_grid"]
 
+#: QSMA static push: steps per decade of the output-DOF displacement, and
+#: decades pushed below the smallest requested amplitude (the work integral
+#: starts at zero displacement)
+QSMA_STEPS_PER_DECADE = 40
+QSMA_DECADES_BELOW = 3
+#: push steps per backbone point: the work integrals use every step (their
+#: error at a kink of a law, e.g. the onset of slip of a Jenkins element,
+#: falls as the square of the step), the backbone reports every
+#: QSMA_SUBSTEPS-th
+QSMA_SUBSTEPS = 4
+#: QSMA equilibrium: Newton converged when max |residual| <= this times the
+#: largest elastic or applied force; iterations per step
+QSMA_TOL = 1e-12
+QSMA_MAX_ITER = 50
+
 
 def _push_template(grid, lin, con, ctl, out):  # pragma: no cover - compiled
     """Displacement-controlled static push through the contact laws; returns the points reached.
@@ -171,8 +186,8 @@ def _assemble(K, f, j, Bm, T, kT, x, alpha, a, A, r):  # pragma: no cover - comp
     return err / scale if scale > 0.0 else err
 
 
-def push_grid(lo: float, hi: float, steps_per_decade: int = config.QSMA_STEPS_PER_DECADE,
-              decades_below: int = config.QSMA_DECADES_BELOW, substeps: int = 1):
+def push_grid(lo: float, hi: float, steps_per_decade: int = QSMA_STEPS_PER_DECADE,
+              decades_below: int = QSMA_DECADES_BELOW, substeps: int = 1):
     """(grid, first): the push's displacements (m) and the index of ``lo`` in it.
 
     Geometric, from ``lo`` ``decades_below`` decades down to ``hi``, with
@@ -217,12 +232,12 @@ def _push(system, grid, out_dof, linear):
     f = np.ascontiguousarray(system.M @ linear.mass_normalised)
     kernel = specialize(_push_template, STEP_JVP=laws[0].step_jvp, INIT=laws[0].init)
     reached = kernel(grid, (K, f, int(out_dof)), (Bm, Pm, Nc, int(ssz)),
-                     (float(config.QSMA_TOL), int(config.QSMA_MAX_ITER)), (xs, als, Ts, kTs))
+                     (float(QSMA_TOL), int(QSMA_MAX_ITER)), (xs, als, Ts, kTs))
     return int(reached), xs, als, Ts, kTs, Bm
 
 
 def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None,
-         steps_per_decade: int = config.QSMA_STEPS_PER_DECADE) -> Backbone:
+         steps_per_decade: int = QSMA_STEPS_PER_DECADE) -> Backbone:
     """Backbone of a nonlinear mode by quasi-static modal analysis (module docstring).
 
     Parameters
@@ -241,7 +256,7 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         system's response DOF).
     steps_per_decade : int
         Backbone points per decade of amplitude; the push takes
-        ``config.QSMA_SUBSTEPS`` steps per point.
+        ``QSMA_SUBSTEPS`` steps per point.
 
     Returns
     -------
@@ -257,7 +272,7 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     out_dof = output_dof_of(system, output_dof)
     spd = V.positive_int("steps_per_decade", steps_per_decade, 1)
     linear = linear_stuck_mode(system, mode, out_dof)
-    sub = config.QSMA_SUBSTEPS
+    sub = QSMA_SUBSTEPS
     grid, first = push_grid(lo, hi, spd, substeps=sub)
     reached, xs, als, Ts, kTs, Bm = _push(system, grid, out_dof, linear)
     u = xs @ Bm.T
@@ -279,7 +294,7 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     status = ModeStatus.COMPLETE if ok else (ModeStatus.FAILED if x.shape[0] else ModeStatus.NO_START)
     message = ("pushed to the largest amplitude" if ok else
                f"the static equilibrium did not converge at {grid[reached]:.6g} m (Newton, "
-               f"{config.QSMA_MAX_ITER} iterations)")
+               f"{QSMA_MAX_ITER} iterations)")
     return Backbone(method="qsma", status=status, message=message, system=system, linear=linear,
                     output_dof=out_dof, harmonics=1, samples=0, amplitude_m=x[:, out_dof].copy(), omega_rad_s=w,
                     xi_rad_s=2.0 * (Dc + Dv) * w, damping_ratio=Dc + Dv, damping_ratio_contacts=Dc,

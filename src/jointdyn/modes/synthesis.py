@@ -19,7 +19,7 @@ the two flanks of the response curve at that amplitude. The response of
 the output DOF is then the backbone's amplitude itself. The flanks meet at
 the peak, where ``g = r^2 - xi^2 (omega^2 - xi^2 / 4)`` changes sign, at
 ``Omega^2 = omega^2 - xi^2 / 2``; it is located between two backbone
-points to ``config.SYNTHESIS_PEAK_RTOL`` in amplitude, by solving the EPMC
+points to ``SYNTHESIS_PEAK_RTOL`` in amplitude, by solving the EPMC
 at intermediate amplitudes (the QSMA backbone is interpolated instead).
 """
 
@@ -30,11 +30,14 @@ import math
 
 import numpy as np
 
-from .. import config
 from ..systems import System
 from .backbone import Backbone, ModeStatus
 
 __all__ = ["single_mode_frc", "modal_forcing"]
+
+#: single-nonlinear-mode synthesis: the resonance peak is located on the
+#: backbone to this relative tolerance in amplitude
+SYNTHESIS_PEAK_RTOL = 1e-10
 
 
 def _forcing_vector(system: System) -> np.ndarray:
@@ -96,7 +99,7 @@ def _refine(backbone: Backbone, system: System, i: int):
         return float(_gap(abs(psi.conj() @ F) / q2, w, xi))
 
     try:
-        lm = brentq(g_at, lam[0], lam[1], xtol=config.SYNTHESIS_PEAK_RTOL / math.log(10.0))
+        lm = brentq(g_at, lam[0], lam[1], xtol=SYNTHESIS_PEAK_RTOL / math.log(10.0))
         if lm not in found:
             g_at(lm)
     except ArithmeticError:  # Newton failed between the points: interpolate instead

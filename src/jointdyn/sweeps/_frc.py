@@ -20,7 +20,7 @@ next higher one, so that jumps and coexisting states of the nonlinear
 response show as a difference between the two directions. After an
 ``unbounded`` point the next one restarts from the solver's linear estimate.
 A line (one System, one direction) runs as consecutive chunks of
-``config.SWEEP_CHUNK_POINTS`` points, each continuing from the previous
+``SweepOptions.chunk_points`` points, each continuing from the previous
 chunk's last state; lines run side by side on a local process or thread
 pool or on a Dask cluster (``_pool.py``), and the result depends neither on
 where nor in which order they ran, nor on the chunking.
@@ -67,9 +67,11 @@ from ._points import (
     ChunkTask,
     empty_arrays,
 )
+from .options import SweepOptions
 
 __all__ = [
     "frc_sweep",
+    "SweepOptions",
     "LineSpec",
     "STATUS_CODES",
     "NOT_COMPUTED",
@@ -253,18 +255,18 @@ def _check_client(client) -> None:
         )
 
 
-def _executor(family, client, n_workers, nlines, on_point):
+def _executor(family, client, n_workers, nlines, on_point, opt: SweepOptions):
     from ._pool import DaskExecutor, LocalExecutor, SerialExecutor
 
     systems = tuple(s for _, _, s in family.entries)
     if client is not None:
-        return DaskExecutor(systems, client)
+        return DaskExecutor(systems, client, opt.tasks_per_worker)
     workers = default_workers() if n_workers is None else n_workers
     if workers <= 1 or nlines == 1:
         return SerialExecutor(systems, on_point=on_point)
-    if config.SWEEP_POOL == "process":
+    if opt.pool == "process":
         _prepare_kernels(systems)
-    return LocalExecutor(systems, min(workers, nlines), config.SWEEP_POOL)
+    return LocalExecutor(systems, min(workers, nlines), opt.pool, opt.tasks_per_worker)
 
 
 def _prepare_kernels(systems) -> None:
@@ -322,6 +324,7 @@ def frc_sweep(
     out=None,
     progress: bool = True,
     on_line=None,
+    options: SweepOptions | None = None,
 ):
     """Steady-state frequency response of a System, of labelled Systems, or of
     the paper damper on a grid of its groups.
@@ -392,6 +395,9 @@ def frc_sweep(
     on_line : callable, optional
         ``on_line(spec, computed)`` after each line is complete; ``computed``
         is False for a line loaded entirely from ``out``.
+    options : SweepOptions, optional
+        How the lines run (chunks, the local pool, the queue, the progress refresh; default
+        ``SweepOptions()``); none of it changes a result.
 
     Returns
     -------
@@ -432,7 +438,10 @@ def frc_sweep(
     if out is not None:  # before computing: no finished chunk is lost to an unwritable out
         V.output_dir("out", out, files=("frc.nc", "frc.csv"), subdirs=("lines",))
     runs = _line_runs(family, directions, g, spp, dofs, loop_outputs)
-    reused, stale = _run(runs, family, client, n_workers, out, progress, on_line)
+    opt = SweepOptions() if options is None else options
+    if not isinstance(opt, SweepOptions):
+        raise ValueError(f"options must be a SweepOptions, got {type(opt).__name__}")
+    reused, stale = _run(runs, family, client, n_workers, out, progress, on_line, opt)
     ds = _assemble(family, runs, directions, g, dofs, spp, loop_outputs)
     ds.attrs["reused_points"] = int(reused)
     ds.attrs["stale_points"] = int(stale)
@@ -456,7 +465,7 @@ def _resume(runs, line_root) -> tuple:
     return reused, stale
 
 
-def _run(runs, family, client, n_workers, out, progress, on_line) -> tuple:
+def _run(runs, family, client, n_workers, out, progress, on_line, opt: SweepOptions) -> tuple:
     """Resume, then compute the rest; returns (reused, stale) point counts."""
     from tqdm import tqdm
 
@@ -490,8 +499,8 @@ def _run(runs, family, client, n_workers, out, progress, on_line) -> tuple:
     todo = [r for r in runs if not r.finished]
     try:
         if todo:
-            executor = _executor(family, client, n_workers, len(todo), show)
-            run_chunks(runs, executor, config.SWEEP_CHUNK_POINTS, on_chunk, on_poll=show)
+            executor = _executor(family, client, n_workers, len(todo), show, opt)
+            run_chunks(runs, executor, opt.chunk_points, on_chunk, on_poll=show, poll_s=opt.progress_poll_s)
     finally:
         bar.close()
     return reused, stale

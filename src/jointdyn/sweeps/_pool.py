@@ -37,7 +37,6 @@ import queue
 import signal
 import threading
 
-from .. import config
 from ._points import Context, solve_chunk
 
 __all__ = ["SerialExecutor", "LocalExecutor", "DaskExecutor", "run_chunks", "die_with_parent", "detach_worker", "process_context"]
@@ -46,6 +45,9 @@ __all__ = ["SerialExecutor", "LocalExecutor", "DaskExecutor", "run_chunks", "die
 PR_SET_PDEATHSIG = 1
 #: exit status of a worker whose parent died
 EXIT_ORPHANED = 1
+#: seconds between checks of a worker process that its parent is alive (the fallback where the
+#: kernel's parent-death signal is not available)
+PARENT_POLL_S = 0.5
 
 #: Systems and context of this worker process (set by its initializer)
 _WORKER: tuple | None = None
@@ -64,7 +66,7 @@ def die_with_parent(parent_pid: int) -> None:
 
     Asks the kernel for SIGKILL at the parent's death (Linux prctl) and
     starts a daemon thread polling the parent pid every
-    ``config.SWEEP_PARENT_POLL_S`` seconds (any POSIX system). Exits at once
+    :data:`PARENT_POLL_S` seconds (any POSIX system). Exits at once
     if the parent is already gone.
     """
     try:
@@ -74,7 +76,7 @@ def die_with_parent(parent_pid: int) -> None:
         pass
     if os.getppid() != parent_pid:
         os._exit(EXIT_ORPHANED)
-    threading.Thread(target=_watch_parent, args=(parent_pid, config.SWEEP_PARENT_POLL_S), daemon=True,
+    threading.Thread(target=_watch_parent, args=(parent_pid, PARENT_POLL_S), daemon=True,
                      name="jointdyn-parent-watchdog").start()
 
 
@@ -174,14 +176,15 @@ class SerialExecutor:
 
 
 class LocalExecutor:
-    """A local pool of ``workers`` processes (``kind="process"``) or threads."""
+    """A local pool of ``workers`` processes (``kind="process"``) or threads, ``tasks_per_worker`` tasks
+    queued per worker (``SweepOptions.tasks_per_worker``)."""
 
-    def __init__(self, systems, workers: int, kind: str):
+    def __init__(self, systems, workers: int, kind: str, tasks_per_worker: int = 2):
         import concurrent.futures as cf
 
         self.systems = systems
         self.futures = set()
-        self.capacity = config.SWEEP_TASKS_PER_WORKER * workers
+        self.capacity = tasks_per_worker * workers
         self.threads = kind == "thread"
         if self.threads:
             self.ctx = Context(counter=_Counter())
@@ -232,9 +235,10 @@ class LocalExecutor:
 
 
 class DaskExecutor:
-    """Chunks on a Dask cluster through a connected ``distributed.Client``."""
+    """Chunks on a Dask cluster through a connected ``distributed.Client``, ``tasks_per_worker`` tasks
+    queued per worker thread (``SweepOptions.tasks_per_worker``)."""
 
-    def __init__(self, systems, client):
+    def __init__(self, systems, client, tasks_per_worker: int = 2):
         import uuid
 
         from distributed import Event
@@ -249,7 +253,7 @@ class DaskExecutor:
         self.done_points = 0  # points of the chunks returned
         self.logged_points = 0  # points the workers reported one by one
         client.subscribe_topic(self.ctx.counter.topic, self._on_points)
-        self.capacity = config.SWEEP_TASKS_PER_WORKER * max(1, sum(client.nthreads().values()))
+        self.capacity = tasks_per_worker * max(1, sum(client.nthreads().values()))
 
     def submit(self, task) -> None:
         """Start a chunk on the cluster."""
@@ -297,16 +301,17 @@ class DaskExecutor:
             self.client.unsubscribe_topic(self.ctx.counter.topic)
 
 
-def _drain(executor, lines, on_chunk) -> None:
-    """After a stop request: collect the chunks still running (partial ones included)."""
+def _drain(executor, lines, on_chunk, poll_s: float) -> None:
+    """After a stop request: collect the chunks still running (partial ones included), waiting ``poll_s``
+    seconds at a time."""
     while executor.pending():
-        res = executor.next_result(config.SWEEP_PROGRESS_POLL_S)
+        res = executor.next_result(poll_s)
         if res is not None:
             lines[res.line].accept(res)
             on_chunk(lines[res.line], res)
 
 
-def run_chunks(lines, executor, chunk_points: int, on_chunk, on_poll=None) -> None:
+def run_chunks(lines, executor, chunk_points: int, on_chunk, on_poll=None, poll_s: float = 0.2) -> None:
     """Run every line's remaining points on ``executor``, chunk by chunk.
 
     Parameters
@@ -321,8 +326,10 @@ def run_chunks(lines, executor, chunk_points: int, on_chunk, on_poll=None) -> No
     on_chunk : callable
         ``on_chunk(line, result)`` after each chunk is back (saves it).
     on_poll : callable, optional
-        Called while waiting (every ``config.SWEEP_PROGRESS_POLL_S`` s) and
+        Called while waiting (every ``poll_s`` seconds) and
         after each chunk (progress).
+    poll_s : float
+        Seconds between those calls while chunks run (``SweepOptions.progress_poll_s``).
 
     Raises
     ------
@@ -338,7 +345,7 @@ def run_chunks(lines, executor, chunk_points: int, on_chunk, on_poll=None) -> No
         while waiting or executor.pending():
             while waiting and executor.pending() < executor.capacity:
                 executor.submit(waiting.popleft().next_task(chunk_points))
-            res = executor.next_result(config.SWEEP_PROGRESS_POLL_S)
+            res = executor.next_result(poll_s)
             if on_poll is not None:
                 on_poll()
             if res is None:
@@ -352,13 +359,13 @@ def run_chunks(lines, executor, chunk_points: int, on_chunk, on_poll=None) -> No
                 waiting.appendleft(line)
     except KeyboardInterrupt:
         executor.request_stop()
-        _drain(executor, lines, on_chunk)
+        _drain(executor, lines, on_chunk, poll_s)
         raise
     except Exception:
         # a chunk failed (a solver's refusal of a System): keep what the others finish, report the first error
         executor.request_stop()
         with contextlib.suppress(Exception):
-            _drain(executor, lines, on_chunk)
+            _drain(executor, lines, on_chunk, poll_s)
         raise
     finally:
         executor.close()
