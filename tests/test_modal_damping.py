@@ -171,8 +171,7 @@ def test_large_solve_falls_back_to_the_dense_solve(monkeypatch):
     rng = np.random.default_rng(5)
     ev = q.evaluate_sparse(1e-4 * rng.standard_normal(q.size), 1.0)
     d, b = rng.standard_normal(q.size + 1), rng.standard_normal(q.size + 1)
-    monkeypatch.setattr(config, "CONT_KRYLOV_RTOL", 0.0)
-    fr = FactorReuse()
+    fr = FactorReuse(linear=LinearSolveOptions(krylov_rtol=1e-300))  # a tolerance nobody reaches
     x, ok = fr.solve(ev.JX, ev.Jp, d, b)
     assert ok and fr.counts["approximation_fallbacks"] == 1
     np.testing.assert_array_equal(x, np.linalg.solve(_bordered(ev.JX.toarray(), ev.Jp, d), b))
