@@ -150,6 +150,7 @@ class StageProgress:
         else:
             self.plain = True
             self._said = False
+            self._next = self._step()
 
     def _step(self) -> int:
         return self.done + max(1, -(-self.total // self.LINES))

@@ -28,7 +28,7 @@ class StabilityOptions:
         Largest companion matrix (2 n (2H+1) rows, n the DOFs of the full
         structure) for which ``auto`` takes the dense method. Measured on the
         scalar-contact chain of ``benchmarks/bench_hb_stability.py`` (one BLAS
-        thread, a 2-core machine at a load of 5): one point took 0.08-0.12 s
+        thread, a 2-core machine at a load of 5): one point took 0.08-0.09 s
         dense against 0.06-0.09 s by Arnoldi at 420 rows, 0.12-0.17 s against
         0.09-0.16 s at 504 rows, 0.16-0.37 s against 0.09-0.18 s at 588 rows
         and 0.01-0.02 s against 0.09-0.13 s at 294 rows (the compiled dense
