@@ -179,7 +179,7 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
                 growth[i] = _arnoldi_growth(problem, ev.JX, ws[i], tr.stability)
                 bar.update(1)
             elif dense:
-                JXs[i % chunk] = ev.JX
+                JXs[i % chunk] = ev.JX if isinstance(ev.JX, np.ndarray) else ev.JX.toarray()  # kept sparse
                 if i % chunk == chunk - 1 or i == n - 1:
                     lo = i - i % chunk
                     growth[lo:i + 1] = _dense_growth(problem, JXs[:i + 1 - lo], ws[lo:i + 1])
