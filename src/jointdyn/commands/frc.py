@@ -94,7 +94,7 @@ def add_arguments(p) -> None:
     p.add_argument("--samples", default=None, metavar="NS|auto",
                    help=f"hb: time samples per period, or auto (default: from {config.HB_SAMPLES}, doubled while a "
                         f"peak changes by more than {100 * config.HB_AUTO_RTOL:g} %% with twice as many)")
-    p.add_argument("--no-stability", action="store_true",
+    p.add_argument("--no-stability", action="store_true", default=None,
                    help="hb: do not compute the stability of the points (stable false, growth NaN, the "
                         "Dataset's stability attribute not-computed); by default dense Hill on small "
                         "problems, shift-invert Arnoldi on large ones")
@@ -156,7 +156,7 @@ _TIME_ONLY = {
     "scheduler": "the continuation is one sequential path",
     "workers": "the continuation is one sequential path",
 }
-_HB_ONLY = ("harmonics", "samples")
+_HB_ONLY = ("harmonics", "samples", "no_stability")
 
 
 def _option(dest: str) -> str:
@@ -532,6 +532,7 @@ def _run_hb(args, gammas):
     result["status"] = br.status.value
     result["message"] = br.message
     result["uncovered"] = [[float(a), float(b)] for a, b in br.uncovered]
+    result["stability"] = br.stability  # hill, hill-arnoldi, or not-computed (--no-stability)
     return br, result
 
 

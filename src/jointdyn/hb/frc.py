@@ -19,6 +19,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
+from .._threads import blas_threads
 from ..continuation import ContinuationOptions, make_options
 from ..systems import System
 from .branch import _forcing_problem, _Request, solve_point
@@ -337,7 +338,8 @@ def _point_stability(problem: HBProblem, JX, w: float, opts: StabilityOptions):
     s = problem.system
     if method == "dense":
         return hill_stability(np.asarray(J), s.M, s.C, w, problem.H)
-    found = hill_arnoldi_exponents(J, s.M, s.C, w, problem.H, opts)
+    with blas_threads():  # ARPACK's BLAS-2 work: 2 OpenBLAS threads on 2 busy cores are slower than one
+        found = hill_arnoldi_exponents(J, s.M, s.C, w, problem.H, opts)
     return found.growth <= config.HB_STABILITY_RTOL, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
 
 
