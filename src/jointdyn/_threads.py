@@ -6,7 +6,8 @@ spinning between calls; where they outnumber the cores the process may use
 each start their own, or where other processes already keep the cores busy,
 the threads wait for one another. One ``numpy.linalg.eigvals`` of Hill's
 companion matrix of 1722 rows took 67.8 s with OpenBLAS's default 2 threads
-and 8.4 s with one thread on a 2-core machine at a load of 8.7
+and 8.4 s with one thread on a 2-core machine at a load of 8.7 (16.5 s
+and 4.0 s at a load of 5.4)
 (``benchmarks/bench_hb_stability.py``, ``eigvals_threads``).
 
 :func:`blas_threads` limits the threads of the BLAS libraries loaded in this

@@ -27,12 +27,14 @@ class StabilityOptions:
     dense_max_rows : int
         Largest companion matrix (2 n (2H+1) rows, n the DOFs of the full
         structure) for which ``auto`` takes the dense method. Measured on the
-        scalar-contact chain of ``benchmarks/bench_hb_stability.py`` (one BLAS
-        thread, a 2-core machine at a load of 5): one point took 0.08-0.09 s
-        dense against 0.06-0.09 s by Arnoldi at 420 rows, 0.12-0.17 s against
-        0.09-0.16 s at 504 rows, 0.16-0.37 s against 0.09-0.18 s at 588 rows
-        and 0.01-0.02 s against 0.09-0.13 s at 294 rows (the compiled dense
-        path).
+        scalar-contact chain of ``benchmarks/bench_hb_stability.py`` (H = 3,
+        one BLAS thread, a 2-core machine at a load of 4-5) per point: with
+        Q(sigma) factorised as a dense matrix (a dense Jacobian), dense Hill
+        and Arnoldi took about the same at 420-504 rows (0.06-0.17 s both)
+        and dense was 1.8-2x slower at 588 rows; with the chain's sparse
+        Jacobian (SuperLU), dense Hill was 17x faster at 294 rows (0.012
+        against 0.208 s, its compiled path) and 3.4x slower at 588 rows
+        (0.094 against 0.028 s), 12x at 1722 and 42x at 4410 rows.
     arnoldi_shifts : int
         Shifts on the imaginary axis between 0 and i w/2, both included
         (>= 2); more shifts cover a wider band about the axis with the same
