@@ -16,11 +16,13 @@ with::
 so each product is one solve with Q(sigma), a matrix of the HB Jacobian's
 size and structure (the linear terms D1 = I (x) C + 2 w nabla (x) M and
 D2 = I (x) M couple the cosine and sine of one harmonic only), factorised
-once per shift: dense LU (LAPACK ``getrf``) for a dense Jacobian, sparse LU
-(SuperLU) for a sparse one, one kept as harmonic blocks plus the pairs'
-sparse part (:class:`~jointdyn.hb._jacobian.HarmonicJacobian`), or a dense
-array with at most ``StabilityOptions.arnoldi_sparse_density`` of its
-entries nonzero (a structure coupled locally: a chain, a mesh).
+once per shift: sparse LU (SuperLU) where at most
+``StabilityOptions.arnoldi_sparse_density`` of its entries are nonzero (a
+structure coupled locally: a chain, a mesh), whether the Jacobian is a dense
+array, a sparse matrix or kept as harmonic blocks plus the pairs' sparse part
+(:class:`~jointdyn.hb._jacobian.HarmonicJacobian`), else dense LU (LAPACK
+``getrf``: a reduced model dense on its interface, where SuperLU's fill
+costs more).
 
 Shifts sigma_j = i j w / (2 m), j = 0..m (``StabilityOptions.arnoldi_shifts``
 = m + 1), lie on the imaginary axis between 0 and i w / 2: the strip
@@ -103,6 +105,15 @@ def _as_sparse(JX):
     return sp.csr_matrix(JX)
 
 
+def _nonzeros(JX) -> int:
+    """Nonzero entries of JX (a HarmonicJacobian: its dense blocks and the pairs' part, an upper bound)."""
+    if isinstance(JX, np.ndarray):
+        return int(np.count_nonzero(JX))
+    if getattr(JX, "structured", False) is True:
+        return sum(B.size for B in JX.blocks) + int(JX.rest.nnz) + JX.shape[0] * len(JX.columns)
+    return int(JX.nnz)
+
+
 class _ShiftInvert:
     """``v -> (A - sigma I)^-1 v`` through one factorisation of Q(sigma) (module docstring)."""
 
@@ -111,10 +122,11 @@ class _ShiftInvert:
         self.N = D2.shape[0]
         dtype = np.complex128 if isinstance(sigma, complex) else np.float64
         self.dtype = dtype
-        if isinstance(JX, np.ndarray) and np.count_nonzero(JX) > sparse_density * JX.size:
+        if _nonzeros(JX) > sparse_density * self.N * self.N:
             import scipy.linalg as sla
 
-            Q = JX.astype(dtype) + sigma * D1.toarray() + (sigma * sigma) * D2.toarray()
+            J = JX if isinstance(JX, np.ndarray) else JX.toarray()
+            Q = J.astype(dtype) + sigma * D1.toarray() + (sigma * sigma) * D2.toarray()
             with warnings.catch_warnings():  # a zero pivot is reported below, as a singular sparse LU is
                 warnings.simplefilter("ignore", sla.LinAlgWarning)
                 lu = sla.lu_factor(Q, check_finite=True)

@@ -42,8 +42,9 @@ class StabilityOptions:
     arnoldi_eigenvalues : int
         Eigenvalues computed nearest each shift (>= 1).
     arnoldi_sparse_density : float
-        A dense Jacobian with at most this fraction of nonzero entries is
-        factorised as a sparse matrix (SuperLU) at each shift, in (0, 1].
+        A Jacobian (dense, sparse or by harmonic blocks) with at most this
+        fraction of nonzero entries is factorised as a sparse matrix
+        (SuperLU) at each shift, a denser one by LAPACK; in (0, 1].
     arnoldi_tol : float
         Relative accuracy of ARPACK's Ritz values (of (A - sigma)^-1; 0:
         machine precision), > 0.
