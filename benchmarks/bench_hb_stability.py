@@ -16,6 +16,11 @@ Hill's companion matrix, 2 n (2H + 1).
   method ran at before) and 4410 rows;
 - ``beyond``: Arnoldi alone on a chain beyond 4000 rows (quick: 4410, full:
   also 8400);
+- ``lap_joint`` (full only): a reduced model dense on its interface, the
+  lap joint of ``bench_hb_scale.py`` (733 DOFs, 120 pairs) solved at 760 Hz
+  with H = 1 (4398 companion rows), its Jacobian by harmonic blocks:
+  Arnoldi, and dense Hill on the same Jacobian, with the BLAS threads of
+  :func:`jointdyn._threads.blas_threads`;
 - ``eigvals_threads``: one ``numpy.linalg.eigvals`` of the dense companion
   matrix of 1722 rows with BLAS's default threads and with one thread
   (``threadpoolctl``), alternated.
@@ -89,6 +94,29 @@ def _beyond(nodes: int) -> dict:
             "exponents_found": int(a.exponents.size), "band_over_w": a.band / w}
 
 
+def _lap() -> dict:
+    import math
+
+    from bench_hb_scale import _system
+
+    from jointdyn._threads import blas_threads
+    from jointdyn.hb import harmonic_balance, hill_arnoldi_exponents, hill_exponents
+
+    s = _system()
+    sol = harmonic_balance(s, 2.0 * math.pi * 760.0 / s.w0, harmonics=1, samples=32, stability=False, condense=False)
+    p = sol.problem
+    w = p.omega(p.f1_ref)
+    JX = p.evaluate_blocks(sol.X, p.f1_ref).JX
+    with blas_threads():
+        a, ta = _best(lambda: hill_arnoldi_exponents(JX, s.M, s.C, w, p.H), 1)
+        (sel, lam), td = _best(lambda: hill_exponents(JX.toarray(), s.M, s.C, w, p.H), 1)
+    return {"rows": 2 * p.size, "solved": bool(sol.status.ok), "arnoldi_s": ta, "dense_s": td,
+            "growth_arnoldi": a.growth, "top_arnoldi_1_s": [a.exponents[0].real, a.exponents[0].imag],
+            "growth_dense": float(sel[0].real) / w, "top_dense_1_s": [float(sel[0].real), float(sel[0].imag)],
+            "max_exponent_diff_over_w": max(float(np.min(np.abs(lam - z))) for z in a.exponents) / w,
+            "w_rad_s": w, "load_1min": os.getloadavg()[0]}
+
+
 def _threads(nodes: int = 41) -> dict:
     from threadpoolctl import threadpool_info, threadpool_limits
 
@@ -109,7 +137,8 @@ def _threads(nodes: int = 41) -> dict:
 
 def run(quick: bool) -> dict:
     sizes = (7, 14, 29, 41) if quick else (7, 14, 29, 41, 95, 105)
-    return {"model": "scalar-contact chain (bench_hb_interface_chain, pairs=False), gamma 1, H = 3, 32 samples",
+    lap = {} if quick else {"lap_joint": _lap()}
+    return {**lap, "model": "scalar-contact chain (bench_hb_interface_chain, pairs=False), gamma 1, H = 3, 32 samples",
             "load_1min": os.getloadavg()[0],
             "dense_vs_arnoldi": [_compare(k) for k in sizes],
             "beyond": [_beyond(k) for k in ((105,) if quick else (105, 200))],
