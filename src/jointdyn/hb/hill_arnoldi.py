@@ -26,21 +26,25 @@ costs more).
 
 Shifts sigma_j = i j w / (2 m), j = 0..m (``StabilityOptions.arnoldi_shifts``
 = m + 1), lie on the imaginary axis between 0 and i w / 2: the strip
-|Im s| <= w/2 where Hill's selection takes one representative of each
-family s + i k w (the upper half suffices: the spectrum of the real A is
-symmetric about the real axis). At each shift the ``arnoldi_eigenvalues``
-eigenvalues nearest it are computed; every eigenvalue within the radius r_j
-of the farthest of them is among those found (Arnoldi converged), so the
-union of the disks covers the band ``|Re s| <= d`` along the strip with
-``d = sqrt(min_j r_j^2 - (w / 4 m)^2)`` (the half-distance between shifts;
-0 when the disks do not overlap: the band is not covered). The exponents
-are those found with |Im s| <= w/2 (Hill's selection, the conjugates
-added, copies of one exponent found from two shifts counted once); the
-growth is the largest real part among them. An exponent farther than d
-from the imaginary axis with a larger real part is not seen: the result
-says d (``band``), and a branch whose exponents are all near the axis (the
-folds and Neimark-Sacker points where stability changes have Re s = 0) is
-labelled as the dense method labels it (tests/test_hb_hill_arnoldi.py).
+|Im s| <= w/2 where each family s + i k w has its representative when its
+members are resolved (the upper half suffices: the spectrum of the real A
+is symmetric about the real axis). At each shift the ``arnoldi_eigenvalues``
+eigenvalues nearest it are computed; every eigenvalue within the distance
+r_j of the farthest of them is among those found (Arnoldi converged), so
+the union of the disks covers the band ``|Re s| <= d`` along the strip with
+``d = sqrt(min_j r_j^2 - h^2)``, h the farthest a point of the axis between
+0 and i w/2 lies from a shift (0 when the disks do not overlap: the band is
+not covered). A shift that falls on an eigenvalue (Q exactly singular) is
+moved by 1e-3 w. Hill's selection is applied to what was found: the
+conjugates added, copies found from two shifts counted once, and where more
+than 2n were found the 2n with the smallest |Im s| (the dense method's
+rule, which also keeps the members of families with no member in the strip:
+modes above (H + 1/2) w); the growth is the largest real part among them.
+An exponent farther than d from the imaginary axis with a larger real part
+is not seen: the result says d (``band``), and a branch whose exponents of
+largest real part are near the axis (the folds and Neimark-Sacker points
+where stability changes have Re s = 0) is labelled as the dense method
+labels it (tests/test_hb_hill_arnoldi.py).
 """
 
 from __future__ import annotations
