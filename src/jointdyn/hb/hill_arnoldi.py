@@ -68,7 +68,8 @@ class ArnoldiExponents:
     Attributes
     ----------
     exponents : ndarray complex
-        Exponents s (1/s) with |Im s| <= w/2, by decreasing real part.
+        Exponents s (1/s) found nearest the axis between -i w/2 and i w/2,
+        after Hill's selection (module docstring), by decreasing real part.
     band : float
         Half-width d (1/s) of the band about the imaginary axis (between
         -i w/2 and i w/2) in which every exponent has been found; 0 where the
@@ -206,7 +207,7 @@ def hill_arnoldi_exponents(JX, M, C, w, H, options: StabilityOptions | None = No
     Returns
     -------
     ArnoldiExponents
-        The exponents found in the strip |Im s| <= w/2, the band covered and the growth.
+        The exponents found (after Hill's selection), the band covered and the growth.
 
     Raises
     ------
