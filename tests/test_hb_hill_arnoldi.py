@@ -138,3 +138,20 @@ def test_time_integration_confirms_an_unstable_and_a_stable_point_beyond_the_den
         assert abs(mu_mono - mu_hill) < 1e-2
         mono[i] = mu_mono
     assert mono[worst] > 1.0 + 2e-3 and mono[calm] < 1.0
+
+
+def test_modal_damping_as_an_operator_gives_the_exponents_of_its_dense_matrix():
+    """A System whose C is a ModalDamping operator: Arnoldi (on the operator's system) equals dense Hill on the
+    dense C, at every point of a branch."""
+    import jointdyn as jd
+
+    s = _damper_with_a_chain(5)
+    op = jd.modal_damping(s.M, s.K, 0.01, form="operator")
+    so = jd.System(M=s.M, C=op, K=s.K, contacts=s.contacts, force=s.force)
+    br = continue_hb(so, 1.1, 1.3, harmonics=5, samples=64, stability=ARNOLDI, progress=False)
+    assert br.status.ok and br.stability == "hill-arnoldi"
+    p = br.problem
+    for i in range(0, br.lam.size, max(1, br.lam.size // 8)):
+        w = p.omega(br.lam[i])
+        sel, _ = hill_exponents(p.evaluate(br.X[i], br.lam[i]).JX, s.M, op.toarray(), w, p.H)
+        assert abs(br.growth[i] - sel[0].real / w) <= EXPONENT_ATOL

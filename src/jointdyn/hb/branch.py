@@ -69,7 +69,7 @@ from ..continuation import (
     refine_maximum,
     turning_points,
 )
-from ..damping import has_damping
+from ..damping import dense_damping, has_damping
 from ..fourier import derivative_matrix
 from ..laws import MACROSLIP, SEPARATION
 from ..systems import System
@@ -209,12 +209,12 @@ def _dense_growth(problem: HBProblem, JXs, ws):
     """max Re(s) / w by dense Hill (:func:`~jointdyn.hb.stability.hill_growth`) of the points ``JXs``."""
     if problem.condensed:
         JXs = np.array([problem.full_jacobian(J, w) for J, w in zip(JXs, ws)])
-    return hill_growth(JXs, problem.system.M, problem.system.C, ws, problem.H)
+    return hill_growth(JXs, problem.system.M, dense_damping(problem.system.C), ws, problem.H)
 
 
 def _arnoldi_growth(problem: HBProblem, JX, w, options) -> float:
     """max Re(s) / w of the exponents nearest the imaginary axis (:mod:`jointdyn.hb.hill_arnoldi`) of a point."""
-    return hill_arnoldi_exponents(_full_jacobian(problem, JX, w), problem.system.M, problem.system.C, w,
+    return hill_arnoldi_exponents(_full_jacobian(problem, JX, w), problem.system.M, dense_damping(problem.system.C), w,
                                   problem.H, options).growth
 
 

@@ -21,6 +21,7 @@ from .. import _validate as V
 from .. import config
 from .._threads import blas_threads
 from ..continuation import ContinuationOptions, make_options
+from ..damping import dense_damping
 from ..systems import System
 from .branch import _forcing_problem, _Request, solve_point
 from .discretisation import adaptive_branch
@@ -337,9 +338,9 @@ def _point_stability(problem: HBProblem, JX, w: float, opts: StabilityOptions):
     J = problem.full_jacobian(JX, w) if problem.condensed else JX
     s = problem.system
     if method == "dense":
-        return hill_stability(np.asarray(J), s.M, s.C, w, problem.H)
+        return hill_stability(np.asarray(J), s.M, dense_damping(s.C), w, problem.H)
     with blas_threads():  # ARPACK's BLAS-2 work: 2 OpenBLAS threads on 2 busy cores are slower than one
-        found = hill_arnoldi_exponents(J, s.M, s.C, w, problem.H, opts)
+        found = hill_arnoldi_exponents(J, s.M, dense_damping(s.C), w, problem.H, opts)
     return found.growth <= config.HB_STABILITY_RTOL, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
 
 
