@@ -43,7 +43,7 @@ LAYERS = {
     "cli": 5, "commands": 5, "figures": 5, "__main__": 5,
 }
 #: helpers outside the layers, importable from anywhere
-UTILITIES = {"config", "status", "_jit", "_cache", "_validate", "_io", "_exit"}
+UTILITIES = {"config", "status", "_jit", "_cache", "_validate", "_io", "_exit", "_threads"}
 
 
 def _modules():

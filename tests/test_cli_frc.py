@@ -117,6 +117,20 @@ def test_hb_json_and_files(capsys, tmp_path):
         assert (tmp_path / name).stat().st_size > 0
 
 
+def test_hb_no_stability_is_said_and_only_then(capsys):
+    args = ["frc", "--method", "hb", "--gamma", "1.1:1.3:0.1", "--eta", "0.5", "--beta", "2", "--harmonics", "3",
+            "--samples", "32", "--json"]
+    out = {}
+    for extra in ([], ["--no-stability"]):
+        assert main(args + extra) == 0
+        out[bool(extra)] = json.loads(capsys.readouterr().out)
+    assert out[False]["stability"] == "hill" and any(s for b in out[False]["branches"] for s in b["stable"])
+    assert out[True]["stability"] == "not-computed"
+    assert not any(s for b in out[True]["branches"] for s in b["stable"])
+    assert main(["frc", "--method", "time", "--gamma", "0.9:1.1:0.1", "--no-stability", "--json"]) == 2
+    assert "--no-stability applies to --method hb only" in capsys.readouterr().err
+
+
 def test_scheduler_address(fake, capsys):
     from distributed import LocalCluster
 

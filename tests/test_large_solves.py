@@ -255,13 +255,22 @@ def test_hb_branch_with_reused_factors_has_the_same_peak(monkeypatch, path):
     assert pb == pytest.approx(pa, rel=1e-6)
 
 
-def test_hill_is_not_computed_beyond_its_size_and_the_branch_says_so(monkeypatch):
-    from jointdyn.hb import branch_dataset, continue_hb
+def test_stability_beyond_the_dense_size_is_computed_and_not_computed_only_when_asked(monkeypatch):
+    """Beyond the size of the dense Jacobian (lowered here) the branch's stability is computed by Arnoldi on
+    the Jacobians the continuation used, as dense Hill computes it; ``stability=False`` alone gives none."""
+    from jointdyn.hb import StabilityOptions, branch_dataset, continue_hb, hill_stability
 
     s = _chain(2)
+    kw = dict(harmonics=2, samples=32, condense=False)
     monkeypatch.setattr(config, "HB_HILL_MAX_ROWS", 2 * 6 * 5 - 1)  # 2 n (2H+1) rows with n = 6, H = 2
-    br = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False)
-    assert br.status.ok and br.lam.size > 5
-    assert np.all(np.isnan(br.growth)) and not np.any(br.stable)
-    assert branch_dataset(br).attrs["stability"] == "not-computed"
-    assert not br.problem.hill_stability(np.eye(br.problem.size), 1.0)[0]
+    br = continue_hb(s, 0.8, 1.2, stability=StabilityOptions(method="arnoldi"), **kw)
+    assert br.status.ok and br.lam.size > 5 and br.stability == "hill-arnoldi"
+    assert branch_dataset(br).attrs["stability"] == "hill-arnoldi"
+    p = br.problem
+    for i in range(br.lam.size):  # dense Hill on the dense Jacobian of every point: the same labels and growth
+        w = p.omega(br.lam[i])
+        stable, growth, _ = hill_stability(p.evaluate(br.X[i], br.lam[i]).JX, s.M, s.C, w, p.H)
+        assert br.stable[i] == stable and abs(br.growth[i] - growth) <= 1e-6
+    none = continue_hb(s, 0.8, 1.2, stability=False, **kw)
+    assert np.all(np.isnan(none.growth)) and not np.any(none.stable) and none.stability == "not-computed"
+    assert branch_dataset(none).attrs["stability"] == "not-computed"

@@ -120,3 +120,40 @@ def test_the_jointdyn_process_asks_for_the_note(monkeypatch):
     monkeypatch.delenv(ANNOUNCE_ENV, raising=False)
     monkeypatch.setattr(cli, "main", lambda argv=None: 0)
     assert cli.console() == 0 and os.environ[ANNOUNCE_ENV] == "1"
+
+
+def test_a_stage_writes_plain_lines_where_stderr_is_not_a_terminal(capsys, monkeypatch):
+    """Plain lines (the items done of the total, the time left, a last line) once the stage has taken
+    QUIET_S seconds (0 here); nothing with progress=False; a short stage says nothing."""
+    monkeypatch.setattr(C.StageProgress, "QUIET_S", 0.0)
+    with C.stage_progress(8, "stability (arnoldi)", None, unit="point") as bar:
+        for _ in range(8):
+            bar.update(1)
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith("stability (arnoldi): 2/8 points, ") and "s left" in err[0]
+    assert len(err) == C.StageProgress.LINES and err[-1].startswith("stability (arnoldi): 8/8 points done in ")
+    with C.stage_progress(8, "x", False) as bar:
+        bar.update(8)
+    monkeypatch.setattr(C.StageProgress, "QUIET_S", 1e9)
+    with C.stage_progress(8, "x", True) as bar:
+        bar.update(8)
+    C.stage_note("HB level 1/6: H = 7, Ns = 128", False)
+    assert capsys.readouterr().err == ""
+    C.stage_note("HB level 1/6: H = 7, Ns = 128")
+    assert capsys.readouterr().err == "HB level 1/6: H = 7, Ns = 128\n"
+
+
+def test_each_level_of_an_automatic_choice_says_which_it_is(capsys):
+    from jointdyn import config
+    from jointdyn.hb.discretisation import level_number
+    from jointdyn.hb.levels import Discretisation, Level
+
+    d = Discretisation.of("auto", "auto")
+    h0, s0 = d.first
+    # raises of H (H -> 2H + 1) and of Ns (doubling) within their bounds, counted by hand from the bounds
+    h_levels = sum(1 for h in (2 * h0 + 1, 4 * h0 + 3, 8 * h0 + 7) if h <= config.HB_AUTO_MAX_HARMONICS)
+    s_levels = sum(1 for k in range(1, 12) if s0 * 2 ** k <= config.HB_AUTO_MAX_SAMPLES)
+    most = 1 + h_levels + s_levels
+    assert level_number(d.first, d) == (1, most)
+    assert level_number(Level(2 * h0 + 1, 2 * s0), d) == (3, most)
+    assert level_number(Level(h0, 2 * s0), Discretisation.of(h0, "auto")) == (2, 1 + s_levels)

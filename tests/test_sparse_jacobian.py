@@ -140,7 +140,7 @@ def test_epmc_backbone_with_sparse_jacobians_equals_the_dense_one(monkeypatch):
 
 def test_hb_branch_with_sparse_jacobians_has_the_same_peak(monkeypatch):
     """An HB branch through the sparse evaluation (large, sparse, Hill beyond its size: the conditions
-    lowered here) against the dense path: the same peak; stability not computed, and said so."""
+    lowered here) against the dense path: the same peak; the same stability (dense Hill at this size)."""
     from jointdyn.hb import continue_hb
 
     s = _two_bodies(3)
@@ -164,4 +164,8 @@ def test_hb_branch_with_sparse_jacobians_has_the_same_peak(monkeypatch):
     assert b.counters["sparse_factorisations"] > 0
     pa, pb = a.response()[0].max(), b.response()[0].max()
     assert pb == pytest.approx(pa, rel=1e-6)
-    assert np.all(np.isnan(b.growth))
+    assert b.stability == a.stability == "hill" and np.all(np.isfinite(b.growth))
+    same = np.isin(b.lam, a.lam)  # the points both paths reached (to the last bit) have one stability
+    assert same.any()
+    np.testing.assert_allclose(b.growth[same], [a.growth[np.flatnonzero(a.lam == v)[0]] for v in b.lam[same]],
+                               rtol=0, atol=1e-9)

@@ -100,6 +100,10 @@ def add_arguments(p) -> None:
     p.add_argument("--samples", default=None, metavar="NS|auto",
                    help=f"hb: time samples per period, or auto (default: from {config.HB_SAMPLES}, doubled while a "
                         f"peak changes by more than {100 * config.HB_AUTO_RTOL:g} %% with twice as many)")
+    p.add_argument("--no-stability", action="store_true", default=None,
+                   help="hb: do not compute the stability of the points (stable false, growth NaN, the "
+                        "Dataset's stability attribute not-computed); by default dense Hill on small "
+                        "problems, shift-invert Arnoldi on large ones")
     p.add_argument("--out", default=None, metavar="DIR",
                    help="write frc.nc, frc.csv, frc.png here (time: resume checkpoints under DIR/lines; a rerun "
                         "reuses them and says how many points it reused)")
@@ -158,7 +162,7 @@ _TIME_ONLY = {
     "scheduler": "the continuation is one sequential path",
     "workers": "the continuation is one sequential path",
 }
-_HB_ONLY = ("harmonics", "samples")
+_HB_ONLY = ("harmonics", "samples", "no_stability")
 
 
 def _option(dest: str) -> str:
@@ -517,7 +521,8 @@ def _run_hb(args, gammas):
     step = float(gammas[1] - gammas[0])
     try:
         br = continue_hb(system, float(gammas[0]), float(gammas[-1]), harmonics=args.harmonics,
-                         samples=args.samples, max_step=step, progress=None if not args.json else False)
+                         samples=args.samples, max_step=step, progress=None if not args.json else False,
+                         stability=False if args.no_stability else None)
     except np.linalg.LinAlgError:
         raise  # a failed solve, not a refusal (the command line says so)
     except ValueError as exc:
@@ -533,6 +538,7 @@ def _run_hb(args, gammas):
     result["status"] = br.status.value
     result["message"] = br.message
     result["uncovered"] = [[float(a), float(b)] for a, b in br.uncovered]
+    result["stability"] = br.stability  # hill, hill-arnoldi, or not-computed (--no-stability)
     return br, result
 
 
@@ -673,14 +679,12 @@ def exit_status(result) -> int:
     return 0 if status.ok or status is ContinuationStatus.UNBOUNDED else EXIT_INCOMPLETE
 
 
-def run(args) -> int:
-    gammas = _validate(args)
-    if args.method == "time":
-        ds, result = _run_time(args, gammas)
-    else:
-        ds, result = _run_hb(args, gammas)
-    if args.out is not None:
-        out = Path(args.out)
+def _export(args, ds, result, out: Path) -> None:
+    """The files of ``--out`` (the Dataset as netCDF + CSV, the figure), with the progress of that stage
+    (a bar on a terminal, plain lines elsewhere when it is long; nothing with ``--json``)."""
+    from ..continuation import stage_progress
+
+    with stage_progress(2, f"export to {out}", False if args.json else None, unit="file") as bar:
         if args.method == "time":
             from ..sweeps import write_outputs
 
@@ -691,7 +695,19 @@ def run(args) -> int:
 
             # frc.csv: one row per point (per-harmonic data in frc.nc)
             write_dataset(_with_frequency(_titled(branch_dataset(ds), result), _system(args).w0), out, "frc")
+        bar.update(1)
         _plot(result, out / "frc.png")
+        bar.update(1)
+
+
+def run(args) -> int:
+    gammas = _validate(args)
+    if args.method == "time":
+        ds, result = _run_time(args, gammas)
+    else:
+        ds, result = _run_hb(args, gammas)
+    if args.out is not None:
+        _export(args, ds, result, Path(args.out))
     if args.json:
         print(json.dumps(result))
     else:

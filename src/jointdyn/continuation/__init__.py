@@ -64,7 +64,8 @@ bordered systems, the compiled LU :func:`~jointdyn.continuation.linalg.lu_solve`
 :mod:`~jointdyn.continuation.walk` (the predictor-corrector walk along a
 branch) and :mod:`~jointdyn.continuation.post` (turning points, maxima and
 their refinement on a computed branch); :mod:`~jointdyn.continuation.progress`
-holds a progress bar over the parameter's range.
+holds a progress bar over the parameter's range and the progress of the stages
+after it (a bar on a terminal, plain lines elsewhere).
 """
 
 from .linalg import preconditioned_by
@@ -72,9 +73,10 @@ from .newton import newton
 from .options import (START_EXTRAPOLATION, ContinuationOptions, ContinuationResult, ContinuationStatus,
                       LinearSolveOptions, make_options)
 from .post import local_maxima, refine_maximum, turning_points
-from .progress import ParameterProgress
+from .progress import ParameterProgress, StageProgress, stage_note, stage_progress
 from .walk import continuation
 
 __all__ = ["ContinuationOptions", "LinearSolveOptions", "START_EXTRAPOLATION", "ContinuationStatus",
            "ContinuationResult", "continuation", "newton",
-           "preconditioned_by", "turning_points", "make_options", "local_maxima", "refine_maximum", "ParameterProgress"]
+           "preconditioned_by", "turning_points", "make_options", "local_maxima", "refine_maximum", "ParameterProgress",
+           "StageProgress", "stage_note", "stage_progress"]

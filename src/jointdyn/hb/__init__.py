@@ -23,7 +23,9 @@ from .parameters import DELTA, ETA, F1, GAMMA, N0, PARAMETERS, HBParameter, Syst
 from .problem import HBProblem
 from .monodromy import monodromy_multipliers
 from .results import DiscretisationCheck, HBBranch, HBPeak, HBSolution, PointStatus, SolveStatus
+from .hill_arnoldi import ArnoldiExponents, hill_arnoldi_exponents, hill_arnoldi_growth
 from .stability import hill_exponents, hill_growth, hill_stability
+from .stability_options import StabilityOptions
 
 __all__ = [
     "frc_hb",
@@ -60,5 +62,9 @@ __all__ = [
     "hill_exponents",
     "hill_stability",
     "hill_growth",
+    "hill_arnoldi_exponents",
+    "hill_arnoldi_growth",
+    "ArnoldiExponents",
+    "StabilityOptions",
     "monodromy_multipliers",
 ]

@@ -46,6 +46,7 @@ curve could be followed only up to it).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 from dataclasses import dataclass
@@ -53,12 +54,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import config
+from .._threads import blas_threads
 from ..continuation import (
     START_EXTRAPOLATION,
     ContinuationOptions,
     ContinuationResult,
     ContinuationStatus,
     ParameterProgress,
+    stage_progress,
     continuation,
     local_maxima,
     make_options,
@@ -67,16 +70,19 @@ from ..continuation import (
     refine_maximum,
     turning_points,
 )
-from ..damping import has_damping
+from ..damping import dense_damping, has_damping
 from ..fourier import derivative_matrix
 from ..laws import MACROSLIP, SEPARATION
 from ..systems import System
 from ._aft import INFO_ERROR, INFO_PASSES, INFO_PERIOD
 from .condense import make_problem
+from .hill_arnoldi import hill_arnoldi_exponents
 from .levels import Level
 from .parameters import F1, GAMMA
 from .problem import HBProblem, reference_scales
 from .results import HBBranch, HBPeak, PointStatus
+from .stability import hill_growth
+from .stability_options import StabilityOptions
 
 __all__ = ["continued_branch", "solve_point"]
 
@@ -96,6 +102,7 @@ class _Request:
     backward: bool
     progress: bool | None
     condense: bool | None
+    stability: StabilityOptions = StabilityOptions()
 
 
 @dataclass(frozen=True)
@@ -148,29 +155,36 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     force_period = np.zeros(n, dtype=int)
     response0 = np.full((n, 3), np.nan)
     ws = np.array([problem.omega(v) for v in lam])
-    growth = np.empty(n)
-    # Hill stability of every point (hill_stability's criterion; NaN where a condensed problem does not compute
-    # it), on chunks of points whose Jacobians fit in config.HB_JACOBIAN_BUDGET_BYTES
-    hill = problem.hill_affordable()  # else growth NaN: no Jacobian needed
-    chunk = max(1, min(n, config.HB_JACOBIAN_BUDGET_BYTES // (8 * problem.size * problem.size))) if hill else 1
-    JXs = np.empty((chunk, problem.size, problem.size) if hill else (1, 0, 0))
-    for i in range(n):
-        ev = tr.evaluations.get(float(lam[i]))
-        if ev is None or ev[0].tobytes() != X[i].tobytes() or (hill and ev[1].JX is None):  # not kept for this X
-            ev = (X[i], problem.evaluate(X[i], lam[i]), *(ev[2:] if ev is not None and ev[1].JX is None else ()))
-        if len(ev) > 2:
-            response0[i] = ev[2]
-        ev = ev[1]
-        if hill:
-            JXs[i % chunk] = ev.JX
-        passes[i] = int(ev.info[INFO_PASSES])
-        periodic_error[i] = ev.info[INFO_ERROR]
-        force_period[i] = int(ev.info[INFO_PERIOD])
-        if not hill:
-            growth[i] = np.nan
-        elif i % chunk == chunk - 1 or i == n - 1:
-            lo = i - i % chunk
-            growth[lo:i + 1] = problem.hill_growth(JXs[:i + 1 - lo], ws[lo:i + 1])
+    growth = np.full(n, np.nan)
+    # the Floquet exponents of every point: dense Hill on chunks of points whose Jacobians fit in
+    # config.HB_JACOBIAN_BUDGET_BYTES, or shift-invert Arnoldi point by point (StabilityOptions.method_for)
+    method = tr.stability.method_for(2 * problem.system.ndof * problem.nh)
+    dense, need = method == "dense", method != "none"
+    chunk = max(1, min(n, config.HB_JACOBIAN_BUDGET_BYTES // (8 * problem.size * problem.size))) if dense else 1
+    JXs = np.empty((chunk, problem.size, problem.size) if dense else (1, 0, 0))
+    lapack = method == "arnoldi" or (dense and 2 * problem.system.ndof * problem.nh > config.HB_SMALL_EIG)
+    with stage_progress(n if need else 0, f"stability ({method})", tr.progress, unit="point") as bar, \
+            (blas_threads() if lapack else contextlib.nullcontext()):
+        for i in range(n):
+            ev = tr.evaluations.get(float(lam[i]))
+            if ev is None or ev[0].tobytes() != X[i].tobytes() or (need and ev[1].JX is None):  # not kept for X
+                ev = (X[i], tr.evaluate(X[i], lam[i], dense),
+                      *(ev[2:] if ev is not None and ev[1].JX is None else ()))
+            if len(ev) > 2:
+                response0[i] = ev[2]
+            ev = ev[1]
+            passes[i] = int(ev.info[INFO_PASSES])
+            periodic_error[i] = ev.info[INFO_ERROR]
+            force_period[i] = int(ev.info[INFO_PERIOD])
+            if method == "arnoldi":
+                growth[i] = _arnoldi_growth(problem, ev.JX, ws[i], tr.stability)
+                bar.update(1)
+            elif dense:
+                JXs[i % chunk] = ev.JX if isinstance(ev.JX, np.ndarray) else ev.JX.toarray()  # kept sparse
+                if i % chunk == chunk - 1 or i == n - 1:
+                    lo = i - i % chunk
+                    growth[lo:i + 1] = _dense_growth(problem, JXs[:i + 1 - lo], ws[lo:i + 1])
+                    bar.update(i + 1 - lo)
     stable, checked = _confirmed_stability(problem, X, lam, growth)
     counters = {**parts.counters, "monodromy_checks": checked}
     # folds need the stability on both sides; without it (a large condensed problem) the turning points stand
@@ -180,7 +194,29 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
                     stable=stable, growth=growth, passes=passes,
                     periodic_error=periodic_error, force_period=force_period, response0=response0,
                     point_status=parts.point_status, peaks=tuple(peaks), uncovered=tuple(uncovered),
-                    response_dof=tr.dof)
+                    response_dof=tr.dof, stability=_STABILITY_NAMES[method])
+
+
+#: the name of each stability method in an HBBranch (and the ``stability`` attribute of its Dataset)
+_STABILITY_NAMES = {"dense": "hill", "arnoldi": "hill-arnoldi", "none": "not-computed"}
+
+
+def _full_jacobian(problem: HBProblem, JX, w):
+    """The full structure's dR/dX at w (rad/s): JX itself, or recovered from a condensed problem's."""
+    return problem.full_jacobian(JX, w) if problem.condensed else JX
+
+
+def _dense_growth(problem: HBProblem, JXs, ws):
+    """max Re(s) / w by dense Hill (:func:`~jointdyn.hb.stability.hill_growth`) of the points ``JXs``."""
+    if problem.condensed:
+        JXs = np.array([problem.full_jacobian(J, w) for J, w in zip(JXs, ws)])
+    return hill_growth(JXs, problem.system.M, dense_damping(problem.system.C), ws, problem.H)
+
+
+def _arnoldi_growth(problem: HBProblem, JX, w, options) -> float:
+    """max Re(s) / w of the exponents nearest the imaginary axis (:mod:`jointdyn.hb.hill_arnoldi`) of a point."""
+    return hill_arnoldi_exponents(_full_jacobian(problem, JX, w), problem.system.M, dense_damping(problem.system.C), w,
+                                  problem.H, options).growth
 
 
 def _saddle_nodes(turning, stable, segment):
@@ -278,8 +314,12 @@ class _Tracker:
     unbounded response.
     """
 
-    def __init__(self, problem: HBProblem, scales, dof: int):
+    def __init__(self, problem: HBProblem, scales, dof: int, stability: StabilityOptions | None = None,
+                 progress=False):
         self.problem = problem
+        #: how the stability of the branch's points is computed, and whether its stages show progress
+        self.stability = StabilityOptions() if stability is None else stability
+        self.progress = progress
         self.scales = scales
         self.dof = dof
         self.kt, self.fy = reference_scales(problem.system)
@@ -307,6 +347,14 @@ class _Tracker:
             ev = self.problem.evaluate(y * xs, lam_s * ps, self.scales)
         self.last = ev
         return ev.scaled
+
+    def evaluate(self, X, lam, dense: bool):
+        """The evaluation at X (m) and lam with its Jacobian: dense, or of the kind the continuation used."""
+        if dense or self.kind == "dense":
+            return self.problem.evaluate(X, lam)
+        if self.kind == "sparse":
+            return self.problem.evaluate_sparse(X, lam)
+        return self.problem.evaluate_blocks(X, lam)
 
     def amplitudes(self, y):
         """(half peak-to-peak, mean, max |x|) of the response DOF at scaled unknowns y, m."""
@@ -515,7 +563,7 @@ def continued_branch(req: _Request, level: Level, watch_for=None):
 
 def _continued(req: _Request, problem: HBProblem, watch_for):
     """:func:`continued_branch` of its problem."""
-    tr = _Tracker(problem, _scales(problem, req.start), req.dof)
+    tr = _Tracker(problem, _scales(problem, req.start), req.dof, req.stability, req.progress)
     opt = req.options
     if req.max_step is not None:
         opt = dataclasses.replace(opt, max_dlam=req.max_step / tr.scales[2])

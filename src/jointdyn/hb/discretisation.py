@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ..continuation import ContinuationOptions, ContinuationStatus, newton, refine_maximum
+from ..continuation import ContinuationOptions, ContinuationStatus, newton, refine_maximum, stage_note
 from .branch import _Request, _scales, _Tracker, continued_branch
 from .condense import make_problem
 from .levels import Discretisation, Level
@@ -32,7 +32,29 @@ def _fixed_branch(req: _Request, level: Level, disc: Discretisation | None = Non
     (``disc``: which of the harmonics and the samples may change; :class:`_PeakWatch`)."""
     watch_for = (lambda tr, opt: _PeakWatch(tr, req, level, disc, opt)) \
         if watch and disc is not None and (disc.harmonics_auto or disc.samples_auto) else None
+    if disc is not None and (disc.harmonics_auto or disc.samples_auto):
+        k, most = level_number(level, disc)
+        stage_note(f"HB level {k}/{most}: H = {level.harmonics}, Ns = {level.samples}", req.progress)
     return continued_branch(req, level, watch_for)
+
+
+def _doublings(a: int, b: int, grow) -> int:
+    """How many times ``grow`` is applied to a before it reaches b (0 when a >= b)."""
+    n = 0
+    while a < b:
+        a, n = grow(a), n + 1
+    return n
+
+
+def level_number(level: Level, disc: Discretisation) -> tuple[int, int]:
+    """(k, most): ``level`` is the k-th of an automatic choice from ``disc.first``, which has at most ``most``
+    (each raise of the harmonics H -> 2H + 1 and of the samples Ns -> 2 Ns within ``config.HB_AUTO_MAX_*``
+    is one level; a samples retry after a failure is one too)."""
+    (h0, s0), grow_h, grow_s = disc.first, (lambda h: 2 * h + 1), (lambda s: 2 * s)
+    k = 1 + _doublings(h0, level.harmonics, grow_h) + _doublings(s0, level.samples, grow_s)
+    most = 1 + (_doublings(h0, config.HB_AUTO_MAX_HARMONICS + 1, grow_h) - 1 if disc.harmonics_auto else 0) \
+        + (_doublings(s0, config.HB_AUTO_MAX_SAMPLES + 1, grow_s) - 1 if disc.samples_auto else 0)
+    return k, max(k, most)
 
 
 def check_levels(level: Level, disc: Discretisation):
@@ -66,7 +88,7 @@ def _at_level(req: _Request, condensed: bool, X, level: Level):
     their H)."""
     problem = make_problem(req.system, condense=condensed, response_dofs=(req.dof,), harmonics=level.harmonics,
                            samples=level.samples, parameter=req.parameter, gamma=req.gamma)
-    tr = _Tracker(problem, _scales(problem, req.start), req.dof)
+    tr = _Tracker(problem, _scales(problem, req.start), req.dof, req.stability, req.progress)
     Xm = np.asarray(X).reshape(-1, problem.n)
     X0 = np.zeros((problem.nh, problem.n))
     X0[: min(Xm.shape[0], problem.nh)] = Xm[: problem.nh]

@@ -167,7 +167,7 @@ def _branch_attrs(branch: HBBranch, dof: int, ds) -> dict:
         peak_amplitude_q=float(ds.peak_amplitude_q.values[top]) if top is not None else math.nan,
         folds=int(branch.fold.sum()),
         unstable_points=int((~branch.stable).sum()),
-        stability="hill" if np.all(np.isfinite(branch.growth)) else "not-computed",
+        stability=branch.stability if np.all(np.isfinite(branch.growth)) else "not-computed",
         condensed=int(p.condensed),
         unknown_dofs=int(p.n),
         max_aft_passes=int(branch.passes.max()) if branch.passes.size else 0,

@@ -13,20 +13,26 @@ the solution at one point and the homotopy start), :mod:`jointdyn.hb.export`
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
 from .. import _validate as V
 from .. import config
+from .._threads import blas_threads
 from ..continuation import START_EXTRAPOLATION, ContinuationOptions, make_options
+from ..damping import dense_damping
 from ..systems import System
 from .branch import _forcing_problem, _Request, solve_point
 from .discretisation import adaptive_branch
 from .export import branch_dataset
+from .hill_arnoldi import hill_arnoldi_exponents
 from .levels import AUTO, Discretisation, Level, check_memory
 from .parameters import GAMMA, parameter_named
 from .problem import HBProblem, reference_scales, stuck_stiffness
 from .results import HBBranch, HBSolution, SolveStatus
+from .stability import hill_stability
+from .stability_options import StabilityOptions, stability_options
 
 __all__ = ["continue_hb", "frc_hb", "harmonic_balance", "check_mean_position"]
 
@@ -110,7 +116,8 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
                 harmonics: int | str = AUTO, samples: int | str = AUTO,
                 max_step: float | None = None, response_dof: int | None = None,
                 options: ContinuationOptions | None = None, backward_after_unbounded: bool = True,
-                progress: bool | None = None, condense: bool | None = None, **overrides) -> HBBranch:
+                progress: bool | None = None, condense: bool | None = None,
+                stability: StabilityOptions | bool | None = None, **overrides) -> HBBranch:
     """Continue harmonic-balance solutions in a scalar parameter.
 
     Parameters
@@ -160,11 +167,21 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         continue a second segment from ``stop`` backwards, so that both
         ends of the range are covered.
     progress : bool, optional
-        Show a tqdm bar (None: only on a TTY).
+        Show the progress of each stage (the continuation over the range,
+        each level of an automatic choice of harmonics and samples, the
+        stability of the points): tqdm bars on a terminal, plain lines on
+        stderr elsewhere; the bar over the range only on a terminal when
+        None; False: nothing.
     condense : bool, optional
         Condense the problem exactly onto the contact DOFs
         (:mod:`jointdyn.hb.condense`); None chooses by size
         (:func:`~jointdyn.hb.condense.use_condensed`).
+    stability : StabilityOptions or False, optional
+        How the Floquet exponents are computed (default
+        :class:`~jointdyn.hb.stability_options.StabilityOptions`: dense Hill
+        up to its ``dense_max_rows`` companion rows, shift-invert Arnoldi
+        beyond); False: not computed (``HBBranch.stability`` is
+        ``not-computed``, growth NaN).
 
     Returns
     -------
@@ -197,14 +214,15 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
     if max_step is not None:
         V.positive("max_step", max_step)
     req = _Request(system=system, start=start, stop=stop, parameter=par, gamma=gamma, max_step=max_step, dof=dof,
-                   options=opt, backward=backward_after_unbounded, progress=progress, condense=condense)
+                   options=opt, backward=backward_after_unbounded, progress=progress, condense=condense,
+                   stability=stability_options(stability))
     return adaptive_branch(req, disc)
 
 
 def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: int | str = AUTO,
            samples: int | str = AUTO, max_step: float | None = None, response_dof: int | None = None,
            options: ContinuationOptions | None = None, progress: bool | None = None, condense: bool | None = None,
-           **overrides):
+           stability: StabilityOptions | bool | None = None, **overrides):
     """Frequency-response curve by harmonic balance and arc-length continuation.
 
     Harmonics 0..H of every DOF (normalised time tau = w t), contact forces
@@ -237,6 +255,8 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
     condense : bool, optional
         Condense exactly onto the contact DOFs (None: by size; see
         :func:`continue_hb`).
+    stability : StabilityOptions or False, optional
+        How the stability is computed, or False for none (see :func:`continue_hb`).
 
     Returns
     -------
@@ -255,14 +275,15 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
         raise ValueError("system must be a jointdyn.System")
     br = continue_hb(system, V.positive("gamma_start", gamma_start), V.positive("gamma_stop", gamma_stop),
                      parameter=GAMMA, harmonics=harmonics, samples=samples, max_step=max_step,
-                     response_dof=response_dof, options=options, progress=progress, condense=condense, **overrides)
+                     response_dof=response_dof, options=options, progress=progress, condense=condense,
+                     stability=stability, **overrides)
     return branch_dataset(br)
 
 
 def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB_HARMONICS,
                      samples: int = config.HB_SAMPLES, guess=None, response_dof: int = 0,
                      tol: float = config.CONT_TOL, max_iter: int = config.HB_SOLVE_MAX_ITER,
-                     condense: bool | None = None) -> HBSolution:
+                     condense: bool | None = None, stability: StabilityOptions | bool | None = None) -> HBSolution:
     """Solve the HB equations at one frequency by damped Newton.
 
     Parameters
@@ -286,8 +307,11 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
         Condense exactly onto the contact DOFs (None: by size; see
         :func:`continue_hb`). The unknowns X (and ``guess``) are then the
         harmonics of the retained DOFs ``problem.dofs``; stability is
-        computed only when the full problem is small
-        (:mod:`jointdyn.hb.condense`).
+        computed on the full problem's Jacobian (:mod:`jointdyn.hb.condense`).
+    stability : StabilityOptions or False, optional
+        How the stability is computed, or False for none (see
+        :func:`continue_hb`); by Arnoldi, ``multipliers`` are those of the
+        exponents found near the imaginary axis.
 
     Returns
     -------
@@ -302,15 +326,31 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
     # the forcing amplitude as the (fixed) parameter: a problem at this gamma
     problem = _forcing_problem(system, gamma, harmonics, samples, condense)
     X, ok, it = solve_point(problem, gamma, None if guess is None else V.finite_array("guess", guess), tol, max_iter)
-    return _make_solution(problem, X, ok, it, response_dof)
+    return _make_solution(problem, X, ok, it, response_dof, stability_options(stability))
 
 
-def _make_solution(problem: HBProblem, X, converged, iterations, response_dof) -> HBSolution:
+def _point_stability(problem: HBProblem, JX, w: float, opts: StabilityOptions):
+    """(stable, max Re(s) / w, Floquet multipliers) of one solution by the method of ``opts``
+    ((False, NaN, empty) when it is ``none``)."""
+    method = opts.method_for(2 * problem.system.ndof * problem.nh)
+    if method == "none":
+        return False, math.nan, np.empty(0, dtype=complex)
+    J = problem.full_jacobian(JX, w) if problem.condensed else JX
+    s = problem.system
+    if method == "dense":
+        return hill_stability(np.asarray(J), s.M, dense_damping(s.C), w, problem.H)
+    with blas_threads():  # ARPACK's BLAS-2 work: 2 OpenBLAS threads on 2 busy cores are slower than one
+        found = hill_arnoldi_exponents(J, s.M, dense_damping(s.C), w, problem.H, opts)
+    return found.growth <= config.HB_STABILITY_RTOL, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
+
+
+def _make_solution(problem: HBProblem, X, converged, iterations, response_dof, opts=None) -> HBSolution:
     """HBSolution at X: residual, amplitudes of ``response_dof`` and Hill stability."""
     lam = problem.f1_ref
     ev = problem.evaluate(X, lam)
     amp, off, mx = problem.amplitudes(X, response_dof, lam)
-    stable, growth, mult = problem.hill_stability(ev.JX, problem.omega(lam))
+    stable, growth, mult = _point_stability(problem, ev.JX, problem.omega(lam),
+                                            StabilityOptions() if opts is None else opts)
     status = SolveStatus.CONVERGED if converged else SolveStatus.NOT_CONVERGED
     return HBSolution(problem=problem, X=X, status=status, iterations=int(iterations),
                       residual_norm=float(np.max(np.abs(ev.R))), amplitude_m=amp, offset_m=off, max_abs_m=mx,

@@ -173,6 +173,11 @@ class HBBranch:
     discretisation : DiscretisationCheck or None
         The automatic choice of harmonics and samples and the convergence
         check of the peaks (None when both were given).
+    stability : str
+        How ``growth`` was computed: ``hill`` (every eigenvalue of Hill's
+        companion matrix), ``hill-arnoldi`` (the exponents nearest the
+        imaginary axis by shift-invert Arnoldi) or ``not-computed``
+        (asked for no stability: growth NaN, no point stable).
     """
 
     problem: HBProblem
@@ -196,6 +201,7 @@ class HBBranch:
     uncovered: tuple
     response_dof: int
     discretisation: DiscretisationCheck | None = None
+    stability: str = "hill"
 
     def gamma(self):
         """gamma = w / w0 per point."""

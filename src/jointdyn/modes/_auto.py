@@ -24,7 +24,8 @@ import math
 import numpy as np
 
 from .. import config
-from ..hb.discretisation import check_levels, next_level
+from ..continuation import stage_note
+from ..hb.discretisation import check_levels, level_number, next_level
 from ..hb.levels import Discretisation
 
 __all__ = ["auto_backbone", "check_points", "level_changes"]
@@ -93,6 +94,8 @@ def auto_backbone(fixed, system, amplitude, *, harmonics, samples, mode: int = 1
     level = disc.first
     levels = [level]
     while True:
+        k, most = level_number(level, disc)
+        stage_note(f"EPMC level {k}/{most}: H = {level.harmonics}, Ns = {level.samples}", kw.get("progress"))
         b = fixed(system, amplitude, harmonics=level.harmonics, samples=level.samples, mode=mode, **kw)
         if not b.points:
             return b

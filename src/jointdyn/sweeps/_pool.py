@@ -37,6 +37,7 @@ import queue
 import signal
 import threading
 
+from .._threads import one_blas_thread_per_process
 from ._points import Context, solve_chunk
 
 __all__ = ["SerialExecutor", "LocalExecutor", "DaskExecutor", "run_chunks", "die_with_parent", "detach_worker", "process_context"]
@@ -100,6 +101,7 @@ def _init_worker(systems, stop, counter, parent_pid) -> None:
     flag and point counter."""
     global _WORKER
     detach_worker(parent_pid)
+    one_blas_thread_per_process()  # the pool's processes use the cores
     _WORKER = (systems, Context(stop, counter))
 
 

@@ -1,0 +1,87 @@
+"""What the stability of a harmonic-balance branch is asked: :class:`StabilityOptions` (every number of it)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .. import _validate as V
+
+__all__ = ["StabilityOptions", "STABILITY_METHODS"]
+
+#: how the Floquet exponents are computed: "auto" (by size), "dense" (every eigenvalue of Hill's companion
+#: matrix, :mod:`jointdyn.hb.stability`), "arnoldi" (those nearest the imaginary axis,
+#: :mod:`jointdyn.hb.hill_arnoldi`), "none" (not computed: growth NaN, the Dataset says ``not-computed``)
+STABILITY_METHODS = ("auto", "dense", "arnoldi", "none")
+
+
+@dataclass(frozen=True)
+class StabilityOptions:
+    """How the Floquet exponents of harmonic-balance solutions are computed.
+
+    Attributes
+    ----------
+    method : {"auto", "dense", "arnoldi", "none"}
+        ``auto`` (default): dense Hill up to ``dense_max_rows`` companion
+        rows, shift-invert Arnoldi beyond; ``none``: no stability (the
+        growth is NaN and the branch says ``not-computed``).
+    dense_max_rows : int
+        Largest companion matrix (2 n (2H+1) rows, n the DOFs of the full
+        structure) for which ``auto`` takes the dense method. Measured on the
+        scalar-contact chain of ``benchmarks/bench_hb_stability.py`` (H = 3,
+        one BLAS thread, a 2-core machine at a load of 4-5) per point: with
+        Q(sigma) factorised as a dense matrix (a dense Jacobian), dense Hill
+        and Arnoldi took about the same at 420-504 rows (0.06-0.17 s both)
+        and dense was 1.8-2x slower at 588 rows; with the chain's sparse
+        Jacobian (SuperLU), dense Hill was 17x faster at 294 rows (0.012
+        against 0.208 s, its compiled path) and 3.4x slower at 588 rows
+        (0.094 against 0.028 s), 12x at 1722 and 42x at 4410 rows.
+    arnoldi_shifts : int
+        Shifts on the imaginary axis between 0 and i w/2, both included
+        (>= 2); more shifts cover a wider band about the axis with the same
+        eigenvalues per shift.
+    arnoldi_eigenvalues : int
+        Eigenvalues computed nearest each shift (>= 1).
+    arnoldi_sparse_density : float
+        A Jacobian (dense, sparse or by harmonic blocks) with at most this
+        fraction of nonzero entries is factorised as a sparse matrix
+        (SuperLU) at each shift, a denser one by LAPACK; in (0, 1].
+    arnoldi_tol : float
+        Relative accuracy of ARPACK's Ritz values (of (A - sigma)^-1; 0:
+        machine precision), > 0.
+    arnoldi_maxiter : int
+        Bound on ARPACK's restarts per shift.
+    """
+
+    method: str = "auto"
+    dense_max_rows: int = 500
+    arnoldi_shifts: int = 3
+    arnoldi_eigenvalues: int = 12
+    arnoldi_sparse_density: float = 0.1
+    arnoldi_tol: float = 1e-13
+    arnoldi_maxiter: int = 2000
+
+    def __post_init__(self) -> None:
+        V.choice("method", self.method, STABILITY_METHODS)
+        V.positive_int("dense_max_rows", self.dense_max_rows, 0)
+        V.positive_int("arnoldi_shifts", self.arnoldi_shifts, 2)
+        V.positive_int("arnoldi_eigenvalues", self.arnoldi_eigenvalues)
+        V.in_range("arnoldi_sparse_density", self.arnoldi_sparse_density, 0.0, 1.0, lo_open=True)
+        V.positive("arnoldi_tol", self.arnoldi_tol)
+        V.positive_int("arnoldi_maxiter", self.arnoldi_maxiter)
+
+    def method_for(self, rows: int) -> str:
+        """The method used for a companion matrix of ``rows`` rows: ``dense``, ``arnoldi`` or ``none``."""
+        if self.method != "auto":
+            return self.method
+        return "dense" if rows <= self.dense_max_rows else "arnoldi"
+
+
+def stability_options(value) -> StabilityOptions:
+    """``value`` as StabilityOptions: None (defaults), False (``method="none"``), or StabilityOptions."""
+    if value is None:
+        return StabilityOptions()
+    if value is False:
+        return StabilityOptions(method="none")
+    if not isinstance(value, StabilityOptions):
+        raise ValueError(f"stability must be a StabilityOptions, None (defaults) or False (none), got {value!r}")
+    return value
