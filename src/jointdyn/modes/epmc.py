@@ -138,7 +138,7 @@ class EPMCProblem:
     def __init__(self, system, *, mode: int = 1, output_dof: int | None = None,
                  harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
                  max_passes: int = config.HB_MAX_PASSES):
-        check_free_vibration(system, "EPMC")
+        check_free_vibration(system, "EPMC", held=True)
         self.system = system
         self.output_dof = output_dof_of(system, output_dof)
         n = system.ndof
@@ -447,7 +447,7 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
 
         return auto_backbone(epmc, system, amplitude, harmonics=harmonics, samples=samples, mode=mode,
                              output_dof=output_dof, options=options, progress=progress, reduce=reduce, **overrides)
-    check_free_vibration(system, "EPMC")
+    check_free_vibration(system, "EPMC", held=True)
     lo, hi = amplitude_range(system, amplitude)
     reduction = None
     if reduce is not None:
