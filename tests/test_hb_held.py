@@ -103,6 +103,9 @@ def test_epmc_backbone_of_a_hanging_part_through_microslip():
     assert abs(w[0] / w_lin - 1.0) < 0.5 * b.amplitude_m[0] / scale
     assert w[-1] < 0.9 * w_lin and np.all(np.diff(w) < 0.0)
     assert b.damping_ratio[-1] > 10.0 * b.damping_ratio[0] > 0.0
+    # beyond microslip the part slides as a whole: the backbone ends there and says why
+    end = epmc(s, (0.5 * scale, 3.0 * scale), mode=2, output_dof=1, harmonics=3, samples=64, progress=False)
+    assert not end.status.ok and "slides as a whole" in end.message
     # a stuck Jenkins contact: the backbone's start is the stuck mode to rounding
     j = jd.System(M2, None, K2, contacts=_hanging("jenkins", 0.0).contacts)
     bj = epmc(j, (1e-3 * scale, 1e-2 * scale), mode=2, output_dof=1, harmonics=3, samples=64, progress=False)
