@@ -212,9 +212,9 @@ def test_max_points_keeps_the_points():
     (lambda: dataclasses.replace(_damper(), contacts=(jd.Contact(jd.make_law("iwan", kt=KT, mu=0.5, n_ref=100.0),
                                                                   normal=jd.SampledLoad([90.0, 110.0])),)),
      "contact 0: its normal load is a SampledLoad, prescribed at a forcing frequency"),
-    (lambda: jd.System(np.eye(1), None, np.zeros((1, 1)),
+    (lambda: jd.System(np.eye(2), None, np.zeros((2, 2)),
                        contacts=(jd.Contact(jd.make_law("iwan", kt=KT, mu=0.5, n_ref=100.0)),)),
-     "K must be positive definite"),
+     "K must be positive definite with every contact stuck"),
     (lambda: jd.System(np.eye(1), None, np.eye(1)), "system must have at least one contact"),
 ])
 def test_bad_systems_are_refused_with_the_reason(make, word):

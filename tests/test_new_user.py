@@ -180,26 +180,35 @@ normal = { n0 = 10.0 }
 """
 
 
-def test_hb_refuses_a_dof_held_only_by_friction_and_says_why(tmp_path, capsys):
-    """DOF 1 hangs on DOF 0 through a friction contact only: stuck, the structure is held, but harmonic
-    balance restarts the law at the mean of the motion, so friction holds no mean position; the solver
-    (and so the command line) says so instead of failing in Newton at the start."""
+def test_hb_takes_a_dof_held_only_by_friction_and_refuses_one_held_by_nothing(tmp_path, capsys):
+    """DOF 1 hangs on DOF 0 through a friction contact only: stuck, the structure is held, and harmonic
+    balance restarts the law at the preloaded static state, so the stuck contact holds DOF 1's mean: the
+    solver (and so the command line) computes the curve. A DOF held by nothing, not even by the stuck
+    contacts, is still refused, and the command line says so in one line before it writes anything."""
     from jointdyn.hb import check_mean_position, frc_hb
+    from jointdyn.hb.problem import held_by_contacts
 
     f = tmp_path / "s.toml"
-    f.write_text(HELD_BY_FRICTION)
+    f.write_text(HELD_BY_FRICTION.replace("amplitude = 2.0", "amplitude = 1.0e-3"))
     s = jd.read_system(f)
-    with pytest.raises(ValueError, match=r"DOF 1 is held only by friction \(by contact\[0\]\.kt\)"):
-        check_mean_position(s)
-    with pytest.raises(ValueError, match="held only by friction"):
-        frc_hb(s, 0.5, 1.5, harmonics=1, samples=16)
+    assert held_by_contacts(s)
+    check_mean_position(s)
+    ds = frc_hb(s, 0.5, 1.5, harmonics=1, samples=16, progress=False)
+    assert ds.attrs["status"] == "complete"
     out = tmp_path / "o"
-    rc = run_cli(["frc", "--system", str(f), "--method", "hb", "--out", str(out)])
+    assert run_cli(["frc", "--system", str(f), "--method", "hb", "--harmonics", "1", "--samples", "16",
+                    "--out", str(out)]) == 0
+    free = HELD_BY_FRICTION.replace("[[1.0, 0.0], [0.0, 0.5]]", "[[1.0, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, 0.2]]")
+    free = free.replace("[[1.0e4, 0.0], [0.0, 0.0]]", "[[1.0e4, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]")
+    g = _write_text(tmp_path / "free.toml", free)
+    with pytest.raises(ValueError, match="mostly DOF 2: held by nothing"):
+        check_mean_position(jd.read_system(g))
+    capsys.readouterr()
+    out2 = tmp_path / "o2"
+    rc = run_cli(["frc", "--system", str(g), "--method", "hb", "--out", str(out2)])
     err = capsys.readouterr().err.strip()
-    assert rc == 2 and len(err.splitlines()) == 1 and "held only by friction" in err and "--method time" in err
-    assert not out.exists()
-    held = f.read_text().replace("[0.0, 0.0]]", "[0.0, 1.0e2]]")  # a soft spring to ground fixes the offset
-    check_mean_position(jd.read_system(_write_text(tmp_path / "h.toml", held)))
+    assert rc == 2 and len(err.splitlines()) == 1 and "held by nothing" in err and "--method time" in err
+    assert not out2.exists()
 
 
 def _write_text(path, text):

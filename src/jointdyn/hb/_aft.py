@@ -22,7 +22,8 @@ residual and its Jacobians) is one compiled call per residual evaluation
 (:func:`_eval_template`), so Newton and continuation pay no Python per
 contact or per harmonic. It is assembled from small helpers inlined by
 Numba, each doing one job: linear part, samples of a contact's
-displacement, restart of the law at the mean displacement, one marched
+displacement, restart of the law at the mean displacement (at the
+reference displacement 0 for a structure held only through its contacts), one marched
 period, the periodicity tests, projection and scatter.
 
 Nothing here knows the physics of a law: the kernels are called unchanged
@@ -81,8 +82,10 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
       and its derivative along the parameter, and per contact the load at
       which the law restarts there;
     * ``four = (E, P)``: synthesis and analysis matrices;
-    * ``ctl = (max_passes, rtol)``: bound on the marched periods and the
-      periodicity tolerance;
+    * ``ctl = (max_passes, rtol, at_ref)``: bound on the marched periods, the
+      periodicity tolerance, and where the laws restart: at the mean
+      displacement (False) or at the reference displacement 0 (True, a
+      structure held only through its contacts: :func:`_restart`);
     * ``out = (R, JX, Jp, T, Nout, code, info)``: outputs, ``T[c]``,
       ``Nout[c]`` and ``code[c]`` the force samples, normal-load samples
       and motion codes of the last pass,
@@ -94,7 +97,7 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
     Per contact c: ``U = Xm Bm[c]``, its normal-load samples (prescribed,
     or ``max(0, P + kn g)`` from ``G = Xm Bnm[c]`` for a spring:
     :func:`_prescribed_loads`, :func:`_spring_loads`), restart of the law
-    at the mean displacement ``U[0]`` and the first load sample (``INIT_JVP``), AFT passes of
+    at the mean displacement ``U[0]`` (or 0 with ``at_ref``) and the first load sample (``INIT_JVP``), AFT passes of
     ``STEP_JVP`` (:func:`_pass`) until the force repeats, projection, and
     scatter ``R += b F``, ``JX += b (b^T dF/dU + bn^T dF/dG)``,
     ``Jp += b dF/dp``; a spring also adds its reaction ``bn P (N - P0)``
@@ -150,13 +153,13 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
         return
     Nsamp, dN, has_p, events = load
     E, P = four
-    max_passes, rtol = ctl
+    max_passes, rtol, at_ref = ctl
     sig, dirs, st, pw, hist, proj, nrm, vst = _workspace(con, four, has_p, code)
     U, u = sig
     a, bb, da, dbb, s_end = st
     Nc, km = nrm[2], nrm[3]
     for c in range(nc):
-        # the law restarted at the mean displacement, marched until its force repeats
+        # the law restarted at the mean displacement (or at the reference: at_ref), marched until its force repeats
         _contact_samples(lin[5], Bm, c, E, U, u)
         if SPRINGS and con[4][c, 1] > 0.0:  # noqa: F821 - bound by specialize
             _spring_loads(lin[5], con, c, E, nrm)
@@ -164,7 +167,7 @@ def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover 
             _prescribed_loads(Nsamp, c, nrm)
         prm = Pm[c]
         _restart(INIT_JVP, prm, U[0], Nc[0], km[0], dN[c, 0] if has_p else 0.0, has_p, E, dirs,  # noqa: F821
-                 (a, bb, da, dbb))
+                 (a, bb, da, dbb), at_ref)
         Tc, dT, T1, T2, dT1, cprev = pw
         for i in range(u.shape[0]):
             T1[i] = 0.0
@@ -296,11 +299,15 @@ def _contact_samples(X, Bm, c, E, U, u):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _restart(init_jvp, prm, U0, N0, k0, dN0, has_p, E, dirs, st):  # pragma: no cover - compiled
+def _restart(init_jvp, prm, U0, N0, k0, dN0, has_p, E, dirs, st, ref):  # pragma: no cover - compiled
     """Virgin state of the law at the mean displacement ``U0`` and load ``N0``, with its exact derivative.
 
     Direction 0 (the constant coefficient of u) moves the mean
-    displacement; the directions of the normal approach's coefficients
+    displacement. With ``ref`` (a structure held only through its contacts,
+    :attr:`jointdyn.hb.HBProblem.restart_at_reference`) the law restarts at
+    the reference displacement 0 instead (the preloaded static state, where
+    every contact is at rest without tangential force), which no unknown
+    moves: direction 0 is then zero. The directions of the normal approach's coefficients
     (indices nh..2nh-1, when the system has springs) move the load by
     ``k0 E[0, d]`` (``k0`` = dN/dg at the first sample); the parameter
     direction (the last) moves it by ``dN0``. The state goes to ``st[0]``,
@@ -310,13 +317,17 @@ def _restart(init_jvp, prm, U0, N0, k0, dN0, has_p, E, dirs, st):  # pragma: no 
     dn0 = dirs[4]
     nh = E.shape[1]
     nd = dx0.shape[0]
+    x0 = U0
     dx0[0] = 1.0
+    if ref:
+        x0 = 0.0
+        dx0[0] = 0.0
     if nd - (1 if has_p else 0) > nh:
         for d in range(nh):
             dn0[nh + d] = k0 * E[0, d]
     if has_p:
         dn0[nd - 1] = dN0
-    init_jvp(prm, U0, dx0, N0, dn0, st[0], st[2])
+    init_jvp(prm, x0, dx0, N0, dn0, st[0], st[2])
 
 
 @jit(inline="always")

@@ -12,7 +12,11 @@ at sample j - 1 (the path between samples is the straight line the element
 integrates exactly), the first step of a pass at the last sample of the
 previous one. The first pass starts from the virgin pair at the mean point
 ``(U_0, G_0)`` (slider ``w = U_0``: no force at the mean displacement, as the
-scalar laws restart there); the march goes on, pass after pass, until the
+scalar laws restart there), or, for a structure held only through its
+contacts (:attr:`jointdyn.hb.HBProblem.restart_at_reference`), at the
+reference point ``(0, G_0)`` (slider ``w = 0``: the preloaded static state,
+at rest without tangential force; the tangential rows of the mean point's
+derivative are zero, :func:`pair_directions`); the march goes on, pass after pass, until the
 slider and its derivative at the end of a pass equal (to ``rtol``) those at
 the end of the previous one, or the force repeats (the periodic steady
 slider). The derivatives are carried along the ``3 (2H+1)`` coefficients of
@@ -38,12 +42,17 @@ from ._aft import INFO_ERROR, INFO_PASSES, INFO_PERIOD, PERIOD_NONE, PERIOD_ONE
 __all__ = ["pair_directions", "pairs_aft", "pairs_aft_kernel"]
 
 
-def pair_directions(E: np.ndarray):
+def pair_directions(E: np.ndarray, at_reference: bool = False):
     """(DU, DG): derivatives of one pair's samples along the 3 nh coefficients of (u1, u2, g).
 
     ``DU`` (Ns + 1, 1, 2, 3 nh), ``DG`` (Ns + 1, 1, 3 nh): row j < Ns is
-    sample j (``d u_k / d Y[k, h] = E[j, h]``), row Ns the mean point
-    (``d / d Y[k, 0] = 1``), the start of the first pass. Built once per problem.
+    sample j (``d u_k / d Y[k, h] = E[j, h]``), row Ns the start of the first
+    pass: the mean point (``d / d Y[k, 0] = 1``), or with ``at_reference``
+    the reference point, whose tangential displacements are 0 whatever the
+    unknowns (``DU[Ns] = 0``; the normal gap stays at its mean). The entry
+    ``DU[Ns, 0, k, k nh]`` (1 or 0) is also the weight of the mean in the
+    start of the slider (:func:`pairs_aft`: ``w = DU[Ns, 0, k, k nh] U_0``),
+    so that the choice is data of the problem. Built once per problem.
     """
     ns, nh = E.shape
     nd = 3 * nh
@@ -51,7 +60,7 @@ def pair_directions(E: np.ndarray):
     DG = np.zeros((ns + 1, 1, nd))
     for k in range(2):
         DU[:ns, 0, k, k * nh:(k + 1) * nh] = E
-        DU[ns, 0, k, k * nh] = 1.0
+        DU[ns, 0, k, k * nh] = 0.0 if at_reference else 1.0
     DG[:ns, 0, 2 * nh:] = E
     DG[ns, 0, 2 * nh] = 1.0
     return DU, DG
@@ -74,8 +83,9 @@ def _pair_coefficients(pairs, i, X, n, Y):  # pragma: no cover - compiled
 
 
 @jit(inline="always")
-def _pair_samples(E, Y, Us, Gs):  # pragma: no cover - compiled
-    """Samples of (u1, u2, g) into Us[j, 0], Gs[j, 0] (j < Ns) and the mean point into row Ns."""
+def _pair_samples(E, Y, Us, Gs, DU):  # pragma: no cover - compiled
+    """Samples of (u1, u2, g) into Us[j, 0], Gs[j, 0] (j < Ns) and the start point into row Ns: the mean
+    point, its tangential components weighted by ``DU[Ns, 0, k, k nh]`` (1: the mean; 0: the reference 0)."""
     ns, nh = E.shape
     for j in range(ns):
         for k in range(3):
@@ -86,8 +96,8 @@ def _pair_samples(E, Y, Us, Gs):  # pragma: no cover - compiled
                 Us[j, 0, k] = acc
             else:
                 Gs[j, 0] = acc
-    Us[ns, 0, 0] = Y[0, 0]
-    Us[ns, 0, 1] = Y[1, 0]
+    Us[ns, 0, 0] = Y[0, 0] * DU[ns, 0, 0, 0]
+    Us[ns, 0, 1] = Y[1, 0] * DU[ns, 0, 1, nh]
     Gs[ns, 0] = Y[2, 0]
 
 
@@ -212,10 +222,10 @@ def pairs_aft(pairs, params, X, n, E, P, DU, DG, max_passes, rtol, R, JX, Gout, 
         for k in range(4):
             prm[0, k] = params[i, k]
         _pair_coefficients(pairs, i, X, n, Y)
-        _pair_samples(E, Y, Us, Gs)
-        # the virgin pair at the mean point: slider at the mean displacement
-        a[0, 0] = Y[0, 0]
-        a[0, 1] = Y[1, 0]
+        _pair_samples(E, Y, Us, Gs, DU)
+        # the virgin pair at the start point: slider at the mean displacement (or at the reference 0)
+        a[0, 0] = Us[ns, 0, 0]
+        a[0, 1] = Us[ns, 0, 1]
         for k in range(2):
             for d in range(nd):
                 da[0, k, d] = DU[ns, 0, k, d]

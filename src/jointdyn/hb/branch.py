@@ -80,7 +80,7 @@ from .hill_arnoldi import hill_arnoldi_exponents
 from .levels import Level
 from .parameters import F1, GAMMA
 from .problem import HBProblem, reference_scales
-from .results import HBBranch, HBPeak, PointStatus
+from .results import HBBranch, HBPeak, PointStatus, sliding_as_a_whole
 from .stability import hill_growth
 from .stability_options import StabilityOptions
 
@@ -413,13 +413,19 @@ class _Tracker:
         return None
 
     def relabel(self, res: ContinuationResult) -> ContinuationResult:
-        """A corrector failure at a very large amplitude is an unbounded response."""
+        """A corrector failure at a very large amplitude is an unbounded response; one where a part held only
+        through its contacts slides as a whole (at the last evaluation) says so
+        (:func:`~jointdyn.hb.results.sliding_as_a_whole`)."""
         if res.status is ContinuationStatus.FAILED and res.y.shape[0] > 0:
             q = self.q(self.amplitudes(res.y[-1])[0])
             if q > config.HB_UNBOUNDED_FAIL_FRACTION * config.HB_UNBOUNDED_Q:
                 return dataclasses.replace(
                     res, status=ContinuationStatus.UNBOUNDED,
                     message=f"Newton failed with q = {q:.4g} growing: unbounded response ({res.message})")
+        if res.status is ContinuationStatus.FAILED and self.last is not None and self.problem.restart_at_reference:
+            why = sliding_as_a_whole(self.problem, self.last.JX)
+            if why:
+                return dataclasses.replace(res, message=res.message + why)
         return res
 
 

@@ -74,7 +74,7 @@ from .._jit import jit
 from ..damping import dense_damping, is_operator
 from ..kinematics import contact_kinematics, selection_matrix
 from ..systems import System
-from .problem import HBProblem, _linear_blocks, contacts_only
+from .problem import HBProblem, _linear_blocks, contacts_only, held_by_contacts
 from .stability import hill_growth, hill_stability
 
 __all__ = ["Receptance", "receptance", "retained_dofs", "CondensedHBProblem", "make_problem", "use_condensed"]
@@ -556,6 +556,7 @@ class CondensedHBProblem(HBProblem):
                  response_dofs=()):
         if not isinstance(system, System):
             raise ValueError("system must be a jointdyn.System")
+        use_condensed(system, True)  # refuses a structure held only through its contacts
         c = retained_dofs(system, response_dofs)
         self.receptance = receptance(system)  # first: it also gives system.w0 (_share_w0)
         self._setup(system, harmonics, samples, parameter, gamma, max_passes, c)
@@ -740,12 +741,24 @@ def use_condensed(system: System, condense=None, response_dofs=()) -> bool:
     Automatic: condensed when the system has at least
     ``config.HB_CONDENSE_MIN_DOFS`` DOFs, retains at most
     ``config.HB_CONDENSE_MAX_FRACTION`` of them, and K is positive definite
-    on the DOFs that are not retained.
+    on the DOFs that are not retained. A structure held only through its
+    contacts (:func:`~jointdyn.hb.problem.held_by_contacts`) is never
+    condensed: the receptance and the static Schur complement are those of K,
+    which has a rigid-body mode there (ValueError naming ``condense`` when it
+    is asked for).
     """
-    if condense is not None:
-        if condense not in (True, False):
-            raise ValueError(f"condense must be True, False or None (automatic), got {condense!r}")
-        return bool(condense)
+    if condense is not None and condense not in (True, False):
+        raise ValueError(f"condense must be True, False or None (automatic), got {condense!r}")
+    if condense is False:
+        return False
+    if held_by_contacts(system):
+        if condense:
+            raise ValueError("condense: the structure is held only through its contacts (K with the tangential "
+                             "contacts free has a rigid-body mode), so its receptance has no static part to "
+                             "condense with; use condense=False (or None: the full problem)")
+        return False
+    if condense:
+        return True
     if system.ndof < config.HB_CONDENSE_MIN_DOFS:
         return False
     c = retained_dofs(system, response_dofs)

@@ -46,16 +46,17 @@ def check_mean_position(system: System) -> None:
     singular matrix; the time domain takes such a structure. A DOF held only
     by stiffnesses many decades apart is ill-conditioned, not free: those
     stiffnesses are named instead, and a DOF held only by pairs open at rest
-    (preload 0) names such a pair. A DOF held only by friction (K + kn
-    singular with the tangential contacts free) is refused too: friction
-    holds no mean position in harmonic balance (:func:`_check_not_held_by_friction`).
+    (preload 0) names such a pair. A DOF held only through the contacts
+    (K + kn singular with the tangential contacts free, K + kt + kn not) is
+    accepted: harmonic balance then restarts the laws at the reference
+    displacement, the preloaded static state, so that a stuck contact holds
+    the mean position (:func:`jointdyn.hb.problem.held_by_contacts`).
     """
     from ..systems import rigid_mode_dof, static_springs
 
     K = stuck_stiffness(system)  # with the normal springs of the contacts and pairs closed at rest
     dof = rigid_mode_dof(K)
     if dof is None:
-        _check_not_held_by_friction(system)
         return
     # the eigenvector names what holds the DOF; beyond this size it is not computed and the general message stands
     vec = np.linalg.eigh(K)[1][:, 0] if system.ndof <= config.SYSTEM_DENSE_CHECK_MAX_DOF else None
@@ -81,35 +82,6 @@ def check_mean_position(system: System) -> None:
                      f"spring closed (mostly DOF {dof}: held by nothing, K + kt + kn is singular), so its mean "
                      "position is not unique; harmonic balance needs one: give that DOF a stiffness in K, or "
                      "use the time domain (--method time)")
-
-
-def _check_not_held_by_friction(system: System) -> None:
-    """ValueError naming the DOF and the tangential springs when a DOF's mean position is held only by friction.
-
-    Harmonic balance restarts each contact's law virgin at the mean of its
-    displacement (:mod:`jointdyn.hb._aft`): a contact's mean force does not
-    depend on its mean displacement, so the static harmonic is held by K
-    and the normal springs alone (``System.K_reference``, the tangential
-    contacts free). This is the physics, not a limitation of the method: a
-    part held only by friction is at rest at any offset at which its
-    contacts can stick, and which one it reaches depends on its history.
-    """
-    from ..systems import rigid_mode_dof, static_springs
-
-    dof = rigid_mode_dof(system.K_reference)
-    if dof is None:
-        return
-    if system.ndof <= config.SYSTEM_DENSE_CHECK_MAX_DOF:
-        vec = np.linalg.eigh(system.K_reference)[1][:, 0]
-        held = [key for key, _, b in static_springs(system) if ".kt" in key and abs(b @ vec) > 1e-6]
-    else:
-        held = []
-    by = f" (by {held[0]}{' and others' if len(held) > 1 else ''})" if held else ""
-    raise ValueError(f"DOF {dof} is held only by friction{by}, with the tangential contacts free K + kn is "
-                     "singular: harmonic balance restarts each contact's law at the mean of its motion, so "
-                     "friction holds no mean position (the part is at rest at any offset its contacts can "
-                     "stick at, and which one depends on its history); give that DOF a stiffness in K (a soft "
-                     "spring to ground fixes the offset), or use the time domain (--method time)")
 
 
 def continue_hb(system: System, start: float, stop: float, *, parameter="gamma", gamma: float | None = None,

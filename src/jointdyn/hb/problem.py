@@ -208,6 +208,10 @@ class HBProblem:
         #: per system DOF, sin and cos of the forcing phase: f sin(w t + phi) has the
         #: coefficients f sin(phi) of cos(w t) and f cos(phi) of sin(w t)
         self.phase_sin, self.phase_cos = np.sin(phi), np.cos(phi)
+        #: True when the structure is held only through its contacts (:func:`held_by_contacts`): the laws and
+        #: the interfaces' pairs restart virgin at the reference displacement (the preloaded static state), not
+        #: at the mean of their motion, so that a stuck contact holds the mean position (made once, here)
+        self.restart_at_reference = held_by_contacts(system)
         self._contact_inputs(contact_kinematics(contacts_only(system)))
         self._interface_inputs()
         #: the AFT's phases and matrices (:meth:`_aft_grid`); evaluations report the uniform samples
@@ -268,7 +272,7 @@ class HBProblem:
         self.pair_positions = pos
         #: per pair kt, kn, mu, preload (N/m, N/m, -, N)
         self.pair_params = np.ascontiguousarray(np.vstack([itf.params for itf in itfs]))
-        self._pair_dirs = pair_directions(self.E)
+        self._pair_dirs = pair_directions(self.E, self.restart_at_reference)
 
     def _aft_grid(self):
         """(tau, E, P, uniform) of the AFT: the phases the laws are marched at, their synthesis and analysis
@@ -476,7 +480,8 @@ class HBProblem:
         self._kernel((*self._linear_terms(w), float(dwdp), X, Fe, Fp, self._lin_cols),
                      (self._Bm, self._Pm, self._ssz, self._Bnm, self._Sp, self.has_springs),
                      (Nsamp, dN if has_p else self._dummy, has_p, events), (self._Eg, self._Pg),
-                     (int(self.max_passes), float(config.HB_PERIODIC_RTOL)), (R, JX, Jp, T, Nout, code, info), scaled)
+                     (int(self.max_passes), float(config.HB_PERIODIC_RTOL), bool(self.restart_at_reference)),
+                     (R, JX, Jp, T, Nout, code, info), scaled)
         if self._uniform is not None:
             at = self._uniform
             T, code, Nout = T[:, at], code[:, at], Nout[:, at]
@@ -771,6 +776,25 @@ def stuck_stiffness(system: System) -> np.ndarray:
             rows = Bi[k::3][closed]
             K += rows.T @ (itf.kt[closed][:, None] * rows)
     return K
+
+
+@by_identity
+def held_by_contacts(system: System) -> bool:
+    """True when ``system`` is held only through its contacts: ``System.K_reference`` (K with the normal
+    springs closed, the tangential contacts free) has a rigid-body mode and :func:`stuck_stiffness` (every
+    contact and pair stuck) has none (:func:`jointdyn.systems.rigid_mode_dof`); cached per System.
+
+    Such a part (a beam joined to another by a bolted joint, a friction damper held by its contacts) is at
+    rest in the preloaded static state, the origin of the coordinates, where every contact is at rest
+    without tangential force. Harmonic balance then restarts each law there instead of at the mean of its
+    motion (:attr:`HBProblem.restart_at_reference`): a stuck contact's force is kt u, its mean holds the
+    part, and only a part that slides as a whole through the cycle has no unique mean position.
+    """
+    from ..systems import rigid_mode_dof
+
+    if not (system.contacts or system.interfaces):
+        return False
+    return rigid_mode_dof(system.K_reference) is not None and rigid_mode_dof(stuck_stiffness(system)) is None
 
 
 @by_identity

@@ -12,10 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import config
 from ..continuation import ContinuationStatus
 from ..status import Status
 from .parameters import GAMMA
-from .problem import HBProblem
+from .problem import HBProblem, stuck_stiffness
 
 __all__ = ["JOINED", "DiscretisationCheck", "HBBranch", "HBPeak", "HBSolution", "PointStatus", "SolveStatus"]
 
@@ -268,5 +269,46 @@ class HBSolution:
 
     @property
     def message(self) -> str:
-        """The status's message, with the residual and the iterations."""
-        return f"{self.status.message} (max |R| = {self.residual_norm:.4g} N after {self.iterations} iterations)"
+        """The status's message, with the residual and the iterations (and, where Newton failed on a part held
+        only through its contacts that slides as a whole, that: :func:`sliding_as_a_whole`)."""
+        out = f"{self.status.message} (max |R| = {self.residual_norm:.4g} N after {self.iterations} iterations)"
+        if not self.status.ok and self.problem.restart_at_reference:
+            out += sliding_as_a_whole(self.problem, self.problem.evaluate(self.X, self.problem.f1_ref).JX)
+        return out
+
+
+#: |dR/dX v| / |K_stuck v| below which a rigid-body mode v of K_reference is not held by the contacts
+_NOT_HELD_RTOL = 1e-8
+
+
+def sliding_as_a_whole(problem: HBProblem, JX) -> str:
+    """``"; ..."`` saying that the part slides as a whole, or ``""``.
+
+    For a problem held only through its contacts
+    (:attr:`HBProblem.restart_at_reference`, full unknowns): where the
+    static harmonic's Jacobian ``JX`` (dense, N/m) along a rigid-body mode v
+    of ``System.K_reference`` is below ``_NOT_HELD_RTOL`` of the stuck
+    structure's ``K_stuck v``, no contact resists a shift of the part: every
+    one of its contacts slips every cycle (macroslip), the
+    part's mean position is not unique, and Newton fails on a singular
+    matrix. That is the physics of the part, not a failure of the method.
+    (A Jenkins element that sticks only at the reversals is such a
+    contact too: each slip forgets where the last one ended.)
+    """
+    if (not problem.restart_at_reference or problem.condensed or not isinstance(JX, np.ndarray)
+            or JX.shape[0] != problem.size or problem.system.ndof > config.SYSTEM_DENSE_CHECK_MAX_DOF
+            or not np.all(np.isfinite(JX))):
+        return ""
+    K = problem.system.K_reference
+    lam, vec = np.linalg.eigh(0.5 * (K + K.T))
+    Ks = stuck_stiffness(problem.system)
+    for j in np.flatnonzero(lam <= config.SYSTEM_RIGID_MODE_RTOL * abs(lam[-1])):
+        v = vec[:, j]
+        held = float(np.linalg.norm(JX[:, :problem.n] @ v))
+        if held <= _NOT_HELD_RTOL * float(np.linalg.norm(Ks @ v)):
+            dof = int(np.argmax(np.abs(v)))
+            return (f"; the part held only through its contacts (mostly DOF {dof}) slides as a whole there: its "
+                    "contacts slip every cycle (macroslip) and resist no shift of it, so its mean position is "
+                    "not unique (the static harmonic is singular): the physics of the part, not a failure of the "
+                    "method")
+    return ""

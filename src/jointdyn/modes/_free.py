@@ -78,7 +78,7 @@ def _constant(load) -> bool:
     return isinstance(load, HarmonicLoad) and load.n1 == 0.0
 
 
-def check_free_vibration(system, method: str, *, springs: bool = True) -> System:
+def check_free_vibration(system, method: str, *, springs: bool = True, held: bool = False) -> System:
     """``system`` if it describes a free vibration with frictional contacts; ValueError otherwise.
 
     Parameters
@@ -89,6 +89,11 @@ def check_free_vibration(system, method: str, *, springs: bool = True) -> System
     springs : bool
         Whether the method takes normal springs and interfaces (node pairs, whose normal loads follow the
         motion): QSMA takes neither.
+    held : bool
+        Whether the method takes a structure held only through its contacts (K with the tangential contacts
+        free singular, the stuck stiffness not: :func:`jointdyn.hb.problem.held_by_contacts`): EPMC does (its
+        harmonic balance restarts the laws at the preloaded static state), QSMA does not (its static
+        equilibrium of the slipping structure needs K with the contacts free).
     """
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
@@ -119,7 +124,19 @@ def check_free_vibration(system, method: str, *, springs: bool = True) -> System
     from scipy.linalg import eigh
 
     lam = eigh(system.K_reference, system.M, eigvals_only=True)
-    if not lam[0] > MODES_MIN_EIGENVALUE_RATIO * abs(lam[-1]):
+    if held and not _resolved(lam):
+        # held only through the contacts: the stuck structure must be held (a DOF held by nothing is refused)
+        lam = eigh(stuck_stiffness(system), system.M, eigvals_only=True)
+        if _resolved(lam):
+            return system
+        what = ("is ill-conditioned with every contact stuck: its smallest eigenvalue of (M, K), "
+                f"{lam[0]:.6g} (rad/s)^2, is {lam[0] / lam[-1]:.3g} of the largest, below the ratio "
+                f"{MODES_MIN_EIGENVALUE_RATIO:g} that double precision resolves (a normal stiffness kn many "
+                "decades below the others?)" if lam[0] > 0.0 else
+                "must be positive definite with every contact stuck (smallest eigenvalue of (M, K + kt + kn) "
+                f"{lam[0]:.6g} (rad/s)^2: a DOF held by nothing)")
+        raise ValueError(f"K {what}: {method} needs a static equilibrium of the stuck structure")
+    if not _resolved(lam):
         # a positive eigenvalue below the ratio is a stiffness too small beside the others, not a free DOF
         what = ("is ill-conditioned with the tangential contacts free: its smallest eigenvalue of (M, K), "
                 f"{lam[0]:.6g} (rad/s)^2, is {lam[0] / lam[-1]:.3g} of the largest, below the ratio "
@@ -130,6 +147,12 @@ def check_free_vibration(system, method: str, *, springs: bool = True) -> System
         raise ValueError(f"K {what}: {method} needs a static equilibrium of the slipping structure (the mean "
                          "of the motion is not held by friction)")
     return system
+
+
+def _resolved(lam) -> bool:
+    """True when the smallest eigenvalue ``lam[0]`` of (M, K) is above ``MODES_MIN_EIGENVALUE_RATIO``
+    of the largest (K positive definite, as double precision resolves it)."""
+    return bool(lam[0] > MODES_MIN_EIGENVALUE_RATIO * abs(lam[-1]))
 
 
 def output_dof_of(system: System, output_dof) -> int:

@@ -69,6 +69,7 @@ from ..hb import HBProblem
 from ..hb._sparse import linear_entries
 from ..hb.levels import AUTO, Discretisation, check_memory
 from ..hb.problem import contacts_only
+from ..hb.results import sliding_as_a_whole
 from ..kinematics import contact_kinematics, selection_matrix
 from ._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
 from .backbone import Backbone, ModeStatus
@@ -152,7 +153,7 @@ class EPMCProblem:
     def __init__(self, system, *, mode: int = 1, output_dof: int | None = None,
                  harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
                  max_passes: int = config.HB_MAX_PASSES):
-        check_free_vibration(system, "EPMC")
+        check_free_vibration(system, "EPMC", held=True)
         self.system = system
         self.output_dof = output_dof_of(system, output_dof)
         n = system.ndof
@@ -461,7 +462,7 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
 
         return auto_backbone(epmc, system, amplitude, harmonics=harmonics, samples=samples, mode=mode,
                              output_dof=output_dof, options=options, progress=progress, reduce=reduce, **overrides)
-    check_free_vibration(system, "EPMC")
+    check_free_vibration(system, "EPMC", held=True)
     lo, hi = amplitude_range(system, amplitude)
     reduction = None
     if reduce is not None:
@@ -496,4 +497,7 @@ def _walked(problem: EPMCProblem, lam0, lam1, opt, progress, reduction) -> Backb
         res = continuation(problem.residual, v0, lam0, lam1, opt, monitor=keep, progress=bar)
     status = _STATUS.get(res.status, ModeStatus.FAILED if res.lam.size else ModeStatus.NO_START)
     message = res.message.replace("lam = ", "log10(amplitude / m) = ")
+    if status is ModeStatus.FAILED and problem.hb.restart_at_reference and problem.last is not None:
+        # a part held only through its contacts that slides as a whole: its mean is not unique (the physics)
+        message += sliding_as_a_whole(problem.hb, problem.last[3].JX)
     return _backbone(problem, status, message, res.lam, res.y, stash, res.counters, reduction)
