@@ -43,6 +43,11 @@ class RingdownOptions:
     min_windows_per_knot : int
         Fewest windows between two knots of the spline that the decay model's misfit is
         measured against.
+    misfit_limit : float
+        Where the decay model's weighted rms residual exceeds this many times that of a
+        cubic spline (knots every 0.25 of ln A), the decay is not of the microslip form (a
+        decay through macroslip): ln A(t) and omega(t) are then the spline's, knots chosen by
+        generalised cross-validation, and the damping ratio is the decay's own.
     trim_decays : float
         Time constants of the band-pass filter's slowest pole trimmed at each end of the
         record (its transients; with the odd extension before filtering, 4 left at most
@@ -52,10 +57,13 @@ class RingdownOptions:
     amplitude_rtol: float = 0.03
     min_windows_per_knot: int = 4
     trim_decays: float = 4.0
+    misfit_limit: float = 3.0
 
     def __post_init__(self) -> None:
         if not 0.0 < self.amplitude_rtol < 1.0:
             raise ValueError(f"amplitude_rtol must be in (0, 1), got {self.amplitude_rtol!r}")
+        if not self.misfit_limit > 1.0:
+            raise ValueError(f"misfit_limit must be > 1 (allowed range (1, inf)), got {self.misfit_limit!r}")
         if not self.trim_decays > 0.0:
             raise ValueError(f"trim_decays must be > 0 (allowed range (0, inf)), got {self.trim_decays!r}")
         if not (isinstance(self.min_windows_per_knot, int) and self.min_windows_per_knot >= 2):
@@ -83,6 +91,34 @@ def _fit(t, y, w, inner):
     spl = make_lsq_spline(t, y, knots, k=3, w=w)
     r = (spl(t) - y) * w
     return spl, float(r @ r), knots.size - 4
+
+
+def _spline_envelope(t, lna, omega, options):
+    """The fallback of :func:`smooth_envelope` for a decay not of the microslip form: cubic
+    least-squares splines of ln A and omega, weighted by A, knots at equal falls of ln A chosen
+    by generalised cross-validation; the noise and the tail as there."""
+    amp = np.exp(lna)
+
+    def best(t_, y_, w_):
+        out = None
+        for fall in (0.1, 0.15, 0.25, 0.4, 0.6, 1.0):
+            inner = _knots(t_, y_, fall, options.min_windows_per_knot)
+            spl, rss, p = _fit(t_, y_, w_, inner)
+            if t_.size - p >= 2:
+                gcv = t_.size * rss / (t_.size - p) ** 2
+                if out is None or gcv < out[0]:
+                    out = (gcv, spl, inner)
+        return (out[1], out[2]) if out else (_fit(t_, y_, w_, np.array([]))[0], np.array([]))
+
+    spl, _ = best(t, lna, amp)
+    r = (spl(t) - lna) * amp
+    noise = 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    bad = np.flatnonzero(noise / np.exp(spl(t)) > options.amplitude_rtol)
+    keep = max(int(bad[0]) if bad.size else t.size, min(t.size, 6))
+    t, lna, omega, amp = t[:keep], lna[:keep], omega[:keep], amp[:keep]
+    spl, inner = best(t, lna, amp)
+    wfit = _fit(t, omega, amp, inner)[0]
+    return keep, spl(t), spl.derivative()(t), wfit(t), noise
 
 
 def power_decay(t, lna0, a0, b, p):
@@ -177,9 +213,9 @@ def smooth_envelope(t, lna, omega, options: RingdownOptions) -> tuple:
         How many windows (from the first) are above the noise; the arrays below have this length.
     lna_fit, rate, omega_fit : ndarray
         The smooth ln A, d ln A / dt (1/s) and omega (rad/s) at ``t[:keep]``.
-    exponent : float
-        p.
-    omega0 : float
+    exponent : float or None
+        p (None: the decay is not of this form, the spline's values are returned).
+    omega0 : float or None
         c0, the frequency the model extrapolates to at zero amplitude, rad/s.
     noise : float
         The amplitude's standard error, in the units of exp(lna).
@@ -189,6 +225,13 @@ def smooth_envelope(t, lna, omega, options: RingdownOptions) -> tuple:
     """
     amp = np.exp(lna)
     x, r, rw = _fit_decay(t, lna, omega, amp)
+    inner = _knots(t, lna, 0.25, options.min_windows_per_knot)
+    if t.size - inner.size - 4 >= 2:
+        rs = _fit(t, lna, amp, inner)[1]
+        misfit = math.sqrt((float(r @ r) / max(t.size - 4, 1)) / max(rs / (t.size - inner.size - 4), 1e-300))
+        if misfit > options.misfit_limit:
+            keep, lf, rate, wfit, noise = _spline_envelope(t, lna, omega, options)
+            return keep, lf, rate, wfit, None, None, noise, misfit
     noise = 1.4826 * float(np.median(np.abs(r - np.median(r))))  # robust scale (MAD)
     fit0 = power_decay(t - t[0], *x[:4])
     bad = np.flatnonzero(noise / np.exp(fit0) > options.amplitude_rtol)

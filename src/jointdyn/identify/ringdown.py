@@ -279,15 +279,18 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
         dropped = max(dropped, float(tk[-1] - centre[keep_w]))
     centre = centre[:keep_w]
     A, D_decay = np.exp(lna), -rate / w
-    D = D_decay * epmc_factor(expo, w0, w)
+    D = D_decay * epmc_factor(expo, w0, w) if expo is not None else D_decay
     w_at = np.interp(tk, centre, w) if power else 1.0
     # for figures only (the points come from the local fits); of the whole filtered record, so
     # that the transform's own end effects fall in the trimmed parts
     env = np.abs(hilbert(yf))[keep] / w_at ** power
     trimmed = (float(tk[0] - t[0]), float(t[-1] - tk[-1]) + dropped)
     msg = (f"band {low:.4g} to {high:.4g} rad/s (zero-phase Butterworth, order {config.RINGDOWN_FILTER_ORDER}); "
-           f"amplitudes of {cycles}-cycle windows between zero crossings, decay -d ln A/dt = a0 + a1 A^p "
-           f"fitted (p = {expo:.3g}; misfit {misfit:.3g} of a spline's), damping from its slope; {trimmed[0]:.4g} s trimmed at the start and "
+           f"amplitudes of {cycles}-cycle windows between zero crossings, " + (
+           f"decay -d ln A/dt = a0 + a1 A^p fitted (p = {expo:.3g}; misfit {misfit:.3g} of a spline's), damping "
+           f"from its slope in EPMC's definition;" if expo is not None else
+           f"not a microslip decay (misfit {misfit:.3g} of a spline's): ln A(t) by a cubic spline, damping the "
+           f"decay's own -(d ln A/dt)/omega, not EPMC's;") + f" {trimmed[0]:.4g} s trimmed at the start and "
            f"{trimmed[1]:.4g} s at the end "
            f"(end effects: {trim / period:.3g} periods each{'; and the tail within the noise' if dropped else ''}); "
            f"{A.size} points")
