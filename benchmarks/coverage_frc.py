@@ -57,7 +57,8 @@ def run(seeds: int) -> dict:
             hits[n] += bool(fit.parameters[n] is None or fit.intervals[n].covers(v))
             if fit.parameters[n] is not None:
                 worst[n] = max(worst[n], abs(fit.parameters[n] / v - 1.0))
-        print(seed, fit.status.value, {n: fit.parameters[n] for n in TRUE}, file=sys.stderr, flush=True)
+        print(seed, fit.status.value, {n: fit.parameters[n] for n in TRUE},
+              {n: fit.intervals[n].covers(v) for n, v in TRUE.items()}, file=sys.stderr, flush=True)
     return {"seeds": seeds, "coverage": {n: h / seeds for n, h in hits.items()}, "largest_relative_error": worst,
             "seconds_median": float(np.median(seconds))}
 
