@@ -16,10 +16,12 @@ W0 = 500.0
 T0 = 2.0 * math.pi / W0
 
 
-def _decay(path, per=64, periods=150, zeta=0.0025, column="x", steady=False):
+def _decay(path, per=64, periods=150, zeta=0.0025, column="x", steady=False, two=False):
     t = np.arange(0.0, periods * T0, T0 / per)
     env = np.ones(t.size) if steady else np.exp(-zeta * W0 * t)
     y = 1e-4 * env * np.cos(W0 * math.sqrt(1 - zeta * zeta) * t)
+    if two:  # a second mode 8 % above the first, as strong: both in one band
+        y = y + 1e-4 * np.exp(-zeta * 1.08 * W0 * t) * np.cos(1.08 * W0 * t)
     np.savetxt(path, np.column_stack([t, y]), delimiter=",", header=f"t,{column}", comments="")
     return path
 
@@ -47,6 +49,7 @@ def test_a_linear_ringdown_is_written_as_a_backbone_and_fitted(tmp_path, capsys)
     (dict(periods=8), "shorter than"),
     (dict(per=6), "aliased"),
     (dict(steady=True), "no decay"),
+    (dict(two=True), "two modes in the band"),
     (dict(column="displacement"), "exactly one of x"),
 ])
 def test_bad_ringdowns_one_line_exit_2_no_file(tmp_path, capsys, kw, word):

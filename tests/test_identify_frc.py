@@ -1,7 +1,8 @@
-"""Stepped-sine response curves to a modal Iwan model (jointdyn.identify.fit_frc, issue 32):
-curves made by harmonic balance (one harmonic: the describing function's own model) at three
-force levels, 50 points each, 1 % noise on the amplitude: k, kt and fy_N within 3 % (zeta: see
-the test)."""
+"""Stepped-sine response curves to a modal Iwan model (jointdyn.identify.fit_frc): curves made
+by harmonic balance (one harmonic: the describing function's own model) at three force levels,
+50 points each, 1 % noise on the amplitude: every parameter within 3 % and inside its 95 %
+interval (the coverage over seeds is measured by benchmarks/coverage_frc.py), and the model's
+response solved by fit_frc's root search against the curves without noise."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ from jointdyn.hb import frc_hb
 from jointdyn.identify.frc import fit_frc
 
 
-def test_response_curves_by_hb_give_the_parameters_within_3_percent():
+def _curves():
     law = jd.make_law("iwan", kt=1e5, mu=0.2, n_ref=100.0)
     m, k, zeta = 2.0, 4e5, 0.002
     cols = []
@@ -26,18 +27,40 @@ def test_response_curves_by_hb_give_the_parameters_within_3_percent():
         g, A = np.asarray(ds["gamma"]), np.asarray(ds["amplitude_m"])
         pick = np.linspace(0, g.size - 1, 50).astype(int)
         cols.append(np.column_stack([np.full(50, F), g[pick] * s.w0, A[pick]]))
-    F, w, A = np.concatenate(cols).T
+    return np.concatenate(cols).T
+
+
+def test_response_curves_by_hb_give_the_parameters_within_3_percent():
+    m, k, zeta = 2.0, 4e5, 0.002
+    F, w, A = _curves()
     A = A * (1.0 + 0.01 * np.random.default_rng(0).normal(size=A.size))
     fit = fit_frc(F, w, A, mass=m, model="iwan")
     assert fit.status.ok, fit.message
-    err = {n: fit.parameters[n] / true - 1.0 for n, true in (("k", k), ("kt", 1e5), ("fy_N", 20.0), ("zeta", zeta))}
+    true = {"k": k, "kt": 1e5, "fy_N": 20.0, "zeta": zeta}
+    err = {n: fit.parameters[n] / v - 1.0 for n, v in true.items()}
     print("relative errors", err, "intervals", {n: (v.low, v.high) for n, v in fit.intervals.items()})
-    for name in ("k", "kt", "fy_N"):
+    # measured at seed 0: k -0.01 %, kt 0.00 %, fy_N +0.08 %, zeta -0.14 % (the weighted
+    # equation error before the amplitude's own error gave zeta +5.3 % and missed kt, fy, zeta)
+    for name in true:
         assert abs(err[name]) < 0.03, err
-    # zeta falls short of issue 32's 3 % (measured +5.3 %; the plain equation error gave -4.6 %):
-    # the linear damping is seen only at the peak of the lowest level, where 1 % amplitude noise
-    # weighs most. This bound records the present state, not the goal.
-    assert abs(err["zeta"]) < 0.06, err
-    # the intervals are reported, but their coverage is not established for response curves:
-    # here they missed kt (+0.4 %), fy_N (-1.0 %) and zeta
-    assert set(fit.to_dict()["intervals"]) == {"k", "kt", "fy_N", "zeta"}
+        assert fit.intervals[name].closed and fit.intervals[name].covers(true[name]), name
+
+
+def test_the_models_response_is_the_hb_curve():
+    """fit_frc's response (the stable root of |Z(A)| A = F nearest the measurement) at the true
+    parameters gives the HB curves' amplitudes within 0.1 % (measured 0.075 %: HB's AFT against
+    the describing function's quadrature), the upper and the lower branch of a fold alike."""
+    from jointdyn.identify.backbone import describing_function
+    from jointdyn.identify.frc import response
+
+    law = jd.make_law("iwan", kt=1e5, mu=20.0, n_ref=1.0)  # fy = 20 N at N = n_ref
+    m, k, c = 2.0, 4e5, 2 * 0.002 * math.sqrt(5e5 * 2.0)
+    F, w, A = _curves()
+
+    def ratio(a):
+        a = np.asarray(a, dtype=float)
+        k1, en = (x.reshape(a.shape) for x in describing_function(law, a.ravel()))
+        return np.hypot(k + k1 - m * w * w, en / (math.pi * a * a) + c * w) * a / F
+
+    got = response(ratio, A, np.geomspace(A.min() / 3.0, A.max() * 3.0, 100))
+    assert np.max(np.abs(got / A - 1.0)) < 1e-3

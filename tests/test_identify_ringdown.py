@@ -1,7 +1,9 @@
-"""Ring-down to backbone (jointdyn.backbone_from_ringdown, issue 32), checked against closed
-forms (a linear free decay) and against the describing-function backbone of an SDOF with an
-Iwan joint whose free decay jointdyn's own time integration computes; and bad data refused
-with one clear error."""
+"""Ring-down to backbone (jointdyn.backbone_from_ringdown), checked against closed forms (a
+linear free decay) and against the EPMC backbone of the same model for free decays that
+jointdyn's own time integration computes, with white noise of 1 % of the record's peak: an
+SDOF with an Iwan joint, one with a Segalman joint, and a 3-DOF chain whose other two modes
+are in the signal; the fitted parameters of the Iwan decay; and bad data refused with one
+clear error."""
 
 from __future__ import annotations
 
@@ -11,7 +13,6 @@ import numpy as np
 import pytest
 
 import jointdyn as jd
-from jointdyn.identify.backbone import _model
 from jointdyn.identify.ringdown import backbone_from_ringdown
 
 W0 = 500.0
@@ -33,39 +34,114 @@ def test_a_linear_decay_gives_its_damping_ratio_and_frequency(kind):
     t, y = _linear(kind=kind)
     b = backbone_from_ringdown(t, y, kind)
     assert b.amplitude_m.size >= 10
-    # what is left of the filter's transients next to the trimmed ends: measured 1.2 % at the
-    # first window, 0.4 % at the last; 3e-6 in the middle
-    np.testing.assert_allclose(b.damping_ratio, 0.0025, rtol=0.015)
-    n = b.amplitude_m.size
-    np.testing.assert_allclose(b.damping_ratio[n // 4: 3 * n // 4], 0.0025, rtol=1e-4)
+    # one decay model for the whole record (the viscous rate a0 alone): measured 5e-4 low
+    np.testing.assert_allclose(b.damping_ratio, 0.0025, rtol=1e-3)
     np.testing.assert_allclose(b.omega_rad_s, W0 * math.sqrt(1 - 0.0025 ** 2), rtol=1e-3)
     # the envelope: exp(-zeta w0 t) at the window centres, m (velocity divided by omega)
     assert np.all(np.diff(b.amplitude_m) < 0.0)
     assert "trimmed" in b.message and b.trimmed_s[0] >= 10 * T0
 
 
-def test_iwan_free_decay_by_time_integration_matches_its_backbone():
-    """m = 2 kg, k = 4e5 N/m, Iwan kt = 1e5 N/m, fy = 20 N, zeta = 0.2 %, released from 3 slip
-    displacements, 64 samples per period. Where the damping ratio changes slowly (amplitudes
-    0.03 to 0.25 phi_max: measured within 1.3 %), the extracted frequency is within 0.5 % and
-    the damping ratio within 5 % of the one-harmonic backbone. Closer to macroslip the damping
-    ratio changes by much within one window (the slowly varying assumption fails, +6 % at
-    0.23 phi_max) and is not checked here."""
-    from jointdyn.dynamics.integrate import integrate_sampled
+def _sdof(name):
+    kw = dict(chi=-0.5, beta=0.1) if name == "segalman" else {}
+    law = jd.make_law(name, kt=1e5, mu=0.2, n_ref=100.0, **kw)
+    m, k, zeta = 2.0, 4e5, 0.002
+    return jd.System.sdof(m=m, k=k, law=law, c=2 * zeta * math.sqrt((k + 1e5) * m)), law
+
+
+def _chain():
+    """3 unit masses in a chain of 1e5 N/m springs fixed at one end, an Iwan joint (kt = 1e5 N/m,
+    fy = 20 N) from the first mass to ground, modal damping 0.2 %; measured at the free end.
+    Stuck frequencies 164, 447 and 611 rad/s."""
+    from jointdyn.systems import modal_damping
 
     law = jd.make_law("iwan", kt=1e5, mu=0.2, n_ref=100.0)
-    m, k, zeta = 2.0, 4e5, 0.002
-    system = jd.System.sdof(m=m, k=k, law=law, c=2 * zeta * math.sqrt((k + 1e5) * m))
-    period = 2.0 * math.pi / math.sqrt((k + 1e5) / m)
-    t = np.arange(0.0, 150 * period, period / 64)
-    tr = integrate_sampled(system, t, np.zeros((t.size, 1)), np.full((t.size, 1), 100.0), x0=[3 * law.x_slip])
-    x = tr.x[np.searchsorted(tr.t, t), 0]
+    K = 1e5 * np.array([[2.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 1.0]])
+    Kst = K.copy()
+    Kst[0, 0] += law.kt
+    C = modal_damping(np.eye(3), Kst, 0.002)
+    return jd.System(M=np.eye(3), C=C, K=K, contacts=(jd.Contact(law=law, dof=0),), output_dof=2), law, Kst
+
+
+def _decay(system, law, x0, dof, w1, periods, per, seed=0):
+    """The free decay from x0 by time integration, sampled ``per`` times a period of w1, with
+    white noise of 1 % of the record's peak."""
+    from jointdyn.dynamics.integrate import integrate_sampled
+
+    period = 2.0 * math.pi / w1
+    t = np.arange(0.0, periods * period, period / per)
+    n = system.ndof
+    tr = integrate_sampled(system, t, np.zeros((t.size, n)), np.full((t.size, 1), 100.0), x0=x0)
+    x = tr.x[np.searchsorted(tr.t, t), dof]
+    return t, x + 0.01 * np.max(np.abs(x)) * np.random.default_rng(seed).normal(size=x.size)
+
+
+def _against_epmc(system, b, harmonics=3):
+    """(omega / EPMC's - 1, D / EPMC's - 1) at the extracted amplitudes."""
+    from jointdyn.modes import epmc
+
+    bb = epmc(system, (0.5 * b.amplitude_m.min(), 1.5 * b.amplitude_m.max()), harmonics=harmonics,
+              progress=False)
+    assert bb.status.ok, bb.message
+    la, at = np.log(bb.amplitude_m), np.log(b.amplitude_m)
+    return b.omega_rad_s / np.interp(at, la, bb.omega_rad_s) - 1.0, b.damping_ratio / np.interp(
+        at, la, bb.damping_ratio) - 1.0
+
+
+@pytest.mark.parametrize("name", ["iwan", "segalman"])
+def test_sdof_free_decay_with_noise_matches_its_epmc_backbone(name):
+    """m = 2 kg, k = 4e5 N/m, kt = 1e5 N/m, fy = 20 N (Segalman: chi = -0.5, beta = 0.1),
+    zeta = 0.2 %, released from 0.4 slip displacements, 64 samples per period, 1 % noise. Over
+    10 noise seeds the largest errors of the damping ratio were 0.5 to 3.7 % (Iwan) and 1.0 to
+    5.9 % (Segalman, one seed above 5 %), of the frequency at most 0.1 %; seed 0 here."""
+    system, law = _sdof(name)
+    t, x = _decay(system, law, [0.4 * law.x_slip], 0, math.sqrt(5e5 / 2.0), 150, 64)
     b = backbone_from_ringdown(t, x, "x")
-    w_ref, D_ref = _model(law, k, zeta, m, b.amplitude_m)
-    assert np.max(np.abs(b.omega_rad_s / w_ref - 1.0)) < 0.005
-    ok = (b.amplitude_m > 0.03 * law.x_slip) & (b.amplitude_m < 0.25 * law.x_slip)
-    assert np.count_nonzero(ok) >= 5
-    assert np.max(np.abs(b.damping_ratio[ok] / D_ref[ok] - 1.0)) < 0.05
+    # the decay covers a decade of amplitude at least
+    assert b.amplitude_m.max() > 10.0 * b.amplitude_m.min() and b.amplitude_m.max() > 0.1 * law.x_slip
+    ew, eD = _against_epmc(system, b)
+    assert np.max(np.abs(ew)) < 0.005
+    assert np.max(np.abs(eD)) < 0.05, eD
+
+
+def test_iwan_free_decay_fitted_parameters_within_3_percent():
+    """The Iwan decay above stays in microslip (below 0.17 phi_max once the filter's end is
+    trimmed): it determines k + kt, R = kt^2 / (2 fy) and zeta, not kt and fy apart. Measured
+    over 6 seeds: k + kt within 0.03 %, R within 2.4 %, zeta within 2.9 %."""
+    system, law = _sdof("iwan")
+    t, x = _decay(system, law, [0.4 * law.x_slip], 0, math.sqrt(5e5 / 2.0), 150, 64)
+    b = backbone_from_ringdown(t, x, "x")
+    fit = jd.fit_backbone(b.amplitude_m, b.omega_rad_s, b.damping_ratio, mass=2.0, model="iwan")
+    assert fit.status.value == "partly-identified" and {"kt", "fy_N"} <= set(fit.not_identifiable)
+    c = fit.determined_combinations
+    for name, true in (("k_plus_kt", 5e5), ("R", 1e10 / 40.0), ("zeta", 0.002)):
+        assert abs(c[name]["value"] / true - 1.0) < 0.03, (name, c[name]["value"])
+
+
+def test_three_dof_free_decay_with_other_modes_matches_its_epmc_backbone():
+    """The chain of _chain released in its first stuck mode (0.4 slip displacements at the
+    joint) plus its second and third (0.03 slip displacements each at the joint: 2 % and 0.5 %
+    of the first mode's amplitude at the measured end), 96 samples per period of the first,
+    1 % noise. The band-pass keeps the other modes out and the frequency is within 0.5 %
+    everywhere. The damping ratio is within 5 % of EPMC's over the lower three quarters of the
+    decay's log-amplitude range (measured over 8 seeds: at most 3.1 %); in the top sixth it is
+    up to 9 to 12 % high for every seed (4.4 % without noise and without the other modes):
+    where the joint slips most this structure decays faster than its single-mode EPMC
+    backbone says, a miss of the ring-down method on this structure that is not noise."""
+    system, law, Kst = _chain()
+    lam, phi = np.linalg.eigh(Kst)
+    x0 = 0.4 * law.x_slip * phi[:, 0] / phi[0, 0] + 0.03 * law.x_slip * (
+        phi[:, 1] / abs(phi[0, 1]) + phi[:, 2] / abs(phi[0, 2]))
+    t, x = _decay(system, law, x0, 2, math.sqrt(lam[0]), 200, 96)
+    b = backbone_from_ringdown(t, x, "x")
+    assert b.band_rad_s[1] < math.sqrt(lam[1])  # the other modes are outside the band
+    ew, eD = _against_epmc(system, b)
+    assert np.max(np.abs(ew)) < 0.005
+    la = np.log(b.amplitude_m)
+    below = la < la.max() - 0.25 * (la.max() - la.min())
+    assert np.count_nonzero(below) > 0.5 * la.size
+    assert np.max(np.abs(eD[below])) < 0.05, eD
+    assert np.max(np.abs(eD)) < 0.15, eD
 
 
 @pytest.mark.parametrize("case,word", [

@@ -22,7 +22,7 @@ from .frc import fit_frc
 from .loops import LOOP_MODELS, fit_loops
 from ._profile import Interval
 from .result import FitResult, FitStatus
-from .ringdown import RingdownBackbone, backbone_from_ringdown
+from .ringdown import RingdownBackbone, RingdownOptions, backbone_from_ringdown
 
 __all__ = ["fit_loops", "fit_backbone", "fit_frc", "describing_function", "FitResult", "FitStatus", "Interval",
-           "backbone_from_ringdown", "RingdownBackbone", "LOOP_MODELS", "BACKBONE_MODELS"]
+           "backbone_from_ringdown", "RingdownBackbone", "RingdownOptions", "LOOP_MODELS", "BACKBONE_MODELS"]

@@ -12,18 +12,25 @@ The ring-down practice of the modal-Iwan literature (docs/guide/identify.md):
    envelope drawn in figures; the points below do not use it: on a decaying
    record its end effects reached several percent of the damping ratio);
 4. the first and last ``trim_periods`` periods, or more where the filter's
-   slowest pole needs ``config.RINGDOWN_TRIM_DECAYS`` time constants to die
+   slowest pole needs ``RingdownOptions.trim_decays`` time constants to die
    out, are dropped: the filter's transients live there (the result says how
    much was dropped);
-5. between upward zero crossings, windows of ``cycles`` whole cycles give
-   the frequency (cycles over the time taken: no derivative of a noisy
-   phase) and, by linear least squares of y ~ A exp(r tau) cos(omega tau +
-   phi) about the window's centre, the amplitude A and the decay rate r
-   (damping ratio -r / omega); a window grows (doubling) until r is known to
-   ``config.RINGDOWN_RATE_RTOL``, and the tail where no window reaches
-   ``config.RINGDOWN_RATE_LIMIT`` is in the noise and dropped;
-6. a velocity or acceleration signal is turned into displacement amplitude
-   by dividing by omega or omega^2.
+5. between upward zero crossings, consecutive windows of ``cycles`` whole
+   cycles give the frequency (cycles over the time taken: no derivative of a
+   noisy phase) and, by linear least squares of y ~ A exp(r tau) cos(omega tau
+   + phi) about the window's centre, the amplitude A;
+6. the decay is not differentiated window by window (with 1 % noise the rate
+   of a two-cycle window scatters by tens of percent): the smooth model
+   -d ln A/dt = a0 + a1 A^p, omega = c0 - c1 A^p (viscous damping and a joint
+   in microslip) is fitted to all windows at once, weighted by their noise,
+   which is measured from the scatter (:mod:`._envelope`); the tail where the
+   amplitude's error exceeds ``RingdownOptions.amplitude_rtol`` is dropped;
+7. the damping ratio is EPMC's: the decay's -(d ln A/dt)/omega times
+   :func:`epmc_factor` (the decay rate counts the energy stored at a turning
+   point, EPMC the first-harmonic stiffness: 2.7 % apart at a quarter of the
+   slip displacement of Iwan's law);
+8. a velocity or acceleration signal is turned into displacement amplitude
+   by dividing by omega or omega^2 before the model is fitted.
 
 Bad data raise ValueError: fewer than 10 samples per period at the top of the
 band (aliased), shorter than ``2 trim_periods + 2 cycles`` periods, no decay
@@ -39,8 +46,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import config
+from ._envelope import RingdownOptions, smooth_envelope
 
-__all__ = ["RingdownBackbone", "backbone_from_ringdown", "SIGNAL_KINDS"]
+__all__ = ["RingdownBackbone", "RingdownOptions", "backbone_from_ringdown", "SIGNAL_KINDS"]
 
 #: what the signal measures: displacement (m), velocity (m/s), acceleration (m/s^2)
 SIGNAL_KINDS = ("x", "v", "a")
@@ -53,8 +61,9 @@ class RingdownBackbone:
     Attributes
     ----------
     amplitude_m, omega_rad_s, damping_ratio : ndarray
-        One point per window, from the largest amplitude down (m, rad/s, -): the columns
-        of ``jointdyn fit --backbone``.
+        One point per window, from the largest amplitude down (m, rad/s, -), of the decay
+        model fitted to all windows (module docstring); the damping ratio is EPMC's
+        (:func:`epmc_factor`). The columns of ``jointdyn fit --backbone``.
     band_rad_s : tuple
         The pass band of the zero-phase filter, rad/s.
     trimmed_s : tuple
@@ -73,6 +82,28 @@ class RingdownBackbone:
     t: np.ndarray
     envelope_m: np.ndarray
     message: str
+
+
+def epmc_factor(p, omega0, omega):
+    """The damping ratio of EPMC over the decay's -(d ln A / dt) / omega at each frequency omega.
+
+    EPMC's damping ratio is the energy dissipated per period over 2 pi m omega^2 A^2 (the
+    first-harmonic stiffness times A^2); the decay rate is the energy per period over the
+    slope of the energy stored at a turning point, which for a joint of Jenkins elements in
+    parallel (Iwan, Segalman, discrete) is A (k + F'(A)), F' the tangent of the virgin curve:
+    the two differ by (k + F') / (k + K1). In microslip K1 = kt - c1(chi) R A^(chi+1) and
+    F' = kt - R A^(chi+1) / (chi+1), so with chi = p - 1 (the decay's exponent) and
+    k + kt = m omega0^2, k + K1 = m omega^2:
+
+        (k + F') / (k + K1) = 1 - (g - 1) (omega0^2 / omega^2 - 1),  g = 1 / ((chi+1) c1(chi)).
+
+    For Iwan's law (p = 1) g = 2: 2.7 % at a quarter of the slip displacement.
+    """
+    from ._microslip import _c1
+
+    chi = max(float(p) - 1.0, -0.99)
+    g = 1.0 / ((chi + 1.0) * _c1(chi))
+    return 1.0 - (g - 1.0) * np.maximum(omega0 * omega0 / (omega * omega) - 1.0, 0.0)
 
 
 def _uniform(t, y, name):
@@ -120,27 +151,49 @@ def _band(y, h):
 
 
 def _local_decay(tau, y, om, corr):
-    """(amplitude, d ln A / dt, its standard error) at tau = 0 of y ~ A exp(r tau) cos(om tau +
-    phi) over one window: linear least squares of (c0 + c1 tau) cos + (d0 + d1 tau) sin,
-    repeated on y exp(-r tau) so that the envelope's curvature does not bias r; the error
-    from the residual variance, the samples counted as independent every ``corr``."""
+    """(amplitude, its relative standard error) at tau = 0 of y ~ A exp(r tau) cos(om tau + phi)
+    over one window: linear least squares of (c0 + c1 tau) cos + (d0 + d1 tau) sin, repeated
+    on y exp(-r tau) so that the envelope's curvature does not bias A; the error from the
+    residual variance, the samples counted as independent every ``corr``. The amplitude is
+    sqrt(c0^2 + d0^2 - var c0 - var d0): without the variances the noise would raise it by
+    about var / (2 A), which at the noisy end of a decay flattens the envelope."""
     r = 0.0
     c, s = np.cos(om * tau), np.sin(om * tau)
     X = np.column_stack([c, s, tau * c, tau * s])
     for _ in range(3):
         z = y * np.exp(-r * tau)
-        coef, rss, _, _ = np.linalg.lstsq(X, z, rcond=None)
+        coef, _, _, _ = np.linalg.lstsq(X, z, rcond=None)
         a2 = coef[0] ** 2 + coef[1] ** 2
         r += (coef[0] * coef[2] + coef[1] * coef[3]) / a2
     res = z - X @ coef
     s2 = float(res @ res) / max(tau.size - 4, 1) * corr
     cov = s2 * np.linalg.inv(X.T @ X)
-    se = math.sqrt((coef[0] ** 2 * cov[2, 2] + coef[1] ** 2 * cov[3, 3]) / (a2 * a2))
-    return math.sqrt(a2), r, se
+    var_a = (coef[0] ** 2 * cov[0, 0] + coef[1] ** 2 * cov[1, 1] + 2.0 * coef[0] * coef[1] * cov[0, 1]) / a2
+    amp = math.sqrt(max(a2 - cov[0, 0] - cov[1, 1], 0.25 * a2))
+    return amp, math.sqrt(var_a) / amp
 
 
-def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_periods: float = 10.0,
-                           cycles: int = 2) -> RingdownBackbone:
+def _windows(tk, yk, tc, cycles, corr, rtol):
+    """(centre s, amplitude, relative error, omega rad/s) of consecutive windows of ``cycles``
+    whole cycles between the upward zero crossings ``tc``, and the seconds of tail dropped
+    (from the first window whose amplitude error exceeds ``rtol``: in the noise)."""
+    out = []
+    dropped = 0.0
+    for j in range(0, tc.size - cycles, cycles):
+        e = j + cycles
+        sel = slice(int(np.searchsorted(tk, tc[j])), int(np.searchsorted(tk, tc[e])))
+        om = 2.0 * math.pi * cycles / (tc[e] - tc[j])
+        centre = 0.5 * (tc[j] + tc[e])
+        amp, rel = _local_decay(tk[sel] - centre, yk[sel], om, corr)
+        if rel > rtol:
+            dropped = float(tk[-1] - tc[j])
+            break
+        out.append((centre, amp, rel, om))
+    return np.array(out).reshape(-1, 4).T, dropped
+
+
+def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_periods: float = 3.0,
+                           cycles: int = 2, options: RingdownOptions | None = None) -> RingdownBackbone:
     """Frequency and damping ratio against amplitude from a free decay (module docstring).
 
     Parameters
@@ -157,6 +210,8 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
         Least periods dropped at each end (more where the filter needs it: module docstring).
     cycles : int
         Whole cycles per backbone point (>= 1).
+    options : RingdownOptions, optional
+        The envelope's smoothing and where the noise ends it (default ``RingdownOptions()``).
 
     Returns
     -------
@@ -174,6 +229,9 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
 
     V.choice("kind", kind, SIGNAL_KINDS)
     V.positive_int("cycles", cycles)
+    options = RingdownOptions() if options is None else options
+    if not isinstance(options, RingdownOptions):
+        raise ValueError(f"options must be a RingdownOptions, got {type(options).__name__}")
     t, y, h = _uniform(t, signal, kind)
     if band is None:
         low, high, peak = _band(y, h)
@@ -201,7 +259,7 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
     from scipy.signal import sos2zpk
 
     slowest = -math.log(float(np.max(np.abs(sos2zpk(sos)[1])))) / h
-    trim = max(trim_periods * period, config.RINGDOWN_TRIM_DECAYS / slowest)
+    trim = max(trim_periods * period, options.trim_decays / slowest)
     keep = (t >= t[0] + trim) & (t <= t[-1] - trim)
     if np.count_nonzero(keep) < 2.0 * cycles * period / h:
         raise ValueError(f"the record lasts {t[-1] - t[0]:.4g} s, shorter than the {2 * trim:.4g} s trimmed (end "
@@ -211,45 +269,30 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
     tc = tk[up] - yk[up] * (tk[up + 1] - tk[up]) / (yk[up + 1] - yk[up])  # upward zero crossings
     # noise: the filtered noise is correlated over about pi / bandwidth seconds
     corr = max(1.0, math.pi / ((high - low) * h))
-    A, w, D, centre = [], [], [], []
-    j, dropped = 0, 0.0
-    while j + cycles < tc.size:
-        c, best = cycles, None
-        while True:  # the shortest window whose decay rate is known to RINGDOWN_RATE_RTOL
-            e = min(j + c, tc.size - 1)
-            sel = slice(int(np.searchsorted(tk, tc[j])), int(np.searchsorted(tk, tc[e])))
-            om = 2.0 * math.pi * (e - j) / (tc[e] - tc[j])
-            amp, rate, se = _local_decay(tk[sel] - 0.5 * (tc[j] + tc[e]), yk[sel], om, corr)
-            rel = se / abs(rate) if rate != 0.0 else math.inf
-            if best is None or rel < best[0]:
-                best = (rel, e, amp, rate, om)
-            if rel <= config.RINGDOWN_RATE_RTOL or e >= tc.size - 1 or c >= config.RINGDOWN_MAX_CYCLES:
-                break
-            c *= 2
-        rel, e, amp, rate, om = best
-        if rel > config.RINGDOWN_RATE_LIMIT:  # the envelope is lost in the noise from here on
-            dropped = float(tk[-1] - tc[j])
-            break
-        A.append(amp)
-        w.append(om)
-        D.append(-rate / om)
-        centre.append(0.5 * (tc[j] + tc[e]))
-        j = e
-    A, w, D, centre = np.array(A), np.array(w), np.array(D), np.array(centre)
-    if A.size < 2 or not A[-1] < (1.0 - config.RINGDOWN_MIN_DECAY) * A[0]:
+    (centre, amp, rel, w), dropped = _windows(tk, yk, tc, cycles, corr, 1.0)
+    if amp.size < 4 or not amp.min() < (1.0 - config.RINGDOWN_MIN_DECAY) * amp[0]:
         raise ValueError(f"no decay: the envelope falls by less than {100 * config.RINGDOWN_MIN_DECAY:g} % over "
-                         f"the record; a ring-down is a free decay")
+                         f"the record above the noise; a ring-down is a free decay")
     power = {"x": 0, "v": 1, "a": 2}[kind]  # displacement amplitude = amplitude / omega^power
+    keep_w, lna, rate, w, expo, w0, _, misfit = smooth_envelope(centre, np.log(amp) - power * np.log(w), w, options)
+    if keep_w < centre.size:
+        dropped = max(dropped, float(tk[-1] - centre[keep_w]))
+    centre = centre[:keep_w]
+    A, D_decay = np.exp(lna), -rate / w
+    D = D_decay * epmc_factor(expo, w0, w) if expo is not None else D_decay
     w_at = np.interp(tk, centre, w) if power else 1.0
     # for figures only (the points come from the local fits); of the whole filtered record, so
     # that the transform's own end effects fall in the trimmed parts
     env = np.abs(hilbert(yf))[keep] / w_at ** power
     trimmed = (float(tk[0] - t[0]), float(t[-1] - tk[-1]) + dropped)
     msg = (f"band {low:.4g} to {high:.4g} rad/s (zero-phase Butterworth, order {config.RINGDOWN_FILTER_ORDER}); "
-           f"local decay fits between zero crossings; {trimmed[0]:.4g} s trimmed at the start and "
+           f"amplitudes of {cycles}-cycle windows between zero crossings, " + (
+           f"decay -d ln A/dt = a0 + a1 A^p fitted (p = {expo:.3g}; misfit {misfit:.3g} of a spline's), damping "
+           f"from its slope in EPMC's definition;" if expo is not None else
+           f"not a microslip decay (misfit {misfit:.3g} of a spline's): ln A(t) by a cubic spline, damping the "
+           f"decay's own -(d ln A/dt)/omega, not EPMC's;") + f" {trimmed[0]:.4g} s trimmed at the start and "
            f"{trimmed[1]:.4g} s at the end "
            f"(end effects: {trim / period:.3g} periods each{'; and the tail within the noise' if dropped else ''}); "
-           f"{A.size} points of {cycles} or more cycles (the decay rate of each to "
-           f"{100 * config.RINGDOWN_RATE_RTOL:g} %)")
-    return RingdownBackbone(amplitude_m=A / w ** power, omega_rad_s=w, damping_ratio=D, band_rad_s=(low, high),
+           f"{A.size} points")
+    return RingdownBackbone(amplitude_m=A, omega_rad_s=w, damping_ratio=D, band_rad_s=(low, high),
                             trimmed_s=trimmed, t=tk, envelope_m=env, message=msg)
