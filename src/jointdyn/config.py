@@ -302,14 +302,6 @@ RINGDOWN_MIN_SAMPLES_PER_PERIOD = 10
 RINGDOWN_MIN_DECAY = 0.1
 #: ring-downs: periods of odd extension at each end before the zero-phase filter
 RINGDOWN_PAD_PERIODS = 10.0
-#: ring-downs: time constants of the filter's slowest pole trimmed at each end
-RINGDOWN_TRIM_DECAYS = 7.0
-#: ring-downs: a window grows (doubling its cycles, at most RINGDOWN_MAX_CYCLES) until its decay
-#: rate has a standard error within RINGDOWN_RATE_RTOL (else the best of them is taken); where
-#: even the best is above RINGDOWN_RATE_LIMIT, the tail is in the noise and is dropped
-RINGDOWN_RATE_RTOL = 0.02
-RINGDOWN_RATE_LIMIT = 0.1
-RINGDOWN_MAX_CYCLES = 32
 
 # --- sweeps --------------------------------------------------------------------------
 #: why a swept point is not-settled (``not_settled_reason``; index = code, 0
