@@ -25,6 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._jacobian import product_with_columns
+
 __all__ = ["DampingSplit", "DampedJacobian"]
 
 
@@ -111,19 +113,10 @@ class DampedJacobian:
         return self._with(columns={**self.columns, **columns})
 
     def __matmul__(self, x):
-        x = np.asarray(x, dtype=np.float64)
-        if x.ndim != 1:
-            return np.stack([self @ c for c in x.T], axis=1)
-        if self.columns:
-            xs = x.copy()
-            xs[list(self.columns)] = 0.0
-        else:
-            xs = x
-        y = self.S @ xs + self.split.harmonics(xs, self.n, self.H, self.w)[0]
-        y *= self.scale
-        for j, c in self.columns.items():
-            y += c * x[j]
-        return y
+        return product_with_columns(self._times, self.columns, self.scale, x)
+
+    def _times(self, xs):
+        return self.S @ xs + self.split.harmonics(xs, self.n, self.H, self.w)[0]
 
     def dot(self, x):
         return self @ x

@@ -16,7 +16,26 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["HarmonicJacobian"]
+__all__ = ["HarmonicJacobian", "product_with_columns"]
+
+
+def product_with_columns(times, columns: dict, scale: float, x):
+    """``scale * times(xs) + sum_j columns[j] x[j]``, xs = x with the replaced columns' entries zeroed: the
+    product of a Jacobian kept as an operator whose columns ``j`` were replaced (a matrix x column by column).
+    """
+    x = np.asarray(x, dtype=np.float64)
+    if x.ndim != 1:
+        return np.stack([product_with_columns(times, columns, scale, c) for c in x.T], axis=1)
+    if columns:
+        xs = x.copy()
+        xs[list(columns)] = 0.0
+    else:
+        xs = x
+    y = times(xs)
+    y *= scale
+    for j, c in columns.items():
+        y += c * x[j]
+    return y
 
 
 class HarmonicJacobian:
@@ -52,20 +71,12 @@ class HarmonicJacobian:
         return HarmonicJacobian(self.spans, self.blocks, self.rest, self.scale, {**self.columns, **columns})
 
     def __matmul__(self, x):
-        x = np.asarray(x, dtype=np.float64)
-        if x.ndim != 1:
-            return np.stack([self @ c for c in x.T], axis=1)
-        if self.columns:
-            xs = x.copy()
-            xs[list(self.columns)] = 0.0
-        else:
-            xs = x
+        return product_with_columns(self._times, self.columns, self.scale, x)
+
+    def _times(self, xs):
         y = self.rest @ xs
         for (lo, hi), B in zip(self.spans, self.blocks):
             y[lo:hi] += B @ xs[lo:hi]
-        y *= self.scale
-        for j, c in self.columns.items():
-            y += c * x[j]
         return y
 
     def dot(self, x):
