@@ -166,3 +166,28 @@ def test_bad_ringdowns_are_refused(case, word):
         kind = "displacement"
     with pytest.raises(ValueError, match=word):
         backbone_from_ringdown(t, x, kind)
+
+
+def test_ringdown_options_set_the_band_the_filter_and_the_checks():
+    t, x = _linear()
+    ref = backbone_from_ringdown(t, x, "x")
+    wide = backbone_from_ringdown(t, x, "x", options=jd.identify.RingdownOptions(band_margin=0.3, filter_order=2))
+    # the band's edges are the spectrum's divided and multiplied by 1 + band_margin
+    assert wide.band_rad_s[1] / ref.band_rad_s[1] == pytest.approx(1.3 / 1.15, rel=1e-12)
+    assert wide.band_rad_s[0] / ref.band_rad_s[0] == pytest.approx(1.15 / 1.3, rel=1e-12)
+    assert "order 4" in ref.message and "order 2" in wide.message
+    # the linear decay falls by exp(-zeta W0 T) = 91 % over the record: a required 95 % is refused
+    with pytest.raises(ValueError, match="less than 95 %"):
+        backbone_from_ringdown(t, x, "x", options=jd.identify.RingdownOptions(min_decay=0.95))
+    with pytest.raises(ValueError, match="fewer than 100: aliased"):
+        backbone_from_ringdown(t, x, "x", options=jd.identify.RingdownOptions(min_samples_per_period=100))
+
+
+@pytest.mark.parametrize("name,value", [
+    ("band_level", 0.0), ("band_level", 1.0), ("band_margin", -0.1), ("band_margin", math.inf),
+    ("second_peak", 0.0), ("second_peak", 1.5), ("filter_order", 0), ("filter_order", 2.5),
+    ("min_samples_per_period", 1), ("min_decay", 1.0), ("min_decay", math.nan), ("pad_periods", -1.0),
+])
+def test_bad_ringdown_options_are_refused(name, value):
+    with pytest.raises(ValueError, match=name):
+        jd.identify.RingdownOptions(**{name: value})

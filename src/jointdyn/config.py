@@ -289,19 +289,6 @@ FIT_RAMP_SAMPLES = 200
 #: loop fits: a record fitted from rest whose first stroke leaves an rms residual above this
 #: many times that of the rest was picked up mid-cycle (its first stroke then sets the state)
 FIT_FIRST_STROKE_MISFIT = 3.0
-#: ring-downs (identify.ringdown): the mode's band is where the spectrum stays above this
-#: fraction of its peak, widened by this fraction on each side; a second spectral peak in it
-#: more prominent than this fraction of the peak is a second mode
-RINGDOWN_BAND_LEVEL = 0.05
-RINGDOWN_BAND_MARGIN = 0.15
-RINGDOWN_SECOND_PEAK = 0.2
-#: ring-downs: Butterworth order of the zero-phase band-pass; fewest samples per period at the
-#: top of the band; least relative fall of the envelope over the record (else: no decay)
-RINGDOWN_FILTER_ORDER = 4
-RINGDOWN_MIN_SAMPLES_PER_PERIOD = 10
-RINGDOWN_MIN_DECAY = 0.1
-#: ring-downs: periods of odd extension at each end before the zero-phase filter
-RINGDOWN_PAD_PERIODS = 10.0
 
 # --- sweeps --------------------------------------------------------------------------
 #: why a swept point is not-settled (``not_settled_reason``; index = code, 0

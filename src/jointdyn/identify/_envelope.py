@@ -30,16 +30,33 @@ __all__ = ["RingdownOptions", "smooth_envelope"]
 
 @dataclass(frozen=True)
 class RingdownOptions:
-    """Numbers of the ring-down's envelope smoothing (:func:`smooth_envelope`).
+    """Numbers of a ring-down's analysis (:func:`jointdyn.backbone_from_ringdown`): the mode's
+    band, the band-pass filter, the checks of the record, and the envelope smoothing
+    (:func:`smooth_envelope`).
 
     Attributes
     ----------
+    band_level : float
+        The mode's band is where the spectrum stays above this fraction of its peak (-).
+    band_margin : float
+        ... widened by this fraction of its edge frequencies on each side (-): the frequency
+        drifts with the amplitude.
+    second_peak : float
+        A second spectral peak in the band more prominent than this fraction of the peak is a
+        second mode (the record is refused) (-).
+    filter_order : int
+        Butterworth order of the zero-phase band-pass.
+    min_samples_per_period : int
+        Fewest samples per period at the top of the band (else the record is refused as
+        aliased).
+    min_decay : float
+        Least relative fall of the envelope over the record (-); else the record is refused
+        (no decay).
+    pad_periods : float
+        Periods of odd extension at each end of the record before the zero-phase filter.
     amplitude_rtol : float
         A window whose amplitude has a relative standard error above this is in the
         noise; from the first such window on, the tail is dropped (-).
-    knot_falls : tuple of float
-        Candidate spacings of the spline's knots, in falls of ln A (-); the one of least
-        generalised cross-validation score is used.
     min_windows_per_knot : int
         Fewest windows between two knots of the spline that the decay model's misfit is
         measured against.
@@ -54,12 +71,28 @@ class RingdownOptions:
         1 % on the damping ratio of the first windows of a decay from macroslip, 2 left 6 %).
     """
 
+    band_level: float = 0.05
+    band_margin: float = 0.15
+    second_peak: float = 0.2
+    filter_order: int = 4
+    min_samples_per_period: int = 10
+    min_decay: float = 0.1
+    pad_periods: float = 10.0
     amplitude_rtol: float = 0.03
     min_windows_per_knot: int = 4
     trim_decays: float = 4.0
     misfit_limit: float = 3.0
 
     def __post_init__(self) -> None:
+        from .. import _validate as V
+
+        V.in_range("band_level", self.band_level, 0.0, 1.0, lo_open=True, hi_open=True)
+        V.nonnegative("band_margin", self.band_margin)
+        V.in_range("second_peak", self.second_peak, 0.0, 1.0, lo_open=True)
+        V.positive_int("filter_order", self.filter_order)
+        V.positive_int("min_samples_per_period", self.min_samples_per_period, minimum=2)
+        V.in_range("min_decay", self.min_decay, 0.0, 1.0, lo_open=True, hi_open=True)
+        V.nonnegative("pad_periods", self.pad_periods)
         if not 0.0 < self.amplitude_rtol < 1.0:
             raise ValueError(f"amplitude_rtol must be in (0, 1), got {self.amplitude_rtol!r}")
         if not self.misfit_limit > 1.0:

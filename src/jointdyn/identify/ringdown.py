@@ -3,11 +3,13 @@
 The ring-down practice of the modal-Iwan literature (docs/guide/identify.md):
 
 1. the mode's band is found from the spectrum (the contiguous region around
-   its peak above ``config.RINGDOWN_BAND_LEVEL`` of the peak, widened by
-   ``config.RINGDOWN_BAND_MARGIN`` on each side: the frequency drifts with the
+   its peak above ``RingdownOptions.band_level`` of the peak, widened by
+   ``RingdownOptions.band_margin`` on each side: the frequency drifts with the
    amplitude);
 2. the signal is band-pass filtered forwards and backwards (zero phase:
-   ``scipy.signal.sosfiltfilt`` of a Butterworth filter);
+   ``scipy.signal.sosfiltfilt`` of a Butterworth filter of order
+   ``RingdownOptions.filter_order``, the record extended by
+   ``RingdownOptions.pad_periods`` periods of odd extension at each end);
 3. (the analytic signal z = y + i H[y], ``scipy.signal.hilbert``, gives the
    envelope drawn in figures; the points below do not use it: on a decaying
    record its end effects reached several percent of the damping ratio);
@@ -32,10 +34,11 @@ The ring-down practice of the modal-Iwan literature (docs/guide/identify.md):
 8. a velocity or acceleration signal is turned into displacement amplitude
    by dividing by omega or omega^2 before the model is fitted.
 
-Bad data raise ValueError: fewer than 10 samples per period at the top of the
-band (aliased), shorter than ``2 trim_periods + 2 cycles`` periods, no decay
-(the envelope falls by less than ``config.RINGDOWN_MIN_DECAY``), two modes in
-the band.
+Bad data raise ValueError: fewer than ``RingdownOptions.min_samples_per_period``
+(10) samples per period at the top of the band (aliased), shorter than ``2 trim_periods + 2 cycles`` periods, no decay
+(the envelope falls by less than ``RingdownOptions.min_decay``), two modes in
+the band (a second spectral peak more prominent than
+``RingdownOptions.second_peak`` of the peak).
 """
 
 from __future__ import annotations
@@ -45,7 +48,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import config
 from ._envelope import RingdownOptions, smooth_envelope
 
 __all__ = ["RingdownBackbone", "RingdownOptions", "backbone_from_ringdown", "SIGNAL_KINDS"]
@@ -122,7 +124,7 @@ def _uniform(t, y, name):
     return t, y, h
 
 
-def _band(y, h):
+def _band(y, h, options):
     """(low, high) rad/s of the mode's band from the spectrum, and the peak, rad/s."""
     from scipy.signal import find_peaks
 
@@ -130,19 +132,19 @@ def _band(y, h):
     f = np.fft.rfftfreq(y.size, h) * 2.0 * math.pi
     spec[0] = 0.0
     ip = int(np.argmax(spec))
-    lev = config.RINGDOWN_BAND_LEVEL * spec[ip]
+    lev = options.band_level * spec[ip]
     lo = ip
     while lo > 1 and spec[lo - 1] >= lev:
         lo -= 1
     hi = ip
     while hi < spec.size - 1 and spec[hi + 1] >= lev:
         hi += 1
-    low, high = f[lo] / (1.0 + config.RINGDOWN_BAND_MARGIN), f[hi] * (1.0 + config.RINGDOWN_BAND_MARGIN)
+    low, high = f[lo] / (1.0 + options.band_margin), f[hi] * (1.0 + options.band_margin)
     sel = (f >= low) & (f <= high)
     # smoothed over a few bins so that the ripple of one decaying mode is not a second peak
     win = max(3, int(0.01 * ip) | 1)
     smooth = np.convolve(spec, np.ones(win) / win, mode="same")
-    peaks, _ = find_peaks(np.where(sel, smooth, 0.0), prominence=config.RINGDOWN_SECOND_PEAK * smooth[ip])
+    peaks, _ = find_peaks(np.where(sel, smooth, 0.0), prominence=options.second_peak * smooth[ip])
     if peaks.size > 1:
         raise ValueError(f"two modes in the band {low:.4g} to {high:.4g} rad/s (spectral peaks at "
                          f"{', '.join(f'{f[p]:.4g}' for p in peaks[:4])} rad/s): the ring-down must excite one "
@@ -211,7 +213,8 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
     cycles : int
         Whole cycles per backbone point (>= 1).
     options : RingdownOptions, optional
-        The envelope's smoothing and where the noise ends it (default ``RingdownOptions()``).
+        The band, the filter, the checks of the record, the envelope's smoothing and where the
+        noise ends it (default ``RingdownOptions()``).
 
     Returns
     -------
@@ -234,26 +237,26 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
         raise ValueError(f"options must be a RingdownOptions, got {type(options).__name__}")
     t, y, h = _uniform(t, signal, kind)
     if band is None:
-        low, high, peak = _band(y, h)
+        low, high, peak = _band(y, h, options)
     else:
         low, high = (float(b) for b in band)
         if not 0.0 < low < high:
             raise ValueError(f"band must be (low, high) with 0 < low < high rad/s, got {band!r}")
         peak = 0.5 * (low + high)
     per_period = 2.0 * math.pi / (high * h)
-    if per_period < config.RINGDOWN_MIN_SAMPLES_PER_PERIOD:
+    if per_period < options.min_samples_per_period:
         raise ValueError(f"the signal has {per_period:.3g} samples per period at {high:.4g} rad/s, fewer than "
-                         f"{config.RINGDOWN_MIN_SAMPLES_PER_PERIOD}: aliased; sample faster")
+                         f"{options.min_samples_per_period}: aliased; sample faster")
     period = 2.0 * math.pi / peak
     need = (2.0 * trim_periods + 2.0 * cycles) * period
     if t[-1] - t[0] < need:
         raise ValueError(f"the record lasts {t[-1] - t[0]:.4g} s, shorter than the {need:.4g} s needed "
                          f"({2 * trim_periods:g} periods trimmed and two windows of {cycles} cycles)")
     nyq = math.pi / h
-    sos = butter(config.RINGDOWN_FILTER_ORDER, (low / nyq, min(high / nyq, 0.99)), btype="band", output="sos")
+    sos = butter(options.filter_order, (low / nyq, min(high / nyq, 0.99)), btype="band", output="sos")
     # padded by odd extension over several periods: the continuation of an oscillation that
     # keeps the filter's start-up transient mostly outside the record
-    pad = min(y.size - 1, int(config.RINGDOWN_PAD_PERIODS * period / h))
+    pad = min(y.size - 1, int(options.pad_periods * period / h))
     yf = sosfiltfilt(sos, y - y.mean(), padlen=pad)
     # the filter's slowest pole: its transient must have died out in what is kept
     from scipy.signal import sos2zpk
@@ -270,8 +273,8 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
     # noise: the filtered noise is correlated over about pi / bandwidth seconds
     corr = max(1.0, math.pi / ((high - low) * h))
     (centre, amp, rel, w), dropped = _windows(tk, yk, tc, cycles, corr, 1.0)
-    if amp.size < 4 or not amp.min() < (1.0 - config.RINGDOWN_MIN_DECAY) * amp[0]:
-        raise ValueError(f"no decay: the envelope falls by less than {100 * config.RINGDOWN_MIN_DECAY:g} % over "
+    if amp.size < 4 or not amp.min() < (1.0 - options.min_decay) * amp[0]:
+        raise ValueError(f"no decay: the envelope falls by less than {100 * options.min_decay:g} % over "
                          f"the record above the noise; a ring-down is a free decay")
     power = {"x": 0, "v": 1, "a": 2}[kind]  # displacement amplitude = amplitude / omega^power
     keep_w, lna, rate, w, expo, w0, _, misfit = smooth_envelope(centre, np.log(amp) - power * np.log(w), w, options)
@@ -285,7 +288,7 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
     # that the transform's own end effects fall in the trimmed parts
     env = np.abs(hilbert(yf))[keep] / w_at ** power
     trimmed = (float(tk[0] - t[0]), float(t[-1] - tk[-1]) + dropped)
-    msg = (f"band {low:.4g} to {high:.4g} rad/s (zero-phase Butterworth, order {config.RINGDOWN_FILTER_ORDER}); "
+    msg = (f"band {low:.4g} to {high:.4g} rad/s (zero-phase Butterworth, order {options.filter_order}); "
            f"amplitudes of {cycles}-cycle windows between zero crossings, " + (
            f"decay -d ln A/dt = a0 + a1 A^p fitted (p = {expo:.3g}; misfit {misfit:.3g} of a spline's), damping "
            f"from its slope in EPMC's definition;" if expo is not None else
