@@ -233,17 +233,6 @@ HB_JACOBIAN_BUDGET_BYTES = 2**28
 MODES_AMPLITUDE_Q = (1e-2, 1e2)
 
 # --- identification (jointdyn.identify) -------------------------------------------
-#: most evaluations of the model (marches, describing functions) of one least-squares fit
-FIT_MAX_NFEV = 400
-#: tolerances of scipy.optimize.least_squares on the cost, the parameters and the gradient
-FIT_FTOL = 1e-12
-FIT_XTOL = 1e-10
-FIT_GTOL = 1e-12
-#: a stiffness, force or friction coefficient whose standard error exceeds this fraction
-#: of its value is reported as not identifiable
-FIT_MAX_RELATIVE_SE = 0.5
-#: a shape parameter (chi, beta) whose standard error exceeds this is reported as not identifiable
-FIT_MAX_SHAPE_SE = 0.5
 #: loop fits: the displacement window after a reversal over which the initial slope (start
 #: of kt) is measured, as a fraction of the peak-to-peak displacement
 FIT_SLOPE_WINDOW = 0.03
@@ -266,17 +255,6 @@ FIT_MAX_LOOP_SAMPLES = 1_000_000
 #: most points of a backbone fit (``fit --backbone``): every point costs a describing function per
 #: evaluation, 4 ms of CPU time per point for the whole fit (1000 points took 3.8 s, measured 2026-12)
 FIT_MAX_BACKBONE_POINTS = 1_000
-#: confidence level of the intervals a fit reports (profile likelihood)
-FIT_LEVEL = 0.95
-#: profile likelihood: a scale parameter whose sum of squares stays below the threshold
-#: over this factor on one side of its optimum is not bounded on that side; the steps
-#: (doubling) taken on a side before it is called open; regula-falsi steps on the crossing
-FIT_PROFILE_SPAN = 100.0
-FIT_PROFILE_STEPS = 12
-FIT_PROFILE_REFINE = 4
-#: profile likelihood: tolerances and evaluation limit of each refit with one parameter held
-FIT_PROFILE_FTOL = 1e-10
-FIT_PROFILE_MAX_NFEV = 60
 #: global start of a Segalman fit: the grid of chi, beta and slip-force factors (times the
 #: data's start value) whose best point (least sum of squares) starts least squares
 FIT_GRID_CHI = (-0.8, -0.5, 0.0, 0.5)

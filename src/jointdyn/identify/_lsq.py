@@ -6,10 +6,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import config
+from ._profile import FIT_LEVEL
 from .result import FitStatus, correlation, covariance
 
 __all__ = ["Param", "solve", "Solution"]
+
+#: most evaluations of the model (marches, describing functions) of one least-squares fit
+FIT_MAX_NFEV = 400
+#: tolerances of scipy.optimize.least_squares on the cost, the parameters and the gradient
+#: (relative); FIT_XTOL x 1e-4 is also the singular-value ratio at or below which the
+#: covariance treats a direction as unseen by the data
+FIT_FTOL = 1e-12
+FIT_XTOL = 1e-10
+FIT_GTOL = 1e-12
+#: a stiffness, force or friction coefficient whose standard error exceeds this fraction
+#: of its value is reported as not identifiable (-)
+FIT_MAX_RELATIVE_SE = 0.5
+#: a shape parameter (chi, beta) whose standard error exceeds this is reported as not identifiable (-)
+FIT_MAX_SHAPE_SE = 0.5
 
 
 @dataclass(frozen=True)
@@ -54,8 +68,8 @@ def _least_squares(resid, u0, lb, ub, diff_step):
     from scipy.optimize import least_squares
 
     return least_squares(resid, np.clip(u0, lb, ub), bounds=(lb, ub), method="trf", x_scale=1.0,
-                         ftol=config.FIT_FTOL, xtol=config.FIT_XTOL, gtol=config.FIT_GTOL,
-                         max_nfev=config.FIT_MAX_NFEV, diff_step=diff_step)
+                         ftol=FIT_FTOL, xtol=FIT_XTOL, gtol=FIT_GTOL,
+                         max_nfev=FIT_MAX_NFEV, diff_step=diff_step)
 
 
 def _weak(params, u, jac, fun):
@@ -63,13 +77,13 @@ def _weak(params, u, jac, fun):
     keep = np.ones(len(params), bool)
     weak = []
     for _ in range(len(params)):
-        cov = covariance(jac, fun, keep)
+        cov = covariance(jac, fun, keep, FIT_XTOL)
         se = np.sqrt(np.abs(np.diag(cov)))
         worst, excess = None, 1.0
         for i, p in enumerate(params):
             if not keep[i]:
                 continue
-            lim = config.FIT_MAX_RELATIVE_SE * abs(u[i]) if p.positive else config.FIT_MAX_SHAPE_SE
+            lim = FIT_MAX_RELATIVE_SE * abs(u[i]) if p.positive else FIT_MAX_SHAPE_SE
             ratio = se[i] / lim if lim > 0.0 else np.inf
             if not np.isfinite(se[i]) or ratio > excess:
                 worst, excess = i, (np.inf if not np.isfinite(se[i]) else ratio)
@@ -80,13 +94,13 @@ def _weak(params, u, jac, fun):
     return keep, weak
 
 
-def solve(fun, params: list, *, diff_step=None, profile: bool = False, level: float = config.FIT_LEVEL,
+def solve(fun, params: list, *, diff_step=None, profile: bool = False, level: float = FIT_LEVEL,
           starts=()) -> Solution:
     """Minimise ``sum(fun(values)^2)`` over the parameters (``fun`` takes a dict of
     values by name and returns the residual vector) with scipy's trust-region
     least squares within the bounds; then the standard errors from the Jacobian at the
     optimum and the residual variance. A parameter whose error exceeds
-    ``config.FIT_MAX_RELATIVE_SE`` of its value (scales) or ``config.FIT_MAX_SHAPE_SE``
+    ``FIT_MAX_RELATIVE_SE`` of its value (scales) or ``FIT_MAX_SHAPE_SE``
     (shapes) is *weak*: the errors of the others are then those with it held.
 
     ``profile``: also the profile-likelihood interval of every parameter at ``level``
@@ -112,7 +126,8 @@ def solve(fun, params: list, *, diff_step=None, profile: bool = False, level: fl
     res = _least_squares(resid, u0, lb, ub, diff_step)
     nfev = int(res.nfev)
     for attempt in range(2 if profile else 0):
-        se_u = np.sqrt(np.abs(np.diag(covariance(np.asarray(res.jac, float), res.fun, np.ones(len(params), bool)))))
+        cov0 = covariance(np.asarray(res.jac, float), res.fun, np.ones(len(params), bool), FIT_XTOL)
+        se_u = np.sqrt(np.abs(np.diag(cov0)))
         bounds, best = profile_intervals(resid, params, res.x, se_u, res.fun.size, level)
         ssr0 = float(res.fun @ res.fun)
         if attempt == 0 and best[0] < ssr0 * (1.0 - 1e-6):
@@ -123,7 +138,7 @@ def solve(fun, params: list, *, diff_step=None, profile: bool = False, level: fl
     u = res.x
     jac = np.asarray(res.jac, dtype=float)
     keep, weak = _weak(params, u, jac, res.fun)
-    cov = covariance(jac, res.fun, keep)
+    cov = covariance(jac, res.fun, keep, FIT_XTOL)
     se_u = np.sqrt(np.abs(np.diag(cov)))
     vals = values(u)
     errors = {p.name: (float(se_u[i] * p.value) if p.positive else float(se_u[i])) if keep[i] else None

@@ -13,7 +13,7 @@ the interval is where the refitted sum of squares S stays below
 i.e. S_min plus the F quantile (the chi-square quantile for many residuals)
 times the residual variance s^2 = S_min / (m - p). A side on which S never
 rises that far before the parameter's range (or a factor
-``config.FIT_PROFILE_SPAN``) is open: the data bound the parameter on one
+``FIT_PROFILE_SPAN``) is open: the data bound the parameter on one
 side only, or not at all, and it is reported as not determined.
 """
 
@@ -24,9 +24,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import config
+__all__ = ["Interval", "profile_intervals", "FIT_LEVEL"]
 
-__all__ = ["Interval", "profile_intervals"]
+#: confidence level of the intervals a fit reports (profile likelihood) (-)
+FIT_LEVEL = 0.95
+#: a scale parameter whose sum of squares stays below the threshold over this factor (-) on
+#: one side of its optimum is not bounded on that side; the steps (doubling) taken on a side
+#: before it is called open; regula-falsi steps on the crossing
+FIT_PROFILE_SPAN = 100.0
+FIT_PROFILE_STEPS = 12
+FIT_PROFILE_REFINE = 4
+#: tolerances of scipy.optimize.least_squares (on the cost, the parameters and the gradient,
+#: relative) and its evaluation limit for each refit with one parameter held
+FIT_PROFILE_FTOL = 1e-10
+FIT_PROFILE_MAX_NFEV = 60
 
 
 @dataclass(frozen=True)
@@ -92,8 +103,8 @@ class _Profiler:
 
             x0 = np.clip(warm[free], self.lb[free], self.ub[free])
             res = least_squares(r, x0, bounds=(self.lb[free], self.ub[free]), method="trf",
-                                ftol=config.FIT_PROFILE_FTOL, xtol=config.FIT_PROFILE_FTOL,
-                                gtol=config.FIT_PROFILE_FTOL, max_nfev=config.FIT_PROFILE_MAX_NFEV)
+                                ftol=FIT_PROFILE_FTOL, xtol=FIT_PROFILE_FTOL,
+                                gtol=FIT_PROFILE_FTOL, max_nfev=FIT_PROFILE_MAX_NFEV)
             u[free] = res.x
             ssr = float(res.fun @ res.fun)
         else:
@@ -108,7 +119,7 @@ class _Profiler:
         c0 = self.coord(i, self.u_opt[i])
         lim_u = self.ub[i] if direction > 0 else self.lb[i]
         if self.params[i].positive:
-            span = math.log(config.FIT_PROFILE_SPAN)
+            span = math.log(FIT_PROFILE_SPAN)
             lim = c0 + direction * span if lim_u <= 0.0 else (
                 min(self.coord(i, lim_u), c0 + span) if direction > 0 else max(self.coord(i, lim_u), c0 - span))
         else:
@@ -117,7 +128,7 @@ class _Profiler:
             return None
         g_of = lambda s: math.sqrt(max(s - self.ssr0, 0.0)) - math.sqrt(self.rise)  # noqa: E731
         prev_c, prev_g, warm = c0, -math.sqrt(self.rise), self.u_opt.copy()
-        for _ in range(config.FIT_PROFILE_STEPS):
+        for _ in range(FIT_PROFILE_STEPS):
             c = c0 + direction * step
             at_limit = (c - lim) * direction >= 0.0
             if at_limit:
@@ -136,7 +147,7 @@ class _Profiler:
         """Regula falsi on g = sqrt(S - S_min) - sqrt(rise) (about linear in the parameter)
         between ca (g < 0) and cb (g >= 0)."""
         c = cb
-        for _ in range(config.FIT_PROFILE_REFINE):
+        for _ in range(FIT_PROFILE_REFINE):
             c = ca + (cb - ca) * (-ga) / (gb - ga) if gb > ga else 0.5 * (ca + cb)
             ssr, warm = self.refit(i, self.unit(i, c), warm)
             g = math.sqrt(max(ssr - self.ssr0, 0.0)) - math.sqrt(self.rise)
@@ -149,7 +160,7 @@ class _Profiler:
         return c
 
 
-def profile_intervals(resid, params, u_opt, se_unit, m: int, level: float = config.FIT_LEVEL) -> tuple:
+def profile_intervals(resid, params, u_opt, se_unit, m: int, level: float = FIT_LEVEL) -> tuple:
     """Profile-likelihood intervals of every parameter.
 
     Parameters

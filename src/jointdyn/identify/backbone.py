@@ -33,6 +33,7 @@ from ..laws import law_parameters, make_law
 from ..laws.segalman import CHI_MAX, CHI_MIN, segalman_constants
 from ._lsq import Param, open_reason, solve, start_values, status_of
 from ._microslip import MICROSLIP_MODELS, microslip_backbone, microslip_constants, microslip_model
+from ._profile import FIT_LEVEL
 from .result import FitResult, FitStatus
 
 __all__ = ["fit_backbone", "describing_function", "BACKBONE_MODELS"]
@@ -284,7 +285,7 @@ def _microslip_result(model, law, sol, m, A, w, D, dscale, weights, defect, refi
 
 def _microslip_suffices(micro, sol, p) -> bool:
     """Whether the microslip model (k + kt, R, chi, zeta) fits as well as the full one: its
-    extra sum of squares below the F test's level ``config.FIT_LEVEL`` for the parameters it
+    extra sum of squares below the F test's level ``FIT_LEVEL`` for the parameters it
     lacks. Then the data do not show the slip force, and kt, fy (beta) are not determined."""
     from scipy.stats import f
 
@@ -295,7 +296,7 @@ def _microslip_suffices(micro, sol, p) -> bool:
     dof = max(m - p, 1)
     if ssr <= 0.0:
         return ssr_m <= 0.0
-    return (ssr_m - ssr) / q <= float(f.ppf(config.FIT_LEVEL, q, dof)) * ssr / dof
+    return (ssr_m - ssr) / q <= float(f.ppf(FIT_LEVEL, q, dof)) * ssr / dof
 
 
 def modal_law(model: str, law_params) -> Callable:

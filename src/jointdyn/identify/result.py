@@ -6,7 +6,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import config
 from ..status import Status
 
 __all__ = ["FitStatus", "FitResult", "covariance"]
@@ -63,8 +62,8 @@ class FitResult:
     evaluations : int
         Model evaluations of the least squares.
     intervals : dict
-        Name -> :class:`jointdyn.identify.Interval`: the profile-likelihood interval at ``config.FIT_LEVEL``
-        (95 %) of every fitted parameter, all the others refitted at each point (so not
+        Name -> :class:`jointdyn.identify.Interval`: the profile-likelihood interval at
+        ``jointdyn.identify._profile.FIT_LEVEL`` (95 %) of every fitted parameter, all the others refitted at each point (so not
         conditional on any held value). ``low`` or ``high`` None: the data do not bound
         the parameter on that side (it is then in ``not_identifiable``).
     conditional_on : tuple of str
@@ -124,11 +123,12 @@ class FitResult:
         }
 
 
-def covariance(jac: np.ndarray, residual: np.ndarray, keep: np.ndarray) -> np.ndarray:
+def covariance(jac: np.ndarray, residual: np.ndarray, keep: np.ndarray, xtol: float) -> np.ndarray:
     """Covariance of the parameters ``keep`` (boolean mask) from the Jacobian of the
     residuals at the optimum and the residual variance sum(r^2) / (m - p); the other
     parameters are held (their rows and columns are NaN). Parameters whose columns are
-    linearly dependent get an infinite variance."""
+    linearly dependent (a singular value at most ``xtol`` x 1e-4 times the largest; the fits
+    pass their least-squares tolerance ``_lsq.FIT_XTOL``) get an infinite variance."""
     p = jac.shape[1]
     cov = np.full((p, p), np.nan)
     idx = np.flatnonzero(keep)
@@ -138,7 +138,7 @@ def covariance(jac: np.ndarray, residual: np.ndarray, keep: np.ndarray) -> np.nd
     dof = max(jac.shape[0] - idx.size, 1)
     s2 = float(residual @ residual) / dof
     u, sv, vt = np.linalg.svd(J, full_matrices=False)
-    tiny = sv <= sv[0] * config.FIT_XTOL * 1e-4 if sv.size and sv[0] > 0.0 else np.ones(sv.size, bool)
+    tiny = sv <= sv[0] * xtol * 1e-4 if sv.size and sv[0] > 0.0 else np.ones(sv.size, bool)
     inv = np.where(tiny, 0.0, 1.0 / np.where(tiny, 1.0, sv) ** 2)
     c = (vt.T * inv) @ vt * s2
     if np.any(tiny):  # directions the data do not see: infinite variance along them
