@@ -5,7 +5,7 @@ march and its steady states; harmonic balance; nonlinear modes; identification; 
 A number that one solver or package alone reads belongs in that solver's options object
 (``ContinuationOptions``, ``LinearSolveOptions``, ``SweepOptions``) or in its module, with its default
 documented there; ``tests/test_architecture.py`` fails on a number here that one package alone reads,
-except those it lists as still to move (harmonic balance, identification). Test tolerances live with the tests (``tests/tolerances.py``). Units are given
+except those it lists as still to move (harmonic balance). Test tolerances live with the tests (``tests/tolerances.py``). Units are given
 where a number has one; "relative" numbers are fractions of the scale named.
 """
 
@@ -233,40 +233,15 @@ HB_JACOBIAN_BUDGET_BYTES = 2**28
 MODES_AMPLITUDE_Q = (1e-2, 1e2)
 
 # --- identification (jointdyn.identify) -------------------------------------------
-#: loop fits: the displacement window after a reversal over which the initial slope (start
-#: of kt) is measured, as a fraction of the peak-to-peak displacement
-FIT_SLOPE_WINDOW = 0.03
-#: loop fits: quantile of |T| / N over the samples in contact taken as the start of mu
-FIT_MU_QUANTILE = 0.99
-#: largest beta of a Segalman fit (the law's own range is unbounded)
-FIT_BETA_MAX = 100.0
-#: start of beta in a Segalman fit
-FIT_BETA_START = 0.1
-#: backbone fits: Gauss-Legendre nodes per smooth piece of the Masing loop in the
-#: first-harmonic quadrature
-FIT_QUAD_NODES = 64
-#: backbone fits refined by EPMC: most EPMC backbones (defect corrections), and the relative
-#: change of every parameter below which the refinement stops
-FIT_REFINE_ITERATIONS = 4
-FIT_REFINE_RTOL = 1e-4
+# The fits' numbers are constants of the modules that read them (jointdyn.identify._lsq,
+# _profile, loops, backbone) and the ring-down's are RingdownOptions fields; here only the
+# input bounds that the fit command checks too.
 #: most data rows of a loop fit (``fit --input``): the least squares evaluates the law over every sample
 #: some hundred times; 1e6 samples took 6 s of CPU time (measured, 2026-12)
 FIT_MAX_LOOP_SAMPLES = 1_000_000
 #: most points of a backbone fit (``fit --backbone``): every point costs a describing function per
 #: evaluation, 4 ms of CPU time per point for the whole fit (1000 points took 3.8 s, measured 2026-12)
 FIT_MAX_BACKBONE_POINTS = 1_000
-#: global start of a Segalman fit: the grid of chi, beta and slip-force factors (times the
-#: data's start value) whose best point (least sum of squares) starts least squares
-FIT_GRID_CHI = (-0.8, -0.5, 0.0, 0.5)
-FIT_GRID_BETA = (0.0, 0.1, 1.0, 10.0, 50.0)
-FIT_GRID_SLIP = (0.7, 1.0, 1.4)
-#: loop fits: a record whose |T| at the first sample is at most this fraction of max |T|
-#: starts from rest; samples of the ramp from rest to the first sample of any other record
-FIT_REST_FORCE = 0.05
-FIT_RAMP_SAMPLES = 200
-#: loop fits: a record fitted from rest whose first stroke leaves an rms residual above this
-#: many times that of the rest was picked up mid-cycle (its first stroke then sets the state)
-FIT_FIRST_STROKE_MISFIT = 3.0
 
 # --- sweeps --------------------------------------------------------------------------
 #: why a swept point is not-settled (``not_settled_reason``; index = code, 0

@@ -24,6 +24,16 @@ FIT_GTOL = 1e-12
 FIT_MAX_RELATIVE_SE = 0.5
 #: a shape parameter (chi, beta) whose standard error exceeds this is reported as not identifiable (-)
 FIT_MAX_SHAPE_SE = 0.5
+#: largest beta of a Segalman fit (-; the law's own range is unbounded)
+FIT_BETA_MAX = 100.0
+#: start of beta in a Segalman fit (-)
+FIT_BETA_START = 0.1
+#: global start of a Segalman fit (loops, backbones, response curves): the grid of chi, beta
+#: and slip-force factors (times the data's start value) whose best point (least sum of
+#: squares) starts least squares (-)
+FIT_GRID_CHI = (-0.8, -0.5, 0.0, 0.5)
+FIT_GRID_BETA = (0.0, 0.1, 1.0, 10.0, 50.0)
+FIT_GRID_SLIP = (0.7, 1.0, 1.4)
 
 
 @dataclass(frozen=True)

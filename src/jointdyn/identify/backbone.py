@@ -31,7 +31,8 @@ from .. import _validate as V
 from .. import config
 from ..laws import law_parameters, make_law
 from ..laws.segalman import CHI_MAX, CHI_MIN, segalman_constants
-from ._lsq import Param, open_reason, solve, start_values, status_of
+from ._lsq import (FIT_BETA_MAX, FIT_BETA_START, FIT_GRID_BETA, FIT_GRID_CHI, FIT_GRID_SLIP, Param, open_reason,
+                   solve, start_values, status_of)
 from ._microslip import MICROSLIP_MODELS, microslip_backbone, microslip_constants, microslip_model
 from ._profile import FIT_LEVEL
 from .result import FitResult, FitStatus
@@ -40,6 +41,13 @@ __all__ = ["fit_backbone", "describing_function", "BACKBONE_MODELS"]
 
 #: laws a backbone fit accepts (at constant load: iwan-closed is iwan)
 BACKBONE_MODELS = ("jenkins", "iwan", "segalman", "iwan-closed", "discrete")
+#: Gauss-Legendre nodes per smooth piece of the Masing loop in the first-harmonic quadrature
+#: of the describing function
+FIT_QUAD_NODES = 64
+#: fits refined by EPMC: most EPMC backbones (defect corrections), and the relative change (-)
+#: of every parameter below which the refinement stops
+FIT_REFINE_ITERATIONS = 4
+FIT_REFINE_RTOL = 1e-4
 
 
 def _virgin_curve(law):
@@ -94,7 +102,7 @@ def describing_function(law, amplitude) -> tuple:
     """
     A = np.atleast_1d(np.asarray(amplitude, dtype=float))
     F, kinks = _virgin_curve(law)
-    t, w = _nodes(config.FIT_QUAD_NODES)
+    t, w = _nodes(FIT_QUAD_NODES)
     # the Masing loop is smooth between 0, the angle where the virgin argument
     # A (1 - cos theta) / 2 crosses a kink, and pi: one Gauss-Legendre piece each
     # (a piece of zero length where the kink is not reached), all amplitudes at once
@@ -168,7 +176,7 @@ def _start(model, A, w, D, m):
                                  CHI_MIN + 0.01, 1.0))
         start["chi"] = chi0
     if "beta" in names:
-        start["beta"] = config.FIT_BETA_START
+        start["beta"] = FIT_BETA_START
     return start
 
 
@@ -192,11 +200,11 @@ def _epmc_defect(law, k, zeta, m, A, harmonics, samples):
 def _refine(sol, params, fun, law_of, m, A, harmonics, samples):
     """Defect correction by EPMC (see fit_backbone): the solution refitted with the
     describing function plus the EPMC defect at the last parameters, until the parameters
-    change by less than ``config.FIT_REFINE_RTOL``. Returns (solution, True) or
+    change by less than ``FIT_REFINE_RTOL``. Returns (solution, True) or
     (the describing-function solution, False) when an EPMC backbone fails, and the last
     defect (zeros when none was computed)."""
     defect = (np.zeros(A.size), np.zeros(A.size))
-    for _ in range(config.FIT_REFINE_ITERATIONS):
+    for _ in range(FIT_REFINE_ITERATIONS):
         v = sol.values
         d = _epmc_defect(law_of(v), v["k"], v["zeta"], m, A, harmonics, samples)
         if d is None:
@@ -207,7 +215,7 @@ def _refine(sol, params, fun, law_of, m, A, harmonics, samples):
         new = solve(lambda u, d=defect: fun(u, *d), start)
         change = max(abs(new.values[k] - v[k]) / max(abs(v[k]), 1e-300) for k in v)
         sol = new
-        if change <= config.FIT_REFINE_RTOL:
+        if change <= FIT_REFINE_RTOL:
             break
     return sol, True, defect
 
@@ -220,17 +228,17 @@ def _params(s0) -> list:
     if "chi" in s0:
         out.append(Param("chi", s0["chi"], False, CHI_MIN, CHI_MAX))
     if "beta" in s0:
-        out.append(Param("beta", s0["beta"], False, 0.0, config.FIT_BETA_MAX))
+        out.append(Param("beta", s0["beta"], False, 0.0, FIT_BETA_MAX))
     return out
 
 
 def _grid(s0) -> list:
     """Further start points of a Segalman backbone fit (a global start): chi, beta and the
-    slip force (factors of the data's start ``s0``) on the grid of ``config.FIT_GRID_*``."""
+    slip force (factors of the data's start ``s0``) on the grid of ``_lsq.FIT_GRID_*``."""
     if "beta" not in s0:
         return []
     return [{**s0, "chi": c, "beta": b, "fy": f * s0["fy"]}
-            for c in config.FIT_GRID_CHI for b in config.FIT_GRID_BETA for f in config.FIT_GRID_SLIP]
+            for c in FIT_GRID_CHI for b in FIT_GRID_BETA for f in FIT_GRID_SLIP]
 
 
 def _weights(r, n, p) -> list:
@@ -343,7 +351,7 @@ def fit_backbone(amplitude_m, omega_rad_s, damping_ratio, *, mass: float, model:
         Refine the fit with EPMC of this many harmonics (>= 1): the difference between
         EPMC's backbone of the fitted model and its describing function is subtracted
         from the data and the describing-function fit repeated (a defect correction, at
-        most ``config.FIT_REFINE_ITERATIONS`` EPMC backbones), so that the parameters are
+        most ``FIT_REFINE_ITERATIONS`` EPMC backbones), so that the parameters are
         those whose EPMC backbone fits the data.
     refine_samples : int
         AFT samples per period of the refining EPMC.

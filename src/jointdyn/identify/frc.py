@@ -25,7 +25,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ._lsq import open_reason, solve, start_values, status_of
+from ._lsq import FIT_BETA_START, open_reason, solve, start_values, status_of
 from .backbone import BACKBONE_MODELS, _grid, _params, describing_function, modal_law
 from .result import FitResult
 
@@ -71,7 +71,7 @@ def _start(model, F, w, A, m):
     kt0 = kstuck / 3.0
     s0 = {"k": kstuck - kt0, "kt": kt0, "fy": 0.5 * kt0 * float(A.max()), "zeta": zeta0}
     if model == "segalman":
-        s0["chi"], s0["beta"] = config.SEGALMAN_CHI, config.FIT_BETA_START
+        s0["chi"], s0["beta"] = config.SEGALMAN_CHI, FIT_BETA_START
     return s0
 
 

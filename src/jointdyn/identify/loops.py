@@ -21,7 +21,8 @@ from .. import config
 from ..drivers import march
 from ..laws import MACROSLIP, law_parameters, make_law
 from ..laws.segalman import CHI_MAX, CHI_MIN
-from ._lsq import Param, open_reason, solve, start_values, status_of
+from ._lsq import (FIT_BETA_MAX, FIT_BETA_START, FIT_GRID_BETA, FIT_GRID_CHI, FIT_GRID_SLIP, Param, open_reason,
+                   solve, start_values, status_of)
 from .result import FitResult
 
 __all__ = ["fit_loops", "LOOP_MODELS"]
@@ -30,6 +31,18 @@ __all__ = ["fit_loops", "LOOP_MODELS"]
 LOOP_MODELS = ("jenkins", "iwan", "segalman", "iwan-closed", "discrete")
 #: law parameters fitted when the law has them (the others are held at their given values)
 SHAPE_PARAMS = ("chi", "beta")
+#: the displacement window after a reversal over which the initial slope (start of kt) is
+#: measured, as a fraction of the peak-to-peak displacement (-)
+FIT_SLOPE_WINDOW = 0.03
+#: quantile of |T| / N over the samples in contact taken as the start of mu (-)
+FIT_MU_QUANTILE = 0.99
+#: a record whose |T| at the first sample is at most this fraction of max |T| (-) starts
+#: from rest; samples of the ramp from rest to the first sample of any other record
+FIT_REST_FORCE = 0.05
+FIT_RAMP_SAMPLES = 200
+#: a record fitted from rest whose first stroke leaves an rms residual above this many times
+#: that of the rest was picked up mid-cycle (its first stroke then sets the state) (-)
+FIT_FIRST_STROKE_MISFIT = 3.0
 
 
 def _array(name, v):
@@ -73,7 +86,7 @@ def _reversals(x):
 
 def _start_kt(x, T, rev):
     """Median slope of T against x just after each reversal (all elements stick)."""
-    w = config.FIT_SLOPE_WINDOW * np.ptp(x)
+    w = FIT_SLOPE_WINDOW * np.ptp(x)
     slopes = []
     ends = np.concatenate((rev[1:], [x.size - 1]))
     for r, e in zip(rev, ends):
@@ -120,14 +133,14 @@ def _start(model, x, N, T, n_ref):
     rev = _reversals(x)
     kt0 = _start_kt(x, T, rev)
     on = N > 0.0
-    mu0 = float(np.quantile(np.abs(T[on]) / N[on], config.FIT_MU_QUANTILE))
+    mu0 = float(np.quantile(np.abs(T[on]) / N[on], FIT_MU_QUANTILE))
     mu0 = max(mu0, 1e-12)
     start = {"kt": kt0, "mu": mu0}
     names = {p.name for p in law_parameters(model)}
     if "chi" in names:
         start["chi"] = _start_chi(x, T, rev, 2.0 * mu0 * n_ref / kt0)
     if "beta" in names:
-        start["beta"] = config.FIT_BETA_START
+        start["beta"] = FIT_BETA_START
     return start
 
 
@@ -137,7 +150,7 @@ def _params(model, start) -> list:
     if "chi" in start:
         out.append(Param("chi", start["chi"], False, CHI_MIN, CHI_MAX))
     if "beta" in start:
-        out.append(Param("beta", start["beta"], False, 0.0, config.FIT_BETA_MAX))
+        out.append(Param("beta", start["beta"], False, 0.0, FIT_BETA_MAX))
     return out
 
 
@@ -147,27 +160,27 @@ def _grid(s0) -> list:
     if "beta" not in s0:
         return []
     return [{**s0, "chi": c, "beta": b, "mu": f * s0["mu"]}
-            for c in config.FIT_GRID_CHI for b in config.FIT_GRID_BETA for f in config.FIT_GRID_SLIP]
+            for c in FIT_GRID_CHI for b in FIT_GRID_BETA for f in FIT_GRID_SLIP]
 
 
 def _record_start(x, N, T, from_rest):
     """(x and N to march, the mask of the record's samples fitted, a sentence saying how the
     initial slip state was set). A record from rest (|T| at the first sample at most
-    ``config.FIT_REST_FORCE`` of max |T|, or ``from_rest``) is marched from the virgin state
+    ``FIT_REST_FORCE`` of max |T|, or ``from_rest``) is marched from the virgin state
     at its first sample and fitted whole. Any other record (a steady cycle picked up
     anywhere) is marched after a ramp from rest at x = 0 to its first sample, and its
     samples before the second reversal (the first full stroke between its extremes, which
     sets the state of every element that slips) only set the slip state: they are not
     fitted."""
     if from_rest is None:
-        from_rest = abs(float(T[0])) <= config.FIT_REST_FORCE * float(np.max(np.abs(T)))
+        from_rest = abs(float(T[0])) <= FIT_REST_FORCE * float(np.max(np.abs(T)))
     if from_rest:
         return x, N, np.ones(x.size, bool), "from rest: the virgin state at the first sample"
     rev = _reversals(x)
     if rev.size < 3:
         raise ValueError("the record does not start from rest (T at the first sample is not 0) and has no full "
                          "stroke between two reversals to set the slip state: record at least one full cycle")
-    ramp = np.linspace(0.0, float(x[0]), config.FIT_RAMP_SAMPLES, endpoint=False)
+    ramp = np.linspace(0.0, float(x[0]), FIT_RAMP_SAMPLES, endpoint=False)
     fitted = np.arange(x.size) >= rev[2]
     return (np.concatenate((ramp, x)), np.concatenate((np.full(ramp.size, N[0]), N)), fitted,
             f"mid-cycle: ramped from rest at x = 0 to the first sample; samples 0 to {int(rev[2]) - 1} (the first "
@@ -204,7 +217,7 @@ def _first_stroke_misfit(setup, values, x, T) -> bool:
         return False
     r = setup["force"](setup["law_of"](values)) - T
     first, rest = r[: rev[2]], r[rev[2]:]
-    return math.sqrt(float(np.mean(first * first))) > config.FIT_FIRST_STROKE_MISFIT * math.sqrt(
+    return math.sqrt(float(np.mean(first * first))) > FIT_FIRST_STROKE_MISFIT * math.sqrt(
         float(np.mean(rest * rest)))
 
 
@@ -259,9 +272,9 @@ def fit_loops(x, N, T, model: str = config.MODEL, *, t=None, n_ref: float | None
         the fit.
     from_rest : bool, optional
         Whether the record starts from rest (the virgin state at the first sample). Default:
-        when |T| at the first sample is at most ``config.FIT_REST_FORCE`` of max |T|.
+        when |T| at the first sample is at most ``FIT_REST_FORCE`` of max |T|.
         Otherwise, or when the fit from rest leaves on the first stroke an rms residual above
-        ``config.FIT_FIRST_STROKE_MISFIT`` times that of the rest of the record, the first
+        ``FIT_FIRST_STROKE_MISFIT`` times that of the rest of the record, the first
         stroke only sets the slip state (``FitResult.record_start`` says which).
 
     Returns
