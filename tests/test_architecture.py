@@ -396,7 +396,7 @@ def test_the_energy_check_finds_a_name_outside_the_rule(tmp_path):
 #: module (as the continuation's, the sweeps', the time march's, the laws', the modes' and the figures' were): the list only shrinks
 PENDING_OWNED = {
     # hb
-    "HB_AUTO_EARLY_DROP", "HB_AUTO_MAX_HARMONICS", "HB_AUTO_MAX_SAMPLES", "HB_BLOCK_PRECONDITIONER",
+    "HB_BLOCK_PRECONDITIONER",
     "HB_CONDENSED_HILL_ROWS", "HB_CONDENSE_CHECK_RTOL", "HB_CONDENSE_MAX_FRACTION", "HB_CONDENSE_MIN_DOFS",
     "HB_CONDENSE_MODAL_RTOL", "HB_CONDENSE_STATIC_RTOL", "HB_FOLD_WINDOW", "HB_HILL_MAX_ROWS", "HB_HOMOTOPY_START",
     "HB_JACOBIAN_BUDGET_BYTES", "HB_MAX_GAMMA_STEP", "HB_PARAMETER_FD_STEP", "HB_PEAK_PROMINENCE",

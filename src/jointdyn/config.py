@@ -108,15 +108,6 @@ HB_SAMPLES = 128
 #: discretisation is refined (and the branch computed again) while a peak amplitude changes by more
 #: than this fraction of the highest peak's
 HB_AUTO_RTOL = 1e-3
-#: while the first branch is continued, its highest point so far is checked once the amplitude has fallen
-#: below this fraction of it (a resonance passed); where that peak converges at a finer level, the branch
-#: stops there and is computed at that level (the rest of it would be discarded), and the finished branch
-#: must confirm the stop, else the choice is made again without stops (jointdyn.hb.discretisation._PeakWatch)
-HB_AUTO_EARLY_DROP = 0.5
-#: the largest H and Ns an automatic choice takes (the check solves go one level beyond); with separation
-#: the samples decide, H = 7 already within 2e-4 of H = 15 on the paper's grid
-HB_AUTO_MAX_HARMONICS = 15
-HB_AUTO_MAX_SAMPLES = 2048
 #: bound on the periods marched per AFT evaluation (two normally suffice
 #: for Masing-type laws; the force must repeat to HB_PERIODIC_RTOL)
 HB_MAX_PASSES = 8

@@ -111,11 +111,11 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         (default): start at ``config.HB_HARMONICS``; every refined peak is
         solved again with 2H + 1 harmonics and, where its amplitude changes
         by more than ``config.HB_AUTO_RTOL``, the branch is computed again
-        with more (up to ``config.HB_AUTO_MAX_HARMONICS``).
+        with more (up to ``jointdyn.hb.discretisation.HB_AUTO_MAX_HARMONICS``).
     samples : int or "auto"
         AFT time samples per period (>= 2H + 2). ``"auto"`` (default):
         start at ``config.HB_SAMPLES`` and double the same way, checked
-        with 2 Ns samples (up to ``config.HB_AUTO_MAX_SAMPLES``). The
+        with 2 Ns samples (up to ``jointdyn.hb.discretisation.HB_AUTO_MAX_SAMPLES``). The
         levels used and the check are in ``HBBranch.discretisation``; a
         converged branch costs two extra solves per peak.
     max_step : float, optional

@@ -147,7 +147,7 @@ def check_memory(system, disc: Discretisation, names=("harmonics", "samples")) -
     """ValueError naming the fixed harmonics or samples of ``disc`` (with the largest value that fits)
     when the harmonic balance of ``system`` would exceed the memory bound
     (:func:`jointdyn._validate.memory_budget`); automatic values are bounded by
-    ``config.HB_AUTO_MAX_*`` and not checked here. Fixed harmonics are
+    ``jointdyn.hb.discretisation.HB_AUTO_MAX_*`` and not checked here. Fixed harmonics are
     estimated with the fewest samples they need (2H + 2), so that their own
     size is what they are blamed for, never the default samples."""
     H, Ns = disc.first
