@@ -119,63 +119,15 @@ HB_PERIODIC_RTOL = 1e-10
 HB_RECONTACT_ALPHA = 1e-12
 
 # --- harmonic balance: branches, starts and single solutions -------------------------------------
-#: harmonic balance in gamma: largest gamma spacing of a branch when the
-#: caller gives none (the command line passes the STEP of --gamma). The chord
-#: bound CONT_CHORD_TOL is a distance in (gamma, ln amplitude); on a steep flank a
-#: chord within it can still miss the amplitude at the same gamma by more
-#: than 1 % (1.4 % at 0.1 gamma spacing on the Jenkins benchmark branch,
-#: F1 = 5 N, docs/hb-comparison.md); 0.02 keeps it below 1 % (0.9 %) for
-#: about 25 % more points
-HB_MAX_GAMMA_STEP = 0.02
-#: Newton iterations of the start of a branch (from the stuck linear solution)
-HB_START_MAX_ITER = 30
-#: Newton iterations of a single solution (harmonic_balance)
-HB_SOLVE_MAX_ITER = 50
-#: a homotopy in the forcing amplitude starts at this fraction of F1
-HB_HOMOTOPY_START = 1e-3
-#: central-difference step, relative to the parameter's scale, of dR/dp for
-#: a parameter that builds a System (jointdyn.hb.parameters.SystemParameter):
-#: about eps^(1/3), which balances the O(h^2) error and rounding
-HB_PARAMETER_FD_STEP = 6e-6
 
 # --- harmonic balance: classification of points ---------------------------------------
-#: response declared unbounded when q = kt X / fy exceeds this (hard bound)
-HB_UNBOUNDED_Q = 1e5
-#: ... or when the corrector fails at the smallest step with q above this
-#: fraction of HB_UNBOUNDED_Q
-HB_UNBOUNDED_FAIL_FRACTION = 0.1
-#: describing-function saturation test (Den Hartog): applied once q exceeds
-#: HB_SATURATION_Q, when the contact slips at least this fraction of the
-#: period and C = 0 (single DOF)
-HB_SATURATION_Q = 30.0
-HB_SATURATION_SLIP_FRACTION = 0.9
 #: a Floquet exponent with Re(s) > HB_STABILITY_RTOL * w marks instability
 HB_STABILITY_RTOL = 1e-6
-#: a Hill growth Re(s)/w between HB_STABILITY_RTOL and this is decided by
-#: the monodromy matrix of the time-domain period map (Hill's method
-#: truncated to H harmonics errs by a few 1e-6 at corners of the contact
-#: force: the onset of slip of an undamped oscillator)
-HB_STABILITY_CONFIRM = 1e-4
 #: Hill companion matrices (2 n (2H+1) rows), or their parity blocks, of at
 #: most this many rows go through the compiled EISPACK eigenvalue solver,
 #: larger ones through LAPACK (benchmarks/bench_linalg.py: the compiled
 #: solver is 1.3-3.7x faster up to 150 rows, LAPACK 1.1-1.3x faster from 300)
 HB_SMALL_EIG = 200
-#: turning points (folds) of a branch: the parameter must come back by more
-#: than this fraction of the range, or log q move by more than
-#: HB_TURNING_BAND_LOG_Q while the parameter is short of its extreme (a fold
-#: whose branches are close in the parameter): the jitter of points at a
-#: non-smooth corner stays within both
-HB_TURNING_BAND = 5e-4
-HB_TURNING_BAND_LOG_Q = 5e-3
-#: a turning point is a fold only with an unstable point between it and the
-#: neighbouring turning points (without one on a side: within this many
-#: points): a saddle-node changes the number of unstable multipliers
-HB_FOLD_WINDOW = 3
-#: a local maximum of the amplitude along a branch is a peak when the
-#: amplitude falls by more than this fraction of it on both sides (before
-#: rising above it again)
-HB_PEAK_PROMINENCE = 1e-3
 
 # --- harmonic balance: condensation onto the contact DOFs (jointdyn.hb.condense) -------
 #: automatic choice: condense systems of at least this many DOFs ...
@@ -211,11 +163,6 @@ HB_HILL_MAX_ROWS = 4000
 #: bordered matrix, reused through GMRES), kept as the reference of
 #: benchmarks/bench_hb_scale.py
 HB_BLOCK_PRECONDITIONER = True
-#: bytes of dense Jacobians a branch keeps at once: the continuation monitor
-#: keeps the evaluations of accepted points with their Jacobians while they fit
-#: (beyond, without: the point is evaluated again for its stability), and
-#: Hill's method runs on chunks of points that fit
-HB_JACOBIAN_BUDGET_BYTES = 2**28
 
 # --- nonlinear modes (jointdyn.modes) ------------------------------------------------
 #: default amplitude range of a backbone (first-harmonic amplitude of the
