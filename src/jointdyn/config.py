@@ -130,26 +130,6 @@ HB_STABILITY_RTOL = 1e-6
 HB_SMALL_EIG = 200
 
 # --- harmonic balance: condensation onto the contact DOFs (jointdyn.hb.condense) -------
-#: automatic choice: condense systems of at least this many DOFs ...
-HB_CONDENSE_MIN_DOFS = 12
-#: ... whose retained DOFs (contacts, DOF 0, response DOFs) are at most this
-#: fraction of all DOFs
-HB_CONDENSE_MAX_FRACTION = 0.5
-#: the damping is modal (receptance by the undamped modes) when C = alpha M +
-#: beta K to this fraction of max |C|, or when the off-diagonal entries of
-#: Phi^T C Phi are at most this fraction of its largest entry; otherwise the
-#: damped (state-space) eigenproblem is used
-HB_CONDENSE_MODAL_RTOL = 1e-12
-#: the static Schur complement comes from the expansion (H_cc(0)^-1) when every
-#: static factor |1 / g_r(0)| is at least this fraction of the largest (K
-#: positive definite); otherwise from a Cholesky factorisation of K_oo
-HB_CONDENSE_STATIC_RTOL = 1e-6
-#: the spectral expansion H of the receptance must satisfy Z(W) H(W) = I at one
-#: frequency to this, relative to max |Z| max |H| (backward error)
-HB_CONDENSE_CHECK_RTOL = 1e-9
-#: a condensed problem computes Hill stability (on the full Jacobian it
-#: assembles) when the full companion matrix has at most this many rows
-HB_CONDENSED_HILL_ROWS = 200
 #: a (full) harmonic-balance problem computes Hill stability when the
 #: companion matrix has at most this many rows (2 n (2H+1)); beyond, all its
 #: eigenvalues cost more than the branch (about a minute per point at 10^4
