@@ -396,8 +396,7 @@ def test_the_energy_check_finds_a_name_outside_the_rule(tmp_path):
 #: module (as the continuation's, the sweeps', the time march's, the laws', the modes' and the figures' were): the list only shrinks
 PENDING_OWNED = {
     # hb
-    "HB_BLOCK_PRECONDITIONER", "HB_HILL_MAX_ROWS", "HB_PERIODIC_RTOL", "HB_RECONTACT_ALPHA", "HB_SMALL_EIG",
-    "HB_STABILITY_RTOL",
+    "HB_SMALL_EIG", "HB_STABILITY_RTOL",
     # identify
     "FIT_BETA_MAX", "FIT_BETA_START", "FIT_FIRST_STROKE_MISFIT", "FIT_FTOL", "FIT_GRID_BETA", "FIT_GRID_CHI",
     "FIT_GRID_SLIP", "FIT_GTOL", "FIT_LEVEL", "FIT_MAX_NFEV", "FIT_MAX_RELATIVE_SE", "FIT_MAX_SHAPE_SE",

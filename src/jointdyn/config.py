@@ -109,14 +109,8 @@ HB_SAMPLES = 128
 #: than this fraction of the highest peak's
 HB_AUTO_RTOL = 1e-3
 #: bound on the periods marched per AFT evaluation (two normally suffice
-#: for Masing-type laws; the force must repeat to HB_PERIODIC_RTOL)
+#: for Masing-type laws; the force must repeat to jointdyn.hb._aft.HB_PERIODIC_RTOL)
 HB_MAX_PASSES = 8
-#: two consecutive marched periods agree when max|T_p - T_(p-1)| <= rtol max|T|
-HB_PERIODIC_RTOL = 1e-10
-#: load at which the AFT restarts a contact law at a re-contact phase between
-#: two samples, as a fraction of the contact's largest |N| (> 0: the law is
-#: in contact and at rest there, as the time integrator's TI_RECONTACT_ALPHA)
-HB_RECONTACT_ALPHA = 1e-12
 
 # --- harmonic balance: branches, starts and single solutions -------------------------------------
 
@@ -130,19 +124,6 @@ HB_STABILITY_RTOL = 1e-6
 HB_SMALL_EIG = 200
 
 # --- harmonic balance: condensation onto the contact DOFs (jointdyn.hb.condense) -------
-#: a (full) harmonic-balance problem computes Hill stability when the
-#: companion matrix has at most this many rows (2 n (2H+1)); beyond, all its
-#: eigenvalues cost more than the branch (about a minute per point at 10^4
-#: rows on 2 cores): stability is not computed (growth NaN, the Dataset's
-#: ``stability`` attribute says so)
-HB_HILL_MAX_ROWS = 4000
-#: from config.CONT_KRYLOV_SOLVE unknowns, the Newton and tangent solves of HB
-#: branches and EPMC backbones are GMRES preconditioned by per-harmonic
-#: factorisations of the Jacobian's diagonal harmonic blocks
-#: (jointdyn.hb._precond); False: the direct path (one LU of the whole
-#: bordered matrix, reused through GMRES), kept as the reference of
-#: benchmarks/bench_hb_scale.py
-HB_BLOCK_PRECONDITIONER = True
 
 # --- nonlinear modes (jointdyn.modes) ------------------------------------------------
 #: default amplitude range of a backbone (first-harmonic amplitude of the
