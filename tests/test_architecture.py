@@ -395,8 +395,6 @@ def test_the_energy_check_finds_a_name_outside_the_rule(tmp_path):
 #: numbers read by one package only that are still in config, to move into that package's options object or
 #: module (as the continuation's, the sweeps', the time march's, the laws', the modes' and the figures' were): the list only shrinks
 PENDING_OWNED = {
-    # hb
-    "HB_SMALL_EIG", "HB_STABILITY_RTOL",
     # identify
     "FIT_BETA_MAX", "FIT_BETA_START", "FIT_FIRST_STROKE_MISFIT", "FIT_FTOL", "FIT_GRID_BETA", "FIT_GRID_CHI",
     "FIT_GRID_SLIP", "FIT_GTOL", "FIT_LEVEL", "FIT_MAX_NFEV", "FIT_MAX_RELATIVE_SE", "FIT_MAX_SHAPE_SE",

@@ -115,13 +115,6 @@ HB_MAX_PASSES = 8
 # --- harmonic balance: branches, starts and single solutions -------------------------------------
 
 # --- harmonic balance: classification of points ---------------------------------------
-#: a Floquet exponent with Re(s) > HB_STABILITY_RTOL * w marks instability
-HB_STABILITY_RTOL = 1e-6
-#: Hill companion matrices (2 n (2H+1) rows), or their parity blocks, of at
-#: most this many rows go through the compiled EISPACK eigenvalue solver,
-#: larger ones through LAPACK (benchmarks/bench_linalg.py: the compiled
-#: solver is 1.3-3.7x faster up to 150 rows, LAPACK 1.1-1.3x faster from 300)
-HB_SMALL_EIG = 200
 
 # --- harmonic balance: condensation onto the contact DOFs (jointdyn.hb.condense) -------
 

@@ -81,7 +81,7 @@ from .levels import Level
 from .parameters import F1, GAMMA
 from .problem import HBProblem, reference_scales
 from .results import HBBranch, HBPeak, PointStatus, sliding_as_a_whole
-from .stability import hill_growth
+from .stability import HB_SMALL_EIG, HB_STABILITY_RTOL, hill_growth
 from .stability_options import StabilityOptions
 
 __all__ = ["continued_branch", "solve_point"]
@@ -204,7 +204,7 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     dense, need = method == "dense", method != "none"
     chunk = max(1, min(n, HB_JACOBIAN_BUDGET_BYTES // (8 * problem.size * problem.size))) if dense else 1
     JXs = np.empty((chunk, problem.size, problem.size) if dense else (1, 0, 0))
-    lapack = method == "arnoldi" or (dense and 2 * problem.system.ndof * problem.nh > config.HB_SMALL_EIG)
+    lapack = method == "arnoldi" or (dense and 2 * problem.system.ndof * problem.nh > HB_SMALL_EIG)
     with stage_progress(n if need else 0, f"stability ({method})", tr.progress, unit="point") as bar, \
             (blas_threads() if lapack else contextlib.nullcontext()):
         for i in range(n):
@@ -293,22 +293,22 @@ def _confirmed_stability(problem: HBProblem, X, lam, growth):
     contact force has a corner (the onset of slip of a Jenkins element on
     an otherwise undamped oscillator gives Re(s)/w of a few 1e-6 at
     points whose period map is contracting). A growth between
-    ``config.HB_STABILITY_RTOL`` and ``HB_STABILITY_CONFIRM`` is
+    ``HB_STABILITY_RTOL`` and ``HB_STABILITY_CONFIRM`` is
     therefore decided by the Floquet multipliers of the time-domain period
     map (:func:`~jointdyn.hb.monodromy.monodromy_multipliers`): unstable
     when one lies outside the unit circle by more than
-    ``2 pi config.HB_STABILITY_RTOL``. Systems with interfaces keep Hill's criterion there: the
+    ``2 pi HB_STABILITY_RTOL``. Systems with interfaces keep Hill's criterion there: the
     time-domain period map does not march interfaces yet.
     """
     from .monodromy import monodromy_multipliers
 
-    stable = growth <= config.HB_STABILITY_RTOL
+    stable = growth <= HB_STABILITY_RTOL
     if problem.has_interfaces:
         return stable, 0
     marginal = np.flatnonzero(~stable & (growth < HB_STABILITY_CONFIRM))
     for i in marginal:
         mu = np.max(np.abs(monodromy_multipliers(problem, X[i], lam[i])))
-        stable[i] = mu <= 1.0 + 2.0 * math.pi * config.HB_STABILITY_RTOL
+        stable[i] = mu <= 1.0 + 2.0 * math.pi * HB_STABILITY_RTOL
     return stable, int(marginal.size)
 
 

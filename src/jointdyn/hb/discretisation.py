@@ -58,7 +58,7 @@ def _doublings(a: int, b: int, grow) -> int:
 
 def level_number(level: Level, disc: Discretisation) -> tuple[int, int]:
     """(k, most): ``level`` is the k-th of an automatic choice from ``disc.first``, which has at most ``most``
-    (each raise of the harmonics H -> 2H + 1 and of the samples Ns -> 2 Ns within ``config.HB_AUTO_MAX_*``
+    (each raise of the harmonics H -> 2H + 1 and of the samples Ns -> 2 Ns within ``HB_AUTO_MAX_*``
     is one level; a samples retry after a failure is one too)."""
     (h0, s0), grow_h, grow_s = disc.first, (lambda h: 2 * h + 1), (lambda s: 2 * s)
     k = 1 + _doublings(h0, level.harmonics, grow_h) + _doublings(s0, level.samples, grow_s)
@@ -79,7 +79,7 @@ def check_levels(level: Level, disc: Discretisation):
 
 
 def next_level(level: Level, disc: Discretisation, bad_h: bool, bad_s: bool) -> Level:
-    """The level the checks ask for, within ``config.HB_AUTO_MAX_*`` (equal to ``level``: no refinement).
+    """The level the checks ask for, within ``HB_AUTO_MAX_*`` (equal to ``level``: no refinement).
 
     The samples first: with too few, the sampling error of the contact
     force also moves the solution with more harmonics, so H is raised

@@ -31,7 +31,7 @@ from .levels import AUTO, Discretisation, Level, check_memory
 from .parameters import GAMMA, parameter_named
 from .problem import HBProblem, reference_scales, stuck_stiffness
 from .results import HBBranch, HBSolution, SolveStatus
-from .stability import hill_stability
+from .stability import HB_STABILITY_RTOL, hill_stability
 from .stability_options import StabilityOptions, stability_options
 
 __all__ = ["continue_hb", "frc_hb", "harmonic_balance", "check_mean_position"]
@@ -322,7 +322,7 @@ def _point_stability(problem: HBProblem, JX, w: float, opts: StabilityOptions):
         return hill_stability(np.asarray(J), s.M, dense_damping(s.C), w, problem.H)
     with blas_threads():  # ARPACK's BLAS-2 work: 2 OpenBLAS threads on 2 busy cores are slower than one
         found = hill_arnoldi_exponents(J, s.M, dense_damping(s.C), w, problem.H, opts)
-    return found.growth <= config.HB_STABILITY_RTOL, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
+    return found.growth <= HB_STABILITY_RTOL, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
 
 
 def _make_solution(problem: HBProblem, X, converged, iterations, response_dof, opts=None) -> HBSolution:
