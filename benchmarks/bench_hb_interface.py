@@ -70,7 +70,7 @@ def _contacts(nc):
 def _time(q, X, count):
     """Microseconds (CPU) per pair of the pairs' AFT kernel alone; for the scalar contacts, per contact of
     their whole evaluation (it includes their problem's linear part, small at 32 DOFs)."""
-    from jointdyn import config
+    from jointdyn.hb._aft import HB_PERIODIC_RTOL
     from jointdyn.hb._aft_pairs import pairs_aft_kernel
 
     if not q.has_interfaces:
@@ -83,7 +83,7 @@ def _time(q, X, count):
     kernel = pairs_aft_kernel()
     t0 = time.thread_time()
     kernel(q.pair_positions, q.pair_params, X, q.n, q.E, q.P, *q._pair_dirs, int(q.max_passes),
-           float(config.HB_PERIODIC_RTOL), R, JX, q._no_blocks, T, N, code, info)
+           float(HB_PERIODIC_RTOL), R, JX, q._no_blocks, T, N, code, info)
     t = (time.thread_time() - t0) / count * 1e6
     return t, type("Ev", (), {"info": info, "pair_code": code})
 

@@ -13,7 +13,7 @@ as :func:`jointdyn.figures.lap.lap_joint_system` builds it. Measured at
 - the HB forced-response branch across the first resonance (``BAND_HZ``).
 
 Each with the Newton and tangent solves preconditioned by the harmonic
-blocks (``config.HB_BLOCK_PRECONDITIONER``, :mod:`jointdyn.hb._precond`)
+blocks (``jointdyn.hb.problem.HB_BLOCK_PRECONDITIONER``, :mod:`jointdyn.hb._precond`)
 and, in the same run, by today's direct path (one LU of the whole bordered
 matrix, reused through GMRES: the reference), the two sides alternated
 (block, direct for the backbone; direct, block for the branch). Each side
@@ -47,11 +47,11 @@ def _system():
 
 
 def _backbone(H: int, blocks: bool) -> dict:
-    from jointdyn import config
     from jointdyn.figures import lap
+    from jointdyn.hb import problem as hb_problem
     from jointdyn.modes import epmc
 
-    config.HB_BLOCK_PRECONDITIONER = blocks
+    hb_problem.HB_BLOCK_PRECONDITIONER = blocks
     s = _system()
     t0 = time.perf_counter()
     b = epmc(s, AMPLITUDE_M, harmonics=H, samples=SAMPLES, max_points=MAX_POINTS, ds_max=lap.LAP_DS_MAX,
@@ -63,10 +63,10 @@ def _backbone(H: int, blocks: bool) -> dict:
 
 
 def _branch(H: int, blocks: bool) -> dict:
-    from jointdyn import config
     from jointdyn.hb import continue_hb
+    from jointdyn.hb import problem as hb_problem
 
-    config.HB_BLOCK_PRECONDITIONER = blocks
+    hb_problem.HB_BLOCK_PRECONDITIONER = blocks
     s = _system()
     g0, g1 = (2.0 * math.pi * f / s.w0 for f in BAND_HZ)
     t0 = time.perf_counter()

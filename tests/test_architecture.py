@@ -392,18 +392,6 @@ def test_the_energy_check_finds_a_name_outside_the_rule(tmp_path):
 
 
 # --- configuration by layer: config keeps only the numbers several packages share ---------------------------
-#: numbers read by one package only that are still in config, to move into that package's options object or
-#: module (as the continuation's, the sweeps', the time march's, the laws', the modes' and the figures' were): the list only shrinks
-PENDING_OWNED = {
-    # hb
-    "HB_AUTO_EARLY_DROP", "HB_AUTO_MAX_HARMONICS", "HB_AUTO_MAX_SAMPLES", "HB_BLOCK_PRECONDITIONER",
-    "HB_CONDENSED_HILL_ROWS", "HB_CONDENSE_CHECK_RTOL", "HB_CONDENSE_MAX_FRACTION", "HB_CONDENSE_MIN_DOFS",
-    "HB_CONDENSE_MODAL_RTOL", "HB_CONDENSE_STATIC_RTOL", "HB_FOLD_WINDOW", "HB_HILL_MAX_ROWS", "HB_HOMOTOPY_START",
-    "HB_JACOBIAN_BUDGET_BYTES", "HB_MAX_GAMMA_STEP", "HB_PARAMETER_FD_STEP", "HB_PEAK_PROMINENCE",
-    "HB_PERIODIC_RTOL", "HB_RECONTACT_ALPHA", "HB_SATURATION_Q", "HB_SATURATION_SLIP_FRACTION", "HB_SMALL_EIG",
-    "HB_SOLVE_MAX_ITER", "HB_STABILITY_CONFIRM", "HB_STABILITY_RTOL", "HB_START_MAX_ITER", "HB_TURNING_BAND",
-    "HB_TURNING_BAND_LOG_Q", "HB_UNBOUNDED_FAIL_FRACTION", "HB_UNBOUNDED_Q",
-}
 #: bounds on the size of an input, kept in config beside the other input bounds whatever reads them
 INPUT_BOUNDS = {"FILES_MAX_DOF"}
 
@@ -452,11 +440,11 @@ def owned_config_constants(root: Path = SRC) -> dict:
 def test_config_keeps_only_shared_numbers():
     owned = owned_config_constants()
     crept = [f"config.{name}: read by {top} alone" for name, top in owned.items()
-             if name not in PENDING_OWNED | INPUT_BOUNDS]
+             if name not in INPUT_BOUNDS]
     assert not crept, ("numbers of one package belong in its options object (docs/architecture.md):\n"
                        + "\n".join(crept))
-    stale = sorted((PENDING_OWNED | INPUT_BOUNDS) - set(owned) - (INPUT_BOUNDS & config_constants()))
-    assert not stale, f"moved out of config or now shared: remove from PENDING_OWNED: {stale}"
+    stale = sorted(INPUT_BOUNDS - set(owned) - (INPUT_BOUNDS & config_constants()))
+    assert not stale, f"moved out of config or now shared: remove from INPUT_BOUNDS: {stale}"
 
 
 def test_the_config_check_finds_an_owned_number(tmp_path):

@@ -15,16 +15,17 @@ import math
 import numpy as np
 import pytest
 
-from jointdyn import System, config
+from jointdyn import System
 from jointdyn.fourier import basis, derivative_matrix
 from jointdyn.hb import HBProblem
+from jointdyn.hb._aft import HB_PERIODIC_RTOL
 
 
 def _value_period(p, law, c, U, u, Nsamp, ev_tau, ev_load, s0, vbuf, Tref):
     """The compiled march's check after the second pass: one period from s0 with the law's plain
     ``step`` (restarts by ``init``), trial states alternating between a copy of s0 and ``vbuf``.
     Returns (largest change of the force against Tref, True when it repeats Tref)."""
-    rtol = config.HB_PERIODIC_RTOL
+    rtol = HB_PERIODIC_RTOL
     va, vb = s0.copy(), vbuf
     Tv = np.empty(u.size)
     for i in range(u.size):
@@ -48,7 +49,7 @@ def _reference(p, X, lam):
     Eg, Pg, ns, n, nh = p._Eg, p._Pg, p._taug.size, p.n, p.nh
     has_p = dN is not None
     nd = nh + int(has_p)
-    rtol = config.HB_PERIODIC_RTOL
+    rtol = HB_PERIODIC_RTOL
     info = np.array([0.0, 0.0, 1.0])
     # the compiled march's second state buffer of its period without derivatives,
     # kept from one contact to the next (zeros at first)

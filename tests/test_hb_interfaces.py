@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import jointdyn as jd
+from jointdyn.hb import branch as hb_branch
 from jointdyn.hb.problem import HBProblem
 from jointdyn.interfaces import Interface
 from jointdyn.kinematics import NormalSpring
@@ -262,13 +263,11 @@ def test_command_line_hb_and_modes_take_interfaces(tmp_path, capsys):
 def test_branch_keeps_no_jacobian_beyond_its_budget(monkeypatch):
     """With no room for Jacobians, the points are evaluated again one by one for Hill's method: the same
     branch, the same stability."""
-    from jointdyn import config
     from jointdyn.hb import continue_hb
 
     s = _system(_patch(), force=(0.5, 0.25, 0.0, 0.0))
     a = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False)
-    # harmonic balance's number, still in config until hb's options take it (PENDING_OWNED in tests/test_architecture.py)
-    monkeypatch.setattr(config, "HB_JACOBIAN_BUDGET_BYTES", 1)
+    monkeypatch.setattr(hb_branch, "HB_JACOBIAN_BUDGET_BYTES", 1)
     b = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False)
     np.testing.assert_array_equal(a.lam, b.lam)
     np.testing.assert_array_equal(a.growth, b.growth)
@@ -280,11 +279,11 @@ def test_branch_keeps_no_jacobian_beyond_its_budget(monkeypatch):
 def test_marginal_hill_growth_with_interfaces_keeps_hills_criterion():
     """A growth in the band where contacts are confirmed by the time-domain period map: that map does not
     march interfaces, so a system with interfaces keeps Hill's criterion (no monodromy check)."""
-    from jointdyn import config
     from jointdyn.hb.branch import _confirmed_stability
+    from jointdyn.hb.stability import HB_STABILITY_RTOL
 
     q = HBProblem(_system(_patch()), harmonics=2, samples=32)
     X = np.zeros((2, q.size))
-    growth = np.array([0.5 * config.HB_STABILITY_RTOL, 0.5 * (config.HB_STABILITY_RTOL + config.HB_STABILITY_CONFIRM)])
+    growth = np.array([0.5 * HB_STABILITY_RTOL, 0.5 * (HB_STABILITY_RTOL + hb_branch.HB_STABILITY_CONFIRM)])
     stable, checked = _confirmed_stability(q, X, np.array([1.0, 1.0]), growth)
     assert stable.tolist() == [True, False] and checked == 0

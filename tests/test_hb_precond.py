@@ -15,6 +15,7 @@ import pytest
 import jointdyn as jd
 from jointdyn import config
 from jointdyn.continuation import LinearSolveOptions, linalg
+from jointdyn.hb import problem as hb_problem
 from jointdyn.hb._precond import HarmonicBlocks, harmonic_blocks
 from jointdyn.hb.problem import HBProblem, reference_scales
 from jointdyn.interfaces import Interface
@@ -105,8 +106,8 @@ def _large(monkeypatch, on: bool):
     # CONT_KRYLOV_SOLVE and CONT_SPARSE_DENSITY are shared (the walk's solves and the form harmonic balance and
     # EPMC give their Jacobians): patched here so that both take the large path at this small size
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
-    monkeypatch.setattr(config, "HB_HILL_MAX_ROWS", 0)
-    monkeypatch.setattr(config, "HB_BLOCK_PRECONDITIONER", on)
+    monkeypatch.setattr(hb_problem, "HB_HILL_MAX_ROWS", 0)
+    monkeypatch.setattr(hb_problem, "HB_BLOCK_PRECONDITIONER", on)
     return LinearSolveOptions(small_solve=0)
 
 

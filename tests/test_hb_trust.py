@@ -343,8 +343,7 @@ def test_a_stop_the_finished_branch_does_not_confirm_is_undone(monkeypatch):
     made = []
     real = hb_disc._fixed_branch
     monkeypatch.setattr(hb_disc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
-    # harmonic balance's number, still in config until hb's options take it (PENDING_OWNED in tests/test_architecture.py)
-    monkeypatch.setattr(config, "HB_AUTO_EARLY_DROP", 1.0)
+    monkeypatch.setattr(hb_disc, "HB_AUTO_EARLY_DROP", 1.0)
     every = frc_hb(system, 0.6, 1.8, max_step=0.01)
     assert isinstance(made[0], hb_disc._Refine) and made[0].peak.lam < 0.7
     assert any(not isinstance(m, hb_disc._Refine) and m.status.value == "failed" for m in made)
@@ -355,7 +354,9 @@ def test_a_stop_the_finished_branch_does_not_confirm_is_undone(monkeypatch):
 
 def test_auto_at_its_bound_says_it_is_not_converged(monkeypatch):
     # with the samples bounded at their start, the check of eta = 0.01, beta = 1 fails and the branch says so
-    monkeypatch.setattr(config, "HB_AUTO_MAX_SAMPLES", config.HB_SAMPLES)
+    from jointdyn.hb import discretisation as hb_disc
+
+    monkeypatch.setattr(hb_disc, "HB_AUTO_MAX_SAMPLES", config.HB_SAMPLES)
     ds = frc_hb(System.paper_damper(eta=0.01, beta=1.0), 0.6, 1.8, max_step=0.01)
     assert ds.attrs["check_converged"] == 0 and ds.attrs["samples"] == config.HB_SAMPLES
     assert ds.attrs["check_samples_change"] > config.HB_AUTO_RTOL

@@ -14,6 +14,7 @@ import pytest
 import jointdyn as jd
 from jointdyn import config
 from jointdyn.continuation import LinearSolveOptions, linalg
+from jointdyn.hb import problem as hb_problem
 
 
 def _bordered_case(rng, n):
@@ -262,7 +263,7 @@ def test_stability_beyond_the_dense_size_is_computed_and_not_computed_only_when_
 
     s = _chain(2)
     kw = dict(harmonics=2, samples=32, condense=False)
-    monkeypatch.setattr(config, "HB_HILL_MAX_ROWS", 2 * 6 * 5 - 1)  # 2 n (2H+1) rows with n = 6, H = 2
+    monkeypatch.setattr(hb_problem, "HB_HILL_MAX_ROWS", 2 * 6 * 5 - 1)  # 2 n (2H+1) rows with n = 6, H = 2
     br = continue_hb(s, 0.8, 1.2, stability=StabilityOptions(method="arnoldi"), **kw)
     assert br.status.ok and br.lam.size > 5 and br.stability == "hill-arnoldi"
     assert branch_dataset(br).attrs["stability"] == "hill-arnoldi"

@@ -14,6 +14,7 @@ import pytest
 import jointdyn as jd
 from jointdyn import config
 from jointdyn.continuation import LinearSolveOptions
+from jointdyn.hb import problem as hb_problem
 from jointdyn.hb.problem import HBProblem, reference_scales
 from test_sparse_jacobian import _two_bodies
 
@@ -188,7 +189,7 @@ def test_hb_branch_and_solution_with_the_operator_equal_those_with_dense_c(monke
     # shared numbers: the size above which Krylov solves and the sparse evaluation are used
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
-    monkeypatch.setattr(config, "HB_HILL_MAX_ROWS", 0)  # an hb number still in config
+    monkeypatch.setattr(hb_problem, "HB_HILL_MAX_ROWS", 0)  # harmonic balance's own bound, in its module
     b = continue_hb(so, 0.7, 1.3, harmonics=2, samples=32, condense=False, linear=LinearSolveOptions(small_solve=0))
     assert a.status.ok and b.status.ok
     assert b.counters["sparse_factorisations"] > 0 and b.counters["krylov_solves"] > 0

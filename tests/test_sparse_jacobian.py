@@ -14,6 +14,7 @@ import pytest
 import jointdyn as jd
 from jointdyn import config
 from jointdyn.continuation import LinearSolveOptions
+from jointdyn.hb import problem as hb_problem
 from jointdyn.hb.problem import HBProblem, reference_scales
 from jointdyn.interfaces import Interface
 
@@ -149,7 +150,7 @@ def test_hb_branch_with_sparse_jacobians_has_the_same_peak(monkeypatch):
     # EPMC give their Jacobians): patched here so that both take the large path at this small size
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
-    monkeypatch.setattr(config, "HB_HILL_MAX_ROWS", 0)
+    monkeypatch.setattr(hb_problem, "HB_HILL_MAX_ROWS", 0)
     calls = []
     orig = HBProblem.evaluate_sparse
 

@@ -3,10 +3,11 @@ contact laws; systems and system files; memory bounds; continuation and the quas
 march and its steady states; harmonic balance; nonlinear modes; identification; sweeps.
 
 A number that one solver or package alone reads belongs in that solver's options object
-(``ContinuationOptions``, ``LinearSolveOptions``, ``SweepOptions``) or in its module, with its default
-documented there; ``tests/test_architecture.py`` fails on a number here that one package alone reads,
-except those it lists as still to move (harmonic balance). Test tolerances live with the tests (``tests/tolerances.py``). Units are given
-where a number has one; "relative" numbers are fractions of the scale named.
+(``ContinuationOptions``, ``LinearSolveOptions``, ``SweepOptions``, ``StabilityOptions``,
+``RingdownOptions``) or in its module, with its default documented there; ``tests/test_architecture.py``
+fails on a number here that one package alone reads. Test tolerances live with the tests
+(``tests/tolerances.py``). Units are given where a number has one; "relative" numbers are fractions of the
+scale named.
 """
 
 from __future__ import annotations
@@ -83,20 +84,11 @@ QS_MAX_SAMPLES = 10_000_000
 #: boundaries snap onto existing samples instead of creating tiny steps
 QS_SNAP_RTOL = 1e-9
 
-# --- time integration (explicit RK4 with events) --------------------------------
-
-# --- steady state: periodicity checks ----------------------------------------------
-
-
-# --- steady state: start and shooting ------------------------------------------------
-
 # --- monodromy (finite-difference Floquet multipliers of the period map) --------------
 #: periods, and samples per period, of the harmonic-balance displacement over
 #: which each contact law is marched to obtain its state at the section
 MONODROMY_WARM_PERIODS = 3
 MONODROMY_WARM_SAMPLES = 4096
-
-# --- steady state: unbounded response ----------------------------------------------
 
 # --- harmonic balance: discretisation and AFT ------------------------------------------
 #: harmonics 0..H of the unknowns
@@ -108,123 +100,9 @@ HB_SAMPLES = 128
 #: discretisation is refined (and the branch computed again) while a peak amplitude changes by more
 #: than this fraction of the highest peak's
 HB_AUTO_RTOL = 1e-3
-#: while the first branch is continued, its highest point so far is checked once the amplitude has fallen
-#: below this fraction of it (a resonance passed); where that peak converges at a finer level, the branch
-#: stops there and is computed at that level (the rest of it would be discarded), and the finished branch
-#: must confirm the stop, else the choice is made again without stops (jointdyn.hb.discretisation._PeakWatch)
-HB_AUTO_EARLY_DROP = 0.5
-#: the largest H and Ns an automatic choice takes (the check solves go one level beyond); with separation
-#: the samples decide, H = 7 already within 2e-4 of H = 15 on the paper's grid
-HB_AUTO_MAX_HARMONICS = 15
-HB_AUTO_MAX_SAMPLES = 2048
 #: bound on the periods marched per AFT evaluation (two normally suffice
-#: for Masing-type laws; the force must repeat to HB_PERIODIC_RTOL)
+#: for Masing-type laws; the force must repeat to jointdyn.hb._aft.HB_PERIODIC_RTOL)
 HB_MAX_PASSES = 8
-#: two consecutive marched periods agree when max|T_p - T_(p-1)| <= rtol max|T|
-HB_PERIODIC_RTOL = 1e-10
-#: load at which the AFT restarts a contact law at a re-contact phase between
-#: two samples, as a fraction of the contact's largest |N| (> 0: the law is
-#: in contact and at rest there, as the time integrator's TI_RECONTACT_ALPHA)
-HB_RECONTACT_ALPHA = 1e-12
-
-# --- harmonic balance: branches, starts and single solutions -------------------------------------
-#: harmonic balance in gamma: largest gamma spacing of a branch when the
-#: caller gives none (the command line passes the STEP of --gamma). The chord
-#: bound CONT_CHORD_TOL is a distance in (gamma, ln amplitude); on a steep flank a
-#: chord within it can still miss the amplitude at the same gamma by more
-#: than 1 % (1.4 % at 0.1 gamma spacing on the Jenkins benchmark branch,
-#: F1 = 5 N, docs/hb-comparison.md); 0.02 keeps it below 1 % (0.9 %) for
-#: about 25 % more points
-HB_MAX_GAMMA_STEP = 0.02
-#: Newton iterations of the start of a branch (from the stuck linear solution)
-HB_START_MAX_ITER = 30
-#: Newton iterations of a single solution (harmonic_balance)
-HB_SOLVE_MAX_ITER = 50
-#: a homotopy in the forcing amplitude starts at this fraction of F1
-HB_HOMOTOPY_START = 1e-3
-#: central-difference step, relative to the parameter's scale, of dR/dp for
-#: a parameter that builds a System (jointdyn.hb.parameters.SystemParameter):
-#: about eps^(1/3), which balances the O(h^2) error and rounding
-HB_PARAMETER_FD_STEP = 6e-6
-
-# --- harmonic balance: classification of points ---------------------------------------
-#: response declared unbounded when q = kt X / fy exceeds this (hard bound)
-HB_UNBOUNDED_Q = 1e5
-#: ... or when the corrector fails at the smallest step with q above this
-#: fraction of HB_UNBOUNDED_Q
-HB_UNBOUNDED_FAIL_FRACTION = 0.1
-#: describing-function saturation test (Den Hartog): applied once q exceeds
-#: HB_SATURATION_Q, when the contact slips at least this fraction of the
-#: period and C = 0 (single DOF)
-HB_SATURATION_Q = 30.0
-HB_SATURATION_SLIP_FRACTION = 0.9
-#: a Floquet exponent with Re(s) > HB_STABILITY_RTOL * w marks instability
-HB_STABILITY_RTOL = 1e-6
-#: a Hill growth Re(s)/w between HB_STABILITY_RTOL and this is decided by
-#: the monodromy matrix of the time-domain period map (Hill's method
-#: truncated to H harmonics errs by a few 1e-6 at corners of the contact
-#: force: the onset of slip of an undamped oscillator)
-HB_STABILITY_CONFIRM = 1e-4
-#: Hill companion matrices (2 n (2H+1) rows), or their parity blocks, of at
-#: most this many rows go through the compiled EISPACK eigenvalue solver,
-#: larger ones through LAPACK (benchmarks/bench_linalg.py: the compiled
-#: solver is 1.3-3.7x faster up to 150 rows, LAPACK 1.1-1.3x faster from 300)
-HB_SMALL_EIG = 200
-#: turning points (folds) of a branch: the parameter must come back by more
-#: than this fraction of the range, or log q move by more than
-#: HB_TURNING_BAND_LOG_Q while the parameter is short of its extreme (a fold
-#: whose branches are close in the parameter): the jitter of points at a
-#: non-smooth corner stays within both
-HB_TURNING_BAND = 5e-4
-HB_TURNING_BAND_LOG_Q = 5e-3
-#: a turning point is a fold only with an unstable point between it and the
-#: neighbouring turning points (without one on a side: within this many
-#: points): a saddle-node changes the number of unstable multipliers
-HB_FOLD_WINDOW = 3
-#: a local maximum of the amplitude along a branch is a peak when the
-#: amplitude falls by more than this fraction of it on both sides (before
-#: rising above it again)
-HB_PEAK_PROMINENCE = 1e-3
-
-# --- harmonic balance: condensation onto the contact DOFs (jointdyn.hb.condense) -------
-#: automatic choice: condense systems of at least this many DOFs ...
-HB_CONDENSE_MIN_DOFS = 12
-#: ... whose retained DOFs (contacts, DOF 0, response DOFs) are at most this
-#: fraction of all DOFs
-HB_CONDENSE_MAX_FRACTION = 0.5
-#: the damping is modal (receptance by the undamped modes) when C = alpha M +
-#: beta K to this fraction of max |C|, or when the off-diagonal entries of
-#: Phi^T C Phi are at most this fraction of its largest entry; otherwise the
-#: damped (state-space) eigenproblem is used
-HB_CONDENSE_MODAL_RTOL = 1e-12
-#: the static Schur complement comes from the expansion (H_cc(0)^-1) when every
-#: static factor |1 / g_r(0)| is at least this fraction of the largest (K
-#: positive definite); otherwise from a Cholesky factorisation of K_oo
-HB_CONDENSE_STATIC_RTOL = 1e-6
-#: the spectral expansion H of the receptance must satisfy Z(W) H(W) = I at one
-#: frequency to this, relative to max |Z| max |H| (backward error)
-HB_CONDENSE_CHECK_RTOL = 1e-9
-#: a condensed problem computes Hill stability (on the full Jacobian it
-#: assembles) when the full companion matrix has at most this many rows
-HB_CONDENSED_HILL_ROWS = 200
-#: a (full) harmonic-balance problem computes Hill stability when the
-#: companion matrix has at most this many rows (2 n (2H+1)); beyond, all its
-#: eigenvalues cost more than the branch (about a minute per point at 10^4
-#: rows on 2 cores): stability is not computed (growth NaN, the Dataset's
-#: ``stability`` attribute says so)
-HB_HILL_MAX_ROWS = 4000
-#: from config.CONT_KRYLOV_SOLVE unknowns, the Newton and tangent solves of HB
-#: branches and EPMC backbones are GMRES preconditioned by per-harmonic
-#: factorisations of the Jacobian's diagonal harmonic blocks
-#: (jointdyn.hb._precond); False: the direct path (one LU of the whole
-#: bordered matrix, reused through GMRES), kept as the reference of
-#: benchmarks/bench_hb_scale.py
-HB_BLOCK_PRECONDITIONER = True
-#: bytes of dense Jacobians a branch keeps at once: the continuation monitor
-#: keeps the evaluations of accepted points with their Jacobians while they fit
-#: (beyond, without: the point is evaluated again for its stability), and
-#: Hill's method runs on chunks of points that fit
-HB_JACOBIAN_BUDGET_BYTES = 2**28
 
 # --- nonlinear modes (jointdyn.modes) ------------------------------------------------
 #: default amplitude range of a backbone (first-harmonic amplitude of the

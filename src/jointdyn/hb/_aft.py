@@ -58,6 +58,9 @@ _CHECK_AFTER = 2
 #: period (the mean of both is used), or not repeated within the bound
 PERIOD_ONE, PERIOD_TWO, PERIOD_NONE = 1.0, 2.0, 0.0
 
+#: two consecutive marched periods agree when max|T_p - T_(p-1)| <= rtol max|T|
+HB_PERIODIC_RTOL = 1e-10
+
 
 def _eval_template(lin, con, load, four, ctl, out, scaled):  # pragma: no cover - compiled
     """Whole HB residual and Jacobian in one call: linear part + AFT of every contact.

@@ -21,6 +21,12 @@ __all__ = ["recontact_events", "NO_EVENT"]
 
 #: phase of an event table entry without a re-contact in the interval before the sample
 NO_EVENT = -1.0
+
+#: load at which the AFT restarts a contact law at a re-contact phase between
+#: two samples, as a fraction of the contact's largest |N| (> 0: the law is
+#: in contact and at rest there, as the time integrator's ``TI_RECONTACT_ALPHA``
+#: of :mod:`jointdyn.dynamics._model`)
+HB_RECONTACT_ALPHA = 1e-12
 #: Newton iterations and relative step (of the sampling interval) of a spring's re-contact root
 _ROOT_MAX_ITER, _ROOT_TOL = 50, 1e-14
 
@@ -136,7 +142,7 @@ def recontact_events(tau, coefficients, derivatives=None, uniform: bool = True):
         :data:`NO_EVENT` where none) and its derivative along the
         parameter.
     ev_load : ndarray (contacts,)
-        Load at which the law restarts there (N): ``config.HB_RECONTACT_ALPHA``
+        Load at which the law restarts there (N): ``HB_RECONTACT_ALPHA``
         times the largest |N| of the contact (> 0, so that the law is in
         contact, at rest).
 
@@ -147,8 +153,6 @@ def recontact_events(tau, coefficients, derivatives=None, uniform: bool = True):
     with the root of the spring's load polynomial in each interval and
     its derivative along every unknown.
     """
-    from .. import config
-
     co = np.atleast_2d(np.asarray(coefficients, dtype=np.float64))
     nc, ns = co.shape[0], tau.size
     ev_tau = np.full((nc, ns), NO_EVENT)
@@ -157,7 +161,7 @@ def recontact_events(tau, coefficients, derivatives=None, uniform: bool = True):
     h = 2.0 * np.pi / ns
     for c in range(nc):
         n0, n1, delta = co[c]
-        ev_load[c] = config.HB_RECONTACT_ALPHA * (abs(n0) + abs(n1))
+        ev_load[c] = HB_RECONTACT_ALPHA * (abs(n0) + abs(n1))
         a1 = abs(n1)
         if not abs(n0) < a1:
             continue

@@ -19,12 +19,12 @@ Without viscous damping the Coulomb-saturated oscillator has no steady
 state at gamma = 1 when friction is too weak (Den Hartog: R/F < pi/4).
 A branch point is declared ``unbounded`` when
 
-* q = kt X / fy exceeds ``config.HB_UNBOUNDED_Q`` (hard bound, any system),
+* q = kt X / fy exceeds ``HB_UNBOUNDED_Q`` (hard bound, any system),
   or the corrector fails at the smallest step beyond
-  ``config.HB_UNBOUNDED_FAIL_FRACTION`` of it; or
+  ``HB_UNBOUNDED_FAIL_FRACTION`` of it; or
 * the describing-function saturation test holds: C = 0, q exceeds
-  ``config.HB_SATURATION_Q``, every contact slips (macroslip or
-  separation) over at least ``config.HB_SATURATION_SLIP_FRACTION`` of the
+  ``HB_SATURATION_Q``, every contact slips (macroslip or
+  separation) over at least ``HB_SATURATION_SLIP_FRACTION`` of the
   period, and (single DOF) the friction force's equivalent first-harmonic
   amplitude R1 = E_fric / (pi X1) (E_fric the energy dissipated per cycle,
   X1 the first-harmonic amplitude; R1 = 4 mu N0 / pi for a Coulomb force
@@ -81,10 +81,52 @@ from .levels import Level
 from .parameters import F1, GAMMA
 from .problem import HBProblem, reference_scales
 from .results import HBBranch, HBPeak, PointStatus, sliding_as_a_whole
-from .stability import hill_growth
+from .stability import HB_SMALL_EIG, HB_STABILITY_RTOL, hill_growth
 from .stability_options import StabilityOptions
 
 __all__ = ["continued_branch", "solve_point"]
+
+#: Newton iterations of the start of a branch (from the stuck linear solution)
+HB_START_MAX_ITER = 30
+#: Newton iterations of a single solution (harmonic_balance)
+HB_SOLVE_MAX_ITER = 50
+#: a homotopy in the forcing amplitude starts at this fraction of F1
+HB_HOMOTOPY_START = 1e-3
+#: response declared unbounded when q = kt X / fy exceeds this (hard bound)
+HB_UNBOUNDED_Q = 1e5
+#: ... or when the corrector fails at the smallest step with q above this
+#: fraction of HB_UNBOUNDED_Q
+HB_UNBOUNDED_FAIL_FRACTION = 0.1
+#: describing-function saturation test (Den Hartog): applied once q exceeds
+#: HB_SATURATION_Q, when the contact slips at least this fraction of the
+#: period and C = 0 (single DOF)
+HB_SATURATION_Q = 30.0
+HB_SATURATION_SLIP_FRACTION = 0.9
+#: a Hill growth Re(s)/w between HB_STABILITY_RTOL and this is decided by
+#: the monodromy matrix of the time-domain period map (Hill's method
+#: truncated to H harmonics errs by a few 1e-6 at corners of the contact
+#: force: the onset of slip of an undamped oscillator)
+HB_STABILITY_CONFIRM = 1e-4
+#: turning points (folds) of a branch: the parameter must come back by more
+#: than this fraction of the range, or log q move by more than
+#: HB_TURNING_BAND_LOG_Q while the parameter is short of its extreme (a fold
+#: whose branches are close in the parameter): the jitter of points at a
+#: non-smooth corner stays within both
+HB_TURNING_BAND = 5e-4
+HB_TURNING_BAND_LOG_Q = 5e-3
+#: a turning point is a fold only with an unstable point between it and the
+#: neighbouring turning points (without one on a side: within this many
+#: points): a saddle-node changes the number of unstable multipliers
+HB_FOLD_WINDOW = 3
+#: a local maximum of the amplitude along a branch is a peak when the
+#: amplitude falls by more than this fraction of it on both sides (before
+#: rising above it again)
+HB_PEAK_PROMINENCE = 1e-3
+#: bytes of dense Jacobians a branch keeps at once: the continuation monitor
+#: keeps the evaluations of accepted points with their Jacobians while they fit
+#: (beyond, without: the point is evaluated again for its stability), and
+#: Hill's method runs on chunks of points that fit
+HB_JACOBIAN_BUDGET_BYTES = 2**28
 
 
 @dataclass(frozen=True)
@@ -157,12 +199,12 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     ws = np.array([problem.omega(v) for v in lam])
     growth = np.full(n, np.nan)
     # the Floquet exponents of every point: dense Hill on chunks of points whose Jacobians fit in
-    # config.HB_JACOBIAN_BUDGET_BYTES, or shift-invert Arnoldi point by point (StabilityOptions.method_for)
+    # HB_JACOBIAN_BUDGET_BYTES, or shift-invert Arnoldi point by point (StabilityOptions.method_for)
     method = tr.stability.method_for(2 * problem.system.ndof * problem.nh)
     dense, need = method == "dense", method != "none"
-    chunk = max(1, min(n, config.HB_JACOBIAN_BUDGET_BYTES // (8 * problem.size * problem.size))) if dense else 1
+    chunk = max(1, min(n, HB_JACOBIAN_BUDGET_BYTES // (8 * problem.size * problem.size))) if dense else 1
     JXs = np.empty((chunk, problem.size, problem.size) if dense else (1, 0, 0))
-    lapack = method == "arnoldi" or (dense and 2 * problem.system.ndof * problem.nh > config.HB_SMALL_EIG)
+    lapack = method == "arnoldi" or (dense and 2 * problem.system.ndof * problem.nh > HB_SMALL_EIG)
     with stage_progress(n if need else 0, f"stability ({method})", tr.progress, unit="point") as bar, \
             (blas_threads() if lapack else contextlib.nullcontext()):
         for i in range(n):
@@ -226,14 +268,14 @@ def _saddle_nodes(turning, stable, segment):
     the number of unstable multipliers changes by one there and one side of
     it is unstable. A turning point is kept when the stretch to the
     neighbouring turning point on either side (or, without one, the
-    ``config.HB_FOLD_WINDOW`` points on that side) holds an unstable point;
+    ``HB_FOLD_WINDOW`` points on that side) holds an unstable point;
     on a piecewise-smooth branch the change of stability can lie a few
     points before the extreme of the parameter. Turning points with stable
     points all around are zigzags of the branch at corners or jumps of a
     closed-form contact force, not folds: a sweep does not jump there.
     """
     out = np.zeros_like(turning)
-    k = config.HB_FOLD_WINDOW
+    k = HB_FOLD_WINDOW
     for sgm in np.unique(segment):
         idx = np.flatnonzero(segment == sgm)
         tp = np.flatnonzero(turning[idx])
@@ -251,22 +293,22 @@ def _confirmed_stability(problem: HBProblem, X, lam, growth):
     contact force has a corner (the onset of slip of a Jenkins element on
     an otherwise undamped oscillator gives Re(s)/w of a few 1e-6 at
     points whose period map is contracting). A growth between
-    ``config.HB_STABILITY_RTOL`` and ``config.HB_STABILITY_CONFIRM`` is
+    ``HB_STABILITY_RTOL`` and ``HB_STABILITY_CONFIRM`` is
     therefore decided by the Floquet multipliers of the time-domain period
     map (:func:`~jointdyn.hb.monodromy.monodromy_multipliers`): unstable
     when one lies outside the unit circle by more than
-    ``2 pi config.HB_STABILITY_RTOL``. Systems with interfaces keep Hill's criterion there: the
+    ``2 pi HB_STABILITY_RTOL``. Systems with interfaces keep Hill's criterion there: the
     time-domain period map does not march interfaces yet.
     """
     from .monodromy import monodromy_multipliers
 
-    stable = growth <= config.HB_STABILITY_RTOL
+    stable = growth <= HB_STABILITY_RTOL
     if problem.has_interfaces:
         return stable, 0
-    marginal = np.flatnonzero(~stable & (growth < config.HB_STABILITY_CONFIRM))
+    marginal = np.flatnonzero(~stable & (growth < HB_STABILITY_CONFIRM))
     for i in marginal:
         mu = np.max(np.abs(monodromy_multipliers(problem, X[i], lam[i])))
-        stable[i] = mu <= 1.0 + 2.0 * math.pi * config.HB_STABILITY_RTOL
+        stable[i] = mu <= 1.0 + 2.0 * math.pi * HB_STABILITY_RTOL
     return stable, int(marginal.size)
 
 
@@ -280,11 +322,11 @@ def _scales(problem: HBProblem, start: float):
 
 def _saturation_test(problem: HBProblem, ev, X, q, lam):
     """Describing-function saturation test (module docstring); None or reason."""
-    if q < config.HB_SATURATION_Q or has_damping(problem.system.C) or problem.system.ndof != 1:
+    if q < HB_SATURATION_Q or has_damping(problem.system.C) or problem.system.ndof != 1:
         return None
     for code in ev.code:
         slip = np.mean((code == MACROSLIP) | (code == SEPARATION))
-        if slip < config.HB_SATURATION_SLIP_FRACTION:
+        if slip < HB_SATURATION_SLIP_FRACTION:
             return None
     # energy dissipated by the contacts per cycle, E = sum_c oint T_c du_c
     Xm = X.reshape(problem.nh, problem.n)
@@ -398,12 +440,12 @@ class _Tracker:
         if self.last is not None:
             ev = self.last
             size = ev.JX.shape[0]
-            if (len(self.evaluations) + 1) * 8 * size * size > config.HB_JACOBIAN_BUDGET_BYTES:
+            if (len(self.evaluations) + 1) * 8 * size * size > HB_JACOBIAN_BUDGET_BYTES:
                 ev = dataclasses.replace(ev, JX=None, scaled=None)  # the Jacobian is evaluated again when needed
             self.evaluations[float(lam)] = (X, ev, amps)
-        if not math.isfinite(q) or q > config.HB_UNBOUNDED_Q:
+        if not math.isfinite(q) or q > HB_UNBOUNDED_Q:
             return (ContinuationStatus.UNBOUNDED,
-                    f"q = kt X / fy = {q:.4g} exceeds {config.HB_UNBOUNDED_Q:g} at {name} = {lam:.6g}")
+                    f"q = kt X / fy = {q:.4g} exceeds {HB_UNBOUNDED_Q:g} at {name} = {lam:.6g}")
         if self.last is not None:
             why = _saturation_test(self.problem, self.last, X, q, lam)
             if why is not None:
@@ -418,7 +460,7 @@ class _Tracker:
         (:func:`~jointdyn.hb.results.sliding_as_a_whole`)."""
         if res.status is ContinuationStatus.FAILED and res.y.shape[0] > 0:
             q = self.q(self.amplitudes(res.y[-1])[0])
-            if q > config.HB_UNBOUNDED_FAIL_FRACTION * config.HB_UNBOUNDED_Q:
+            if q > HB_UNBOUNDED_FAIL_FRACTION * HB_UNBOUNDED_Q:
                 return dataclasses.replace(
                     res, status=ContinuationStatus.UNBOUNDED,
                     message=f"Newton failed with q = {q:.4g} growing: unbounded response ({res.message})")
@@ -457,7 +499,7 @@ def solve_point(problem: HBProblem, gamma: float, guess, tol: float, max_iter: i
     reference value, at ``gamma`` (:func:`_forcing_problem`). Newton starts
     from ``guess`` (m; default the stuck-contact linear solution); where it
     fails from the linear solution, the forcing amplitude is continued from
-    ``config.HB_HOMOTOPY_START`` F1 to F1 at this gamma, where the
+    ``HB_HOMOTOPY_START`` F1 to F1 at this gamma, where the
     stuck-contact linear solution is a good start (:func:`_homotopy`), and
     Newton is made again from its end.
     """
@@ -483,13 +525,13 @@ def solve_point(problem: HBProblem, gamma: float, guess, tol: float, max_iter: i
 
 def _homotopy(problem: HBProblem, gamma: float, tol: float):
     """X (m) at the full forcing amplitude F1 of ``problem``, continued in the forcing amplitude from
-    ``config.HB_HOMOTOPY_START`` F1 at the same gamma and discretisation (None where the branch does not
+    ``HB_HOMOTOPY_START`` F1 at the same gamma and discretisation (None where the branch does not
     reach F1); the request :func:`jointdyn.hb.continue_hb` makes with ``parameter="f1"``."""
     system, f1 = problem.system, problem.f1_ref
     opt = make_options(None, {"tol": tol})
     if opt.start_extrapolation is None and all(c.law.smooth_force for c in system.contacts):
         opt = dataclasses.replace(opt, start_extrapolation=START_EXTRAPOLATION)
-    req = _Request(system=system, start=config.HB_HOMOTOPY_START * f1, stop=f1, parameter=F1, gamma=gamma,
+    req = _Request(system=system, start=HB_HOMOTOPY_START * f1, stop=f1, parameter=F1, gamma=gamma,
                    max_step=None, dof=system.response_dof, options=opt, backward=False, progress=False,
                    condense=problem.condensed)
     br = continued_branch(req, Level(problem.H, problem.Ns))
@@ -507,11 +549,11 @@ def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress, mon
     with _bar(lam_a / ps, lam_b / ps, f"HB {problem.parameter.name}", progress, problem.parameter.name, ps) as bar:
         y0 = problem.linear_guess(lam_a) / xs
         if (problem.parameter is GAMMA
-                and not newton(tr.residual, y0, lam_a / ps, opt, max_iter=config.HB_START_MAX_ITER)[1]):
+                and not newton(tr.residual, y0, lam_a / ps, opt, max_iter=HB_START_MAX_ITER)[1]):
             # start by a homotopy in the forcing amplitude at this gamma
             # when Newton from the stuck-contact solution fails
             X, ok, _ = solve_point(_forcing_problem(problem.system, lam_a, problem.H, problem.Ns, problem.condensed),
-                                   lam_a, None, opt.tol, config.HB_SOLVE_MAX_ITER)
+                                   lam_a, None, opt.tol, HB_SOLVE_MAX_ITER)
             if ok:
                 y0 = X / xs
         return tr.relabel(continuation(tr.residual, y0, lam_a / ps, lam_b / ps, opt,
@@ -738,7 +780,7 @@ def _peaks(tr: _Tracker, res: ContinuationResult, g, segment: int, opt) -> list:
     its points (HBPeak)."""
     if res.lam.size < 3:
         return []
-    return [_refined_peak(tr, res, g, i, segment, opt) for i in local_maxima(g, res.gap, config.HB_PEAK_PROMINENCE)]
+    return [_refined_peak(tr, res, g, i, segment, opt) for i in local_maxima(g, res.gap, HB_PEAK_PROMINENCE)]
 
 
 def _refined_peak(tr: _Tracker, res: ContinuationResult, g, i: int, segment: int, opt) -> HBPeak:
@@ -783,18 +825,18 @@ def _turning_mask(lam, observed, segment, gap, start, stop):
     """Folds: points where the parameter is extremal along a segment, beyond a dead band.
 
     A reversal of the parameter counts once it exceeds
-    ``config.HB_TURNING_BAND`` of the range, or once log q has moved by
-    more than ``config.HB_TURNING_BAND_LOG_Q`` while the parameter is still
+    ``HB_TURNING_BAND`` of the range, or once log q has moved by
+    more than ``HB_TURNING_BAND_LOG_Q`` while the parameter is still
     short of the extreme (a fold whose two branches are close in the
     parameter but far apart in amplitude). The jitter of points at a
     non-smooth corner (onset of slip or separation, where the branch keeps
     going) is within both bands and does not count.
     """
     m = np.zeros(lam.size, dtype=bool)
-    band = config.HB_TURNING_BAND * abs(stop - start)
+    band = HB_TURNING_BAND * abs(stop - start)
     for sgm in np.unique(segment):
         idx = np.flatnonzero(segment == sgm)
         tp = turning_points(lam[idx], gap[idx], band=band, observed=observed[idx],
-                            observed_band=config.HB_TURNING_BAND_LOG_Q)
+                            observed_band=HB_TURNING_BAND_LOG_Q)
         m[idx[tp]] = True
     return m

@@ -55,7 +55,7 @@ value, :meth:`CondensedHBProblem.full_coefficients`).
 Stability: Hill's method needs the full-size Jacobian. A condensed problem
 assembles it exactly (:meth:`CondensedHBProblem.full_jacobian`) and runs
 Hill's method when the full companion matrix has at most
-``config.HB_CONDENSED_HILL_ROWS`` rows; beyond, stability is not computed
+``HB_CONDENSED_HILL_ROWS`` rows; beyond, stability is not computed
 (growth NaN; the branch's Dataset says so in its ``stability`` attribute).
 """
 
@@ -74,10 +74,31 @@ from .._jit import jit
 from ..damping import dense_damping, is_operator
 from ..kinematics import contact_kinematics, selection_matrix
 from ..systems import System
+from .levels import HB_CONDENSE_MIN_DOFS
 from .problem import HBProblem, _linear_blocks, contacts_only, held_by_contacts
 from .stability import hill_growth, hill_stability
 
 __all__ = ["Receptance", "receptance", "retained_dofs", "CondensedHBProblem", "make_problem", "use_condensed"]
+
+#: automatic choice: condense systems of at least ``HB_CONDENSE_MIN_DOFS`` DOFs
+#: (:mod:`jointdyn.hb.levels`) whose retained DOFs (contacts, DOF 0, response DOFs) are at most this
+#: fraction of all DOFs
+HB_CONDENSE_MAX_FRACTION = 0.5
+#: the damping is modal (receptance by the undamped modes) when C = alpha M +
+#: beta K to this fraction of max |C|, or when the off-diagonal entries of
+#: Phi^T C Phi are at most this fraction of its largest entry; otherwise the
+#: damped (state-space) eigenproblem is used
+HB_CONDENSE_MODAL_RTOL = 1e-12
+#: the static Schur complement comes from the expansion (H_cc(0)^-1) when every
+#: static factor |1 / g_r(0)| is at least this fraction of the largest (K
+#: positive definite); otherwise from a Cholesky factorisation of K_oo
+HB_CONDENSE_STATIC_RTOL = 1e-6
+#: the spectral expansion H of the receptance must satisfy Z(W) H(W) = I at one
+#: frequency to this, relative to max |Z| max |H| (backward error)
+HB_CONDENSE_CHECK_RTOL = 1e-9
+#: a condensed problem computes Hill stability (on the full Jacobian it
+#: assembles) when the full companion matrix has at most this many rows
+HB_CONDENSED_HILL_ROWS = 200
 
 #: kinds of spectral expansion of the receptance
 MODAL, STATE_SPACE = "modal", "state-space"
@@ -301,10 +322,10 @@ def _condensed_blocks(exp, pairs, w, Z0, out):  # pragma: no cover - compiled
 
 
 def _is_modal(Ct) -> bool:
-    """True when the modal damping matrix Phi^T C Phi is diagonal to ``config.HB_CONDENSE_MODAL_RTOL``."""
+    """True when the modal damping matrix Phi^T C Phi is diagonal to ``HB_CONDENSE_MODAL_RTOL``."""
     off = Ct - np.diag(np.diag(Ct))
     scale = float(np.max(np.abs(Ct))) if Ct.size else 0.0
-    return float(np.max(np.abs(off), initial=0.0)) <= config.HB_CONDENSE_MODAL_RTOL * scale
+    return float(np.max(np.abs(off), initial=0.0)) <= HB_CONDENSE_MODAL_RTOL * scale
 
 
 def _state_space(w2, Ct):
@@ -337,7 +358,7 @@ def _check_frequency(w2) -> float:
 
 
 def _rayleigh(M, C, K):
-    """(alpha, beta) when C = alpha M + beta K to ``config.HB_CONDENSE_MODAL_RTOL`` (0, 0 for C = 0), else None.
+    """(alpha, beta) when C = alpha M + beta K to ``HB_CONDENSE_MODAL_RTOL`` (0, 0 for C = 0), else None.
 
     A least-squares fit on the entries (2 x 2 normal equations), O(n^2):
     Rayleigh damping (and no damping) needs no product Phi^T C Phi of the
@@ -352,7 +373,7 @@ def _rayleigh(M, C, K):
         alpha, beta = np.linalg.solve(G, np.array([m @ c, k @ c]))
     except np.linalg.LinAlgError:  # K a multiple of M
         return None
-    if float(np.max(np.abs(C - alpha * M - beta * K))) <= config.HB_CONDENSE_MODAL_RTOL * scale:
+    if float(np.max(np.abs(C - alpha * M - beta * K))) <= HB_CONDENSE_MODAL_RTOL * scale:
         return float(alpha), float(beta)
     return None
 
@@ -428,7 +449,7 @@ def receptance(system: System) -> Receptance:
     A dense expansion (damping other than Rayleigh) is checked at one
     frequency W between natural frequencies: the residual Z(W) H(W)[:, cols]
     - I[:, cols] of a few columns (O(n^2)) must be at most
-    ``config.HB_CONDENSE_CHECK_RTOL`` times max|Z(W)| max|H(W)[:, cols]| (a
+    ``HB_CONDENSE_CHECK_RTOL`` times max|Z(W)| max|H(W)[:, cols]| (a
     backward-error test, rounding being ~1e-16 n of that); ValueError
     naming ``condense`` otherwise (a defective damped eigenproblem). The
     factored form (orthogonal reductions, backward stable) is not checked:
@@ -454,7 +475,7 @@ def _check(system: System, rec: Receptance, w2) -> None:
     ZH = _real_times(Zr, Hb) + 1j * W * _real_times(C, Hb)
     err = float(np.max(np.abs(ZH - np.eye(n)[:, cols])))
     zmax = float(np.max(np.abs(Zr) + W * np.abs(C)))
-    bound = config.HB_CONDENSE_CHECK_RTOL * zmax * float(np.max(np.abs(Hb)))
+    bound = HB_CONDENSE_CHECK_RTOL * zmax * float(np.max(np.abs(Hb)))
     if not err <= bound:
         raise ValueError(f"condense: the {rec.kind} expansion of the receptance misses Z(W) H(W) = I by "
                          f"{err:.3g} (allowed {bound:.3g}); use condense=False")
@@ -482,7 +503,7 @@ def _static_parts(K, c, rec: Receptance | None = None):
     recovery: x = S0(rows) x_c for a static load on the retained DOFs c only.
 
     With a receptance ``rec`` whose static factors g(0) are all finite and no
-    smaller than ``config.HB_CONDENSE_STATIC_RTOL`` of the largest (K positive
+    smaller than ``HB_CONDENSE_STATIC_RTOL`` of the largest (K positive
     definite), Z0 = H_cc(0)^-1 from the expansion and S0 is a function
     ``rows -> H(0)[rows, c] Z0`` (O(n^2) per row, nothing O(n^3)). Otherwise by
     a Cholesky factorisation of K_oo: S0 is then the array (n, m) (rows c:
@@ -493,7 +514,7 @@ def _static_parts(K, c, rec: Receptance | None = None):
     if rec is not None:
         g0 = rec.factors(np.zeros(1))[0][0]
         inv = np.abs(1.0 / g0) if np.all(np.isfinite(g0)) and np.all(g0 != 0.0) else None
-        if inv is not None and float(inv.min()) > config.HB_CONDENSE_STATIC_RTOL * float(inv.max()):
+        if inv is not None and float(inv.min()) > HB_CONDENSE_STATIC_RTOL * float(inv.max()):
             Pc = rec.rows(c)
             Z0 = np.linalg.inv(((Pc * g0) @ Pc.T).real)
             right = g0[:, None] * (Pc.T @ Z0)
@@ -718,7 +739,7 @@ class CondensedHBProblem(HBProblem):
 
     def hill_affordable(self) -> bool:
         """True when the full companion matrix (2 ndof (2H+1) rows) is small enough for Hill's method here."""
-        return 2 * self.system.ndof * self.nh <= config.HB_CONDENSED_HILL_ROWS
+        return 2 * self.system.ndof * self.nh <= HB_CONDENSED_HILL_ROWS
 
     def hill_growth(self, JXs, ws):
         """Hill's method on the full Jacobians when affordable (:meth:`hill_affordable`), else NaN."""
@@ -739,8 +760,8 @@ def use_condensed(system: System, condense=None, response_dofs=()) -> bool:
     """Whether harmonic balance condenses ``system``: ``condense`` if True/False, else automatic.
 
     Automatic: condensed when the system has at least
-    ``config.HB_CONDENSE_MIN_DOFS`` DOFs, retains at most
-    ``config.HB_CONDENSE_MAX_FRACTION`` of them, and K is positive definite
+    ``HB_CONDENSE_MIN_DOFS`` DOFs, retains at most
+    ``HB_CONDENSE_MAX_FRACTION`` of them, and K is positive definite
     on the DOFs that are not retained. A structure held only through its
     contacts (:func:`~jointdyn.hb.problem.held_by_contacts`) is never
     condensed: the receptance and the static Schur complement are those of K,
@@ -759,10 +780,10 @@ def use_condensed(system: System, condense=None, response_dofs=()) -> bool:
         return False
     if condense:
         return True
-    if system.ndof < config.HB_CONDENSE_MIN_DOFS:
+    if system.ndof < HB_CONDENSE_MIN_DOFS:
         return False
     c = retained_dofs(system, response_dofs)
-    if c.size > config.HB_CONDENSE_MAX_FRACTION * system.ndof:
+    if c.size > HB_CONDENSE_MAX_FRACTION * system.ndof:
         return False
     try:
         _static_parts(system.K, c, receptance(system))

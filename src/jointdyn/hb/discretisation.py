@@ -25,6 +25,16 @@ from .condense import make_problem
 from .levels import Discretisation, Level
 from .results import DiscretisationCheck, HBBranch, HBPeak
 
+#: while the first branch is continued, its highest point so far is checked once the amplitude has fallen
+#: below this fraction of it (a resonance passed); where that peak converges at a finer level, the branch
+#: stops there and is computed at that level (the rest of it would be discarded), and the finished branch
+#: must confirm the stop, else the choice is made again without stops (:class:`_PeakWatch`)
+HB_AUTO_EARLY_DROP = 0.5
+#: the largest H and Ns an automatic choice takes (the check solves go one level beyond); with separation
+#: the samples decide, H = 7 already within 2e-4 of H = 15 on the paper's grid
+HB_AUTO_MAX_HARMONICS = 15
+HB_AUTO_MAX_SAMPLES = 2048
+
 
 def _fixed_branch(req: _Request, level: Level, disc: Discretisation | None = None, watch: bool = False):
     """The branch at ``level``: a :class:`~jointdyn.hb.branch._Draft`,
@@ -48,12 +58,12 @@ def _doublings(a: int, b: int, grow) -> int:
 
 def level_number(level: Level, disc: Discretisation) -> tuple[int, int]:
     """(k, most): ``level`` is the k-th of an automatic choice from ``disc.first``, which has at most ``most``
-    (each raise of the harmonics H -> 2H + 1 and of the samples Ns -> 2 Ns within ``config.HB_AUTO_MAX_*``
+    (each raise of the harmonics H -> 2H + 1 and of the samples Ns -> 2 Ns within ``HB_AUTO_MAX_*``
     is one level; a samples retry after a failure is one too)."""
     (h0, s0), grow_h, grow_s = disc.first, (lambda h: 2 * h + 1), (lambda s: 2 * s)
     k = 1 + _doublings(h0, level.harmonics, grow_h) + _doublings(s0, level.samples, grow_s)
-    most = 1 + (_doublings(h0, config.HB_AUTO_MAX_HARMONICS + 1, grow_h) - 1 if disc.harmonics_auto else 0) \
-        + (_doublings(s0, config.HB_AUTO_MAX_SAMPLES + 1, grow_s) - 1 if disc.samples_auto else 0)
+    most = 1 + (_doublings(h0, HB_AUTO_MAX_HARMONICS + 1, grow_h) - 1 if disc.harmonics_auto else 0) \
+        + (_doublings(s0, HB_AUTO_MAX_SAMPLES + 1, grow_s) - 1 if disc.samples_auto else 0)
     return k, max(k, most)
 
 
@@ -69,7 +79,7 @@ def check_levels(level: Level, disc: Discretisation):
 
 
 def next_level(level: Level, disc: Discretisation, bad_h: bool, bad_s: bool) -> Level:
-    """The level the checks ask for, within ``config.HB_AUTO_MAX_*`` (equal to ``level``: no refinement).
+    """The level the checks ask for, within ``HB_AUTO_MAX_*`` (equal to ``level``: no refinement).
 
     The samples first: with too few, the sampling error of the contact
     force also moves the solution with more harmonics, so H is raised
@@ -77,8 +87,8 @@ def next_level(level: Level, disc: Discretisation, bad_h: bool, bad_s: bool) -> 
     """
     by_h, by_s = check_levels(level, disc)
     if bad_s and by_s is not None:
-        return by_s if by_s.samples <= config.HB_AUTO_MAX_SAMPLES else level
-    if bad_h and by_h is not None and by_h.harmonics <= config.HB_AUTO_MAX_HARMONICS:
+        return by_s if by_s.samples <= HB_AUTO_MAX_SAMPLES else level
+    if bad_h and by_h is not None and by_h.harmonics <= HB_AUTO_MAX_HARMONICS:
         return by_h
     return level
 
@@ -202,7 +212,7 @@ class _PeakWatch:
     they are passed.
 
     The highest accepted point of the segment so far is checked once the
-    amplitude has fallen below ``config.HB_AUTO_EARLY_DROP`` times its
+    amplitude has fallen below ``HB_AUTO_EARLY_DROP`` times its
     amplitude (and again for a higher point later): one Newton step from
     it with twice the samples (with 2H + 1 harmonics where the samples are
     fixed), one evaluation, gives the change of its amplitude to first
@@ -244,7 +254,7 @@ class _PeakWatch:
         if g > self.checked and (self.top is None or g > pts[self.top][0]):
             self.top = len(pts) - 1
             return None
-        if self.top is None or g >= pts[self.top][0] + math.log(config.HB_AUTO_EARLY_DROP):
+        if self.top is None or g >= pts[self.top][0] + math.log(HB_AUTO_EARLY_DROP):
             return None
         i, self.top = self.top, None
         self.checked = pts[i][0]
@@ -309,7 +319,7 @@ def _watched_branch(req: _Request, level, disc, levels, retry_failed: bool, watc
         levels.append(level)
         br = _fixed_branch(req, level, disc)
     while retry_failed and br.status is ContinuationStatus.FAILED and disc.samples_auto \
-            and 2 * level.samples <= config.HB_AUTO_MAX_SAMPLES:
+            and 2 * level.samples <= HB_AUTO_MAX_SAMPLES:
         level = Level(level.harmonics, 2 * level.samples)
         levels.append(level)
         br = _fixed_branch(req, level, disc)

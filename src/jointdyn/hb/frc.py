@@ -23,7 +23,7 @@ from .._threads import blas_threads
 from ..continuation import START_EXTRAPOLATION, ContinuationOptions, make_options
 from ..damping import dense_damping
 from ..systems import System
-from .branch import _forcing_problem, _Request, solve_point
+from .branch import HB_SOLVE_MAX_ITER, _forcing_problem, _Request, solve_point
 from .discretisation import adaptive_branch
 from .export import branch_dataset
 from .hill_arnoldi import hill_arnoldi_exponents
@@ -31,10 +31,19 @@ from .levels import AUTO, Discretisation, Level, check_memory
 from .parameters import GAMMA, parameter_named
 from .problem import HBProblem, reference_scales, stuck_stiffness
 from .results import HBBranch, HBSolution, SolveStatus
-from .stability import hill_stability
+from .stability import HB_STABILITY_RTOL, hill_stability
 from .stability_options import StabilityOptions, stability_options
 
 __all__ = ["continue_hb", "frc_hb", "harmonic_balance", "check_mean_position"]
+
+#: harmonic balance in gamma: largest gamma spacing of a branch when the
+#: caller gives none (the command line passes the STEP of --gamma). The chord
+#: bound CONT_CHORD_TOL is a distance in (gamma, ln amplitude); on a steep flank a
+#: chord within it can still miss the amplitude at the same gamma by more
+#: than 1 % (1.4 % at 0.1 gamma spacing on the Jenkins benchmark branch,
+#: F1 = 5 N, docs/hb-comparison.md); 0.02 keeps it below 1 % (0.9 %) for
+#: about 25 % more points
+HB_MAX_GAMMA_STEP = 0.02
 
 
 def check_mean_position(system: System) -> None:
@@ -111,17 +120,17 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         (default): start at ``config.HB_HARMONICS``; every refined peak is
         solved again with 2H + 1 harmonics and, where its amplitude changes
         by more than ``config.HB_AUTO_RTOL``, the branch is computed again
-        with more (up to ``config.HB_AUTO_MAX_HARMONICS``).
+        with more (up to ``jointdyn.hb.discretisation.HB_AUTO_MAX_HARMONICS``).
     samples : int or "auto"
         AFT time samples per period (>= 2H + 2). ``"auto"`` (default):
         start at ``config.HB_SAMPLES`` and double the same way, checked
-        with 2 Ns samples (up to ``config.HB_AUTO_MAX_SAMPLES``). The
+        with 2 Ns samples (up to ``jointdyn.hb.discretisation.HB_AUTO_MAX_SAMPLES``). The
         levels used and the check are in ``HBBranch.discretisation``; a
         converged branch costs two extra solves per peak.
     max_step : float, optional
         Largest change of the parameter between consecutive points (in its
         own unit, e.g. a gamma grid spacing); default
-        ``config.HB_MAX_GAMMA_STEP`` when the parameter is gamma, none
+        ``HB_MAX_GAMMA_STEP`` when the parameter is gamma, none
         beyond the chord bound otherwise.
     response_dof : int, optional
         DOF whose amplitude the step control follows and the peaks report
@@ -182,7 +191,7 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         # every force smooth at the onset of slip: the corrector starts from the branch's extrapolation
         opt = dataclasses.replace(opt, start_extrapolation=START_EXTRAPOLATION)
     if max_step is None and par is GAMMA:
-        max_step = config.HB_MAX_GAMMA_STEP
+        max_step = HB_MAX_GAMMA_STEP
     if max_step is not None:
         V.positive("max_step", max_step)
     req = _Request(system=system, start=start, stop=stop, parameter=par, gamma=gamma, max_step=max_step, dof=dof,
@@ -217,7 +226,7 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
         >= 2H + 2, or chosen likewise (default).
     max_step : float, optional
         Largest gamma spacing between consecutive points (e.g. the STEP of
-        a gamma grid; default ``config.HB_MAX_GAMMA_STEP``); the chord
+        a gamma grid; default ``HB_MAX_GAMMA_STEP``); the chord
         bound (``chord_tol``) applies in any case.
     response_dof : int, optional
         DOF whose response is reported (default ``system.response_dof``).
@@ -254,7 +263,7 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
 
 def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB_HARMONICS,
                      samples: int = config.HB_SAMPLES, guess=None, response_dof: int = 0,
-                     tol: float = config.CONT_TOL, max_iter: int = config.HB_SOLVE_MAX_ITER,
+                     tol: float = config.CONT_TOL, max_iter: int = HB_SOLVE_MAX_ITER,
                      condense: bool | None = None, stability: StabilityOptions | bool | None = None) -> HBSolution:
     """Solve the HB equations at one frequency by damped Newton.
 
@@ -268,7 +277,7 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
     guess : ndarray, optional
         Starting coefficients (default: the stuck-contact linear solution;
         if Newton fails from it, a continuation in the forcing amplitude
-        from ``config.HB_HOMOTOPY_START`` F1 to F1 at this gamma).
+        from ``jointdyn.hb.branch.HB_HOMOTOPY_START`` F1 to F1 at this gamma).
     response_dof : int
         DOF reported in the amplitudes.
     tol : float
@@ -313,7 +322,7 @@ def _point_stability(problem: HBProblem, JX, w: float, opts: StabilityOptions):
         return hill_stability(np.asarray(J), s.M, dense_damping(s.C), w, problem.H)
     with blas_threads():  # ARPACK's BLAS-2 work: 2 OpenBLAS threads on 2 busy cores are slower than one
         found = hill_arnoldi_exponents(J, s.M, dense_damping(s.C), w, problem.H, opts)
-    return found.growth <= config.HB_STABILITY_RTOL, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
+    return found.growth <= HB_STABILITY_RTOL, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
 
 
 def _make_solution(problem: HBProblem, X, converged, iterations, response_dof, opts=None) -> HBSolution:

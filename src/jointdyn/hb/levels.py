@@ -30,6 +30,10 @@ from ..kinematics import NormalSpring
 
 __all__ = ["AUTO", "Level", "Discretisation", "hb_bytes", "check_memory"]
 
+#: the automatic choice condenses onto the contact DOFs (:mod:`jointdyn.hb.condense`) systems of at least
+#: this many DOFs whose retained DOFs are at most ``HB_CONDENSE_MAX_FRACTION`` of all DOFs (read there)
+HB_CONDENSE_MIN_DOFS = 12
+
 #: the value of ``harmonics`` or ``samples`` (and of ``--harmonics``, ``--samples``) asking for the
 #: automatic choice
 AUTO = "auto"
@@ -104,7 +108,7 @@ def _unknown_dofs(system) -> int:
     """DOFs whose harmonics are unknowns: all of a small system; at least
     the contact DOFs (and DOF 0) of one condensed onto them."""
     n = system.ndof
-    if n < config.HB_CONDENSE_MIN_DOFS:
+    if n < HB_CONDENSE_MIN_DOFS:
         return n
     keep = {0, system.response_dof}
     for c in system.contacts:
@@ -147,7 +151,7 @@ def check_memory(system, disc: Discretisation, names=("harmonics", "samples")) -
     """ValueError naming the fixed harmonics or samples of ``disc`` (with the largest value that fits)
     when the harmonic balance of ``system`` would exceed the memory bound
     (:func:`jointdyn._validate.memory_budget`); automatic values are bounded by
-    ``config.HB_AUTO_MAX_*`` and not checked here. Fixed harmonics are
+    ``jointdyn.hb.discretisation.HB_AUTO_MAX_*`` and not checked here. Fixed harmonics are
     estimated with the fewest samples they need (2H + 2), so that their own
     size is what they are blamed for, never the default samples."""
     H, Ns = disc.first

@@ -40,10 +40,14 @@ from typing import Callable
 import numpy as np
 
 from .. import _validate as V
-from .. import config
 
 __all__ = ["HBParameter", "Gamma", "F1Amplitude", "LoadRatio", "StaticLoad", "LoadPhase", "SystemParameter",
            "GAMMA", "F1", "ETA", "N0", "DELTA", "PARAMETERS", "parameter_named"]
+
+#: central-difference step, relative to the parameter's scale, of dR/dp for
+#: a parameter that builds a System (:class:`SystemParameter`):
+#: about eps^(1/3), which balances the O(h^2) error and rounding
+HB_PARAMETER_FD_STEP = 6e-6
 
 
 class HBParameter:
@@ -212,7 +216,7 @@ class SystemParameter(HBParameter):
     contacts, laws, forcing, loads) is that of ``build(p)``. The residual
     at p is the harmonic-balance residual of ``build(p)``; its derivative
     along p is the central difference
-    ``(R(p + h) - R(p - h)) / (2 h)`` with ``h = config.HB_PARAMETER_FD_STEP``
+    ``(R(p + h) - R(p - h)) / (2 h)`` with ``h = HB_PARAMETER_FD_STEP``
     times ``scale_value`` (or |p|; error O(h^2) plus rounding of order
     eps |R| / h), the
     only derivative of harmonic balance that is not exact: use a built-in
@@ -252,6 +256,6 @@ class SystemParameter(HBParameter):
             V.in_range(f"{self.name} {what}", v, self.lower, self.upper)
 
     def step(self, p: float) -> float:
-        """Central-difference step h at p: ``config.HB_PARAMETER_FD_STEP`` times the scale (or |p|, or 1)."""
+        """Central-difference step h at p: ``HB_PARAMETER_FD_STEP`` times the scale (or |p|, or 1)."""
         unit = self.scale_value if self.scale_value is not None else (abs(p) if p != 0.0 else 1.0)
-        return config.HB_PARAMETER_FD_STEP * unit
+        return HB_PARAMETER_FD_STEP * unit

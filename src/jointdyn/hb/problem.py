@@ -45,7 +45,8 @@ from ..kinematics import NORMAL_SPRING, contact_kinematics, no_contact_init_jvp,
 from ..laws import law_dispatch
 from ..laws._base import MACROSLIP, SEPARATION, STICK_SLIP
 from ..systems import System
-from ._aft import NO_EVENT, PERIOD_ONE, eval_kernel, recontact_events
+from ._aft import HB_PERIODIC_RTOL, NO_EVENT, PERIOD_ONE, eval_kernel, recontact_events
+from ._recontact import HB_RECONTACT_ALPHA
 from ._aft_pairs import pair_directions, pairs_aft_kernel
 from ._sparse import linear_entries
 from .levels import Level
@@ -53,6 +54,14 @@ from .parameters import SystemParameter, _FixedFrequency, parameter_named
 from .stability import hill_growth, hill_stability
 
 __all__ = ["HBProblem"]
+
+#: Hill stability of a (full) problem with at most this many companion rows (2 n (2H+1)); beyond, O(rows^3)
+#: costs more than the branch (a minute per point at 10^4 rows on 2 cores): not computed (growth NaN)
+HB_HILL_MAX_ROWS = 4000
+#: from ``config.CONT_KRYLOV_SOLVE`` unknowns, HB and EPMC Newton and tangent solves are GMRES preconditioned by
+#: per-harmonic factorisations of the Jacobian's diagonal harmonic blocks (:mod:`jointdyn.hb._precond`); False:
+#: the direct path (one LU of the bordered matrix, reused through GMRES), the reference of bench_hb_scale.py
+HB_BLOCK_PRECONDITIONER = True
 
 
 @dataclass(slots=True)
@@ -247,7 +256,7 @@ class HBProblem:
         #: (P, kn, restart load at a re-contact between samples) per contact, kn = 0 for a prescribed load
         self._Sp = np.zeros((nc, 3))
         self._Sp[springs, :2] = kin.normal_par[springs, :2]
-        self._Sp[:, 2] = config.HB_RECONTACT_ALPHA * self._Sp[:, 0]
+        self._Sp[:, 2] = HB_RECONTACT_ALPHA * self._Sp[:, 0]
         if nc:
             disp = law_dispatch([c.law for c in self.contacts])
             self._Pm, self._ssz = disp.P, disp.state_size
@@ -480,7 +489,7 @@ class HBProblem:
         self._kernel((*self._linear_terms(w), float(dwdp), X, Fe, Fp, self._lin_cols),
                      (self._Bm, self._Pm, self._ssz, self._Bnm, self._Sp, self.has_springs),
                      (Nsamp, dN if has_p else self._dummy, has_p, events), (self._Eg, self._Pg),
-                     (int(self.max_passes), float(config.HB_PERIODIC_RTOL), bool(self.restart_at_reference)),
+                     (int(self.max_passes), float(HB_PERIODIC_RTOL), bool(self.restart_at_reference)),
                      (R, JX, Jp, T, Nout, code, info), scaled)
         if self._uniform is not None:
             at = self._uniform
@@ -496,7 +505,7 @@ class HBProblem:
         ev.pair_T, ev.pair_N = np.empty((npairs, ns, 2)), np.empty((npairs, ns))
         ev.pair_code = np.empty((npairs, ns), dtype=np.int8)
         pairs_aft_kernel()(self.pair_positions, self.pair_params, X, self.n, self.E, self.P, *self._pair_dirs,
-                           int(self.max_passes), float(config.HB_PERIODIC_RTOL), ev.R, ev.JX, self._no_blocks,
+                           int(self.max_passes), float(HB_PERIODIC_RTOL), ev.R, ev.JX, self._no_blocks,
                            ev.pair_T, ev.pair_N, ev.pair_code, ev.info)
         if ev.scaled is not None:
             scl = scaled[0]
@@ -506,9 +515,8 @@ class HBProblem:
     def block_preconditioner(self, columns=()):
         """The structured preconditioner of this problem's large solves (one factorisation per harmonic,
         :class:`jointdyn.hb._precond.HarmonicBlocks`; ``columns``: those of the Jacobian it takes exactly),
-        or None where ``config.HB_BLOCK_PRECONDITIONER`` is off or the problem is below
-        ``config.CONT_KRYLOV_SOLVE`` unknowns (its solves are direct)."""
-        if not config.HB_BLOCK_PRECONDITIONER or self.size + 1 < config.CONT_KRYLOV_SOLVE:
+        or None where ``HB_BLOCK_PRECONDITIONER`` is off or below ``config.CONT_KRYLOV_SOLVE`` unknowns."""
+        if not HB_BLOCK_PRECONDITIONER or self.size + 1 < config.CONT_KRYLOV_SOLVE:
             return None
         from ._precond import HarmonicBlocks
 
@@ -580,7 +588,7 @@ class HBProblem:
         ev.pair_T, ev.pair_N = np.empty((npairs, ns, 2)), np.empty((npairs, ns))
         ev.pair_code = np.empty((npairs, ns), dtype=np.int8)
         pairs_aft_kernel()(self.pair_positions, self.pair_params, X, self.n, self.E, self.P, *self._pair_dirs,
-                           int(self.max_passes), float(config.HB_PERIODIC_RTOL), ev.R, self._dummy, G,
+                           int(self.max_passes), float(HB_PERIODIC_RTOL), ev.R, self._dummy, G,
                            ev.pair_T, ev.pair_N, ev.pair_code, ev.info)
         return ev, G
 
@@ -588,7 +596,7 @@ class HBProblem:
         """How the Jacobian is evaluated from ``config.CONT_KRYLOV_SOLVE`` unknowns: ``"sparse"``
         (:meth:`evaluate_sparse`: at most ``config.CONT_SPARSE_DENSITY`` of its entries nonzero),
         ``"blocks"`` (:meth:`evaluate_blocks`: a structure dense on its DOFs, with
-        ``config.HB_BLOCK_PRECONDITIONER``) or ``"dense"`` (:meth:`evaluate`: smaller problems, scalar
+        ``HB_BLOCK_PRECONDITIONER``) or ``"dense"`` (:meth:`evaluate`: smaller problems, scalar
         contacts, condensed problems, a SystemParameter)."""
         if (self.size < config.CONT_KRYLOV_SOLVE or self.contacts or not self.has_interfaces or self.condensed
                 or isinstance(self.parameter, SystemParameter)):
@@ -604,7 +612,7 @@ class HBProblem:
         if bound <= 4 * config.CONT_SPARSE_DENSITY * float(self.size) ** 2:
             if self.sparse_pattern().density <= config.CONT_SPARSE_DENSITY:
                 return "sparse"
-        return "blocks" if config.HB_BLOCK_PRECONDITIONER else "dense"
+        return "blocks" if HB_BLOCK_PRECONDITIONER else "dense"
 
     def evaluate_blocks(self, X, p) -> _Eval:
         """:meth:`evaluate_sparse` with dR/dX as a :class:`jointdyn.hb._jacobian.HarmonicJacobian` (N/m): the
@@ -732,10 +740,8 @@ class HBProblem:
 
     # --- stability ----------------------------------------------------------
     def hill_affordable(self) -> bool:
-        """True when the companion matrix of Hill's method (2 n (2H+1) rows) has at most
-        ``config.HB_HILL_MAX_ROWS`` rows: all its eigenvalues cost O(rows^3), about a minute per point at
-        10^4 rows on two cores, far more than the point itself."""
-        return 2 * self.size <= config.HB_HILL_MAX_ROWS
+        """True when the companion matrix of Hill's method (2 n (2H+1) rows) has at most ``HB_HILL_MAX_ROWS``."""
+        return 2 * self.size <= HB_HILL_MAX_ROWS
 
     def hill_growth(self, JXs, ws):
         """max Re(s) / w of the Floquet exponents (Hill's method) at many points

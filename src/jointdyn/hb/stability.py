@@ -15,7 +15,7 @@ derivative of the periodic force coefficients, the standard choice for
 hysteretic forces, which are not differentiable in velocity) and nabla the
 d/dtau operator on the coefficients. It is solved in first-order (companion)
 form, size 2 n (2H+1) (all its eigenvalues by LAPACK ``dgeev``, except
-for matrices (or parity blocks, below) of at most ``config.HB_SMALL_EIG``
+for matrices (or parity blocks, below) of at most ``HB_SMALL_EIG``
 rows: the compiled EISPACK QR iteration of :mod:`jointdyn.hb._eig` is
 faster there, ``benchmarks/bench_linalg.py``).
 Each Floquet exponent s appears there as a family
@@ -43,13 +43,20 @@ import math
 
 import numpy as np
 
-from .. import config
 from .._cache import by_value
 from .._jit import jit
 from ..fourier import derivative_matrix
 from ._eig import eigvals_inplace
 
 __all__ = ["hill_exponents", "hill_stability", "hill_growth"]
+
+#: a Floquet exponent with Re(s) > HB_STABILITY_RTOL * w marks instability
+HB_STABILITY_RTOL = 1e-6
+#: Hill companion matrices (2 n (2H+1) rows), or their parity blocks, of at
+#: most this many rows go through the compiled EISPACK eigenvalue solver,
+#: larger ones through LAPACK (benchmarks/bench_linalg.py: the compiled
+#: solver is 1.3-3.7x faster up to 150 rows, LAPACK 1.1-1.3x faster from 300)
+HB_SMALL_EIG = 200
 
 
 def _centroids(V, n, H):
@@ -251,7 +258,7 @@ def _hill_eigvals_lapack(JX, M, C, w, H, small: int = 0):
 
 def _small_eig(JX) -> bool:
     """True when the whole companion matrix of JX (twice its rows) is small enough for the compiled path."""
-    return 2 * JX.shape[0] <= config.HB_SMALL_EIG
+    return 2 * JX.shape[0] <= HB_SMALL_EIG
 
 
 def _hill_all(JX, M, C, w, H):
@@ -263,7 +270,7 @@ def _hill_all(JX, M, C, w, H):
         lam, ok = _hill_eigvals(D2iJ_pre, JX, B1[0], B1[1], float(w), parity)
         if ok:
             return lam
-    return _hill_eigvals_lapack(JX, M, C, w, H, config.HB_SMALL_EIG)
+    return _hill_eigvals_lapack(JX, M, C, w, H, HB_SMALL_EIG)
 
 
 def hill_exponents(JX, M, C, w, H):
@@ -290,7 +297,7 @@ def hill_exponents(JX, M, C, w, H):
     -----
     The eigenvalues of the 2 n (2H+1) companion matrix (or of its parity
     blocks) are computed by LAPACK (``numpy.linalg.eigvals``), up to
-    ``config.HB_SMALL_EIG`` rows by the compiled EISPACK sequence of
+    ``HB_SMALL_EIG`` rows by the compiled EISPACK sequence of
     :mod:`jointdyn.hb._eig` (balancing,
     Hessenberg reduction, Francis double-shift QR), which agrees with
     LAPACK to rounding and is faster there (LAPACK is used if its QR
@@ -332,7 +339,7 @@ def hill_growth(JXs, M, C, ws, H):
     ``JXs`` (points, N, N) are the HB Jacobians and ``ws`` (points,) the
     angular frequencies; the same exponents as :func:`hill_exponents`
     (points with a tie at the selection cut or a QR failure go through it).
-    Small companions (``config.HB_SMALL_EIG``) in one compiled loop.
+    Small companions (``HB_SMALL_EIG``) in one compiled loop.
     """
     JXs = np.ascontiguousarray(JXs, dtype=np.float64)
     ws = np.ascontiguousarray(ws, dtype=np.float64)
@@ -345,7 +352,7 @@ def hill_growth(JXs, M, C, ws, H):
     else:
         growth, ok = np.empty(JXs.shape[0]), np.empty(JXs.shape[0], dtype=bool)
         for k in range(JXs.shape[0]):
-            sel, tie = _select(_hill_eigvals_lapack(JXs[k], M, C, ws[k], H, config.HB_SMALL_EIG), ws[k], 2 * n)
+            sel, tie = _select(_hill_eigvals_lapack(JXs[k], M, C, ws[k], H, HB_SMALL_EIG), ws[k], 2 * n)
             growth[k], ok[k] = sel[0].real / ws[k], not tie
     for k in np.flatnonzero(~ok):
         sel, _ = hill_exponents(JXs[k], M, C, ws[k], H)
@@ -353,7 +360,7 @@ def hill_growth(JXs, M, C, ws, H):
     return growth
 
 
-def hill_stability(JX, M, C, w, H, rtol: float = config.HB_STABILITY_RTOL):
+def hill_stability(JX, M, C, w, H, rtol: float = HB_STABILITY_RTOL):
     """(stable, max Re(s) / w, Floquet multipliers) of a periodic HB solution.
 
     See the module docstring for the method and references.

@@ -11,7 +11,8 @@ backbone's largest) changes by more than ``config.HB_AUTO_RTOL``, the
 backbone is computed again at the finer level (the samples first: with
 too few, the sampling error of a contact force that jumps where the
 contact separates moves the solution with more harmonics too), up to
-``config.HB_AUTO_MAX_HARMONICS`` and ``config.HB_AUTO_MAX_SAMPLES``. The
+``HB_AUTO_MAX_HARMONICS`` and ``HB_AUTO_MAX_SAMPLES`` of
+:mod:`jointdyn.hb.discretisation`. The
 levels used and the last check are said in the backbone's message and
 counters.
 """
