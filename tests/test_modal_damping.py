@@ -305,3 +305,23 @@ def test_resume_key_of_a_system_with_the_operator():
     M, K = _pencil(5, seed=9)
     keys = [fingerprint(jd.System(M=M, K=K, C=jd.modal_damping(M, K, z, form="operator"))) for z in (0.01, 0.01, 0.02)]
     assert keys[0] == keys[1] != keys[2]
+
+
+def test_arnoldi_stability_of_a_branch_with_the_operator_equals_dense_c(monkeypatch):
+    """Stability by Arnoldi on a branch evaluated sparse with the modal-damping operator (its Jacobian a
+    sparse part plus the operator) equals that of the dense C."""
+    from jointdyn.hb import StabilityOptions, continue_hb
+    from jointdyn.hb import problem as hb_problem
+
+    sa, so = _pair(3)
+    arnoldi = StabilityOptions(method="arnoldi")
+    a = continue_hb(sa, 0.9, 1.1, harmonics=2, samples=32, condense=False, stability=arnoldi)
+    monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)  # shared: the large-solve paths at this size
+    monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
+    monkeypatch.setattr(hb_problem, "HB_HILL_MAX_ROWS", 0)  # harmonic balance's own bound, in its module
+    b = continue_hb(so, 0.9, 1.1, harmonics=2, samples=32, condense=False, stability=arnoldi,
+                    linear=LinearSolveOptions(small_solve=0))
+    assert a.status.ok and b.status.ok and b.stability == a.stability
+    assert np.all(np.isfinite(b.growth))
+    peak_a, peak_b = np.argmax(a.response()[0]), np.argmax(b.response()[0])
+    assert b.growth[peak_b] == pytest.approx(a.growth[peak_a], rel=1e-6, abs=1e-9)

@@ -215,6 +215,8 @@ def hill_arnoldi_exponents(JX, M, C, w, H, options: StabilityOptions | None = No
         Where Q(sigma) is singular at a shift, or ARPACK does not converge.
     """
     opt = StabilityOptions() if options is None else options
+    if getattr(JX, "approximation", None) is not None:  # a sparse part plus a modal-damping operator: Q(sigma)
+        JX = JX.toarray()                                # is factorised as the whole matrix it is
     w = float(w)
     n = M.shape[0]
     N = n * (2 * H + 1)
