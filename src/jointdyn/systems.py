@@ -25,12 +25,14 @@ import numpy as np
 
 from . import _validate as V
 from . import config
+from ._cache import by_identity
 from .damping import ModalDamping
 from .interfaces import Interface
 from .kinematics import ConstantLoad, HarmonicLoad, NormalLoad, NormalSpring, _selection
 from .laws import ContactLaw, make_law
 
-__all__ = ["Contact", "System", "PAPER", "PAPER_NORMAL_DOF", "modal_damping", "stuck_stiffness"]
+__all__ = ["Contact", "System", "PAPER", "PAPER_NORMAL_DOF", "free_modes", "modal_damping", "rigid_body_modes",
+           "stuck_stiffness"]
 
 #: a matrix is positive semi-definite when its smallest eigenvalue is at least -this times
 #: its largest (rounding of an assembled singular matrix)
@@ -576,6 +578,55 @@ def rigid_mode_dof(K: np.ndarray) -> int | None:
 
     _, vec = eigsh(op, k=1, sigma=-shift, which="LM")
     return int(np.argmax(np.abs(vec[:, 0])))
+
+
+def loose_dofs(K: np.ndarray) -> np.ndarray:
+    """The DOFs whose row of the stiffness ``K`` (N/m) is zero, int array: joined to nothing (a free-free
+    assembly's rigid-body modes move DOFs joined to others; a DOF joined to nothing is a forgotten
+    stiffness far more often than a free body, and the solvers that take free-free structures refuse it)."""
+    return np.flatnonzero(~np.any(np.asarray(K) != 0.0, axis=1))
+
+
+def rigid_body_modes(K: np.ndarray, M: np.ndarray) -> np.ndarray:
+    """The rigid-body modes of (M, K): (n, r) with Phi^T M Phi = I (kg^-1/2), r = 0 when there is none.
+
+    A mode is rigid when its eigenvalue of (M, K) is at most ``config.SYSTEM_RIGID_MODE_RTOL`` times the
+    largest (the rule of :func:`rigid_mode_dof`, on the pencil). Dense eigen-decomposition up to
+    ``config.SYSTEM_DENSE_CHECK_MAX_DOF`` DOFs, else shift-invert Lanczos iterations asked for more modes
+    until one is elastic; the modes found are M-orthonormalised (Cholesky of Phi^T M Phi)."""
+    n = K.shape[0]
+    if rigid_mode_dof(K) is None:
+        return np.zeros((n, 0))
+    if n <= config.SYSTEM_DENSE_CHECK_MAX_DOF:
+        from scipy.linalg import eigh
+
+        lam, vec = eigh(0.5 * K + 0.5 * K.T, M)
+        phi = vec[:, lam <= config.SYSTEM_RIGID_MODE_RTOL * abs(lam[-1])]
+    else:
+        from scipy.sparse.linalg import eigsh
+
+        top = abs(_largest_eigenvalue(_operator(K), _operator(M)))
+        k = 8
+        while True:
+            lam, vec = eigsh(_operator(K), k=min(k, n - 1), M=_operator(M), sigma=-config.SYSTEM_RIGID_MODE_RTOL * top,
+                             which="LM")
+            rigid = lam <= config.SYSTEM_RIGID_MODE_RTOL * top
+            if not np.all(rigid) or k >= n - 1:
+                break
+            k *= 2
+        phi = vec[:, rigid]
+    L = np.linalg.cholesky(phi.T @ M @ phi)
+    return np.ascontiguousarray(np.linalg.solve(L, phi.T).T)
+
+
+@by_identity
+def free_modes(system) -> np.ndarray:
+    """The rigid-body modes of ``system`` with every contact and every interface pair closed at rest stuck
+    (:func:`stuck_stiffness`): (n, r), M-orthonormal (kg^-1/2), r = 0 for a structure held in place
+    (cached per System). A free-free assembly (a bolted beam hung on bungees) has r > 0: 6 in 3-D, 3 in
+    2-D, 1 for a chain along its axis. The contacts and pairs cannot act on such a mode (their springs
+    hold it by nothing: b^T Phi = 0), nor can K: their forces balance."""
+    return rigid_body_modes(stuck_stiffness(system), system.M)
 
 
 def _lowest_elastic_large(M: np.ndarray, K: np.ndarray) -> float | None:
