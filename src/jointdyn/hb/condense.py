@@ -73,7 +73,7 @@ from .._cache import by_identity
 from .._jit import jit
 from ..damping import dense_damping, is_operator
 from ..kinematics import contact_kinematics, selection_matrix
-from ..systems import System
+from ..systems import System, free_modes
 from .levels import HB_CONDENSE_MIN_DOFS
 from .problem import HBProblem, _linear_blocks, contacts_only, held_by_contacts
 from .stability import hill_growth, hill_stability
@@ -766,11 +766,20 @@ def use_condensed(system: System, condense=None, response_dofs=()) -> bool:
     contacts (:func:`~jointdyn.hb.problem.held_by_contacts`) is never
     condensed: the receptance and the static Schur complement are those of K,
     which has a rigid-body mode there (ValueError naming ``condense`` when it
-    is asked for).
+    is asked for). Nor is a free-free structure (rigid-body modes with every
+    contact stuck, :func:`jointdyn.systems.free_modes`): its receptance has
+    rigid-body terms 1/w^2 and K no static inverse; the full problem gauges
+    the rigid-body part of the mean (:func:`jointdyn.hb.problem.mean_gauge`).
     """
     if condense is not None and condense not in (True, False):
         raise ValueError(f"condense must be True, False or None (automatic), got {condense!r}")
     if condense is False:
+        return False
+    if free_modes(system).shape[1]:
+        if condense:
+            raise ValueError("condense: the structure is free-free (rigid-body modes even with every contact "
+                             "stuck), so its receptance has 1/w^2 rigid-body terms and no static part to condense "
+                             "with; use condense=False (or None: the full problem)")
         return False
     if held_by_contacts(system):
         if condense:

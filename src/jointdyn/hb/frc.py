@@ -47,30 +47,42 @@ HB_MAX_GAMMA_STEP = 0.02
 
 
 def check_mean_position(system: System) -> None:
-    """ValueError naming the DOF where ``system`` has a rigid-body mode even with every contact stuck and
-    every normal spring (of the contacts and of the interfaces' pairs closed at rest) closed.
+    """ValueError where the mean position of ``system`` is not defined with every contact stuck and every
+    normal spring (of the contacts and of the interfaces' pairs closed at rest) closed.
 
-    Harmonic balance starts from that static stiffness: a DOF that it holds
-    by nothing has no unique mean position, and Newton would fail on a
-    singular matrix; the time domain takes such a structure. A DOF held only
-    by stiffnesses many decades apart is ill-conditioned, not free: those
-    stiffnesses are named instead, and a DOF held only by pairs open at rest
-    (preload 0) names such a pair. A DOF held only through the contacts
-    (K + kn singular with the tangential contacts free, K + kt + kn not) is
+    Harmonic balance starts from that static stiffness. A DOF held only by
+    stiffnesses many decades apart is ill-conditioned, not free: those
+    stiffnesses are named; a DOF held only by pairs open at rest (preload 0)
+    names such a pair. A structure held only through the contacts (K + kn
+    singular with the tangential contacts free, K + kt + kn not) is
     accepted: harmonic balance then restarts the laws at the reference
     displacement, the preloaded static state, so that a stuck contact holds
-    the mean position (:func:`jointdyn.hb.problem.held_by_contacts`).
+    the mean position (:func:`jointdyn.hb.problem.held_by_contacts`). A
+    free-free structure (K + kt + kn itself has rigid-body modes, which no
+    spring holds: the parts of a bolted beam hung on bungees) is accepted:
+    harmonic balance fixes the rigid-body part of the mean at zero
+    (:func:`jointdyn.hb.problem.mean_gauge`). A DOF joined to nothing (its
+    row of K + kt + kn zero: a forgotten stiffness far more often than a
+    free body) is refused, naming it.
     """
-    from ..systems import rigid_mode_dof, static_springs
+    from ..systems import loose_dofs, rigid_mode_dof, static_springs
 
     K = stuck_stiffness(system)  # with the normal springs of the contacts and pairs closed at rest
     dof = rigid_mode_dof(K)
     if dof is None:
         return
-    # the eigenvector names what holds the DOF; beyond this size it is not computed and the general message stands
-    vec = np.linalg.eigh(K)[1][:, 0] if system.ndof <= config.SYSTEM_DENSE_CHECK_MAX_DOF else None
+    loose = loose_dofs(K)
+    if loose.size:
+        raise ValueError(f"the structure has a rigid-body mode even with every contact stuck and every normal "
+                         f"spring closed (mostly DOF {int(loose[0])}: held by nothing, joined to no other DOF: its "
+                         "row of K + kt + kn is zero), so its mean position is not unique; harmonic balance "
+                         "needs one: give that DOF a stiffness in K, or use the time domain (--method time)")
+    if system.ndof > config.SYSTEM_DENSE_CHECK_MAX_DOF:
+        return  # beyond this size the null vectors are not computed: a free-free structure is taken as such
+    lam, vecs = np.linalg.eigh(K)
+    vecs = vecs[:, lam <= config.SYSTEM_RIGID_MODE_RTOL * abs(lam[-1])]
     springs = static_springs(system)
-    holders = [] if vec is None else [(key, k) for key, k, b in springs if abs(b @ vec) > 1e-6]
+    holders = [(key, k) for key, k, b in springs if np.abs(b @ vecs).max() > 1e-6]
     if holders:  # held, by a stiffness many decades below the largest: ill-conditioned
         key, k = min(holders, key=lambda h: h[1])
         top_key, top = max([("K", float(np.max(np.abs(system.K))))] + [(sp[0], sp[1]) for sp in springs],
@@ -80,17 +92,12 @@ def check_mean_position(system: System) -> None:
                          f"times {top_key} = {top:.4g} N/m, below the ratio {config.SYSTEM_RIGID_MODE_RTOL:g} that "
                          f"double precision resolves; bring {key} and {top_key} within that ratio, or use the time "
                          "domain (--method time)")
-    opened = [] if vec is None else [key for key, _, b in static_springs(system, open_pairs=True)
-                                     if abs(b @ vec) > 1e-6]
+    opened = [key for key, _, b in static_springs(system, open_pairs=True) if np.abs(b @ vecs).max() > 1e-6]
     if opened:  # held only by pairs that touch without load: the mean is not unique while they are open
         raise ValueError(f"DOF {dof} is held only by {opened[0]}, a pair open at rest (preload 0: it touches "
                          "without load), so its mean position is not unique while the pair is open and harmonic "
                          "balance has no start; give the pair a preload > 0 or that DOF a stiffness in K, or use "
                          "the time domain (--method time)")
-    raise ValueError(f"the structure has a rigid-body mode even with every contact stuck and every normal "
-                     f"spring closed (mostly DOF {dof}: held by nothing, K + kt + kn is singular), so its mean "
-                     "position is not unique; harmonic balance needs one: give that DOF a stiffness in K, or "
-                     "use the time domain (--method time)")
 
 
 def continue_hb(system: System, start: float, stop: float, *, parameter="gamma", gamma: float | None = None,

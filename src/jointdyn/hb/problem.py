@@ -47,6 +47,7 @@ from ..laws._base import MACROSLIP, SEPARATION, STICK_SLIP
 from ..systems import System
 from ._aft import HB_PERIODIC_RTOL, NO_EVENT, PERIOD_ONE, eval_kernel, recontact_events
 from ._recontact import HB_RECONTACT_ALPHA
+from ._rigid import held_by_contacts, mean_gauge
 from ._aft_pairs import pair_directions, pairs_aft_kernel
 from ._sparse import linear_entries
 from .levels import Level
@@ -123,9 +124,10 @@ def _load_events(n0: float, n1: float, delta: float) -> tuple:
                         for ph in (a, math.pi - a)))
 
 
-def _linear_blocks(system: System, H: int):
+def _linear_blocks(system: System, H: int, gauge=None):
     """(AK, AC, AM) with A(w) = AK + w AC + w^2 AM the linear terms of harmonics 0..H (dense; their entries
-    per harmonic block: :func:`jointdyn.hb._sparse.linear_entries`)."""
+    per harmonic block: :func:`jointdyn.hb._sparse.linear_entries`); ``gauge`` (n, n), N/m, added to K on
+    harmonic 0 alone (:func:`mean_gauge`)."""
     size = system.ndof * (2 * H + 1)
     rows, cols, *values = linear_entries(system.K, dense_damping(system.C), system.M, H)
     out = []
@@ -134,6 +136,9 @@ def _linear_blocks(system: System, H: int):
         A = np.zeros((size, size))
         A[rows, cols] = v
         out.append(A)
+    if gauge is not None:
+        n = system.ndof
+        out[0][:n, :n] += gauge
     return tuple(out)
 
 
@@ -221,6 +226,13 @@ class HBProblem:
         #: the interfaces' pairs restart virgin at the reference displacement (the preloaded static state), not
         #: at the mean of their motion, so that a stuck contact holds the mean position (made once, here)
         self.restart_at_reference = held_by_contacts(system)
+        #: s M Phi_r Phi_r^T M (n, n), N/m, added to K on harmonic 0 of a free-free structure (its stuck
+        #: stiffness has rigid-body modes Phi_r: :func:`mean_gauge`); None for a structure held in place
+        self.gauge = mean_gauge(system, self.w0)
+        if self.gauge is not None and self.n != system.ndof:
+            raise ValueError("condense: the structure is free-free (rigid-body modes even with every contact "
+                             "stuck), so its receptance has no static part to condense with; use condense=False "
+                             "(or None: the full problem)")
         self._contact_inputs(contact_kinematics(contacts_only(system)))
         self._interface_inputs()
         #: the AFT's phases and matrices (:meth:`_aft_grid`); evaluations report the uniform samples
@@ -307,7 +319,7 @@ class HBProblem:
         """(AK, AC, AM) of :func:`_linear_blocks`, dense (3 N^2 entries: 730 MB at 5500 unknowns), built at
         their first use: an evaluation with a sparse Jacobian (:meth:`evaluate_sparse`) never needs them."""
         if getattr(self, "_lin_blocks", None) is None:
-            self._lin_blocks = _linear_blocks(self.system, self.H)
+            self._lin_blocks = _linear_blocks(self.system, self.H, self.gauge)
         return self._lin_blocks
 
     @property
@@ -420,7 +432,7 @@ class HBProblem:
         n, X = self.n, np.empty(self.size)
         for k, (lo, hi) in enumerate(harmonic_blocks(n, self.H)):
             if k == 0:
-                X[lo:hi] = np.linalg.solve(K + Kc, F[lo:hi])
+                X[lo:hi] = np.linalg.solve(K + Kc if self.gauge is None else K + Kc + self.gauge, F[lo:hi])
                 continue
             D = K + Kc - (k * w) ** 2 * M
             X[lo:hi] = np.linalg.solve(np.block([[D, (k * w) * C], [-(k * w) * C, D]]), F[lo:hi])
@@ -526,9 +538,10 @@ class HBProblem:
     def sparse_pattern(self):
         """The CSR pattern of dR/dX (:class:`jointdyn.hb._sparse.SparsePattern`; built once), or None
         where :meth:`evaluate_sparse` does not apply: scalar contacts (their kernel writes a dense
-        Jacobian), no interfaces, a condensed problem, or a
+        Jacobian), no interfaces, a condensed problem, a free-free structure (its gauge of the mean,
+        :func:`mean_gauge`, is dense), or a
         :class:`~jointdyn.hb.parameters.SystemParameter`."""
-        if (self.contacts or not self.has_interfaces or self.condensed
+        if (self.contacts or not self.has_interfaces or self.condensed or self.gauge is not None
                 or isinstance(self.parameter, SystemParameter)):
             return None
         if getattr(self, "_pattern", None) is None:
@@ -601,6 +614,8 @@ class HBProblem:
         if (self.size < config.CONT_KRYLOV_SOLVE or self.contacts or not self.has_interfaces or self.condensed
                 or isinstance(self.parameter, SystemParameter)):
             return "dense"
+        if self.gauge is not None:  # the gauge of the mean is dense on the DOFs
+            return "blocks" if HB_BLOCK_PRECONDITIONER else "dense"
         sys_ = self.system
         # an upper bound of the pattern's density without building it (np.unique of millions of keys for a
         # reduced model, only to find it dense); modal damping enters the pattern by its Rayleigh part
@@ -634,7 +649,7 @@ class HBProblem:
         for k, (lo, hi) in enumerate(spans):
             B = np.empty((hi - lo, hi - lo))
             if k == 0:
-                B[:] = K
+                B[:] = K if self.gauge is None else K + self.gauge
             else:
                 np.multiply(M, -(k * w) ** 2, out=B[:n, :n])
                 B[:n, :n] += K
@@ -782,25 +797,6 @@ def stuck_stiffness(system: System) -> np.ndarray:
             rows = Bi[k::3][closed]
             K += rows.T @ (itf.kt[closed][:, None] * rows)
     return K
-
-
-@by_identity
-def held_by_contacts(system: System) -> bool:
-    """True when ``system`` is held only through its contacts: ``System.K_reference`` (K with the normal
-    springs closed, the tangential contacts free) has a rigid-body mode and :func:`stuck_stiffness` (every
-    contact and pair stuck) has none (:func:`jointdyn.systems.rigid_mode_dof`); cached per System.
-
-    Such a part (a beam joined to another by a bolted joint, a friction damper held by its contacts) is at
-    rest in the preloaded static state, the origin of the coordinates, where every contact is at rest
-    without tangential force. Harmonic balance then restarts each law there instead of at the mean of its
-    motion (:attr:`HBProblem.restart_at_reference`): a stuck contact's force is kt u, its mean holds the
-    part, and only a part that slides as a whole through the cycle has no unique mean position.
-    """
-    from ..systems import rigid_mode_dof
-
-    if not (system.contacts or system.interfaces):
-        return False
-    return rigid_mode_dof(system.K_reference) is not None and rigid_mode_dof(stuck_stiffness(system)) is None
 
 
 @by_identity

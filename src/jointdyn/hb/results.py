@@ -15,6 +15,7 @@ import numpy as np
 from .. import config
 from ..continuation import ContinuationStatus
 from ..status import Status
+from ..systems import free_modes
 from .parameters import GAMMA
 from .problem import HBProblem, stuck_stiffness
 
@@ -287,7 +288,8 @@ def sliding_as_a_whole(problem: HBProblem, JX) -> str:
     For a problem held only through its contacts
     (:attr:`HBProblem.restart_at_reference`, full unknowns): where the
     static harmonic's Jacobian ``JX`` (dense, N/m) along a rigid-body mode v
-    of ``System.K_reference`` is below ``_NOT_HELD_RTOL`` of the stuck
+    of ``System.K_reference`` (less its part along the rigid-body modes of the
+    whole, for a free-free structure) is below ``_NOT_HELD_RTOL`` of the stuck
     structure's ``K_stuck v``, no contact resists a shift of the part: every
     one of its contacts slips every cycle (macroslip), the
     part's mean position is not unique, and Newton fails on a singular
@@ -302,8 +304,13 @@ def sliding_as_a_whole(problem: HBProblem, JX) -> str:
     K = problem.system.K_reference
     lam, vec = np.linalg.eigh(0.5 * (K + K.T))
     Ks = stuck_stiffness(problem.system)
+    free, M = free_modes(problem.system), problem.system.M
     for j in np.flatnonzero(lam <= config.SYSTEM_RIGID_MODE_RTOL * abs(lam[-1])):
-        v = vec[:, j]
+        # of a free-free structure, the motion of the parts relative to each other: the whole's rigid-body
+        # modes (gauged on harmonic 0) taken out
+        v = vec[:, j] - free @ (free.T @ (M @ vec[:, j]))
+        if not np.linalg.norm(v) > 1e-6:
+            continue
         held = float(np.linalg.norm(JX[:, :problem.n] @ v))
         if held <= _NOT_HELD_RTOL * float(np.linalg.norm(Ks @ v)):
             dof = int(np.argmax(np.abs(v)))
