@@ -12,7 +12,10 @@ needs constant normal loads).
 
 The linear **stuck** mode (every contact a spring kt, normal springs in
 place) starts every backbone: mode ``K`` (1-based, increasing frequency)
-of ``(M, K_reference + sum_c kt_c b_c b_c^T)``.
+of ``(M, K_reference + sum_c kt_c b_c b_c^T)``. Of a free-free structure
+(that stiffness has rigid-body modes: :func:`jointdyn.systems.free_modes`)
+the modes are counted among the elastic ones: mode 1 is the first elastic
+mode, the rigid-body modes are never chosen.
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ from .. import _validate as V
 from .. import config
 from ..kinematics import HarmonicLoad, NormalSpring
 from ..hb.problem import stuck_stiffness
-from ..systems import System
+from ..systems import System, free_modes, loose_dofs
 
 __all__ = ["LinearMode", "check_free_vibration", "linear_stuck_mode", "output_dof_of", "amplitude_range",
            "contact_scale"]
@@ -45,7 +48,8 @@ class LinearMode:
     Attributes
     ----------
     index : int
-        Mode number, 1-based, in increasing frequency.
+        Mode number, 1-based, in increasing frequency, among the elastic modes (a free-free structure's
+        rigid-body modes are not counted).
     omega_rad_s : float
         Natural frequency, rad/s.
     shape : ndarray (n,)
@@ -91,9 +95,11 @@ def check_free_vibration(system, method: str, *, springs: bool = True, held: boo
         motion): QSMA takes neither.
     held : bool
         Whether the method takes a structure held only through its contacts (K with the tangential contacts
-        free singular, the stuck stiffness not: :func:`jointdyn.hb.problem.held_by_contacts`): EPMC does (its
-        harmonic balance restarts the laws at the preloaded static state), QSMA does not (its static
-        equilibrium of the slipping structure needs K with the contacts free).
+        free singular, the stuck stiffness not: :func:`jointdyn.hb.problem.held_by_contacts`) and a free-free
+        one (the stuck stiffness has rigid-body modes, :func:`jointdyn.systems.free_modes`, and no DOF is
+        joined to nothing): EPMC does (its harmonic balance restarts the laws at the preloaded static state
+        and gauges the rigid-body part of the mean), QSMA does not (its static equilibrium of the slipping
+        structure needs K with the contacts free).
     """
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
@@ -126,8 +132,17 @@ def check_free_vibration(system, method: str, *, springs: bool = True, held: boo
     lam = eigh(system.K_reference, system.M, eigvals_only=True)
     if held and not _resolved(lam):
         # held only through the contacts: the stuck structure must be held (a DOF held by nothing is refused)
-        lam = eigh(stuck_stiffness(system), system.M, eigvals_only=True)
+        Ks = stuck_stiffness(system)
+        lam = eigh(Ks, system.M, eigvals_only=True)
         if _resolved(lam):
+            return system
+        r = free_modes(system).shape[1]
+        if 0 < r < lam.size and not loose_dofs(Ks).size and _resolved(lam[r:]):
+            # free-free: the stuck structure's rigid-body modes are never chosen, its mean gauged by harmonic
+            # balance (ill-conditioned stiffnesses and pairs open at rest named as harmonic balance names them)
+            from ..hb import check_mean_position
+
+            check_mean_position(system)
             return system
         what = ("is ill-conditioned with every contact stuck: its smallest eigenvalue of (M, K), "
                 f"{lam[0]:.6g} (rad/s)^2, is {lam[0] / lam[-1]:.3g} of the largest, below the ratio "
@@ -176,11 +191,14 @@ def linear_stuck_mode(system: System, mode: int, output_dof: int) -> LinearMode:
     from scipy.linalg import eigh
 
     n = system.ndof
+    r = free_modes(system).shape[1]  # rigid-body modes of a free-free structure: never chosen, not counted
     k = V.positive_int("mode", mode, 1)
-    if k > n:
-        raise ValueError(f"mode must be in [1, {n}] (the system has {n} DOFs), got {mode!r}")
+    if k > n - r:
+        what = f"{n} DOFs" if r == 0 else f"{n - r} elastic modes beside its {r} rigid-body modes"
+        raise ValueError(f"mode must be in [1, {n - r}] (the system has {what}), got {mode!r}")
     Ks = stuck_stiffness(system)
     lam, phi = eigh(Ks, system.M)
+    lam, phi = lam[r:], phi[:, r:]  # the elastic modes, in increasing frequency
     v = phi[:, k - 1]
     big = float(np.max(np.abs(v)))
     if not abs(v[output_dof]) > MODES_MIN_PARTICIPATION * big:
