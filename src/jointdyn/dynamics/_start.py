@@ -3,7 +3,9 @@
 * the equivalent-linearisation estimate (describing function of each
   contact law, marched over the harmonic displacement of the estimate);
 * law states rebuilt from one period alone (forgetting a transient's memory)
-  before shooting.
+  before shooting;
+* the rigid-body part of a free-free structure's start set to the periodic
+  motion of the free body (:func:`free_body_start`).
 
 Both march a law over a history with the compiled march of
 :mod:`jointdyn.drivers` (:func:`~jointdyn.drivers._march.law_marcher`).
@@ -20,7 +22,7 @@ from ..drivers import march
 from ..drivers._march import law_marcher
 from ..kinematics import load_table, tangential_history
 
-__all__ = ["linear_start", "clean_states"]
+__all__ = ["linear_start", "clean_states", "free_body_start"]
 
 #: describing-function iterations of the linear start
 SS_LINEAR_ITERS = 30
@@ -213,3 +215,31 @@ def clean_states(model, x, v, S, rdof, count):
         sf = march(law, uu, NN, state=s0)[3]
         Snew[i, : sf.size] = sf
     return x, v, np.ascontiguousarray(Snew)
+
+
+def free_body_start(model, x, v):
+    """(x, v) with their rigid-body part replaced by the periodic motion of the free body at t = 0.
+
+    A free-free structure (rigid-body modes Phi_r of the stuck structure, M-orthonormal:
+    :func:`jointdyn.systems.free_modes`) feels no force of K, of the contacts or of the pairs along Phi_r;
+    its rigid-body coordinates q = Phi_r^T M x obey q'' + Phi_r^T C Phi_r q' = Phi_r^T F(t). Started at rest,
+    the forcing f sin(w t + phi) gives them a mean velocity (f cos(phi) / w for a free mass) and the body
+    drifts for ever. Their periodic motion q = Im(Q e^{i w t}),
+    (-w^2 + i w Phi_r^T C Phi_r) Q = Phi_r^T f e^{i phi}, has a zero mean position and momentum; its state
+    at t = 0, (Im Q, w Re Q), replaces the rigid-body part Phi_r Phi_r^T M (x, v) of the start (the
+    contacts cannot see it: b^T Phi_r = 0), the elastic part is kept. Exact when C does not couple the
+    rigid-body modes to the elastic ones (C Phi_r = 0: stiffness-proportional or modal damping; a
+    mass-proportional part damps the rigid-body motion, and any drift then decays). ``(x, v)`` themselves
+    for a structure held in place or sampled loads (w = 0)."""
+    from ..systems import free_modes
+
+    phi = free_modes(model.system)
+    r, w = phi.shape[1], float(model.w)
+    if r == 0 or not w > 0.0:
+        return x, v
+    pk = model.pack
+    Cr = phi.T @ pk.C @ phi
+    Q = np.linalg.solve(-w * w * np.eye(r) + 1j * w * Cr, phi.T @ (pk.fsin + 1j * pk.fcos))
+    x = x - phi @ (phi.T @ (pk.M @ x)) + phi @ Q.imag
+    v = v - phi @ (phi.T @ (pk.M @ v)) + phi @ (w * Q.real)
+    return x, v

@@ -23,6 +23,7 @@ from ..systems import System
 from ._core import LOADS_SAMPLED
 from ._model import (TI_MAX_OMEGA_H, TI_RECONTACT_ALPHA, TI_SPRING_OMEGA_H, TI_STEPS_PER_PERIOD, Model, make_model,
                      refine_if_opened, run)
+from ._start import free_body_start
 from .status import RunStatus
 
 __all__ = ["Trajectory", "Restart", "integrate", "integrate_sampled"]
@@ -148,7 +149,10 @@ def integrate(
         ``TI_SPRING_OMEGA_H`` when a normal spring opens; events and
         reversals add steps.
     x0, v0 : array_like, optional
-        Initial displacements (m) and velocities (m/s); default rest.
+        Initial displacements (m) and velocities (m/s); default rest (the preloaded static state); for
+        a free-free structure (rigid-body modes with every contact stuck) the default starts its
+        rigid-body part in the periodic motion of the free body, zero mean position and momentum
+        (:func:`jointdyn.dynamics._start.free_body_start`), so that the forcing's start imparts no drift.
     states : array_like, optional
         Committed law states (one row per contact); default virgin at x0.
     start : Restart, optional
@@ -166,9 +170,12 @@ def integrate(
     periods = V.positive_int("periods", periods)
     w = _omega(system, gamma)
     model = make_model(system, w, spp)
+    rest = start is None and x0 is None and v0 is None
     if start is not None:
         x0, v0, states = start.x, start.v, start.states
     x, v, S = _start_vectors(model, x0, v0, states)
+    if rest:  # a free-free structure: its rigid-body part in the free body's periodic motion (no drift)
+        x, v = free_body_start(model, x, v)
     start = (x.copy(), v.copy(), S.copy())
     res = model.run_periods(x, v, S, periods, rec=True)
     finer = refine_if_opened(model, res.summary)

@@ -26,7 +26,7 @@ from .._jit import jit
 from ..systems import System
 from ._core import N_SUMMARY, S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
 from ._model import TI_STEPS_PER_PERIOD, Model, make_model, pack_system, refine_if_opened
-from ._start import clean_states, linear_start
+from ._start import clean_states, free_body_start, linear_start
 from .integrate import Restart, Trajectory, _omega, _trajectory
 from .monodromy import fd_monodromy
 from .status import SS_DISSIPATION_FLOOR, EnergyCheck, SteadyStatus
@@ -837,12 +837,16 @@ def prepare_kernels(systems) -> None:
 
 def _first_state(model, start):
     """(x, v, S) to start from: the warm start, else the equivalent-linearisation
-    estimate, else rest with virgin law states."""
+    estimate, else rest with virgin law states; a free-free structure's rigid-body part, whatever the
+    start, at the periodic motion of the free body at this frequency (:func:`free_body_start`: no drift)."""
     if start is not None:
-        return _unpack_start(start, model)
-    est = linear_start(model)
-    if est is None:
-        x = np.zeros(model.n)
-        return x, np.zeros(model.n), model.initial_states(x)
-    x, v, S = est
+        x, v, S = _unpack_start(start, model)
+    else:
+        est = linear_start(model)
+        if est is None:
+            x = np.zeros(model.n)
+            x, v, S = x, np.zeros(model.n), model.initial_states(x)
+        else:
+            x, v, S = est
+    x, v = free_body_start(model, x, v)
     return x, v, np.ascontiguousarray(S)
