@@ -100,6 +100,13 @@ def test_hb_of_a_stuck_free_free_assembly_equals_the_free_free_frf(gamma):
     assert abs(lam[0]) < 1e-9 * lam[-1]
     np.testing.assert_allclose(z[0], -1j * s.force[0] * h00, rtol=1e-10)
     assert abs(phi[0, 0] ** 2 / (-w * w) + 1.0 / (3.0 * w * w)) < 1e-12 / w ** 2
+    # stable: the elastic motion's exponents, or the free body's neutral one (0, shifted to +-i w0 by the
+    # gauge and counted where it falls into Hill's central strip)
+    A = np.block([[np.zeros((4, 4)), np.eye(4)], [-np.linalg.solve(s.M, stuck_stiffness(s)),
+                                                   -np.linalg.solve(s.M, np.asarray(s.C))]])
+    ex = np.linalg.eigvals(A)
+    elastic = ex[np.abs(ex) > 1e-6 * np.abs(ex).max()].real.max() / w
+    assert sol.stable and (abs(sol.growth) < 1e-8 or sol.growth == pytest.approx(elastic, rel=1e-8))
     # the free body's mean stays where it was; the Jacobian's static block is K_stuck + s M Phi Phi^T M
     ev = sol.problem.evaluate(sol.X, sol.problem.f1_ref)
     np.testing.assert_allclose(ev.JX[:4, :4], stuck_stiffness(s) + sol.problem.gauge, rtol=1e-12)
