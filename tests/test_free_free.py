@@ -277,3 +277,28 @@ def test_a_free_free_system_file_through_the_command_line(tmp_path, capsys):
     lam = eigh(stuck_stiffness(s), s.M, eigvals_only=True)
     assert rc == 0 and out["status"] == "complete", out["message"]
     assert out["omega_linear_rad_s"] == pytest.approx(math.sqrt(lam[3]), rel=1e-10)  # after 3 rigid-body modes
+
+
+def test_rigid_body_modes_large_path_agrees(monkeypatch):
+    """The shift-invert path of large structures finds the same rigid-body subspace as the dense one: a
+    free chain of 40 DOFs in two directions (2 rigid-body modes), and none once one DOF is grounded."""
+    from jointdyn import config
+    from jointdyn.systems import rigid_body_modes
+
+    rng = np.random.default_rng(5)
+    n = 40
+    K = np.zeros((n, n))
+    for d in range(n - 2):  # two interleaved chains: DOFs of the same parity joined
+        K += _spring(n, d, d + 2, float(rng.uniform(1e3, 1e4)))
+    M = np.diag(rng.uniform(0.5, 2.0, n))
+    dense = rigid_body_modes(K, M)
+    assert dense.shape == (n, 2)
+    monkeypatch.setattr(config, "SYSTEM_DENSE_CHECK_MAX_DOF", 10)
+    large = rigid_body_modes(K, M)
+    assert large.shape == (n, 2)
+    np.testing.assert_allclose(large.T @ M @ large, np.eye(2), atol=1e-10)
+    P = dense @ dense.T @ M  # the M-orthogonal projector on the dense subspace keeps the large one
+    np.testing.assert_allclose(P @ large, large, atol=1e-8 * np.abs(large).max())
+    Kg = K.copy()
+    Kg[0, 0] += 1e3
+    assert rigid_body_modes(Kg, M).shape == (n, 1)
