@@ -266,6 +266,15 @@ def test_a_free_free_system_file_through_the_command_line(tmp_path, capsys):
     f = _free_free_file(tmp_path / "ff.toml")
     s = jd.read_system(f)
     assert free_modes(s).shape[1] == 3 and held_by_contacts(s)
+    # stuck pair: harmonic balance and the time domain on the free-free FRF (modal damping: no rigid-body part)
+    from jointdyn.damping import dense_damping
+
+    w = 0.8 * s.w0
+    z = np.linalg.solve(stuck_stiffness(s) - w * w * s.M + 1j * w * dense_damping(s.C), -1j * s.force)
+    sol = harmonic_balance(s, 0.8, harmonics=3, samples=32, response_dof=9)
+    assert sol.status.ok and sol.amplitude_m == pytest.approx(abs(z[9]), rel=1e-8)
+    ss = jd.steady_state(s, 0.8, response_dof=9)
+    assert ss.status.ok and ss.amplitude_m == pytest.approx(abs(z[9]), rel=1e-4)
     capsys.readouterr()
     rc = main(["frc", "--system", str(f), "--method", "hb", "--gamma", "0.3:1.5:0.05", "--harmonics", "3",
                "--samples", "32", "--out", str(tmp_path / "o1"), "--json"])
