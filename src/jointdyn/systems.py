@@ -591,20 +591,31 @@ def rigid_body_modes(K: np.ndarray, M: np.ndarray) -> np.ndarray:
     """The rigid-body modes of (M, K): (n, r) with Phi^T M Phi = I (kg^-1/2), r = 0 when there is none.
 
     A mode is rigid when its eigenvalue of (M, K) is at most ``config.SYSTEM_RIGID_MODE_RTOL`` times the
-    largest (the rule of :func:`rigid_mode_dof`, on the pencil). Dense eigen-decomposition up to
-    ``config.SYSTEM_DENSE_CHECK_MAX_DOF`` DOFs, else shift-invert Lanczos iterations asked for more modes
-    until one is elastic; the modes found are M-orthonormalised (Cholesky of Phi^T M Phi)."""
+    largest (the rule of :func:`rigid_mode_dof`, on the pencil). Up to ``config.SYSTEM_DENSE_CHECK_MAX_DOF``
+    DOFs a Cholesky factorisation of K less the tolerance times a bound of its largest eigenvalue says
+    "none" for a structure held in place, else a dense eigen-decomposition; beyond, shift-invert Lanczos
+    iterations asked for more modes until one is elastic. The modes found are M-orthonormalised
+    (Cholesky of Phi^T M Phi)."""
     n = K.shape[0]
-    if rigid_mode_dof(K) is None:
-        return np.zeros((n, 0))
     if n <= config.SYSTEM_DENSE_CHECK_MAX_DOF:
+        Ks = 0.5 * K + 0.5 * K.T
+        # no rigid-body mode when K less the tolerance times a bound of its largest eigenvalue (the largest
+        # absolute row sum) is positive definite: one Cholesky factorisation, a fraction of an eigensolve
+        shift = config.SYSTEM_RIGID_MODE_RTOL * float(np.max(np.sum(np.abs(Ks), axis=1)))
+        try:
+            np.linalg.cholesky(Ks - shift * np.eye(n))
+            return np.zeros((n, 0))
+        except np.linalg.LinAlgError:
+            pass
         from scipy.linalg import eigh
 
-        lam, vec = eigh(0.5 * K + 0.5 * K.T, M)
+        lam, vec = eigh(Ks, M)
         phi = vec[:, lam <= config.SYSTEM_RIGID_MODE_RTOL * abs(lam[-1])]
     else:
         from scipy.sparse.linalg import eigsh
 
+        if rigid_mode_dof(K) is None:
+            return np.zeros((n, 0))
         top = abs(_largest_eigenvalue(_operator(K), _operator(M)))
         k = 8
         while True:
@@ -615,6 +626,8 @@ def rigid_body_modes(K: np.ndarray, M: np.ndarray) -> np.ndarray:
                 break
             k *= 2
         phi = vec[:, rigid]
+    if phi.shape[1] == 0:
+        return np.zeros((n, 0))
     L = np.linalg.cholesky(phi.T @ M @ phi)
     return np.ascontiguousarray(np.linalg.solve(L, phi.T).T)
 

@@ -65,20 +65,27 @@ def check_mean_position(system: System) -> None:
     row of K + kt + kn zero: a forgotten stiffness far more often than a
     free body) is refused, naming it.
     """
-    from ..systems import loose_dofs, rigid_mode_dof, static_springs
+    from ..systems import loose_dofs, rigid_mode_dof
 
     K = stuck_stiffness(system)  # with the normal springs of the contacts and pairs closed at rest
     dof = rigid_mode_dof(K)
     if dof is None:
         return
+    if system.ndof <= config.SYSTEM_DENSE_CHECK_MAX_DOF:  # beyond, the null vectors are not computed
+        _check_null_space(system, K, dof)
     loose = loose_dofs(K)
     if loose.size:
         raise ValueError(f"the structure has a rigid-body mode even with every contact stuck and every normal "
                          f"spring closed (mostly DOF {int(loose[0])}: held by nothing, joined to no other DOF: its "
                          "row of K + kt + kn is zero), so its mean position is not unique; harmonic balance "
                          "needs one: give that DOF a stiffness in K, or use the time domain (--method time)")
-    if system.ndof > config.SYSTEM_DENSE_CHECK_MAX_DOF:
-        return  # beyond this size the null vectors are not computed: a free-free structure is taken as such
+
+
+def _check_null_space(system: System, K: np.ndarray, dof: int) -> None:
+    """ValueError where the near-null space of the static stiffness ``K`` (N/m) is held by a stiffness many
+    decades below the largest (ill-conditioned) or only by pairs open at rest; ``dof`` the DOF named."""
+    from ..systems import static_springs
+
     lam, vecs = np.linalg.eigh(K)
     vecs = vecs[:, lam <= config.SYSTEM_RIGID_MODE_RTOL * abs(lam[-1])]
     springs = static_springs(system)
