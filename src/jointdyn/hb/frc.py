@@ -288,8 +288,9 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
     condense : bool, optional
         Condense exactly onto the contact DOFs (None: by size; see
         :func:`continue_hb`). The unknowns X (and ``guess``) are then the
-        harmonics of the retained DOFs ``problem.dofs``; stability is
-        computed on the full problem's Jacobian (:mod:`jointdyn.hb.condense`).
+        harmonics of the retained DOFs ``problem.dofs``; stability is the full
+        structure's (dense Hill on its Jacobian, or Arnoldi through the condensed
+        form, :mod:`jointdyn.hb.hill_condensed`).
     stability : StabilityOptions or False, optional
         How the stability is computed, or False for none (see
         :func:`continue_hb`); by Arnoldi, ``multipliers`` are those of the
