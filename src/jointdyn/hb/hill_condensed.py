@@ -50,6 +50,8 @@ rounding (tests/test_hb_hill_condensed.py).
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .._cache import by_identity
@@ -88,7 +90,7 @@ class _CondensedShiftInvert:
         p = np.concatenate(([complex(sigma)], sigma + 1j * k * w, sigma - 1j * k * w))
         self.g = self._factors(p, pole_rtol)  # (2H + 1, R)
         m = Psi_c.shape[0]
-        Hb = np.einsum("ir,hr,jr->hij", Psi_c, self.g, Psi_c)  # Psi_c diag(g) Psi_c^T, (2H + 1, m, m)
+        Hb = (self.g[:, None, :] * Psi_c[None, :, :]) @ Psi_c.T  # Psi_c diag(g) Psi_c^T, (2H + 1, m, m)
         nh = 2 * H + 1
         Hcc = np.zeros((nh * m, nh * m), dtype=np.complex128)
         Hcc[:m, :m] = Hb[0]
@@ -98,19 +100,18 @@ class _CondensedShiftInvert:
             Hcc[ci:ci + m, ci:ci + m] = Hcc[si:si + m, si:si + m] = 0.5 * (hu + hv)
             Hcc[ci:ci + m, si:si + m] = -0.5j * (hu - hv)
             Hcc[si:si + m, ci:ci + m] = 0.5j * (hu - hv)
-        import scipy.linalg as sla
+        import scipy.linalg as sla  # not at import: a short command on a small model never loads it
 
         with np.errstate(all="ignore"):
             F = np.eye(nh * m) + Hcc @ G
         if not np.all(np.isfinite(F)):
             raise ValueError("I + H_cc G is not finite")
-        import warnings
-
         with warnings.catch_warnings():  # a zero pivot is reported below
             warnings.simplefilter("ignore", sla.LinAlgWarning)
-            self._lu = sla.lu_factor(F, check_finite=False)
-        if not np.all(np.abs(self._lu[0].diagonal()) > 0.0):
+            lu = sla.lu_factor(F, check_finite=False)
+        if not np.all(np.abs(lu[0].diagonal()) > 0.0):
             raise ValueError("I + H_cc(sigma) G is exactly singular")
+        self._lu_solve = lambda b: sla.lu_solve(lu, b, check_finite=False)
 
     def _factors(self, p, pole_rtol: float):
         """g_r(p) (len(p), R): 1 / (w_r^2 + p^2 + p c_r), or 1 / (p - lambda_r); ValueError within
@@ -155,11 +156,9 @@ class _CondensedShiftInvert:
 
     def solve(self, r):
         """Q(sigma)^-1 r (r: (2H+1) n, modal coordinates)."""
-        import scipy.linalg as sla
-
         V = np.asarray(r).reshape(2 * self.H + 1, self.R)
         u = self._lin_inv(V)
-        xc = sla.lu_solve(self._lu, (u @ self.Phi_c.T).ravel(), check_finite=False)
+        xc = self._lu_solve((u @ self.Phi_c.T).ravel())
         corr = (self.G @ xc).reshape(2 * self.H + 1, -1) @ self.Phi_c
         return (u - self._lin_inv(corr)).ravel()
 
