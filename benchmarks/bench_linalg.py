@@ -28,7 +28,7 @@ Jacobian at a response where the contact slips part of the period.
   subprocess), the cost they add to a first run.
 
 Each timing is the best of repeats (CPU time), both paths measured in the
-same process one after the other. The thresholds ``jointdyn.hb.stability.HB_SMALL_EIG``
+same process one after the other. The thresholds ``StabilityOptions.small_eig``
 (rows of a matrix handed to the QR iteration: the companion or one parity
 block) and ``LinearSolveOptions.small_solve`` (largest size given to the compiled
 path) are set from this table, measured with ``OPENBLAS_NUM_THREADS=1``
@@ -233,7 +233,7 @@ def _cold_compile(which):
 def run(quick: bool = False) -> dict:
     sys.path.insert(0, str(SRC))
     from jointdyn.continuation import LinearSolveOptions
-    from jointdyn.hb.stability import HB_SMALL_EIG
+    from jointdyn.hb import StabilityOptions
 
     dofs = DOFS[:-1] if quick else DOFS
     budget = 0.05 if quick else 0.3
@@ -242,7 +242,7 @@ def run(quick: bool = False) -> dict:
         "hill_eigenvalues": [_hill_row(n, eta, budget) for n in dofs for eta in (0.0, 0.5)],
         "bordered_solve": [_solve_row(n, budget) for n in dofs],
         "aft_projection": [_projection_row(h, ns, budget) for h, ns in ((7, 128), (7, 256), (15, 512))],
-        "thresholds": {"HB_SMALL_EIG": HB_SMALL_EIG, "CONT_SMALL_SOLVE": LinearSolveOptions().small_solve},
+        "thresholds": {"small_eig": StabilityOptions().small_eig, "CONT_SMALL_SOLVE": LinearSolveOptions().small_solve},
     }
     if not quick:
         out["cold_compile_s"] = {"hill_eisport": _cold_compile("eig"), "bordered_lu": _cold_compile("lu")}

@@ -115,7 +115,7 @@ def test_hill_parity_split_matches_lapack(eta, splits):
 @pytest.mark.parametrize("eta", [0.0, 0.5])
 def test_lapack_and_compiled_hill_paths_agree(eta):
     # the two paths of Hill's eigenvalues (compiled EISPACK for small
-    # companions, LAPACK above HB_SMALL_EIG): same spectrum to rounding,
+    # companions, LAPACK above StabilityOptions.small_eig): same spectrum to rounding,
     # same parity split decision
     from jointdyn.hb import continue_hb
     from jointdyn.hb.stability import _hill_eigvals, _hill_eigvals_lapack, _hill_matrix, _hill_parts, _parity_blocks
@@ -136,12 +136,12 @@ def test_lapack_and_compiled_hill_paths_agree(eta):
 
 @pytest.mark.parametrize("eta", [0.0, 0.5])
 def test_hill_growth_of_a_large_system(eta):
-    # 10 DOFs, H = 7: a companion of 300 rows, above HB_SMALL_EIG,
+    # 10 DOFs, H = 7: a companion of 300 rows, above StabilityOptions.small_eig,
     # assembled with NumPy and solved by parity blocks of 150 rows (compiled
     # EISPACK, eta = 0) or whole (LAPACK, eta > 0); the growth rates equal
     # those of the all-compiled batch to rounding
-    from jointdyn.hb import HBProblem
-    from jointdyn.hb.stability import HB_SMALL_EIG, _hill_growth_batch, _hill_parts, hill_growth
+    from jointdyn.hb import HBProblem, StabilityOptions
+    from jointdyn.hb.stability import _hill_growth_batch, _hill_parts, hill_growth
 
     n = 10
     K = 3.9e5 * (2 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1))
@@ -153,7 +153,7 @@ def test_hill_growth_of_a_large_system(eta):
     s = System(M=10.0 * np.eye(n), C=1e-4 * K, K=K, force=np.r_[40.0, np.zeros(n - 1)],
                contacts=(Contact(law=law, dof=0, normal=HarmonicLoad(100.0, eta * 100.0)),))
     p = HBProblem(s, harmonics=7, samples=64)
-    assert 2 * p.size > HB_SMALL_EIG
+    assert 2 * p.size > StabilityOptions().small_eig
     gammas = (0.5, 1.1, 1.7)
     JXs = np.array([p.evaluate(p.linear_guess(g) * 30.0, g).JX for g in gammas])
     ws = np.array([p.omega(g) for g in gammas])

@@ -155,3 +155,42 @@ def test_modal_damping_as_an_operator_gives_the_exponents_of_its_dense_matrix():
         w = p.omega(br.lam[i])
         sel, _ = hill_exponents(p.evaluate(br.X[i], br.lam[i]).JX, s.M, op.toarray(), w, p.H)
         assert abs(br.growth[i] - sel[0].real / w) <= EXPONENT_ATOL
+
+
+def test_stability_numbers_are_options(damper_branches):
+    """StabilityOptions.rtol, confirm and small_eig: the defaults those of the module constants they replaced,
+    each honoured, each refused outside its range with its name."""
+    from jointdyn.hb import hill_stability
+
+    opt = StabilityOptions()
+    assert (opt.rtol, opt.confirm, opt.small_eig) == (1e-6, 1e-4, 200)
+    a, _ = damper_branches
+    p, s = a.problem, a.problem.system
+    i = int(np.flatnonzero(~a.stable)[0])
+    JX, w = p.evaluate(a.X[i], a.lam[i]).JX, p.omega(a.lam[i])
+    stable, growth, mult = hill_stability(JX, s.M, s.C, w, p.H)
+    assert not stable and growth == a.growth[i] > opt.rtol
+    # LAPACK (small_eig 0) for the compiled eigenvalue path of this 30-row companion: the same growth
+    lap = hill_stability(JX, s.M, s.C, w, p.H, StabilityOptions(small_eig=0))
+    assert abs(lap[1] - growth) <= 1e-12 and not lap[0]
+    # the growth is compared with rtol: a bound above it labels the point stable
+    assert hill_stability(JX, s.M, s.C, w, p.H, StabilityOptions(rtol=2.0 * growth))[0]
+    for name, bad in (("rtol", 0.0), ("confirm", -1.0), ("small_eig", -1), ("arnoldi_pole_rtol", 1.0)):
+        with pytest.raises(ValueError, match=name):
+            StabilityOptions(**{name: bad})
+
+
+def test_confirm_band_decides_by_the_period_map_only_inside_it():
+    """A growth between rtol and confirm goes to the time-domain period map; confirm at rtol sends none."""
+    from jointdyn.hb.branch import _confirmed_stability
+
+    br = continue_hb(System.paper_damper(eta=10.0, beta=2.0, model="iwan-closed"), 0.5, 0.6, harmonics=3,
+                     samples=64, progress=False)
+    i = np.array([0, br.lam.size - 1])
+    opt = StabilityOptions()
+    growth = np.array([0.5 * (opt.rtol + opt.confirm), 2.0 * opt.confirm])
+    stable, checked = _confirmed_stability(br.problem, br.X[i], br.lam[i], growth, opt)
+    assert checked == 1 and stable[0] and not stable[1]  # the period map of a stable point says stable
+    stable, checked = _confirmed_stability(br.problem, br.X[i], br.lam[i], growth,
+                                           StabilityOptions(confirm=opt.rtol))
+    assert checked == 0 and not stable.any()

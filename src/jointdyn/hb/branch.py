@@ -77,11 +77,12 @@ from ..systems import System
 from ._aft import INFO_ERROR, INFO_PASSES, INFO_PERIOD
 from .condense import make_problem
 from .hill_arnoldi import hill_arnoldi_exponents
+from .hill_condensed import condensed_hill_exponents
 from .levels import Level
 from .parameters import F1, GAMMA
 from .problem import HBProblem, reference_scales
 from .results import HBBranch, HBPeak, PointStatus, sliding_as_a_whole
-from .stability import HB_SMALL_EIG, HB_STABILITY_RTOL, hill_growth
+from .stability import hill_growth
 from .stability_options import StabilityOptions
 
 __all__ = ["continued_branch", "solve_point"]
@@ -102,11 +103,6 @@ HB_UNBOUNDED_FAIL_FRACTION = 0.1
 #: period and C = 0 (single DOF)
 HB_SATURATION_Q = 30.0
 HB_SATURATION_SLIP_FRACTION = 0.9
-#: a Hill growth Re(s)/w between HB_STABILITY_RTOL and this is decided by
-#: the monodromy matrix of the time-domain period map (Hill's method
-#: truncated to H harmonics errs by a few 1e-6 at corners of the contact
-#: force: the onset of slip of an undamped oscillator)
-HB_STABILITY_CONFIRM = 1e-4
 #: turning points (folds) of a branch: the parameter must come back by more
 #: than this fraction of the range, or log q move by more than
 #: HB_TURNING_BAND_LOG_Q while the parameter is short of its extreme (a fold
@@ -204,7 +200,7 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     dense, need = method == "dense", method != "none"
     chunk = max(1, min(n, HB_JACOBIAN_BUDGET_BYTES // (8 * problem.size * problem.size))) if dense else 1
     JXs = np.empty((chunk, problem.size, problem.size) if dense else (1, 0, 0))
-    lapack = method == "arnoldi" or (dense and 2 * problem.system.ndof * problem.nh > HB_SMALL_EIG)
+    lapack = method == "arnoldi" or (dense and 2 * problem.system.ndof * problem.nh > tr.stability.small_eig)
     with stage_progress(n if need else 0, f"stability ({method})", tr.progress, unit="point") as bar, \
             (blas_threads() if lapack else contextlib.nullcontext()):
         for i in range(n):
@@ -225,11 +221,11 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
                 JXs[i % chunk] = ev.JX if isinstance(ev.JX, np.ndarray) else ev.JX.toarray()  # kept sparse
                 if i % chunk == chunk - 1 or i == n - 1:
                     lo = i - i % chunk
-                    growth[lo:i + 1] = _dense_growth(problem, JXs[:i + 1 - lo], ws[lo:i + 1])
+                    growth[lo:i + 1] = _dense_growth(problem, JXs[:i + 1 - lo], ws[lo:i + 1], tr.stability)
                     bar.update(i + 1 - lo)
-    stable, checked = _confirmed_stability(problem, X, lam, growth)
+    stable, checked = _confirmed_stability(problem, X, lam, growth, tr.stability)
     counters = {**parts.counters, "monodromy_checks": checked}
-    # folds need the stability on both sides; without it (a large condensed problem) the turning points stand
+    # folds need the stability on both sides; without it (no stability asked for) the turning points stand
     fold = _saddle_nodes(parts.fold, stable, parts.segment) if np.all(np.isfinite(growth)) else parts.fold
     return HBBranch(problem=problem, parameter=problem.parameter.name, status=status, message=message, lam=lam,
                     X=X, segment=parts.segment, fold=fold, gap=parts.gap, counters=counters,
@@ -243,22 +239,20 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
 _STABILITY_NAMES = {"dense": "hill", "arnoldi": "hill-arnoldi", "none": "not-computed"}
 
 
-def _full_jacobian(problem: HBProblem, JX, w):
-    """The full structure's dR/dX at w (rad/s): JX itself, or recovered from a condensed problem's."""
-    return problem.full_jacobian(JX, w) if problem.condensed else JX
-
-
-def _dense_growth(problem: HBProblem, JXs, ws):
+def _dense_growth(problem: HBProblem, JXs, ws, options):
     """max Re(s) / w by dense Hill (:func:`~jointdyn.hb.stability.hill_growth`) of the points ``JXs``."""
     if problem.condensed:
         JXs = np.array([problem.full_jacobian(J, w) for J, w in zip(JXs, ws)])
-    return hill_growth(JXs, problem.system.M, dense_damping(problem.system.C), ws, problem.H)
+    return hill_growth(JXs, problem.system.M, dense_damping(problem.system.C), ws, problem.H, options)
 
 
 def _arnoldi_growth(problem: HBProblem, JX, w, options) -> float:
-    """max Re(s) / w of the exponents nearest the imaginary axis (:mod:`jointdyn.hb.hill_arnoldi`) of a point."""
-    return hill_arnoldi_exponents(_full_jacobian(problem, JX, w), problem.system.M, dense_damping(problem.system.C), w,
-                                  problem.H, options).growth
+    """max Re(s) / w of the exponents nearest the imaginary axis (:mod:`jointdyn.hb.hill_arnoldi`) of a point;
+    a condensed problem's through its condensed form (:mod:`jointdyn.hb.hill_condensed`)."""
+    if problem.condensed:
+        return condensed_hill_exponents(problem, JX, w, options).growth
+    return hill_arnoldi_exponents(JX, problem.system.M, dense_damping(problem.system.C), w, problem.H,
+                                  options).growth
 
 
 def _saddle_nodes(turning, stable, segment):
@@ -286,29 +280,29 @@ def _saddle_nodes(turning, stable, segment):
     return out
 
 
-def _confirmed_stability(problem: HBProblem, X, lam, growth):
+def _confirmed_stability(problem: HBProblem, X, lam, growth, options: StabilityOptions):
     """(stable, number of monodromy checks): Hill's criterion, with marginal growth decided by the monodromy.
 
     Hill's method truncated to H harmonics is only approximate where the
     contact force has a corner (the onset of slip of a Jenkins element on
     an otherwise undamped oscillator gives Re(s)/w of a few 1e-6 at
     points whose period map is contracting). A growth between
-    ``HB_STABILITY_RTOL`` and ``HB_STABILITY_CONFIRM`` is
+    ``options.rtol`` and ``options.confirm`` (StabilityOptions) is
     therefore decided by the Floquet multipliers of the time-domain period
     map (:func:`~jointdyn.hb.monodromy.monodromy_multipliers`): unstable
     when one lies outside the unit circle by more than
-    ``2 pi HB_STABILITY_RTOL``. Systems with interfaces keep Hill's criterion there: the
+    ``2 pi options.rtol``. Systems with interfaces keep Hill's criterion there: the
     time-domain period map does not march interfaces yet.
     """
     from .monodromy import monodromy_multipliers
 
-    stable = growth <= HB_STABILITY_RTOL
+    stable = growth <= options.rtol
     if problem.has_interfaces:
         return stable, 0
-    marginal = np.flatnonzero(~stable & (growth < HB_STABILITY_CONFIRM))
+    marginal = np.flatnonzero(~stable & (growth < options.confirm))
     for i in marginal:
         mu = np.max(np.abs(monodromy_multipliers(problem, X[i], lam[i])))
-        stable[i] = mu <= 1.0 + 2.0 * math.pi * HB_STABILITY_RTOL
+        stable[i] = mu <= 1.0 + 2.0 * math.pi * options.rtol
     return stable, int(marginal.size)
 
 

@@ -52,11 +52,13 @@ response DOFs asked for; any other DOF's response is recovered from the
 solution (:meth:`CondensedHBProblem.dof_coefficients` with the parameter
 value, :meth:`CondensedHBProblem.full_coefficients`).
 
-Stability: Hill's method needs the full-size Jacobian. A condensed problem
-assembles it exactly (:meth:`CondensedHBProblem.full_jacobian`) and runs
-Hill's method when the full companion matrix has at most
-``HB_CONDENSED_HILL_ROWS`` rows; beyond, stability is not computed
-(growth NaN; the branch's Dataset says so in its ``stability`` attribute).
+Stability: Hill's method on the full structure. Where its companion matrix
+is small (``StabilityOptions.dense_max_rows``) the full Jacobian is
+assembled exactly (:meth:`CondensedHBProblem.full_jacobian`) for dense
+Hill; beyond, shift-invert Arnoldi solves Hill's problem through the
+condensed form, the receptance at complex frequencies plus the contact part
+of the condensed Jacobian (:mod:`jointdyn.hb.hill_condensed`), without
+forming anything of the full size.
 """
 
 from __future__ import annotations
@@ -76,7 +78,9 @@ from ..kinematics import contact_kinematics, selection_matrix
 from ..systems import System, free_modes
 from .levels import HB_CONDENSE_MIN_DOFS
 from .problem import HBProblem, _linear_blocks, contacts_only, held_by_contacts
+from .hill_condensed import condensed_hill_exponents
 from .stability import hill_growth, hill_stability
+from .stability_options import StabilityOptions
 
 __all__ = ["Receptance", "receptance", "retained_dofs", "CondensedHBProblem", "make_problem", "use_condensed"]
 
@@ -96,9 +100,6 @@ HB_CONDENSE_STATIC_RTOL = 1e-6
 #: the spectral expansion H of the receptance must satisfy Z(W) H(W) = I at one
 #: frequency to this, relative to max |Z| max |H| (backward error)
 HB_CONDENSE_CHECK_RTOL = 1e-9
-#: a condensed problem computes Hill stability (on the full Jacobian it
-#: assembles) when the full companion matrix has at most this many rows
-HB_CONDENSED_HILL_ROWS = 200
 
 #: kinds of spectral expansion of the receptance
 MODAL, STATE_SPACE = "modal", "state-space"
@@ -129,6 +130,10 @@ class Receptance:
         LAPACK's dsytrd (``(reflectors, tau)``) and S the eigenvectors of the
         tridiagonal matrix: rows of Psi cost O(n^2) each
         (:meth:`rows`, :meth:`project`), not the O(n^3) of forming Q S.
+    modes : tuple or None
+        ``state-space`` only: (Phi (n, n), Phi^T C Phi (n, n), Y (n, 2n)), the undamped mass-normalised
+        modes, the damping in their coordinates and the damped eigenvectors there (Psi = Phi Y), for the stability of a condensed problem
+        (:mod:`jointdyn.hb.hill_condensed`).
     """
 
     kind: str
@@ -137,6 +142,7 @@ class Receptance:
     b: np.ndarray
     seconds: float
     basis: tuple | None = None
+    modes: tuple | None = None
 
     def _coordinates(self, B):
         """S^T Q^T L^-1 B = Psi^T B for a real B (n, r) (``basis`` form)."""
@@ -403,7 +409,7 @@ def _tridiagonal_modes(M, K):
 
 
 def _expansion(system: System):
-    """(kind, vectors, a, b, basis) of the receptance expansion and the undamped w_r^2 (module docstring).
+    """(kind, vectors, a, b, basis, modes) of the receptance expansion and the undamped w_r^2 (module docstring).
 
     Rayleigh (or no) damping keeps Psi factored (:func:`_tridiagonal_modes`);
     other damping needs the dense modes for Phi^T C Phi, except modal damping kept as an operator on the
@@ -413,20 +419,20 @@ def _expansion(system: System):
 
     if is_operator(system.C) and system.C.modes_of(system.K):  # modal damping on the modes of (M, K)
         op = system.C
-        return (MODAL, np.array(op.phi), np.array(op.lam), np.array(op.d), None), np.array(op.lam)
+        return (MODAL, np.array(op.phi), np.array(op.lam), np.array(op.d), None, None), np.array(op.lam)
     M, C, K = system.M, dense_damping(system.C), system.K
     ab = _rayleigh(M, C, K)
     if ab is not None and system.ndof > 1:
         w2, basis = _tridiagonal_modes(M, K)
-        return (MODAL, None, w2, ab[0] + ab[1] * w2, basis), w2
+        return (MODAL, None, w2, ab[0] + ab[1] * w2, basis, None), w2
     w2, Phi = eigh(K, M)
     if ab is not None:
-        return (MODAL, Phi, w2, ab[0] + ab[1] * w2, None), w2
+        return (MODAL, Phi, w2, ab[0] + ab[1] * w2, None, None), w2
     Ct = Phi.T @ C @ Phi
     if _is_modal(Ct):
-        return (MODAL, Phi, w2, np.diag(Ct).copy(), None), w2
+        return (MODAL, Phi, w2, np.diag(Ct).copy(), None, None), w2
     lam, Y = _state_space(w2, Ct)
-    return (STATE_SPACE, Phi @ Y, lam, np.zeros(lam.size), None), w2
+    return (STATE_SPACE, Phi @ Y, lam, np.zeros(lam.size), None, (Phi, Ct, Y)), w2
 
 
 def _real_times(A, B):
@@ -456,9 +462,9 @@ def receptance(system: System) -> Receptance:
     forming its columns would cost the O(n^3) it avoids.
     """
     t0 = time.process_time()
-    (kind, vectors, a, b, basis), w2 = _expansion(system)
+    (kind, vectors, a, b, basis, modes), w2 = _expansion(system)
     _share_w0(system, w2)
-    out = Receptance(kind, vectors, a, b, 0.0, basis)
+    out = Receptance(kind, vectors, a, b, 0.0, basis, modes)
     if basis is None:
         _check(system, out, w2)
     return dataclasses.replace(out, seconds=time.process_time() - t0)
@@ -723,37 +729,50 @@ class CondensedHBProblem(HBProblem):
         return self._recover(X, float(p), np.arange(self.system.ndof)).ravel()
 
     # --- stability ------------------------------------------------------------
+    def contact_jacobian(self, JX, w):
+        """The contact part ``JX - Z_red(w)`` of the condensed dR/dX at w (rad/s), N/m: it acts on the
+        retained DOFs only (harmonic-major, m(2H+1) square)."""
+        return np.asarray(JX) - self._linear_at(float(w))[0]
+
     def full_jacobian(self, JX, w):
         """The full problem's dR/dX (ndof(2H+1) square) from the condensed one at w (rad/s).
 
-        The contact part ``JX - Z_red(w)`` acts on the retained DOFs only; the
+        The contact part (:meth:`contact_jacobian`) acts on the retained DOFs only; the
         linear part is the full A(w) of :func:`~jointdyn.hb.problem._linear_blocks`.
         """
         n, nh, m = self.system.ndof, self.nh, self.n
         AK, AC, AM = _linear_blocks(self.system, self.H)
         J = AK + w * AC + (w * w) * AM
-        G = np.asarray(JX) - self._linear_at(float(w))[0]
+        G = self.contact_jacobian(JX, w)
         idx = (np.arange(nh)[:, None] * n + self.dofs[None, :]).ravel()
         J[np.ix_(idx, idx)] += G.reshape(nh * m, nh * m)
         return J
 
     def hill_affordable(self) -> bool:
-        """True when the full companion matrix (2 ndof (2H+1) rows) is small enough for Hill's method here."""
-        return 2 * self.system.ndof * self.nh <= HB_CONDENSED_HILL_ROWS
+        """True: Hill's method runs at any size here (dense on the full Jacobian where its companion matrix is
+        small, else Arnoldi through the condensed form, :mod:`jointdyn.hb.hill_condensed`)."""
+        return True
+
+    def _hill_dense(self) -> bool:
+        """Whether the default StabilityOptions take dense Hill for the full companion matrix."""
+        return StabilityOptions().method_for(2 * self.system.ndof * self.nh) == "dense"
 
     def hill_growth(self, JXs, ws):
-        """Hill's method on the full Jacobians when affordable (:meth:`hill_affordable`), else NaN."""
-        if not self.hill_affordable():
-            return np.full(len(ws), np.nan)
-        full = np.array([self.full_jacobian(J, w) for J, w in zip(JXs, ws)])
-        return hill_growth(full, self.system.M, dense_damping(self.system.C), ws, self.H)
+        """max Re(s) / w of the Floquet exponents at many points: dense Hill on the full Jacobians, or Arnoldi
+        through the condensed form, by size (:meth:`hill_affordable`)."""
+        if self._hill_dense():
+            full = np.array([self.full_jacobian(J, w) for J, w in zip(JXs, ws)])
+            return hill_growth(full, self.system.M, dense_damping(self.system.C), ws, self.H)
+        return np.array([condensed_hill_exponents(self, J, w).growth for J, w in zip(JXs, ws)])
 
     def hill_stability(self, JX, w):
-        """(stable, growth, multipliers) by Hill's method on the full Jacobian, or (False, NaN, empty)."""
-        if not self.hill_affordable():
-            return False, math.nan, np.empty(0, dtype=complex)
-        return hill_stability(self.full_jacobian(JX, w), self.system.M, dense_damping(self.system.C), w,
-                              self.H)
+        """(stable, growth, multipliers) by dense Hill on the full Jacobian, or by Arnoldi through the
+        condensed form (the multipliers of the exponents found near the imaginary axis), by size."""
+        if self._hill_dense():
+            return hill_stability(self.full_jacobian(JX, w), self.system.M, dense_damping(self.system.C), w,
+                                  self.H)
+        found = condensed_hill_exponents(self, JX, w)
+        return found.growth <= StabilityOptions().rtol, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
 
 
 def use_condensed(system: System, condense=None, response_dofs=()) -> bool:

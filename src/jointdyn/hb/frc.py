@@ -27,11 +27,12 @@ from .branch import HB_SOLVE_MAX_ITER, _forcing_problem, _Request, solve_point
 from .discretisation import adaptive_branch
 from .export import branch_dataset
 from .hill_arnoldi import hill_arnoldi_exponents
+from .hill_condensed import condensed_hill_exponents
 from .levels import AUTO, Discretisation, Level, check_memory
 from .parameters import GAMMA, parameter_named
 from .problem import HBProblem, reference_scales, stuck_stiffness
 from .results import HBBranch, HBSolution, SolveStatus
-from .stability import HB_STABILITY_RTOL, hill_stability
+from .stability import hill_stability
 from .stability_options import StabilityOptions, stability_options
 
 __all__ = ["continue_hb", "frc_hb", "harmonic_balance", "check_mean_position"]
@@ -301,8 +302,9 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
     condense : bool, optional
         Condense exactly onto the contact DOFs (None: by size; see
         :func:`continue_hb`). The unknowns X (and ``guess``) are then the
-        harmonics of the retained DOFs ``problem.dofs``; stability is
-        computed on the full problem's Jacobian (:mod:`jointdyn.hb.condense`).
+        harmonics of the retained DOFs ``problem.dofs``; stability is the full
+        structure's (dense Hill on its Jacobian, or Arnoldi through the condensed
+        form, :mod:`jointdyn.hb.hill_condensed`).
     stability : StabilityOptions or False, optional
         How the stability is computed, or False for none (see
         :func:`continue_hb`); by Arnoldi, ``multipliers`` are those of the
@@ -330,13 +332,16 @@ def _point_stability(problem: HBProblem, JX, w: float, opts: StabilityOptions):
     method = opts.method_for(2 * problem.system.ndof * problem.nh)
     if method == "none":
         return False, math.nan, np.empty(0, dtype=complex)
-    J = problem.full_jacobian(JX, w) if problem.condensed else JX
     s = problem.system
     if method == "dense":
-        return hill_stability(np.asarray(J), s.M, dense_damping(s.C), w, problem.H)
+        J = problem.full_jacobian(JX, w) if problem.condensed else JX
+        return hill_stability(np.asarray(J), s.M, dense_damping(s.C), w, problem.H, opts)
     with blas_threads():  # ARPACK's BLAS-2 work: 2 OpenBLAS threads on 2 busy cores are slower than one
-        found = hill_arnoldi_exponents(J, s.M, dense_damping(s.C), w, problem.H, opts)
-    return found.growth <= HB_STABILITY_RTOL, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
+        if problem.condensed:  # through the condensed form, nothing of the full size
+            found = condensed_hill_exponents(problem, JX, w, opts)
+        else:
+            found = hill_arnoldi_exponents(JX, s.M, dense_damping(s.C), w, problem.H, opts)
+    return found.growth <= opts.rtol, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
 
 
 def _make_solution(problem: HBProblem, X, converged, iterations, response_dof, opts=None) -> HBSolution:

@@ -161,18 +161,18 @@ def _dedupe(lam, w, tol):
     return np.array(out, dtype=np.complex128)
 
 
-def _nearest(JX, D1, D2, y, w, k, opt):
+def _nearest(operator, N, y, w, k, opt):
     """(shift y, the k eigenvalues nearest i y): the shift moved towards the middle of the strip by
     ``1e-3 w`` at a time where Q(i y) is exactly singular (i y is then an eigenvalue itself, e.g. an
-    undamped mean at w = 2 w0)."""
+    undamped mean at w = 2 w0). ``operator(sigma)`` is the shift-invert product at sigma (``sigma``,
+    ``dtype``, called on a vector of 2N), raising RuntimeError or ValueError where Q(sigma) is singular."""
     import scipy.sparse.linalg as spla
 
-    N = D2.shape[0]
     step = 1e-3 * w * (1.0 if y < 0.25 * w else -1.0)
     for attempt in range(3):
         sigma = complex(0.0, y) if y != 0.0 else 0.0
         try:
-            op = _ShiftInvert(JX, D1, D2, sigma, opt.arnoldi_sparse_density)
+            op = operator(sigma)
             break
         except (RuntimeError, ValueError) as exc:  # SuperLU: "Factor is exactly singular"
             if attempt == 2:
@@ -219,15 +219,26 @@ def hill_arnoldi_exponents(JX, M, C, w, H, options: StabilityOptions | None = No
         JX = JX.toarray()                                # is factorised as the whole matrix it is
     w = float(w)
     n = M.shape[0]
-    N = n * (2 * H + 1)
     D1, D2 = _linear_parts(np.asarray(M, dtype=np.float64), np.asarray(C, dtype=np.float64), w, H)
+    return shift_invert_exponents(lambda sigma: _ShiftInvert(JX, D1, D2, sigma, opt.arnoldi_sparse_density),
+                                  n, H, w, opt)
+
+
+def shift_invert_exponents(operator, n: int, H: int, w: float, opt: StabilityOptions) -> ArnoldiExponents:
+    """The exponents nearest the imaginary axis of a Hill problem of ``n`` DOFs and ``H`` harmonics from its
+    shift-invert product: ``operator(sigma)`` gives ``v -> (A - sigma I)^-1 v`` on vectors of 2 n (2H+1)
+    (with attributes ``sigma`` and ``dtype``; RuntimeError or ValueError where Q(sigma) is singular), in any
+    coordinates similar to the companion matrix A's. The shifts, the Hill selection and the band of the
+    module docstring; ``opt`` the StabilityOptions."""
+    w = float(w)
+    N = n * (2 * H + 1)
     k = min(opt.arnoldi_eigenvalues, 2 * N - 2)
     if k < 1:
         raise ValueError(f"Hill's companion matrix has {2 * N} rows: too few for Arnoldi (at least 3)")
     m = opt.arnoldi_shifts - 1
     found, radii, ys = [], [], []
     for j in range(m + 1):
-        y, lam = _nearest(JX, D1, D2, 0.5 * w * j / m, w, k, opt)
+        y, lam = _nearest(operator, N, 0.5 * w * j / m, w, k, opt)
         found.append(lam)
         ys.append(y)
         radii.append(float(np.max(np.abs(lam - complex(0.0, y)))))

@@ -15,8 +15,8 @@ derivative of the periodic force coefficients, the standard choice for
 hysteretic forces, which are not differentiable in velocity) and nabla the
 d/dtau operator on the coefficients. It is solved in first-order (companion)
 form, size 2 n (2H+1) (all its eigenvalues by LAPACK ``dgeev``, except
-for matrices (or parity blocks, below) of at most ``HB_SMALL_EIG``
-rows: the compiled EISPACK QR iteration of :mod:`jointdyn.hb._eig` is
+for matrices (or parity blocks, below) of at most
+``StabilityOptions.small_eig`` rows: the compiled EISPACK QR iteration of :mod:`jointdyn.hb._eig` is
 faster there, ``benchmarks/bench_linalg.py``).
 Each Floquet exponent s appears there as a family
 s + i k w (k = -H..H), of which the truncation resolves well only the
@@ -31,7 +31,7 @@ Phys. 416, 2020): the eigenvector's harmonic centroid, in the complex
 exponential basis, nearest to 0. The large-|Im| eigenvalues that this
 discards include the truncation artefacts at the edge of the harmonic
 range, which may have spurious positive real parts. The solution is
-unstable when a selected exponent has ``Re(s) > HB_STABILITY_RTOL * w``.
+unstable when a selected exponent has ``Re(s) > StabilityOptions.rtol * w``.
 Floquet multipliers are ``exp(2 pi s / w)``.
 
 The independent monodromy check lives in :mod:`jointdyn.hb.monodromy`.
@@ -47,16 +47,9 @@ from .._cache import by_value
 from .._jit import jit
 from ..fourier import derivative_matrix
 from ._eig import eigvals_inplace
+from .stability_options import StabilityOptions
 
 __all__ = ["hill_exponents", "hill_stability", "hill_growth"]
-
-#: a Floquet exponent with Re(s) > HB_STABILITY_RTOL * w marks instability
-HB_STABILITY_RTOL = 1e-6
-#: Hill companion matrices (2 n (2H+1) rows), or their parity blocks, of at
-#: most this many rows go through the compiled EISPACK eigenvalue solver,
-#: larger ones through LAPACK (benchmarks/bench_linalg.py: the compiled
-#: solver is 1.3-3.7x faster up to 150 rows, LAPACK 1.1-1.3x faster from 300)
-HB_SMALL_EIG = 200
 
 
 def _centroids(V, n, H):
@@ -256,24 +249,25 @@ def _hill_eigvals_lapack(JX, M, C, w, H, small: int = 0):
     return np.concatenate(out)
 
 
-def _small_eig(JX) -> bool:
-    """True when the whole companion matrix of JX (twice its rows) is small enough for the compiled path."""
-    return 2 * JX.shape[0] <= HB_SMALL_EIG
+def _small_eig(JX, small: int) -> bool:
+    """True when the whole companion matrix of JX (twice its rows) has at most ``small`` rows (the compiled
+    path, ``StabilityOptions.small_eig``)."""
+    return 2 * JX.shape[0] <= small
 
 
-def _hill_all(JX, M, C, w, H):
-    """All Hill eigenvalues: compiled for small companions (LAPACK if its QR fails), else
-    assembled with NumPy and solved by blocks (:func:`_hill_eigvals_lapack`)."""
+def _hill_all(JX, M, C, w, H, small: int):
+    """All Hill eigenvalues: compiled for companions of at most ``small`` rows (LAPACK if its QR fails),
+    else assembled with NumPy and solved by blocks (:func:`_hill_eigvals_lapack`)."""
     JX = np.ascontiguousarray(JX, dtype=np.float64)
-    if _small_eig(JX):
+    if _small_eig(JX, small):
         D2iJ_pre, B1, _, parity = _hill_parts(M, C, H)
         lam, ok = _hill_eigvals(D2iJ_pre, JX, B1[0], B1[1], float(w), parity)
         if ok:
             return lam
-    return _hill_eigvals_lapack(JX, M, C, w, H, HB_SMALL_EIG)
+    return _hill_eigvals_lapack(JX, M, C, w, H, small)
 
 
-def hill_exponents(JX, M, C, w, H):
+def hill_exponents(JX, M, C, w, H, options: StabilityOptions | None = None):
     """All Hill eigenvalues and the 2n selected Floquet exponents.
 
     Parameters
@@ -286,6 +280,8 @@ def hill_exponents(JX, M, C, w, H):
         Angular frequency of the periodic solution, rad/s.
     H : int
         Number of harmonics.
+    options : StabilityOptions, optional
+        ``small_eig``: the size of the compiled eigenvalue path.
 
     Returns
     -------
@@ -297,7 +293,7 @@ def hill_exponents(JX, M, C, w, H):
     -----
     The eigenvalues of the 2 n (2H+1) companion matrix (or of its parity
     blocks) are computed by LAPACK (``numpy.linalg.eigvals``), up to
-    ``HB_SMALL_EIG`` rows by the compiled EISPACK sequence of
+    ``StabilityOptions.small_eig`` rows by the compiled EISPACK sequence of
     :mod:`jointdyn.hb._eig` (balancing,
     Hessenberg reduction, Francis double-shift QR), which agrees with
     LAPACK to rounding and is faster there (LAPACK is used if its QR
@@ -305,7 +301,7 @@ def hill_exponents(JX, M, C, w, H):
     from LAPACK.
     """
     n = M.shape[0]
-    lam = _hill_all(JX, M, C, w, H)
+    lam = _hill_all(JX, M, C, w, H, (StabilityOptions() if options is None else options).small_eig)
     sel, tie = _select(lam, float(w), 2 * n)
     if tie:
         # a tie at the cut: break it by the eigenvector centroid
@@ -333,39 +329,42 @@ def _hill_growth_batch(D2iJ, JXs, B1c, B1w, ws, parity, m):  # pragma: no cover 
     return growth, ok
 
 
-def hill_growth(JXs, M, C, ws, H):
+def hill_growth(JXs, M, C, ws, H, options: StabilityOptions | None = None):
     """max Re(s) / w of the selected Floquet exponents at many points.
 
     ``JXs`` (points, N, N) are the HB Jacobians and ``ws`` (points,) the
     angular frequencies; the same exponents as :func:`hill_exponents`
     (points with a tie at the selection cut or a QR failure go through it).
-    Small companions (``HB_SMALL_EIG``) in one compiled loop.
+    Small companions (``StabilityOptions.small_eig``, of ``options``) in one compiled loop.
     """
+    opt = StabilityOptions() if options is None else options
     JXs = np.ascontiguousarray(JXs, dtype=np.float64)
     ws = np.ascontiguousarray(ws, dtype=np.float64)
     n = M.shape[0]
     if JXs.shape[0] == 0:
         return np.empty(0)
-    if _small_eig(JXs[0]):
+    if _small_eig(JXs[0], opt.small_eig):
         D2iJ_pre, B1, _, parity = _hill_parts(M, C, H)
         growth, ok = _hill_growth_batch(D2iJ_pre, JXs, B1[0], B1[1], ws, parity, 2 * n)
     else:
         growth, ok = np.empty(JXs.shape[0]), np.empty(JXs.shape[0], dtype=bool)
         for k in range(JXs.shape[0]):
-            sel, tie = _select(_hill_eigvals_lapack(JXs[k], M, C, ws[k], H, HB_SMALL_EIG), ws[k], 2 * n)
+            sel, tie = _select(_hill_eigvals_lapack(JXs[k], M, C, ws[k], H, opt.small_eig), ws[k], 2 * n)
             growth[k], ok[k] = sel[0].real / ws[k], not tie
     for k in np.flatnonzero(~ok):
-        sel, _ = hill_exponents(JXs[k], M, C, ws[k], H)
+        sel, _ = hill_exponents(JXs[k], M, C, ws[k], H, opt)
         growth[k] = float(sel[0].real) / ws[k]
     return growth
 
 
-def hill_stability(JX, M, C, w, H, rtol: float = HB_STABILITY_RTOL):
-    """(stable, max Re(s) / w, Floquet multipliers) of a periodic HB solution.
+def hill_stability(JX, M, C, w, H, options: StabilityOptions | None = None):
+    """(stable, max Re(s) / w, Floquet multipliers) of a periodic HB solution: stable when the growth is at
+    most ``options.rtol`` (StabilityOptions; defaults when None).
 
     See the module docstring for the method and references.
     """
-    sel, _ = hill_exponents(JX, M, C, w, H)
+    opt = StabilityOptions() if options is None else options
+    sel, _ = hill_exponents(JX, M, C, w, H, opt)
     growth = float(sel[0].real) / w  # sel is sorted by decreasing real part
     mult = np.exp(sel * 2.0 * np.pi / w)
-    return growth <= rtol, growth, mult
+    return growth <= opt.rtol, growth, mult

@@ -50,6 +50,27 @@ class StabilityOptions:
         machine precision), > 0.
     arnoldi_maxiter : int
         Bound on ARPACK's restarts per shift.
+    arnoldi_pole_rtol : float
+        Arnoldi through a condensed problem's receptance
+        (:mod:`jointdyn.hb.hill_condensed`): a shift where a receptance
+        factor's denominator is at most this fraction of its terms' size (a
+        structural mode at sigma + i k w) is moved as a singular one (the
+        solve there loses about 1e-16 / this of relative accuracy); in (0, 1).
+    rtol : float
+        A solution is unstable when a selected Floquet exponent has
+        Re(s) > ``rtol`` w (a growth Re(s) / w above it); > 0.
+    confirm : float
+        A growth between ``rtol`` and this is decided by the Floquet
+        multipliers of the time-domain period map (Hill's method truncated
+        to H harmonics errs by a few 1e-6 at corners of the contact force:
+        the onset of slip of an undamped oscillator); >= 0 (at most
+        ``rtol``: never).
+    small_eig : int
+        Hill companion matrices (2 n (2H+1) rows), or their parity blocks,
+        of at most this many rows go through the compiled EISPACK
+        eigenvalue solver of the dense method, larger ones through LAPACK
+        (``benchmarks/bench_linalg.py``: the compiled solver is 1.3-3.7x
+        faster up to 150 rows, LAPACK 1.1-1.3x faster from 300); >= 0.
     """
 
     method: str = "auto"
@@ -59,6 +80,10 @@ class StabilityOptions:
     arnoldi_sparse_density: float = 0.1
     arnoldi_tol: float = 1e-13
     arnoldi_maxiter: int = 2000
+    arnoldi_pole_rtol: float = 1e-8
+    rtol: float = 1e-6
+    confirm: float = 1e-4
+    small_eig: int = 200
 
     def __post_init__(self) -> None:
         V.choice("method", self.method, STABILITY_METHODS)
@@ -68,6 +93,10 @@ class StabilityOptions:
         V.in_range("arnoldi_sparse_density", self.arnoldi_sparse_density, 0.0, 1.0, lo_open=True)
         V.positive("arnoldi_tol", self.arnoldi_tol)
         V.positive_int("arnoldi_maxiter", self.arnoldi_maxiter)
+        V.in_range("arnoldi_pole_rtol", self.arnoldi_pole_rtol, 0.0, 1.0, lo_open=True, hi_open=True)
+        V.positive("rtol", self.rtol)
+        V.nonnegative("confirm", self.confirm)
+        V.positive_int("small_eig", self.small_eig, 0)
 
     def method_for(self, rows: int) -> str:
         """The method used for a companion matrix of ``rows`` rows: ``dense``, ``arnoldi`` or ``none``."""
