@@ -11,7 +11,7 @@ from jointdyn.dynamics._core import N_SUMMARY, S_EC, S_EV, S_W, S_XMAX, S_XMIN
 from jointdyn.dynamics._model import make_model
 from jointdyn.dynamics.steady import _History, _check_periodic
 from jointdyn.systems import System
-from jointdyn.dynamics.steady import SS_AMP_RTOL, SS_BALANCE_RTOL, SS_ENERGY_RTOL
+from jointdyn.dynamics import SteadyStateOptions
 
 
 def _reference(summ, Z, p, K, n, w, K_stuck, M, floor, amp_rtol, energy_rtol, balance_rtol):
@@ -45,7 +45,7 @@ def test_compiled_periodicity_check_equals_reference():
     system = System.paper_damper(eta=0.5, beta=2.0)
     model = make_model(system, 1.1 * system.w0, 64)
     rng = np.random.default_rng(7)
-    amp_rtol, energy_rtol = SS_AMP_RTOL, SS_ENERGY_RTOL
+    amp_rtol, energy_rtol = SteadyStateOptions().amp_rtol, SteadyStateOptions().energy_rtol
     outcomes = set()
     for case in range(3000):
         periods = int(rng.integers(1, 30))
@@ -73,7 +73,7 @@ def test_compiled_periodicity_check_equals_reference():
         got = _check_periodic(h, p, K, model, amp_rtol, energy_rtol)
         floor = 1e-14 + 1e-9 * sum(c.law.fy / c.law.kt for c in system.contacts)
         want = _reference(h.summ, h.Z, p, K, model.n, model.w, model.pack.K_stuck, system.M, floor,
-                          amp_rtol, energy_rtol, SS_BALANCE_RTOL)  # fmt: skip
+                          amp_rtol, energy_rtol, SteadyStateOptions().balance_rtol)  # fmt: skip
         assert got == want, f"case {case}"
         outcomes.add(got)
     assert outcomes == {True, False}

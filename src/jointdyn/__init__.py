@@ -51,6 +51,7 @@ _LAZY = {
     "integrate_sampled": "dynamics",
     "steady_state": "dynamics",
     "SteadyState": "dynamics",
+    "SteadyStateOptions": "dynamics",
     "Trajectory": "dynamics",
     "Restart": "dynamics",
     "harmonic_balance": "hb",
