@@ -196,7 +196,8 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     stable, checked = _confirmed_stability(problem, X, lam, growth)
     counters = {**parts.counters, "monodromy_checks": checked}
     # folds need the stability on both sides; without it (a large condensed problem) the turning points stand
-    fold = _saddle_nodes(parts.fold, stable, parts.segment, problem.options.fold_window) if np.all(np.isfinite(growth)) else parts.fold
+    fold = (_saddle_nodes(parts.fold, stable, parts.segment, problem.options.fold_window)
+            if np.all(np.isfinite(growth)) else parts.fold)
     return HBBranch(problem=problem, parameter=problem.parameter.name, status=status, message=message, lam=lam,
                     X=X, segment=parts.segment, fold=fold, gap=parts.gap, counters=counters,
                     stable=stable, growth=growth, passes=passes,
@@ -751,7 +752,8 @@ def _peaks(tr: _Tracker, res: ContinuationResult, g, segment: int, opt) -> list:
     its points (HBPeak)."""
     if res.lam.size < 3:
         return []
-    return [_refined_peak(tr, res, g, i, segment, opt) for i in local_maxima(g, res.gap, tr.problem.options.peak_prominence)]
+    prominence = tr.problem.options.peak_prominence
+    return [_refined_peak(tr, res, g, i, segment, opt) for i in local_maxima(g, res.gap, prominence)]
 
 
 def _refined_peak(tr: _Tracker, res: ContinuationResult, g, i: int, segment: int, opt) -> HBPeak:
