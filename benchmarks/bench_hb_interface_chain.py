@@ -21,7 +21,7 @@ evaluation on (``jointdyn.hb._sparse``: this chain's K, M and C are sparse
 and each pair couples only its own DOFs), the Newton systems are factorised
 by SuperLU and the factors reused through GMRES (``factorisations`` counts
 the dense and sparse ones), and Hill's method is beyond
-``jointdyn.hb.problem.HB_HILL_MAX_ROWS`` (stability not computed). Both backbones run
+``HBOptions.hill_max_rows`` (stability not computed). Both backbones run
 over the three decades, bounded to ``MAX_POINTS`` points.
 """
 

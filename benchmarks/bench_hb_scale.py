@@ -13,7 +13,7 @@ as :func:`jointdyn.figures.lap.lap_joint_system` builds it. Measured at
 - the HB forced-response branch across the first resonance (``BAND_HZ``).
 
 Each with the Newton and tangent solves preconditioned by the harmonic
-blocks (``jointdyn.hb.problem.HB_BLOCK_PRECONDITIONER``, :mod:`jointdyn.hb._precond`)
+blocks (``HBOptions.block_preconditioner``, :mod:`jointdyn.hb._precond`)
 and, in the same run, by today's direct path (one LU of the whole bordered
 matrix, reused through GMRES: the reference), the two sides alternated
 (block, direct for the backbone; direct, block for the branch). Each side
@@ -48,14 +48,13 @@ def _system():
 
 def _backbone(H: int, blocks: bool) -> dict:
     from jointdyn.figures import lap
-    from jointdyn.hb import problem as hb_problem
+    from jointdyn.hb import HBOptions
     from jointdyn.modes import epmc
 
-    hb_problem.HB_BLOCK_PRECONDITIONER = blocks
     s = _system()
     t0 = time.perf_counter()
     b = epmc(s, AMPLITUDE_M, harmonics=H, samples=SAMPLES, max_points=MAX_POINTS, ds_max=lap.LAP_DS_MAX,
-             progress=False)
+             progress=False, hb_options=HBOptions(block_preconditioner=blocks))
     return {"s": time.perf_counter() - t0, "status": b.status.value, "points": int(b.points),
             "counters": {k: int(v) for k, v in b.counters.items() if isinstance(v, (int, np.integer))},
             "amplitude_m": b.amplitude_m.tolist(), "omega_rad_s": b.omega_rad_s.tolist(),
@@ -63,14 +62,13 @@ def _backbone(H: int, blocks: bool) -> dict:
 
 
 def _branch(H: int, blocks: bool) -> dict:
-    from jointdyn.hb import continue_hb
-    from jointdyn.hb import problem as hb_problem
+    from jointdyn.hb import HBOptions, continue_hb
 
-    hb_problem.HB_BLOCK_PRECONDITIONER = blocks
     s = _system()
     g0, g1 = (2.0 * math.pi * f / s.w0 for f in BAND_HZ)
     t0 = time.perf_counter()
-    br = continue_hb(s, g0, g1, harmonics=H, samples=SAMPLES, condense=False, progress=False, stability=False)
+    br = continue_hb(s, g0, g1, harmonics=H, samples=SAMPLES, condense=False, progress=False, stability=False,
+                     hb_options=HBOptions(block_preconditioner=blocks))
     peak = max(br.peaks, key=lambda p: p.amplitude_m) if br.peaks else None
     return {"s": time.perf_counter() - t0, "status": br.status.value, "points": int(br.lam.size),
             "counters": {k: int(v) for k, v in br.counters.items() if isinstance(v, (int, np.integer))},

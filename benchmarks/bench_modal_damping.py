@@ -49,18 +49,17 @@ def _system(nodes: int, operator: bool):
 
 def _lower(quick: bool) -> dict:
     """The large-solve paths at the quick model's size (where the dense C still makes it dense): the shared
-    thresholds set in config, harmonic balance's Hill bound in its module, the walk's own as its ``linear``
-    option (returned as keyword arguments)."""
+    thresholds set in config, harmonic balance's Hill bound as its ``hb_options``, the walk's own as its
+    ``linear`` option (returned as keyword arguments)."""
     from jointdyn import config
     from jointdyn.continuation import LinearSolveOptions
-    from jointdyn.hb import problem as hb_problem
+    from jointdyn.hb import HBOptions
 
     if not quick:
         return {}
     config.CONT_KRYLOV_SOLVE = 0
     config.CONT_SPARSE_DENSITY = 0.1
-    hb_problem.HB_HILL_MAX_ROWS = 0
-    return {"linear": LinearSolveOptions(small_solve=0)}
+    return {"linear": LinearSolveOptions(small_solve=0), "hb_options": HBOptions(hill_max_rows=0)}
 
 
 def _counters(c) -> dict:

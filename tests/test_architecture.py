@@ -494,3 +494,99 @@ def test_the_config_check_finds_an_owned_number(tmp_path):
     (pkg / "modes" / "b.py").write_text("from ..config import SHARED\n")
     (pkg / "_validate.py").write_text("from . import config\ny = config.HELPER\n")
     assert owned_config_constants(pkg) == {"LEFT": "nobody", "OWNED": "hb"}
+
+
+# --- tests set options, not module constants ------------------------------------------------------------------
+TESTS = SRC.parents[1] / "tests"
+#: (module, name) of the upper-case module constants a test may still patch, with the reason: not a solver
+#: number (no options object owns it)
+PATCHABLE = {
+    ("jointdyn.commands.frc", "SCHEDULER_TIMEOUT_S"): "the command line's wait for a Dask scheduler (a command)",
+    ("jointdyn.dynamics.version", "SOLVER_VERSION"): "a format version, raised to make saved points stale",
+}
+
+
+def _module_names(tree: ast.AST) -> dict:
+    """Local name -> dotted name of every ``import jointdyn...`` / ``from jointdyn... import x`` of a file."""
+    out = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                if a.name.split(".")[0] == "jointdyn":
+                    out[a.asname or a.name.split(".")[0]] = a.name if a.asname else "jointdyn"
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").split(".")[0] == "jointdyn":
+            for a in node.names:
+                out[a.asname or a.name] = f"{node.module}.{a.name}"
+    return out
+
+
+def _dotted(node: ast.AST, names: dict):
+    """The dotted name of ``a.b.c`` with ``a`` replaced by what it was imported as (None: not a name chain
+    from an import of jointdyn)."""
+    parts = []
+    while isinstance(node, ast.Attribute):
+        parts.append(node.attr)
+        node = node.value
+    if not isinstance(node, ast.Name) or node.id not in names:
+        return None
+    return ".".join([names[node.id], *reversed(parts)])
+
+
+def _is_module(dotted: str, root: Path) -> bool:
+    rel = Path(*dotted.split(".")[1:])
+    return (root / rel).with_suffix(".py").is_file() or (root / rel / "__init__.py").is_file()
+
+
+def patched_constants(tests: Path = TESTS, root: Path = SRC) -> list:
+    """``file:line module.NAME`` of every ``setattr(module, "NAME", ...)`` (monkeypatch or a
+    ``MonkeyPatch`` context) in ``tests`` that sets an upper-case constant of a jointdyn module other than
+    ``config`` (the shared numbers), or ``setattr("jointdyn.module.NAME", ...)``, outside ``PATCHABLE``."""
+    found = []
+    for path in sorted(tests.rglob("*.py")):
+        tree = ast.parse(path.read_text(), str(path))
+        names = _module_names(tree)
+        for node in ast.walk(tree):
+            if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+                    and node.func.attr == "setattr" and node.args):
+                continue
+            first = node.args[0]
+            if isinstance(first, ast.Constant) and isinstance(first.value, str):
+                module, _, name = first.value.rpartition(".")
+            elif (_dotted(first, names) is not None and len(node.args) > 1
+                  and isinstance(node.args[1], ast.Constant) and isinstance(node.args[1].value, str)):
+                module, name = _dotted(first, names), node.args[1].value
+            else:
+                continue
+            if (module.split(".")[0] != "jointdyn" or not name[:1].isalpha() or not name.isupper()
+                    or module == "jointdyn.config" or not _is_module(module, root)
+                    or (module, name) in PATCHABLE):
+                continue
+            found.append(f"{path.name}:{node.lineno} {module}.{name}")
+    return found
+
+
+def test_tests_set_options_instead_of_patching_module_constants():
+    found = patched_constants()
+    assert not found, ("a solver's number is a field of its options object: set it there instead of patching "
+                       "the module (docs/architecture.md):\n" + "\n".join(found))
+
+
+def test_the_patch_check_finds_a_patched_constant(tmp_path):
+    pkg, tests = tmp_path / "jointdyn", tmp_path / "tests"
+    (pkg / "hb").mkdir(parents=True)
+    tests.mkdir()
+    for f in ("__init__.py", "config.py", "hb/__init__.py", "hb/branch.py"):
+        (pkg / f).write_text("")
+    (tests / "test_x.py").write_text(
+        "from jointdyn import config\nfrom jointdyn.hb import branch as hb_branch\nimport jointdyn.hb.branch\n"
+        "def test_a(monkeypatch):\n"
+        "    monkeypatch.setattr(config, 'SHARED', 1)\n"
+        "    monkeypatch.setattr(hb_branch, 'HB_FOLD_WINDOW', 1)\n"
+        "    monkeypatch.setattr(hb_branch, '_fixed_branch', None)\n"
+        "    monkeypatch.setattr('jointdyn.hb.branch.HB_PEAK_PROMINENCE', 0.5)\n"
+        "    monkeypatch.setattr(hb_branch.HBOptions, 'X', 1)\n"
+        "    monkeypatch.setattr(jointdyn.hb.branch, 'HB_TURNING_BAND', 1)\n")
+    assert patched_constants(tests, pkg) == ["test_x.py:6 jointdyn.hb.branch.HB_FOLD_WINDOW",
+                                             "test_x.py:8 jointdyn.hb.branch.HB_PEAK_PROMINENCE",
+                                             "test_x.py:10 jointdyn.hb.branch.HB_TURNING_BAND"]
+    assert patched_constants(TESTS, SRC) == []  # (the same check on this package's tests)

@@ -25,7 +25,10 @@ from jointdyn.dynamics import (
 from jointdyn.dynamics._core import LOADS_HARMONIC, RUN_BLOWUP, RUN_OK, RUN_OVERFLOW
 from jointdyn.dynamics._model import make_model, run
 from jointdyn.dynamics._model import TI_STEPS_PER_PERIOD
-from jointdyn.dynamics.steady import SS_AMP_RTOL, SS_CHECK_PERIODS, SS_CHUNK, SS_MAX_PERIODS
+from jointdyn.dynamics import SteadyStateOptions
+
+#: the steady state's defaults
+SS = SteadyStateOptions()
 
 M, K, KT = PAPER["m"], PAPER["k"], PAPER["kt"]
 
@@ -313,11 +316,11 @@ def test_loop_is_one_closed_period_and_warm_start_is_cheap():
     assert lp.t[-1] == pytest.approx(2 * math.pi / w, rel=1e-12)
     X = 0.5 * (lp.x[:, 0].max() - lp.x[:, 0].min())
     assert X == pytest.approx(r.amplitude_m, rel=1e-6)
-    assert np.abs(lp.x[-1, 0] - lp.x[0, 0]) <= 10 * SS_AMP_RTOL * r.amplitude_m
+    assert np.abs(lp.x[-1, 0] - lp.x[0, 0]) <= 10 * SS.amp_rtol * r.amplitude_m
     assert isinstance(r.restart, Restart)
     r2 = steady_state(s, 1.2, start=r)
-    assert r2.status.ok and r2.periods <= SS_CHECK_PERIODS + SS_CHUNK + 1
-    assert r2.amplitude_m == pytest.approx(r.amplitude_m, rel=10 * SS_AMP_RTOL)
+    assert r2.status.ok and r2.periods <= SS.check_periods + SS.chunk + 1
+    assert r2.amplitude_m == pytest.approx(r.amplitude_m, rel=10 * SS.amp_rtol)
     r3 = steady_state(s, 1.3, start=r, keep_loop=False)
     assert r3.status.ok and r3.loop is None
 
@@ -325,13 +328,13 @@ def test_loop_is_one_closed_period_and_warm_start_is_cheap():
 def test_unsettled_response_is_not_reported_as_a_number():
     # near the jump of the eta = 0.5, beta = 2 curve the closed-form Iwan law
     # (not the discrete one nor the exact law, which are period-1 there)
-    # settles to a period-7 response, beyond p <= SS_MAX_MULTIPLE:
+    # settles to a period-7 response, beyond p <= SS.max_multiple:
     # "not-settled", amplitudes NaN
     s = System.paper_damper(eta=0.5, beta=2.0, model="iwan-closed")
     r = steady_state(s, 1.15)
     assert r.status == "not-settled"
     assert math.isnan(r.amplitude_q) and math.isnan(r.amplitude_m)
-    assert r.periods < SS_MAX_PERIODS
+    assert r.periods < SS.max_periods
     assert steady_state(System.paper_damper(eta=0.5, beta=2.0), 1.15).status == "periodic"
 
 

@@ -9,6 +9,7 @@ import pytest
 
 import jointdyn as jd
 from jointdyn.hb import branch as hb_branch
+from jointdyn.hb import HBOptions
 from jointdyn.hb.problem import HBProblem
 from jointdyn.interfaces import Interface
 from jointdyn.kinematics import NormalSpring
@@ -260,15 +261,15 @@ def test_command_line_hb_and_modes_take_interfaces(tmp_path, capsys):
     assert rc == 0 and out["status"] == "complete"
 
 
-def test_branch_keeps_no_jacobian_beyond_its_budget(monkeypatch):
+def test_branch_keeps_no_jacobian_beyond_its_budget():
     """With no room for Jacobians, the points are evaluated again one by one for Hill's method: the same
     branch, the same stability."""
     from jointdyn.hb import continue_hb
 
     s = _system(_patch(), force=(0.5, 0.25, 0.0, 0.0))
     a = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False)
-    monkeypatch.setattr(hb_branch, "HB_JACOBIAN_BUDGET_BYTES", 1)
-    b = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False)
+    b = continue_hb(s, 0.8, 1.2, harmonics=2, samples=32, condense=False,
+                    hb_options=HBOptions(jacobian_budget_bytes=1))
     np.testing.assert_array_equal(a.lam, b.lam)
     np.testing.assert_array_equal(a.growth, b.growth)
     np.testing.assert_array_equal(a.stable, b.stable)

@@ -15,7 +15,7 @@ import pytest
 import jointdyn as jd
 from jointdyn import config
 from jointdyn.continuation import LinearSolveOptions, linalg
-from jointdyn.hb import problem as hb_problem
+from jointdyn.hb import HBOptions
 from jointdyn.hb._precond import HarmonicBlocks, harmonic_blocks
 from jointdyn.hb.problem import HBProblem, reference_scales
 from jointdyn.interfaces import Interface
@@ -102,13 +102,12 @@ def test_structured_solve_meets_the_tolerance_on_a_coupled_matrix(monkeypatch):
 
 def _large(monkeypatch, on: bool):
     """The large-problem path at this small size: direct (on False) or preconditioned by the blocks; returns
-    the linear-solve options of that path."""
+    the keyword arguments of that path (the linear-solve options and harmonic balance's options)."""
     # CONT_KRYLOV_SOLVE and CONT_SPARSE_DENSITY are shared (the walk's solves and the form harmonic balance and
     # EPMC give their Jacobians): patched here so that both take the large path at this small size
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
-    monkeypatch.setattr(hb_problem, "HB_HILL_MAX_ROWS", 0)
-    monkeypatch.setattr(hb_problem, "HB_BLOCK_PRECONDITIONER", on)
-    return LinearSolveOptions(small_solve=0)
+    return {"linear": LinearSolveOptions(small_solve=0),
+            "hb_options": HBOptions(hill_max_rows=0, block_preconditioner=on)}
 
 
 def test_hb_branch_on_a_dense_reduced_model_equals_the_direct_path(monkeypatch):
@@ -119,9 +118,9 @@ def test_hb_branch_on_a_dense_reduced_model_equals_the_direct_path(monkeypatch):
     kw = dict(harmonics=3, samples=32, condense=False)
     out = {}
     for on in (False, True):
-        out[on] = continue_hb(s, 0.8, 1.25, linear=_large(monkeypatch, on), **kw)
+        out[on] = continue_hb(s, 0.8, 1.25, **_large(monkeypatch, on), **kw)
     a, b = out[False], out[True]
-    assert HBProblem(s, harmonics=3, samples=32).large_jacobian() == "blocks"  # (the flag is on here)
+    assert HBProblem(s, harmonics=3, samples=32).large_jacobian() == "blocks"  # (the blocks by default)
     assert a.status.ok and b.status.ok
     # the whole bordered matrix factorised only where fresh blocks did not reach the tolerance
     assert b.counters["block_factorisations"] > 0 and b.counters["factorisations"] < a.counters["factorisations"] / 4
@@ -144,7 +143,7 @@ def test_epmc_backbone_on_a_dense_reduced_model_equals_the_direct_path(monkeypat
     rng_a = (0.01 * fy / kt, 10.0 * fy / kt)
     out = {}
     for on in (False, True):
-        out[on] = epmc(s, rng_a, harmonics=3, samples=32, linear=_large(monkeypatch, on))
+        out[on] = epmc(s, rng_a, harmonics=3, samples=32, **_large(monkeypatch, on))
     a, b = out[False], out[True]
     assert a.status.ok and b.status.ok
     assert b.counters["block_factorisations"] > 0 and b.counters["factorisations"] < a.counters["factorisations"] / 4

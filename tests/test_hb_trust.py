@@ -20,7 +20,7 @@ from test_hb import _df_amplitude, _jenkins_system
 from jointdyn import System, config
 from jointdyn.cli import EXIT_INCOMPLETE, main
 from jointdyn.fourier import fourier_matrices
-from jointdyn.hb import PointStatus, frc_hb, harmonic_balance
+from jointdyn.hb import HBOptions, PointStatus, frc_hb, harmonic_balance
 
 GRID = "0.6:1.8:0.01"
 
@@ -343,8 +343,7 @@ def test_a_stop_the_finished_branch_does_not_confirm_is_undone(monkeypatch):
     made = []
     real = hb_disc._fixed_branch
     monkeypatch.setattr(hb_disc, "_fixed_branch", lambda *a, **k: made.append(real(*a, **k)) or made[-1])
-    monkeypatch.setattr(hb_disc, "HB_AUTO_EARLY_DROP", 1.0)
-    every = frc_hb(system, 0.6, 1.8, max_step=0.01)
+    every = frc_hb(system, 0.6, 1.8, max_step=0.01, hb_options=HBOptions(auto_early_drop=1.0))
     assert isinstance(made[0], hb_disc._Refine) and made[0].peak.lam < 0.7
     assert any(not isinstance(m, hb_disc._Refine) and m.status.value == "failed" for m in made)
     assert every.attrs["status"] == default.attrs["status"] == "complete"
@@ -352,12 +351,10 @@ def test_a_stop_the_finished_branch_does_not_confirm_is_undone(monkeypatch):
     np.testing.assert_array_equal(every.amplitude_q.values, default.amplitude_q.values)
 
 
-def test_auto_at_its_bound_says_it_is_not_converged(monkeypatch):
+def test_auto_at_its_bound_says_it_is_not_converged():
     # with the samples bounded at their start, the check of eta = 0.01, beta = 1 fails and the branch says so
-    from jointdyn.hb import discretisation as hb_disc
-
-    monkeypatch.setattr(hb_disc, "HB_AUTO_MAX_SAMPLES", config.HB_SAMPLES)
-    ds = frc_hb(System.paper_damper(eta=0.01, beta=1.0), 0.6, 1.8, max_step=0.01)
+    ds = frc_hb(System.paper_damper(eta=0.01, beta=1.0), 0.6, 1.8, max_step=0.01,
+                hb_options=HBOptions(auto_max_samples=config.HB_SAMPLES))
     assert ds.attrs["check_converged"] == 0 and ds.attrs["samples"] == config.HB_SAMPLES
     assert ds.attrs["check_samples_change"] > config.HB_AUTO_RTOL
     assert "not converged in the discretisation" in ds.attrs["message"]

@@ -14,7 +14,7 @@ import pytest
 import jointdyn as jd
 from jointdyn import config
 from jointdyn.continuation import LinearSolveOptions, linalg
-from jointdyn.hb import problem as hb_problem
+from jointdyn.hb import HBOptions
 
 
 def _bordered_case(rng, n):
@@ -256,14 +256,14 @@ def test_hb_branch_with_reused_factors_has_the_same_peak(monkeypatch, path):
     assert pb == pytest.approx(pa, rel=1e-6)
 
 
-def test_stability_beyond_the_dense_size_is_computed_and_not_computed_only_when_asked(monkeypatch):
+def test_stability_beyond_the_dense_size_is_computed_and_not_computed_only_when_asked():
     """Beyond the size of the dense Jacobian (lowered here) the branch's stability is computed by Arnoldi on
     the Jacobians the continuation used, as dense Hill computes it; ``stability=False`` alone gives none."""
     from jointdyn.hb import StabilityOptions, branch_dataset, continue_hb, hill_stability
 
     s = _chain(2)
     kw = dict(harmonics=2, samples=32, condense=False)
-    monkeypatch.setattr(hb_problem, "HB_HILL_MAX_ROWS", 2 * 6 * 5 - 1)  # 2 n (2H+1) rows with n = 6, H = 2
+    kw["hb_options"] = HBOptions(hill_max_rows=2 * 6 * 5 - 1)  # 2 n (2H+1) rows with n = 6, H = 2
     br = continue_hb(s, 0.8, 1.2, stability=StabilityOptions(method="arnoldi"), **kw)
     assert br.status.ok and br.lam.size > 5 and br.stability == "hill-arnoldi"
     assert branch_dataset(br).attrs["stability"] == "hill-arnoldi"

@@ -14,7 +14,7 @@ import pytest
 import jointdyn as jd
 from jointdyn import config
 from jointdyn.continuation import LinearSolveOptions
-from jointdyn.hb import problem as hb_problem
+from jointdyn.hb import HBOptions
 from jointdyn.hb.problem import HBProblem, reference_scales
 from test_sparse_jacobian import _two_bodies
 
@@ -189,8 +189,8 @@ def test_hb_branch_and_solution_with_the_operator_equal_those_with_dense_c(monke
     # shared numbers: the size above which Krylov solves and the sparse evaluation are used
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
-    monkeypatch.setattr(hb_problem, "HB_HILL_MAX_ROWS", 0)  # harmonic balance's own bound, in its module
-    b = continue_hb(so, 0.7, 1.3, harmonics=2, samples=32, condense=False, linear=LinearSolveOptions(small_solve=0))
+    b = continue_hb(so, 0.7, 1.3, harmonics=2, samples=32, condense=False, linear=LinearSolveOptions(small_solve=0),
+                    hb_options=HBOptions(hill_max_rows=0))  # harmonic balance's own bound, its option
     assert a.status.ok and b.status.ok
     assert b.counters["sparse_factorisations"] > 0 and b.counters["krylov_solves"] > 0
     assert b.response()[0].max() == pytest.approx(a.response()[0].max(), rel=1e-8)
@@ -310,17 +310,15 @@ def test_resume_key_of_a_system_with_the_operator():
 def test_arnoldi_stability_of_a_branch_with_the_operator_equals_dense_c(monkeypatch):
     """Stability by Arnoldi on a branch evaluated sparse with the modal-damping operator (its Jacobian a
     sparse part plus the operator) equals that of the dense C."""
-    from jointdyn.hb import StabilityOptions, continue_hb
-    from jointdyn.hb import problem as hb_problem
+    from jointdyn.hb import HBOptions, StabilityOptions, continue_hb
 
     sa, so = _pair(3)
     arnoldi = StabilityOptions(method="arnoldi")
     a = continue_hb(sa, 0.9, 1.1, harmonics=2, samples=32, condense=False, stability=arnoldi)
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)  # shared: the large-solve paths at this size
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
-    monkeypatch.setattr(hb_problem, "HB_HILL_MAX_ROWS", 0)  # harmonic balance's own bound, in its module
     b = continue_hb(so, 0.9, 1.1, harmonics=2, samples=32, condense=False, stability=arnoldi,
-                    linear=LinearSolveOptions(small_solve=0))
+                    linear=LinearSolveOptions(small_solve=0), hb_options=HBOptions(hill_max_rows=0))
     assert a.status.ok and b.status.ok and b.stability == a.stability
     assert np.all(np.isfinite(b.growth))
     peak_a, peak_b = np.argmax(a.response()[0]), np.argmax(b.response()[0])

@@ -17,8 +17,7 @@ import pytest
 import jointdyn as jd
 import reference_modes as ref
 import tolerances as tol
-from jointdyn.modes import EPMCProblem, ModeStatus, backbone_dataset, epmc
-from jointdyn.modes.epmc import MODES_DS_MAX
+from jointdyn.modes import EPMCOptions, EPMCProblem, ModeStatus, backbone_dataset, epmc
 from modes_support import solve_at
 from reference_tmdsimpy import HARMONICS, SAMPLES, TMDSIMPY_JENKINS_EPMC
 
@@ -197,7 +196,7 @@ def test_dataset_and_frozen_result():
     np.testing.assert_allclose(ds.harmonic_amplitude_m[:, 1, 0], ds.amplitude_m, rtol=1e-12)
     np.testing.assert_allclose(ds.mode_shape_m[:, 2, 0], 0.0, atol=1e-20)  # the phase normalisation
     # arc-length steps bound the spacing in decades of amplitude
-    assert 0 < np.diff(np.log10(ds.amplitude_m)).max() <= MODES_DS_MAX * (1 + 1e-12)
+    assert 0 < np.diff(np.log10(ds.amplitude_m)).max() <= EPMCOptions().ds_max * (1 + 1e-12)
     with pytest.raises(dataclasses.FrozenInstanceError):
         b.status = ModeStatus.FAILED
 

@@ -13,10 +13,9 @@ import pytest
 import jointdyn as jd
 from jointdyn import config
 from jointdyn.cli import main
-from jointdyn.modes import epmc
+from jointdyn.modes import EPMCOptions, epmc
 from jointdyn.hb import Discretisation, Level
 from jointdyn.modes._auto import check_points, level_changes
-from jointdyn.modes._auto import MODES_AUTO_CHECK_POINTS
 
 BLADE = Path(__file__).resolve().parents[1] / "examples" / "blade.toml"
 
@@ -51,7 +50,7 @@ def test_check_points_spread_and_include_the_largest_damping():
     b = epmc(jd.System.paper_damper(eta=0.0), progress=False)
     idx = check_points(b)
     assert idx[0] == 0 and idx[-1] == b.points - 1 and int(np.argmax(b.damping_ratio)) in idx
-    assert len(idx) <= MODES_AUTO_CHECK_POINTS + 1
+    assert len(idx) <= EPMCOptions().auto_check_points + 1
 
 
 def test_cli_modes_chooses_automatically_unless_given(capsys):

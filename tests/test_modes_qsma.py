@@ -11,8 +11,7 @@ import pytest
 import jointdyn as jd
 import reference_modes as ref
 import tolerances as tol
-from jointdyn.modes import ModeStatus, epmc, qsma
-from jointdyn.modes.qsma import QSMA_STEPS_PER_DECADE
+from jointdyn.modes import ModeStatus, QSMAOptions, epmc, qsma
 
 M_, K_, KT, FY = 10.0, 3.9e5, 3.0e5, 50.0
 XS = FY / KT
@@ -21,7 +20,7 @@ XS = FY / KT
 def test_iwan_equals_the_masing_secant_and_loop_area():
     b = qsma(jd.System.paper_damper(eta=0.0, model="iwan"))
     assert b.status is ModeStatus.COMPLETE and b.method == "qsma"
-    assert b.points == 4 * QSMA_STEPS_PER_DECADE + 1
+    assert b.points == 4 * QSMAOptions().steps_per_decade + 1
     tb, _ = ref.iwan_backbone(KT, FY)
     for a, w, D, E in zip(b.amplitude_m, b.omega_rad_s, b.damping_ratio, b.contact_energy_J[:, 0]):
         w_ref, D_ref = ref.masing_qsma(M_, K_, tb, a)
@@ -120,4 +119,4 @@ def test_backbone_spans_the_requested_range_exactly(lo, hi):
     assert b.amplitude_m[-1] == pytest.approx(hi * XS, rel=1e-12)
     step = np.diff(np.log10(b.amplitude_m))
     np.testing.assert_allclose(step, step[0], rtol=1e-6)
-    assert step[0] <= 1.0 / QSMA_STEPS_PER_DECADE * (1 + 1e-9)
+    assert step[0] <= 1.0 / QSMAOptions().steps_per_decade * (1 + 1e-9)

@@ -17,8 +17,7 @@ import pytest
 
 import tolerances as tol
 from jointdyn.continuation import newton
-from jointdyn.modes import EPMCProblem
-from jointdyn.modes.epmc import MODES_TOL
+from jointdyn.modes import EPMCOptions, EPMCProblem
 from reference_tmdsimpy_interface import HARMONICS, NODES, ONE_BRANCH, SAMPLES, TMDSIMPY_CHAIN_EPMC
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -76,7 +75,7 @@ def _backbone_at(problem: EPMCProblem, las):
         while True:
             (l1, z1), (l0, z0) = path[-1], path[-2] if len(path) > 1 else path[-1]
             guess = z1 + (z1 - z0) * (la - l1) / (l1 - l0) if l1 != l0 else z1
-            z, ok, _ = newton(residual, guess, la, tol=MODES_TOL, max_iter=MAX_ITER)
+            z, ok, _ = newton(residual, guess, la, tol=EPMCOptions().tol, max_iter=MAX_ITER)
             w1 = problem.unpack(z1[:-1], z1[-1])[1]
             _, w, xi = problem.unpack(z[:-1], z[-1])
             if ok and abs(w - w1) <= 0.1 * w1:

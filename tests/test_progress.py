@@ -144,14 +144,17 @@ def test_a_stage_writes_plain_lines_where_stderr_is_not_a_terminal(capsys, monke
 
 
 def test_each_level_of_an_automatic_choice_says_which_it_is(capsys):
-    from jointdyn.hb.discretisation import HB_AUTO_MAX_HARMONICS, HB_AUTO_MAX_SAMPLES, level_number
+    from jointdyn.hb import HBOptions
+    from jointdyn.hb.discretisation import level_number
+
+    bounds = HBOptions()
     from jointdyn.hb.levels import Discretisation, Level
 
     d = Discretisation.of("auto", "auto")
     h0, s0 = d.first
     # raises of H (H -> 2H + 1) and of Ns (doubling) within their bounds, counted by hand from the bounds
-    h_levels = sum(1 for h in (2 * h0 + 1, 4 * h0 + 3, 8 * h0 + 7) if h <= HB_AUTO_MAX_HARMONICS)
-    s_levels = sum(1 for k in range(1, 12) if s0 * 2 ** k <= HB_AUTO_MAX_SAMPLES)
+    h_levels = sum(1 for h in (2 * h0 + 1, 4 * h0 + 3, 8 * h0 + 7) if h <= bounds.auto_max_harmonics)
+    s_levels = sum(1 for k in range(1, 12) if s0 * 2 ** k <= bounds.auto_max_samples)
     most = 1 + h_levels + s_levels
     assert level_number(d.first, d) == (1, most)
     assert level_number(Level(2 * h0 + 1, 2 * s0), d) == (3, most)

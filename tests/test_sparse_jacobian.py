@@ -14,7 +14,7 @@ import pytest
 import jointdyn as jd
 from jointdyn import config
 from jointdyn.continuation import LinearSolveOptions
-from jointdyn.hb import problem as hb_problem
+from jointdyn.hb import HBOptions
 from jointdyn.hb.problem import HBProblem, reference_scales
 from jointdyn.interfaces import Interface
 
@@ -150,7 +150,6 @@ def test_hb_branch_with_sparse_jacobians_has_the_same_peak(monkeypatch):
     # EPMC give their Jacobians): patched here so that both take the large path at this small size
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
-    monkeypatch.setattr(hb_problem, "HB_HILL_MAX_ROWS", 0)
     calls = []
     orig = HBProblem.evaluate_sparse
 
@@ -160,7 +159,7 @@ def test_hb_branch_with_sparse_jacobians_has_the_same_peak(monkeypatch):
 
     monkeypatch.setattr(HBProblem, "evaluate_sparse", counted)
     b = continue_hb(s, 0.7, 1.3, harmonics=2, samples=32, condense=False,
-                    linear=LinearSolveOptions(small_solve=0))
+                    linear=LinearSolveOptions(small_solve=0), hb_options=HBOptions(hill_max_rows=0))
     assert a.status.ok and b.status.ok and calls
     assert b.counters["sparse_factorisations"] > 0
     pa, pb = a.response()[0].max(), b.response()[0].max()

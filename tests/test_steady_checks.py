@@ -5,13 +5,15 @@ every chunk of periods) must take the same decision as the straightforward
 array formulation below on histories near and far from periodic.
 """
 
+import dataclasses
+
 import numpy as np
 
+from jointdyn.dynamics import SteadyStateOptions
 from jointdyn.dynamics._core import N_SUMMARY, S_EC, S_EV, S_W, S_XMAX, S_XMIN
 from jointdyn.dynamics._model import make_model
 from jointdyn.dynamics.steady import _History, _check_periodic
 from jointdyn.systems import System
-from jointdyn.dynamics.steady import SS_AMP_RTOL, SS_BALANCE_RTOL, SS_ENERGY_RTOL
 
 
 def _reference(summ, Z, p, K, n, w, K_stuck, M, floor, amp_rtol, energy_rtol, balance_rtol):
@@ -45,7 +47,8 @@ def test_compiled_periodicity_check_equals_reference():
     system = System.paper_damper(eta=0.5, beta=2.0)
     model = make_model(system, 1.1 * system.w0, 64)
     rng = np.random.default_rng(7)
-    amp_rtol, energy_rtol = SS_AMP_RTOL, SS_ENERGY_RTOL
+    defaults = SteadyStateOptions()
+    amp_rtol, energy_rtol = defaults.amp_rtol, defaults.energy_rtol
     outcomes = set()
     for case in range(3000):
         periods = int(rng.integers(1, 30))
@@ -70,10 +73,10 @@ def test_compiled_periodicity_check_equals_reference():
             summ[k, S_W] = 1.1 * E * b[1] * (1 + (noise + rng.choice([0.0, 0.05])) * rng.normal())
         h = _History(Z[0])
         h.add(summ, Z[1:])
-        got = _check_periodic(h, p, K, model, amp_rtol, energy_rtol)
+        got = _check_periodic(h, p, model, dataclasses.replace(defaults, check_periods=K))
         floor = 1e-14 + 1e-9 * sum(c.law.fy / c.law.kt for c in system.contacts)
         want = _reference(h.summ, h.Z, p, K, model.n, model.w, model.pack.K_stuck, system.M, floor,
-                          amp_rtol, energy_rtol, SS_BALANCE_RTOL)  # fmt: skip
+                          amp_rtol, energy_rtol, defaults.balance_rtol)  # fmt: skip
         assert got == want, f"case {case}"
         outcomes.add(got)
     assert outcomes == {True, False}

@@ -36,7 +36,7 @@ import numpy as np
 from jointdyn import DiscreteIwan, Iwan, IwanClosedForm, harmonic_loop
 from jointdyn._io import atomic_write_text
 from jointdyn.dynamics import steady_state
-from jointdyn.dynamics.steady import SS_AMP_RTOL
+from jointdyn.dynamics import SteadyStateOptions
 from jointdyn.laws.exact import piece_count
 from jointdyn.systems import PAPER, System
 
@@ -272,7 +272,7 @@ def summary() -> str:
             f"{100 * SUMMARY['points']:.1e} % at the damper points")
     if "grid" in SUMMARY:
         text += (f" and by {100 * SUMMARY['grid']:.1e} % over the whole Fig 6 grid (there the periodicity "
-                 f"tolerance {SS_AMP_RTOL:g} of the steady states bounds the comparison)")
+                 f"tolerance {SteadyStateOptions().amp_rtol:g} of the steady states bounds the comparison)")
     return text + "; the requirement is 0.1 %."
 
 

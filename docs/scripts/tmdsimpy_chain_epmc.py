@@ -285,7 +285,7 @@ def run_jointdyn(reference: dict) -> dict:
 
     from jointdyn.continuation import newton
     from jointdyn.modes import EPMCProblem
-    from jointdyn.modes.epmc import MODES_TOL
+    from jointdyn.modes import EPMCOptions
 
     p = EPMCProblem(chain(reference["nodes"]), harmonics=reference["harmonics"], samples=reference["samples"])
     residual = _jointdyn_at_modal_amplitude(p)
@@ -293,7 +293,7 @@ def run_jointdyn(reference: dict) -> dict:
     v0 = p.linear_guess()
     Y = p.unpack(v0, 0.0)[0]
     z0 = np.append(v0, las[0] - 0.5 * math.log10(float(Y[p.n:2 * p.n] @ p.system.M @ Y[p.n:2 * p.n])))
-    newton(residual, z0, las[0], tol=MODES_TOL, max_iter=30)  # loads or compiles the kernels
+    newton(residual, z0, las[0], tol=EPMCOptions().tol, max_iter=30)  # loads or compiles the kernels
     path = [(las[0], z0)]
     rows, halvings, stopped = [], 0, None
     t, tc = time.perf_counter(), time.process_time()
@@ -302,7 +302,7 @@ def run_jointdyn(reference: dict) -> dict:
         while stopped is None:
             (l1, z1), (l0, z0) = path[-1], path[-2] if len(path) > 1 else path[-1]
             guess = z1 + (z1 - z0) * (la - l1) / (l1 - l0) if l1 != l0 else z1
-            z, ok, _ = newton(residual, guess, la, tol=MODES_TOL, max_iter=30)  # as tmdsimpy's
+            z, ok, _ = newton(residual, guess, la, tol=EPMCOptions().tol, max_iter=30)  # as tmdsimpy's
             w1 = p.unpack(z1[:-1], z1[-1])[1]
             _, w, xi = p.unpack(z[:-1], z[-1])
             if ok and w > 0 and abs(w - w1) <= MAX_OMEGA_CHANGE * w1:

@@ -2,7 +2,7 @@
 
 Public API: :func:`integrate` (harmonic loads), :func:`integrate_sampled`
 (sampled loads), :class:`Trajectory`, :class:`Restart`,
-:func:`steady_state` and :class:`SteadyState` (:func:`prepare_kernels`
+:func:`steady_state`, :class:`SteadyStateOptions` (its numbers) and :class:`SteadyState` (:func:`prepare_kernels`
 compiles its kernels ahead, for process pools; :func:`check_period_steps`
 refuses a step grid larger than the memory before computing), the statuses
 :class:`RunStatus` and :class:`SteadyStatus`, and the monodromy matrix of
@@ -12,6 +12,7 @@ the period map (:func:`monodromy_matrix`, :func:`fd_monodromy`).
 from ._model import check_period_steps
 from .integrate import Restart, Trajectory, integrate, integrate_sampled
 from .monodromy import fd_monodromy, monodromy_matrix
+from .options import SteadyStateOptions
 from .status import EnergyCheck, RunStatus, SteadyStatus
 from .steady import SteadyState, energy_check, prepare_kernels, steady_state
 
@@ -24,6 +25,7 @@ __all__ = [
     "check_period_steps",
     "prepare_kernels",
     "SteadyState",
+    "SteadyStateOptions",
     "RunStatus",
     "SteadyStatus",
     "EnergyCheck",

@@ -15,6 +15,7 @@ neutral (a multiplier 1).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -25,68 +26,14 @@ from .. import _validate as V
 from .._jit import jit
 from ..systems import System
 from ._core import N_SUMMARY, S_EC, S_EV, S_STEPS, S_W, S_XMAX, S_XMEAN, S_XMIN
-from ._model import TI_STEPS_PER_PERIOD, Model, make_model, pack_system, refine_if_opened
+from ._model import Model, make_model, pack_system, refine_if_opened
 from ._start import clean_states, free_body_start, linear_start
 from .integrate import Restart, Trajectory, _omega, _trajectory
 from .monodromy import fd_monodromy
+from .options import SteadyStateOptions, steady_options
 from .status import SS_DISSIPATION_FLOOR, EnergyCheck, SteadyStatus
 
 __all__ = ["SteadyState", "energy_check", "prepare_kernels", "steady_state"]
-
-#: relative tolerance on the half peak-to-peak amplitude and on the
-#: period-boundary state (Poincare points)
-SS_AMP_RTOL = 1e-4
-#: relative tolerance on the energy per period
-SS_ENERGY_RTOL = 1e-3
-#: work of the forcing = dissipation per period to this (relative; the
-#: energy integrals carry the discretisation error)
-SS_BALANCE_RTOL = 1e-2
-#: windows (of p periods) that must agree
-SS_CHECK_PERIODS = 3
-#: largest period multiple p accepted as a periodic steady state
-SS_MAX_MULTIPLE = 4
-#: longer multiples (up to this) are detected and reported as
-#: "not-settled", detail "period-P", instead of running to max_periods
-SS_DETECT_MULTIPLE = 12
-#: a multiple p > 1 is accepted only when the largest one-period mismatch
-#: over the last K p periods is at least this fraction of that over the
-#: K p periods before (no decaying beat)
-SS_MULTIPLE_DECAY = 0.97
-#: after shooting, stop as "quasi-periodic-or-chaotic" when the largest
-#: one-period mismatch over the last SS_STALL_PERIODS/2 periods is >=
-#: SS_STALL_RATIO times that over the half before
-SS_STALL_PERIODS = 240
-SS_STALL_RATIO = 0.9
-#: cap on integrated periods
-SS_MAX_PERIODS = 1500
-#: periods integrated between two checks
-SS_CHUNK = 8
-#: shooting (Newton on the period map) when the estimated number of
-#: periods to converge exceeds this
-SS_SHOOT_AFTER = 40
-#: Newton iterations of one shooting attempt
-SS_SHOOT_MAXIT = 12
-#: largest Newton step (relative to the amplitude) and step halvings of the
-#: line search
-SS_SHOOT_MAXSTEP = 1.0
-SS_SHOOT_HALVINGS = 8
-#: before shooting (section at phase 0), rebuild the law states from the
-#: last period alone (forget the transient's memory)
-SS_SHOOT_CLEAN_STATE = True
-#: shooting attempts per run
-SS_MAX_SHOTS = 3
-#: relative finite-difference step of the monodromy matrix
-SS_SHOOT_FD = 1e-6
-#: a Floquet multiplier above 1 + this marks an unstable orbit
-SS_FLOQUET_TOL = 1e-3
-#: amplitude increasing over this many consecutive periods ...
-SS_GROWTH_PERIODS = 40
-#: ... with increments of the second half >= this fraction of the first
-SS_GROWTH_RATIO = 0.9
-#: ... and with the amplitude of x[response_dof] above this many fy/kt of
-#: the first contact (friction saturated: only then can friction lose)
-SS_UNBOUNDED_Q = 20.0
-
 
 @dataclass(frozen=True)
 class SteadyState:
@@ -104,10 +51,10 @@ class SteadyState:
     message : str
         More on the status: ``"integration"`` or ``"shooting"`` (how a
         periodic state was reached); ``"growing"``, ``"blow-up"``
-        (unbounded); ``"period-P"`` (repeats every P > SS_MAX_MULTIPLE
+        (unbounded); ``"period-P"`` (repeats every P > ``SteadyStateOptions.max_multiple``
         periods), ``"slowly-converging"`` (Poincare distance still
         shrinking at max_periods), ``"quasi-periodic-or-chaotic"`` (the
-        one-period mismatch stopped shrinking over SS_STALL_PERIODS periods,
+        one-period mismatch stopped shrinking over ``SteadyStateOptions.stall_periods`` periods,
         after shooting; quasi-periodic and chaotic are not told apart).
     period_multiple : int
         p: the response repeats every p forcing periods (0 if not periodic).
@@ -298,24 +245,25 @@ def _periodic_arrays(summ, Z, p, K, n, w, K_stuck, M, floor, amp_rtol, energy_rt
     return True
 
 
-def _check_periodic(h: _History, p: int, K: int, model, amp_rtol, energy_rtol):
-    """True if the last K windows of p periods repeat within the tolerances.
+def _check_periodic(h: _History, p: int, model, o: SteadyStateOptions):
+    """True if the last K = ``o.check_periods`` windows of p periods repeat within the tolerances.
 
     Over the last K windows of p periods: the half peak-to-peak amplitudes
-    agree within ``amp_rtol`` of the amplitude, so do the Poincare points
+    agree within ``o.amp_rtol`` of the amplitude, so do the Poincare points
     (state one window apart; velocities scaled by w), the energy dissipated
-    and the work of the forcing per period within ``energy_rtol`` of the
-    energy flow, and work equals dissipation within ``SS_BALANCE_RTOL``.
+    and the work of the forcing per period within ``o.energy_rtol`` of the
+    energy flow, and work equals dissipation within ``o.balance_rtol``.
     """
+    K = o.check_periods
     if h.size < K * p:
         return False
     return bool(_periodic_arrays(h.summ, h.Z, p, K, model.n, model.w, model.pack.K_stuck, model.pack.M,
-                                 _amplitude_scale(model, 0.0), amp_rtol, energy_rtol, SS_BALANCE_RTOL))  # fmt: skip
+                                 _amplitude_scale(model, 0.0), o.amp_rtol, o.energy_rtol, o.balance_rtol))  # fmt: skip
 
 
-def _growing(h: _History, model, amp_rtol) -> bool:
-    """Amplitude increasing over the last SS_GROWTH_PERIODS periods without slowing down."""
-    G = SS_GROWTH_PERIODS
+def _growing(h: _History, model, o: SteadyStateOptions) -> bool:
+    """Amplitude increasing over the last ``o.growth_periods`` periods without slowing down."""
+    G = o.growth_periods
     if h.size < G + 1:
         return False
     S = np.asarray(h.summ[-(G + 1):])
@@ -324,48 +272,50 @@ def _growing(h: _History, model, amp_rtol) -> bool:
     if not np.all(d > 0):
         return False
     half = d.size // 2
-    if d[half:].mean() < SS_GROWTH_RATIO * d[:half].mean():
+    if d[half:].mean() < o.growth_ratio * d[:half].mean():
         return False
     # energy surplus (W - E_c - E_v) / W per period: stays positive and does
     # not decay when the response is unbounded (Den Hartog: 1 - 4R/(pi F));
     # it decays to 0 on a (slow) approach to a bounded state
     sur = (S[1:, S_W] - S[1:, S_EC] - S[1:, S_EV]) / np.maximum(np.abs(S[1:, S_W]), 1e-300)
     q = max(sur.size // 4, 1)
-    if not np.all(sur > 0) or sur[-q:].mean() < SS_GROWTH_RATIO * sur[:q].mean():
+    if not np.all(sur > 0) or sur[-q:].mean() < o.growth_ratio * sur[:q].mean():
         return False
-    if d.mean() <= amp_rtol * A[-1]:
+    if d.mean() <= o.amp_rtol * A[-1]:
         return False
     # a contact in microslip dissipates ~A^3 (faster than the work ~A of the
     # forcing): growth can only be unbounded once the friction saturates
     laws = model.pack.laws
-    if laws and not A[-1] > SS_UNBOUNDED_Q * laws[0].fy / laws[0].kt:
+    if laws and not A[-1] > o.unbounded_q * laws[0].fy / laws[0].kt:
         return False
     return True
 
 
-def _long_period(h: _History, K: int, model, amp_rtol, energy_rtol) -> int:
-    """Smallest multiple p in (SS_MAX_MULTIPLE, SS_DETECT_MULTIPLE] that repeats (0 if none)."""
-    for p in range(SS_MAX_MULTIPLE + 1, SS_DETECT_MULTIPLE + 1):
+def _long_period(h: _History, model, o: SteadyStateOptions) -> int:
+    """Smallest multiple p in (``o.max_multiple``, ``o.detect_multiple``] that repeats (0 if none)."""
+    K = o.check_periods
+    for p in range(o.max_multiple + 1, o.detect_multiple + 1):
         if h.size < K * p:
             break
-        if _check_periodic(h, p, K, model, amp_rtol, energy_rtol) and not _one_period_decaying(h, K * p, model):
+        if _check_periodic(h, p, model, o) and not _one_period_decaying(h, K * p, model, o.multiple_decay):
             return p
     return 0
 
 
-def _one_period_decaying(h: _History, m: int, model) -> bool:
+def _one_period_decaying(h: _History, m: int, model, decay: float) -> bool:
     """True unless the one-period mismatch of the Poincare points has stopped decaying.
 
     A genuine p-periodic orbit repeats its one-period mismatches exactly; a
     slowly decaying beat that happens to be nearly commensurate with the
     forcing (lightly damped transients) shrinks them. Compares the largest
     mismatch over the last m periods with that over the m periods before
-    (needs 2m periods of history; undecided counts as decaying).
+    (needs 2m periods of history; undecided counts as decaying): decaying when the later is below
+    ``decay`` times the earlier (``SteadyStateOptions.multiple_decay``).
     """
     if h.size < 2 * m:
         return True
     d = _mismatches(h, 2 * m, model)
-    return d[m:].max() < SS_MULTIPLE_DECAY * d[:m].max()
+    return d[m:].max() < decay * d[:m].max()
 
 
 def _mismatches(h: _History, count: int, model) -> np.ndarray:
@@ -376,17 +326,17 @@ def _mismatches(h: _History, count: int, model) -> np.ndarray:
     return np.max(np.abs(D), axis=1)
 
 
-def _stalled(h: _History, model) -> bool:
+def _stalled(h: _History, model, o: SteadyStateOptions) -> bool:
     """True when the one-period mismatch has stopped shrinking (quasi-periodic, chaotic).
 
-    Compares the largest mismatch over the last SS_STALL_PERIODS / 2 periods
+    Compares the largest mismatch over the last ``o.stall_periods`` / 2 periods
     with that over the half before.
     """
-    m = SS_STALL_PERIODS // 2
+    m = o.stall_periods // 2
     if h.size < 2 * m:
         return False
     d = _mismatches(h, 2 * m, model)
-    return d[m:].max() >= SS_STALL_RATIO * d[:m].max()
+    return d[m:].max() >= o.stall_ratio * d[:m].max()
 
 
 def _contraction(h: _History, model):
@@ -413,14 +363,14 @@ def _booker(counters):
     return count
 
 
-def _section(model: Model, x, v, S, rdof, count):
+def _section(model: Model, x, v, S, rdof, count, clean: bool):
     """Move to the Poincare section of shooting; returns (x, v, S, grid of one
     period from there, section time s), or None on a blow-up.
 
     The section is at phase 0, or in the middle of a separation when every
     contact separates (law states reset there, so (x, v) is the whole state
     and the map is exact); at phase 0 the law states are first rebuilt from
-    the last period alone (``SS_SHOOT_CLEAN_STATE``).
+    the last period alone where ``clean`` (``SteadyStateOptions.shoot_clean_state``).
     """
     ts = model.section_time()
     if ts > 0.0:
@@ -429,7 +379,7 @@ def _section(model: Model, x, v, S, rdof, count):
         if not res.status.ok:
             return None
         return x, v, S, model.segment_grid(ts, ts + model.period), ts
-    if SS_SHOOT_CLEAN_STATE and model.nc:
+    if clean and model.nc:
         cl = clean_states(model, x, v, S, rdof, count)
         if cl is None:
             return None
@@ -437,14 +387,14 @@ def _section(model: Model, x, v, S, rdof, count):
     return x, v, S, model.grid, ts
 
 
-def _line_search(phi, z, dz, D, S1, rn):
-    """Damped Newton step: the first of z + lam dz D (lam = 1, 1/2, ...; |lam dz|
-    <= SS_SHOOT_MAXSTEP) whose residual is below ``rn``; None if none is."""
+def _line_search(phi, z, dz, D, S1, rn, o: SteadyStateOptions):
+    """Damped Newton step: the first of z + lam dz D (lam = 1, 1/2, ... ``o.shoot_halvings`` times;
+    |lam dz| <= ``o.shoot_maxstep``) whose residual is below ``rn``; None if none is."""
     lam = 1.0
     big = float(np.max(np.abs(dz)))
-    if big > SS_SHOOT_MAXSTEP:
-        lam = SS_SHOOT_MAXSTEP / big
-    for _ls in range(SS_SHOOT_HALVINGS):
+    if big > o.shoot_maxstep:
+        lam = o.shoot_maxstep / big
+    for _ls in range(o.shoot_halvings):
         zn = z + lam * dz * D
         zn1, Sn1, sn1 = phi(zn, S1)
         if zn1 is not None:
@@ -455,7 +405,7 @@ def _line_search(phi, z, dz, D, S1, rn):
     return None
 
 
-def _newton(model: Model, phi, z, S, tol, counters):
+def _newton(model: Model, phi, z, S, tol, counters, o: SteadyStateOptions):
     """Newton on the period map from (z, S); returns (z, S, converged, floquet_max)
     (converged False also when the period map blows up).
 
@@ -473,7 +423,7 @@ def _newton(model: Model, phi, z, S, tol, counters):
         return z, S, False, floq
     best = None  # (residual, z, S, first residual) in the fixed scale D0
     D0 = None
-    for _ in range(SS_SHOOT_MAXIT):
+    for _ in range(o.shoot_maxit):
         A = 0.5 * (s1[S_XMAX] - s1[S_XMIN])
         xs = _amplitude_scale(model, max(A, np.max(np.abs(z[:n]))))
         D = np.concatenate([np.full(n, xs), np.full(n, xs * w)])
@@ -487,12 +437,12 @@ def _newton(model: Model, phi, z, S, tol, counters):
             return z, S, True, floq
         D = D0
         counters["shoot"] += 1
-        Jm = fd_monodromy(lambda zz: phi(zz, S)[0], z, D, SS_SHOOT_FD, z1)
+        Jm = fd_monodromy(lambda zz: phi(zz, S)[0], z, D, o.shoot_fd, z1)
         if Jm is None:
             return z, S, False, floq
         floq = float(np.max(np.abs(np.linalg.eigvals(Jm))))
         dz = np.linalg.lstsq(Jm - np.eye(2 * n), -r, rcond=1e-8)[0]
-        step = _line_search(phi, z, dz, D, S1, rn)
+        step = _line_search(phi, z, dz, D, S1, rn, o)
         if step is None:
             break
         z, S, z1, S1, s1 = step[0], S1, step[1], step[2], step[3]
@@ -501,7 +451,7 @@ def _newton(model: Model, phi, z, S, tol, counters):
     return best[1], best[2], True, floq
 
 
-def _shoot(model: Model, x, v, S, rdof, tol, counters):
+def _shoot(model: Model, x, v, S, rdof, tol, counters, o: SteadyStateOptions):
     """Newton on the period map (x, v) -> (x, v)(t + T) with the law state carried.
 
     The finite-difference monodromy (:func:`~jointdyn.dynamics.monodromy.fd_monodromy`,
@@ -515,7 +465,7 @@ def _shoot(model: Model, x, v, S, rdof, tol, counters):
     n = model.n
     x0, v0, S0 = x.copy(), v.copy(), S.copy()
     count = _booker(counters)
-    sec = _section(model, x, v, S, rdof, count)
+    sec = _section(model, x, v, S, rdof, count, o.shoot_clean_state)
     if sec is None:
         return x0, v0, S0, False, math.nan
     x, v, S, grid, ts = sec
@@ -528,7 +478,7 @@ def _shoot(model: Model, x, v, S, rdof, tol, counters):
             return None, None, None
         return np.concatenate([xx, vv]), S2, res.summary[0]
 
-    z, S, ok, floq = _newton(model, phi, np.concatenate([x, v]), S, tol, counters)
+    z, S, ok, floq = _newton(model, phi, np.concatenate([x, v]), S, tol, counters, o)
     if not ok:
         return x0, v0, S0, False, floq
     x = z[:n].copy()
@@ -565,60 +515,63 @@ class _March:
     S: np.ndarray
     hist: _History
     counters: dict
+    o: SteadyStateOptions
     shots: int = 0
     floq: float = math.nan
 
-    def shoot(self, model, rdof, amp_rtol) -> bool:
+    def shoot(self, model, rdof) -> bool:
         """One shooting attempt; the state and a fresh history are kept if it
         converged to a stable orbit (the largest multiplier is always kept)."""
         self.shots += 1
         xs_, vs_, Ss_, ok, self.floq = _shoot(model, self.x.copy(), self.v.copy(), self.S.copy(), rdof,
-                                              0.1 * amp_rtol, self.counters)  # fmt: skip
-        if ok and not (self.floq > 1.0 + SS_FLOQUET_TOL):
+                                              0.1 * self.o.amp_rtol, self.counters, self.o)  # fmt: skip
+        if ok and not (self.floq > 1.0 + self.o.floquet_tol):
             self.x, self.v, self.S = xs_, vs_, np.ascontiguousarray(Ss_)
             self.hist = _History(np.concatenate([self.x, self.v]))
             return True
         return False
 
 
-def _period_multiple(hist, model, K, amp_rtol, energy_rtol) -> int:
-    """Smallest p <= SS_MAX_MULTIPLE with which the history repeats (0 if none);
+def _period_multiple(hist, model, o: SteadyStateOptions) -> int:
+    """Smallest p <= ``o.max_multiple`` with which the history repeats (0 if none);
     a multiple p > 1 must not be a slowly alternating approach to period 1."""
-    for p in range(1, SS_MAX_MULTIPLE + 1):
-        if _check_periodic(hist, p, K, model, amp_rtol, energy_rtol):
-            if p > 1 and _one_period_decaying(hist, K * p, model):
+    for p in range(1, o.max_multiple + 1):
+        if _check_periodic(hist, p, model, o):
+            if p > 1 and _one_period_decaying(hist, o.check_periods * p, model, o.multiple_decay):
                 continue
             return p
     return 0
 
 
-def _need_shoot(hist, model, growing, amp_rtol, chunk) -> bool:
+def _need_shoot(hist, model, growing, chunk, o: SteadyStateOptions) -> bool:
     """Shoot when the estimated number of periods to converge exceeds
-    SS_SHOOT_AFTER, when the distance does not contract, or when growing."""
+    ``o.shoot_after``, when the distance does not contract, or when growing."""
     est = _contraction(hist, model)
     if est is None:
         return False
     rho, dlast = est
     A = 0.5 * (hist.summ[-1][S_XMAX] - hist.summ[-1][S_XMIN])
-    target = amp_rtol * _amplitude_scale(model, A)
+    target = o.amp_rtol * _amplitude_scale(model, A)
     if growing:
         return True
     if rho >= 1.0:
         return hist.size >= 2 * chunk
     if dlast > target:
-        return math.log(target / dlast) / math.log(rho) > SS_SHOOT_AFTER
+        return math.log(target / dlast) / math.log(rho) > o.shoot_after
     return False
 
 
-def _settle(model, st: _March, K, maxp, amp_rtol, energy_rtol, rdof, shooting):
+def _settle(model, st: _March, rdof, shooting):
     """Integrate chunks of periods (shooting over slow transients) until classified.
 
     Once a normal spring opens, the model is replaced by its refined twin
     (:func:`~jointdyn.dynamics._model.refine_if_opened`) and the history
     starts again. Returns (status or None when max_periods ran out, detail,
-    p, the model in use).
+    p, the model in use); the numbers are ``st.o``'s.
     """
-    chunk = max(SS_CHUNK, K)
+    o = st.o
+    maxp = o.max_periods
+    chunk = max(o.chunk, o.check_periods)
     while True:
         nrun = int(min(chunk, maxp - st.counters["periods"]))
         if nrun <= 0:
@@ -632,16 +585,16 @@ def _settle(model, st: _March, K, maxp, amp_rtol, energy_rtol, rdof, shooting):
         if finer is not None:
             model, st.hist = finer, _History(np.concatenate([st.x, st.v]))
             continue
-        p_found = _period_multiple(st.hist, model, K, amp_rtol, energy_rtol)
-        long_p = 0 if p_found else _long_period(st.hist, K, model, amp_rtol, energy_rtol)
-        growing = False if (p_found or long_p) else _growing(st.hist, model, amp_rtol)
-        can_shoot = shooting and st.shots < SS_MAX_SHOTS
+        p_found = _period_multiple(st.hist, model, o)
+        long_p = 0 if p_found else _long_period(st.hist, model, o)
+        growing = False if (p_found or long_p) else _growing(st.hist, model, o)
+        can_shoot = shooting and st.shots < o.max_shots
         # a multiple p > 1 may be a lightly damped transient whose free
         # frequency is commensurate with the forcing: first look for a
         # stable period-1 orbit by shooting (once per history)
         if (p_found > 1 or long_p) and can_shoot and not st.hist.shot_checked:
             st.hist.shot_checked = True
-            if st.shoot(model, rdof, amp_rtol):
+            if st.shoot(model, rdof):
                 continue
         if p_found:
             return SteadyStatus.PERIODIC, "shooting" if st.counters["shoot"] else "integration", p_found, model
@@ -649,10 +602,10 @@ def _settle(model, st: _March, K, maxp, amp_rtol, energy_rtol, rdof, shooting):
             return SteadyStatus.NOT_SETTLED, f"period-{long_p}", 0, model
         if growing and not can_shoot:
             return SteadyStatus.UNBOUNDED, "growing", 0, model
-        if st.counters["periods"] >= maxp or (not can_shoot and _stalled(st.hist, model)):
+        if st.counters["periods"] >= maxp or (not can_shoot and _stalled(st.hist, model, o)):
             return None, "", 0, model
-        if can_shoot and _need_shoot(st.hist, model, growing, amp_rtol, chunk):
-            st.shoot(model, rdof, amp_rtol)
+        if can_shoot and _need_shoot(st.hist, model, growing, chunk, o):
+            st.shoot(model, rdof)
 
 
 def _periodic_values(model, st: _March, p, rdof, keep_loop):
@@ -694,13 +647,14 @@ def steady_state(
     response_dof: int | None = None,
     keep_loop: bool = True,
     shooting: bool = True,
+    options: SteadyStateOptions | None = None,
     _events: bool = True,
 ) -> SteadyState:
     """Steady periodic response at frequency ratio ``gamma``, classified.
 
     Integrates M x'' + C x' + K x = f sin(w t) - sum_c B_c T_c(u_c, N_c(t))
     (docs/model.md section 6), w = gamma w0, until the response repeats with the
-    forcing period or a multiple p <= ``SS_MAX_MULTIPLE``: over the
+    forcing period or a multiple p <= ``options.max_multiple``: over the
     last ``check_periods`` windows of p periods the half peak-to-peak
     amplitude of x[response_dof] and the period-boundary state agree within
     ``amp_rtol`` (relative to the amplitude) and the dissipated energy and
@@ -714,17 +668,17 @@ def steady_state(
     gamma : float
         w / w0 (> 0).
     steps_per_period : int, optional
-        Base RK4 steps per forcing period (default ``TI_STEPS_PER_PERIOD``).
+        Base RK4 steps per forcing period (default ``options.steps_per_period``, 256).
     start : SteadyState or Restart, optional
         Warm start (state at a period boundary, e.g. the previous sweep
         point). Default: equivalent-linearisation estimate (stuck stiffness
         kt refined by the law's describing function).
     amp_rtol, energy_rtol : float, optional
-        Tolerances (defaults ``SS_AMP_RTOL``, ``SS_ENERGY_RTOL``).
+        Tolerances (defaults ``options.amp_rtol``, 1e-4, and ``options.energy_rtol``, 1e-3).
     check_periods : int, optional
-        K, windows that must agree (default ``SS_CHECK_PERIODS``).
+        K, windows that must agree (default ``options.check_periods``, 3).
     max_periods : int, optional
-        Cap on integrated periods (default ``SS_MAX_PERIODS``).
+        Cap on integrated periods (default ``options.max_periods``, 1500).
     response_dof : int, optional
         DOF whose amplitude is reported (default: the system's response DOF,
         ``[output] dof`` of a system file, as :func:`jointdyn.frc_hb`,
@@ -733,6 +687,9 @@ def steady_state(
         Record the final p periods in ``loop``.
     shooting : bool
         Allow shooting to skip slow transients.
+    options : SteadyStateOptions, optional
+        Every number of the steady state (:class:`~jointdyn.dynamics.options.SteadyStateOptions`;
+        None: the defaults); the keyword arguments above, where given, replace its fields.
 
     Returns
     -------
@@ -742,25 +699,20 @@ def steady_state(
     """
     if not isinstance(system, System):
         raise ValueError(f"system must be a System, got {type(system).__name__}")
-    spp = V.positive_int(
-        "steps_per_period", TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period, 4
-    )
-    amp_rtol = V.positive("amp_rtol", SS_AMP_RTOL if amp_rtol is None else amp_rtol)
-    energy_rtol = V.positive("energy_rtol", SS_ENERGY_RTOL if energy_rtol is None else energy_rtol)
-    K = V.positive_int("check_periods", SS_CHECK_PERIODS if check_periods is None else check_periods, 2)
-    maxp = V.positive_int("max_periods", SS_MAX_PERIODS if max_periods is None else max_periods)
+    o = _resolved(steady_options(options), steps_per_period=steps_per_period, amp_rtol=amp_rtol,
+                  energy_rtol=energy_rtol, check_periods=check_periods, max_periods=max_periods)
     rdof = V.positive_int("response_dof", system.response_dof if response_dof is None else response_dof, 0)
     if rdof >= system.ndof:
         raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {rdof}")
     w = _omega(system, gamma)
-    model = make_model(system, w, spp, events=_events)
+    model = make_model(system, w, o.steps_per_period, events=_events)
     x, v, S = _first_state(model, start)
-    st = _March(x, v, S, _History(np.concatenate([x, v])), {"periods": 0, "steps": 0, "shoot": 0})
-    status, detail, p_found, model = _settle(model, st, K, maxp, amp_rtol, energy_rtol, rdof, shooting)
+    st = _March(x, v, S, _History(np.concatenate([x, v])), {"periods": 0, "steps": 0, "shoot": 0}, o)
+    status, detail, p_found, model = _settle(model, st, rdof, shooting)
     if status is None:
         # did not settle within max_periods: say why if we can
         status = SteadyStatus.NOT_SETTLED
-        stalled = st.hist.size >= SS_STALL_PERIODS and _stalled(st.hist, model)
+        stalled = st.hist.size >= o.stall_periods and _stalled(st.hist, model, o)
         detail = "quasi-periodic-or-chaotic" if stalled else "slowly-converging"
     last = st.hist.summ[-1] if st.hist.size else None
     last_amp = 0.5 * (last[S_XMAX] - last[S_XMIN]) if last is not None else math.nan
@@ -818,21 +770,27 @@ def prepare_kernels(systems) -> None:
     history too short to pass: milliseconds once compiled. A system that
     steady_state refuses (ValueError) is left to the solve that reports it.
     """
-    seen = set()
+    seen, o = set(), SteadyStateOptions()
     for system in systems:
         pack = pack_system(system)
         if (pack.runner, pack.init) in seen:
             continue
         seen.add((pack.runner, pack.init))
         try:
-            model = make_model(system, _omega(system, 1.0), TI_STEPS_PER_PERIOD)
+            model = make_model(system, _omega(system, 1.0), o.steps_per_period)
         except ValueError:
             continue
         x, v, S = _first_state(model, None)
         clean_states(model, x, v, S, 0, lambda res: None)
-        _periodic_arrays(np.empty((0, N_SUMMARY)), np.zeros((1, 2 * model.n)), 1, SS_CHECK_PERIODS, model.n,
-                         model.w, model.pack.K_stuck, model.pack.M, _amplitude_scale(model, 0.0), SS_AMP_RTOL,
-                         SS_ENERGY_RTOL, SS_BALANCE_RTOL)  # fmt: skip
+        _periodic_arrays(np.empty((0, N_SUMMARY)), np.zeros((1, 2 * model.n)), 1, o.check_periods, model.n,
+                         model.w, model.pack.K_stuck, model.pack.M, _amplitude_scale(model, 0.0), o.amp_rtol,
+                         o.energy_rtol, o.balance_rtol)  # fmt: skip
+
+
+def _resolved(o: SteadyStateOptions, **given) -> SteadyStateOptions:
+    """``o`` with the fields given as keyword arguments (not None) replaced, each validated by its name."""
+    given = {k: v for k, v in given.items() if v is not None}
+    return dataclasses.replace(o, **given) if given else o
 
 
 def _first_state(model, start):

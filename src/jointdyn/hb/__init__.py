@@ -22,6 +22,7 @@ from .levels import AUTO, Discretisation, Level, check_memory, hb_bytes
 from .parameters import DELTA, ETA, F1, GAMMA, N0, PARAMETERS, HBParameter, SystemParameter, parameter_named
 from .problem import HBProblem
 from .monodromy import monodromy_multipliers
+from .options import HBOptions
 from .results import DiscretisationCheck, HBBranch, HBPeak, HBSolution, PointStatus, SolveStatus
 from .hill_arnoldi import ArnoldiExponents, hill_arnoldi_exponents, hill_arnoldi_growth
 from .stability import hill_exponents, hill_growth, hill_stability
@@ -66,5 +67,6 @@ __all__ = [
     "hill_arnoldi_growth",
     "ArnoldiExponents",
     "StabilityOptions",
+    "HBOptions",
     "monodromy_multipliers",
 ]

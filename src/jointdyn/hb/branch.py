@@ -19,12 +19,12 @@ Without viscous damping the Coulomb-saturated oscillator has no steady
 state at gamma = 1 when friction is too weak (Den Hartog: R/F < pi/4).
 A branch point is declared ``unbounded`` when
 
-* q = kt X / fy exceeds ``HB_UNBOUNDED_Q`` (hard bound, any system),
+* q = kt X / fy exceeds ``HBOptions.unbounded_q`` (hard bound, any system),
   or the corrector fails at the smallest step beyond
-  ``HB_UNBOUNDED_FAIL_FRACTION`` of it; or
+  ``HBOptions.unbounded_fail_fraction`` of it; or
 * the describing-function saturation test holds: C = 0, q exceeds
-  ``HB_SATURATION_Q``, every contact slips (macroslip or
-  separation) over at least ``HB_SATURATION_SLIP_FRACTION`` of the
+  ``HBOptions.saturation_q``, every contact slips (macroslip or
+  separation) over at least ``HBOptions.saturation_slip_fraction`` of the
   period, and (single DOF) the friction force's equivalent first-harmonic
   amplitude R1 = E_fric / (pi X1) (E_fric the energy dissipated per cycle,
   X1 the first-harmonic amplitude; R1 = 4 mu N0 / pi for a Coulomb force
@@ -53,7 +53,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import config
 from .._threads import blas_threads
 from ..continuation import (
     START_EXTRAPOLATION,
@@ -79,6 +78,7 @@ from .condense import make_problem
 from .hill_arnoldi import hill_arnoldi_exponents
 from .hill_condensed import condensed_hill_exponents
 from .levels import Level
+from .options import HBOptions
 from .parameters import F1, GAMMA
 from .problem import HBProblem, reference_scales
 from .results import HBBranch, HBPeak, PointStatus, sliding_as_a_whole
@@ -87,42 +87,6 @@ from .stability_options import StabilityOptions
 
 __all__ = ["continued_branch", "solve_point"]
 
-#: Newton iterations of the start of a branch (from the stuck linear solution)
-HB_START_MAX_ITER = 30
-#: Newton iterations of a single solution (harmonic_balance)
-HB_SOLVE_MAX_ITER = 50
-#: a homotopy in the forcing amplitude starts at this fraction of F1
-HB_HOMOTOPY_START = 1e-3
-#: response declared unbounded when q = kt X / fy exceeds this (hard bound)
-HB_UNBOUNDED_Q = 1e5
-#: ... or when the corrector fails at the smallest step with q above this
-#: fraction of HB_UNBOUNDED_Q
-HB_UNBOUNDED_FAIL_FRACTION = 0.1
-#: describing-function saturation test (Den Hartog): applied once q exceeds
-#: HB_SATURATION_Q, when the contact slips at least this fraction of the
-#: period and C = 0 (single DOF)
-HB_SATURATION_Q = 30.0
-HB_SATURATION_SLIP_FRACTION = 0.9
-#: turning points (folds) of a branch: the parameter must come back by more
-#: than this fraction of the range, or log q move by more than
-#: HB_TURNING_BAND_LOG_Q while the parameter is short of its extreme (a fold
-#: whose branches are close in the parameter): the jitter of points at a
-#: non-smooth corner stays within both
-HB_TURNING_BAND = 5e-4
-HB_TURNING_BAND_LOG_Q = 5e-3
-#: a turning point is a fold only with an unstable point between it and the
-#: neighbouring turning points (without one on a side: within this many
-#: points): a saddle-node changes the number of unstable multipliers
-HB_FOLD_WINDOW = 3
-#: a local maximum of the amplitude along a branch is a peak when the
-#: amplitude falls by more than this fraction of it on both sides (before
-#: rising above it again)
-HB_PEAK_PROMINENCE = 1e-3
-#: bytes of dense Jacobians a branch keeps at once: the continuation monitor
-#: keeps the evaluations of accepted points with their Jacobians while they fit
-#: (beyond, without: the point is evaluated again for its stability), and
-#: Hill's method runs on chunks of points that fit
-HB_JACOBIAN_BUDGET_BYTES = 2**28
 
 
 @dataclass(frozen=True)
@@ -141,6 +105,7 @@ class _Request:
     progress: bool | None
     condense: bool | None
     stability: StabilityOptions = StabilityOptions()
+    hb: HBOptions = HBOptions()
 
 
 @dataclass(frozen=True)
@@ -195,10 +160,10 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     ws = np.array([problem.omega(v) for v in lam])
     growth = np.full(n, np.nan)
     # the Floquet exponents of every point: dense Hill on chunks of points whose Jacobians fit in
-    # HB_JACOBIAN_BUDGET_BYTES, or shift-invert Arnoldi point by point (StabilityOptions.method_for)
+    # HBOptions.jacobian_budget_bytes, or shift-invert Arnoldi point by point (StabilityOptions.method_for)
     method = tr.stability.method_for(2 * problem.system.ndof * problem.nh)
     dense, need = method == "dense", method != "none"
-    chunk = max(1, min(n, HB_JACOBIAN_BUDGET_BYTES // (8 * problem.size * problem.size))) if dense else 1
+    chunk = max(1, min(n, problem.options.jacobian_budget_bytes // (8 * problem.size * problem.size))) if dense else 1
     JXs = np.empty((chunk, problem.size, problem.size) if dense else (1, 0, 0))
     lapack = method == "arnoldi" or (dense and 2 * problem.system.ndof * problem.nh > tr.stability.small_eig)
     with stage_progress(n if need else 0, f"stability ({method})", tr.progress, unit="point") as bar, \
@@ -226,7 +191,8 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     stable, checked = _confirmed_stability(problem, X, lam, growth, tr.stability)
     counters = {**parts.counters, "monodromy_checks": checked}
     # folds need the stability on both sides; without it (no stability asked for) the turning points stand
-    fold = _saddle_nodes(parts.fold, stable, parts.segment) if np.all(np.isfinite(growth)) else parts.fold
+    fold = (_saddle_nodes(parts.fold, stable, parts.segment, problem.options.fold_window)
+            if np.all(np.isfinite(growth)) else parts.fold)
     return HBBranch(problem=problem, parameter=problem.parameter.name, status=status, message=message, lam=lam,
                     X=X, segment=parts.segment, fold=fold, gap=parts.gap, counters=counters,
                     stable=stable, growth=growth, passes=passes,
@@ -255,21 +221,21 @@ def _arnoldi_growth(problem: HBProblem, JX, w, options) -> float:
                                   options).growth
 
 
-def _saddle_nodes(turning, stable, segment):
+def _saddle_nodes(turning, stable, segment, window: int):
     """The turning points that can be folds: an unstable point next to them along the branch.
 
     At a fold of a smooth branch a real Floquet multiplier crosses +1, so
     the number of unstable multipliers changes by one there and one side of
     it is unstable. A turning point is kept when the stretch to the
     neighbouring turning point on either side (or, without one, the
-    ``HB_FOLD_WINDOW`` points on that side) holds an unstable point;
+    ``window`` points on that side, ``HBOptions.fold_window``) holds an unstable point;
     on a piecewise-smooth branch the change of stability can lie a few
     points before the extreme of the parameter. Turning points with stable
     points all around are zigzags of the branch at corners or jumps of a
     closed-form contact force, not folds: a sweep does not jump there.
     """
     out = np.zeros_like(turning)
-    k = HB_FOLD_WINDOW
+    k = window
     for sgm in np.unique(segment):
         idx = np.flatnonzero(segment == sgm)
         tp = np.flatnonzero(turning[idx])
@@ -316,11 +282,12 @@ def _scales(problem: HBProblem, start: float):
 
 def _saturation_test(problem: HBProblem, ev, X, q, lam):
     """Describing-function saturation test (module docstring); None or reason."""
-    if q < HB_SATURATION_Q or has_damping(problem.system.C) or problem.system.ndof != 1:
+    opts = problem.options
+    if q < opts.saturation_q or has_damping(problem.system.C) or problem.system.ndof != 1:
         return None
     for code in ev.code:
         slip = np.mean((code == MACROSLIP) | (code == SEPARATION))
-        if slip < HB_SATURATION_SLIP_FRACTION:
+        if slip < opts.saturation_slip_fraction:
             return None
     # energy dissipated by the contacts per cycle, E = sum_c oint T_c du_c
     Xm = X.reshape(problem.nh, problem.n)
@@ -427,6 +394,7 @@ class _Tracker:
     def monitor(self, y, lam_s):
         xs, _, ps = self.scales
         name = self.problem.parameter.name
+        opts = self.problem.options
         X = y * xs
         amps = self._accepted_amps[y.tobytes()] = self.amplitudes(y)
         q = self.q(amps[0])
@@ -434,12 +402,12 @@ class _Tracker:
         if self.last is not None:
             ev = self.last
             size = ev.JX.shape[0]
-            if (len(self.evaluations) + 1) * 8 * size * size > HB_JACOBIAN_BUDGET_BYTES:
+            if (len(self.evaluations) + 1) * 8 * size * size > opts.jacobian_budget_bytes:
                 ev = dataclasses.replace(ev, JX=None, scaled=None)  # the Jacobian is evaluated again when needed
             self.evaluations[float(lam)] = (X, ev, amps)
-        if not math.isfinite(q) or q > HB_UNBOUNDED_Q:
+        if not math.isfinite(q) or q > opts.unbounded_q:
             return (ContinuationStatus.UNBOUNDED,
-                    f"q = kt X / fy = {q:.4g} exceeds {HB_UNBOUNDED_Q:g} at {name} = {lam:.6g}")
+                    f"q = kt X / fy = {q:.4g} exceeds {opts.unbounded_q:g} at {name} = {lam:.6g}")
         if self.last is not None:
             why = _saturation_test(self.problem, self.last, X, q, lam)
             if why is not None:
@@ -454,7 +422,7 @@ class _Tracker:
         (:func:`~jointdyn.hb.results.sliding_as_a_whole`)."""
         if res.status is ContinuationStatus.FAILED and res.y.shape[0] > 0:
             q = self.q(self.amplitudes(res.y[-1])[0])
-            if q > HB_UNBOUNDED_FAIL_FRACTION * HB_UNBOUNDED_Q:
+            if q > self.problem.options.unbounded_fail_fraction * self.problem.options.unbounded_q:
                 return dataclasses.replace(
                     res, status=ContinuationStatus.UNBOUNDED,
                     message=f"Newton failed with q = {q:.4g} growing: unbounded response ({res.message})")
@@ -480,10 +448,11 @@ def _bar(start: float, stop: float, desc: str, progress, name: str, scale: float
     return ParameterProgress(start, stop, desc, progress, name=name, scale=scale)
 
 
-def _forcing_problem(system: System, gamma: float, harmonics: int, samples: int, condense):
+def _forcing_problem(system: System, gamma: float, harmonics: int, samples: int, condense,
+                     options: HBOptions | None = None):
     """The problem at this gamma with the forcing amplitude as its (fixed) parameter."""
     return make_problem(system, condense=condense, harmonics=harmonics, samples=samples, parameter="f1",
-                        gamma=gamma)
+                        gamma=gamma, options=options)
 
 
 def solve_point(problem: HBProblem, gamma: float, guess, tol: float, max_iter: int):
@@ -493,7 +462,7 @@ def solve_point(problem: HBProblem, gamma: float, guess, tol: float, max_iter: i
     reference value, at ``gamma`` (:func:`_forcing_problem`). Newton starts
     from ``guess`` (m; default the stuck-contact linear solution); where it
     fails from the linear solution, the forcing amplitude is continued from
-    ``HB_HOMOTOPY_START`` F1 to F1 at this gamma, where the
+    ``HBOptions.homotopy_start`` F1 to F1 at this gamma, where the
     stuck-contact linear solution is a good start (:func:`_homotopy`), and
     Newton is made again from its end.
     """
@@ -519,15 +488,15 @@ def solve_point(problem: HBProblem, gamma: float, guess, tol: float, max_iter: i
 
 def _homotopy(problem: HBProblem, gamma: float, tol: float):
     """X (m) at the full forcing amplitude F1 of ``problem``, continued in the forcing amplitude from
-    ``HB_HOMOTOPY_START`` F1 at the same gamma and discretisation (None where the branch does not
+    ``HBOptions.homotopy_start`` F1 at the same gamma and discretisation (None where the branch does not
     reach F1); the request :func:`jointdyn.hb.continue_hb` makes with ``parameter="f1"``."""
     system, f1 = problem.system, problem.f1_ref
     opt = make_options(None, {"tol": tol})
     if opt.start_extrapolation is None and all(c.law.smooth_force for c in system.contacts):
         opt = dataclasses.replace(opt, start_extrapolation=START_EXTRAPOLATION)
-    req = _Request(system=system, start=HB_HOMOTOPY_START * f1, stop=f1, parameter=F1, gamma=gamma,
+    req = _Request(system=system, start=problem.options.homotopy_start * f1, stop=f1, parameter=F1, gamma=gamma,
                    max_step=None, dof=system.response_dof, options=opt, backward=False, progress=False,
-                   condense=problem.condensed)
+                   condense=problem.condensed, hb=problem.options)
     br = continued_branch(req, Level(problem.H, problem.Ns))
     lam = br.parts.lam
     if br.status is ContinuationStatus.COMPLETE and lam.size and lam[-1] == f1:
@@ -543,11 +512,12 @@ def _segment(tr: _Tracker, lam_a, lam_b, opt: ContinuationOptions, progress, mon
     with _bar(lam_a / ps, lam_b / ps, f"HB {problem.parameter.name}", progress, problem.parameter.name, ps) as bar:
         y0 = problem.linear_guess(lam_a) / xs
         if (problem.parameter is GAMMA
-                and not newton(tr.residual, y0, lam_a / ps, opt, max_iter=HB_START_MAX_ITER)[1]):
+                and not newton(tr.residual, y0, lam_a / ps, opt, max_iter=problem.options.start_max_iter)[1]):
             # start by a homotopy in the forcing amplitude at this gamma
             # when Newton from the stuck-contact solution fails
-            X, ok, _ = solve_point(_forcing_problem(problem.system, lam_a, problem.H, problem.Ns, problem.condensed),
-                                   lam_a, None, opt.tol, HB_SOLVE_MAX_ITER)
+            X, ok, _ = solve_point(_forcing_problem(problem.system, lam_a, problem.H, problem.Ns, problem.condensed,
+                                                    problem.options),
+                                   lam_a, None, opt.tol, problem.options.solve_max_iter)
             if ok:
                 y0 = X / xs
         return tr.relabel(continuation(tr.residual, y0, lam_a / ps, lam_b / ps, opt,
@@ -598,7 +568,7 @@ def continued_branch(req: _Request, level: Level, watch_for=None):
     to stop, and a ``restart()`` for the segment continued back), that target where it stopped the branch
     (:class:`jointdyn.hb.discretisation._PeakWatch`)."""
     problem = make_problem(req.system, condense=req.condense, response_dofs=(req.dof,), harmonics=level.harmonics,
-                           samples=level.samples, parameter=req.parameter, gamma=req.gamma)
+                           samples=level.samples, parameter=req.parameter, gamma=req.gamma, options=req.hb)
     with preconditioned_by(problem.block_preconditioner()):
         return _continued(req, problem, watch_for)
 
@@ -677,7 +647,8 @@ def _join(tr: _Tracker, parts, fills, start, stop, opt) -> _Draft:
     peaks += [pk for k, (f, y_left) in enumerate(fills)
               for pk in _fill_peak(tr, f, logqs[main + k], tr.observe(y_left, 0.0), main + k, opt)]
     logq = np.concatenate(logqs)
-    joined = dataclasses.replace(joined, fold=_turning_mask(joined.lam, logq, joined.segment, joined.gap, start, stop))
+    joined = dataclasses.replace(joined, fold=_turning_mask(joined.lam, logq, joined.segment, joined.gap, start, stop,
+                                                                      tr.problem.options))
     return _Draft(tr, status, message, joined, tuple(peaks), tuple(uncovered))
 
 
@@ -774,7 +745,8 @@ def _peaks(tr: _Tracker, res: ContinuationResult, g, segment: int, opt) -> list:
     its points (HBPeak)."""
     if res.lam.size < 3:
         return []
-    return [_refined_peak(tr, res, g, i, segment, opt) for i in local_maxima(g, res.gap, HB_PEAK_PROMINENCE)]
+    prominence = tr.problem.options.peak_prominence
+    return [_refined_peak(tr, res, g, i, segment, opt) for i in local_maxima(g, res.gap, prominence)]
 
 
 def _refined_peak(tr: _Tracker, res: ContinuationResult, g, i: int, segment: int, opt) -> HBPeak:
@@ -815,22 +787,22 @@ def _fill_peak(tr: _Tracker, fill: ContinuationResult, g, g_left: float, segment
     return [_refined_peak(tr, fill, g, j, segment, opt)]
 
 
-def _turning_mask(lam, observed, segment, gap, start, stop):
+def _turning_mask(lam, observed, segment, gap, start, stop, opts: HBOptions):
     """Folds: points where the parameter is extremal along a segment, beyond a dead band.
 
     A reversal of the parameter counts once it exceeds
-    ``HB_TURNING_BAND`` of the range, or once log q has moved by
-    more than ``HB_TURNING_BAND_LOG_Q`` while the parameter is still
+    ``opts.turning_band`` of the range, or once log q has moved by
+    more than ``opts.turning_band_log_q`` while the parameter is still
     short of the extreme (a fold whose two branches are close in the
     parameter but far apart in amplitude). The jitter of points at a
     non-smooth corner (onset of slip or separation, where the branch keeps
     going) is within both bands and does not count.
     """
     m = np.zeros(lam.size, dtype=bool)
-    band = HB_TURNING_BAND * abs(stop - start)
+    band = opts.turning_band * abs(stop - start)
     for sgm in np.unique(segment):
         idx = np.flatnonzero(segment == sgm)
         tp = turning_points(lam[idx], gap[idx], band=band, observed=observed[idx],
-                            observed_band=HB_TURNING_BAND_LOG_Q)
+                            observed_band=opts.turning_band_log_q)
         m[idx[tp]] = True
     return m

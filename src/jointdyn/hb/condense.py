@@ -76,7 +76,7 @@ from .._jit import jit
 from ..damping import dense_damping, is_operator
 from ..kinematics import contact_kinematics, selection_matrix
 from ..systems import System, free_modes
-from .levels import HB_CONDENSE_MIN_DOFS
+from .options import HBOptions, hb_options
 from .problem import HBProblem, _linear_blocks, contacts_only, held_by_contacts
 from .hill_condensed import condensed_hill_exponents
 from .stability import hill_growth, hill_stability
@@ -84,10 +84,6 @@ from .stability_options import StabilityOptions
 
 __all__ = ["Receptance", "receptance", "retained_dofs", "CondensedHBProblem", "make_problem", "use_condensed"]
 
-#: automatic choice: condense systems of at least ``HB_CONDENSE_MIN_DOFS`` DOFs
-#: (:mod:`jointdyn.hb.levels`) whose retained DOFs (contacts, DOF 0, response DOFs) are at most this
-#: fraction of all DOFs
-HB_CONDENSE_MAX_FRACTION = 0.5
 #: the damping is modal (receptance by the undamped modes) when C = alpha M +
 #: beta K to this fraction of max |C|, or when the off-diagonal entries of
 #: Phi^T C Phi are at most this fraction of its largest entry; otherwise the
@@ -572,7 +568,7 @@ class CondensedHBProblem(HBProblem):
 
     Parameters
     ----------
-    system, harmonics, samples, parameter, gamma, max_passes
+    system, harmonics, samples, parameter, gamma, max_passes, options
         As for :class:`~jointdyn.hb.problem.HBProblem`.
     response_dofs : sequence of int
         DOFs kept among the unknowns besides the contact DOFs and DOF 0.
@@ -580,9 +576,10 @@ class CondensedHBProblem(HBProblem):
 
     def __init__(self, system: System, *, harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
                  parameter="gamma", gamma: float | None = None, max_passes: int = config.HB_MAX_PASSES,
-                 response_dofs=()):
+                 response_dofs=(), options: HBOptions | None = None):
         if not isinstance(system, System):
             raise ValueError("system must be a jointdyn.System")
+        self.options = hb_options(options)
         use_condensed(system, True)  # refuses a structure held only through its contacts
         c = retained_dofs(system, response_dofs)
         self.receptance = receptance(system)  # first: it also gives system.w0 (_share_w0)
@@ -775,12 +772,12 @@ class CondensedHBProblem(HBProblem):
         return found.growth <= StabilityOptions().rtol, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
 
 
-def use_condensed(system: System, condense=None, response_dofs=()) -> bool:
+def use_condensed(system: System, condense=None, response_dofs=(), options: HBOptions | None = None) -> bool:
     """Whether harmonic balance condenses ``system``: ``condense`` if True/False, else automatic.
 
     Automatic: condensed when the system has at least
-    ``HB_CONDENSE_MIN_DOFS`` DOFs, retains at most
-    ``HB_CONDENSE_MAX_FRACTION`` of them, and K is positive definite
+    ``options.condense_min_dofs`` DOFs, retains at most
+    ``options.condense_max_fraction`` of them (:class:`~jointdyn.hb.options.HBOptions`), and K is positive definite
     on the DOFs that are not retained. A structure held only through its
     contacts (:func:`~jointdyn.hb.problem.held_by_contacts`) is never
     condensed: the receptance and the static Schur complement are those of K,
@@ -808,10 +805,11 @@ def use_condensed(system: System, condense=None, response_dofs=()) -> bool:
         return False
     if condense:
         return True
-    if system.ndof < HB_CONDENSE_MIN_DOFS:
+    opts = hb_options(options)
+    if system.ndof < opts.condense_min_dofs:
         return False
     c = retained_dofs(system, response_dofs)
-    if c.size > HB_CONDENSE_MAX_FRACTION * system.ndof:
+    if c.size > opts.condense_max_fraction * system.ndof:
         return False
     try:
         _static_parts(system.K, c, receptance(system))
@@ -825,10 +823,11 @@ def make_problem(system: System, *, condense=None, response_dofs=(), **kwargs) -
 
     ``condense``: True, False, or None for the automatic choice of
     :func:`use_condensed`; ``response_dofs`` are kept among the unknowns of
-    a condensed problem; other keyword arguments go to the problem.
+    a condensed problem; other keyword arguments go to the problem (``options``, an
+    :class:`~jointdyn.hb.options.HBOptions`, also to the automatic choice).
     """
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
-    if use_condensed(system, condense, response_dofs):
+    if use_condensed(system, condense, response_dofs, kwargs.get("options")):
         return CondensedHBProblem(system, response_dofs=response_dofs, **kwargs)
     return HBProblem(system, **kwargs)

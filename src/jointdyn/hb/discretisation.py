@@ -23,18 +23,8 @@ from ..continuation import ContinuationOptions, ContinuationStatus, newton, refi
 from .branch import _Request, _scales, _Tracker, continued_branch
 from .condense import make_problem
 from .levels import Discretisation, Level
+from .options import HBOptions, hb_options
 from .results import DiscretisationCheck, HBBranch, HBPeak
-
-#: while the first branch is continued, its highest point so far is checked once the amplitude has fallen
-#: below this fraction of it (a resonance passed); where that peak converges at a finer level, the branch
-#: stops there and is computed at that level (the rest of it would be discarded), and the finished branch
-#: must confirm the stop, else the choice is made again without stops (:class:`_PeakWatch`)
-HB_AUTO_EARLY_DROP = 0.5
-#: the largest H and Ns an automatic choice takes (the check solves go one level beyond); with separation
-#: the samples decide, H = 7 already within 2e-4 of H = 15 on the paper's grid
-HB_AUTO_MAX_HARMONICS = 15
-HB_AUTO_MAX_SAMPLES = 2048
-
 
 def _fixed_branch(req: _Request, level: Level, disc: Discretisation | None = None, watch: bool = False):
     """The branch at ``level``: a :class:`~jointdyn.hb.branch._Draft`,
@@ -43,7 +33,7 @@ def _fixed_branch(req: _Request, level: Level, disc: Discretisation | None = Non
     watch_for = (lambda tr, opt: _PeakWatch(tr, req, level, disc, opt)) \
         if watch and disc is not None and (disc.harmonics_auto or disc.samples_auto) else None
     if disc is not None and (disc.harmonics_auto or disc.samples_auto):
-        k, most = level_number(level, disc)
+        k, most = level_number(level, disc, req.hb)
         stage_note(f"HB level {k}/{most}: H = {level.harmonics}, Ns = {level.samples}", req.progress)
     return continued_branch(req, level, watch_for)
 
@@ -56,14 +46,16 @@ def _doublings(a: int, b: int, grow) -> int:
     return n
 
 
-def level_number(level: Level, disc: Discretisation) -> tuple[int, int]:
+def level_number(level: Level, disc: Discretisation, options: HBOptions | None = None) -> tuple[int, int]:
     """(k, most): ``level`` is the k-th of an automatic choice from ``disc.first``, which has at most ``most``
-    (each raise of the harmonics H -> 2H + 1 and of the samples Ns -> 2 Ns within ``HB_AUTO_MAX_*``
-    is one level; a samples retry after a failure is one too)."""
+    (each raise of the harmonics H -> 2H + 1 and of the samples Ns -> 2 Ns within
+    ``options.auto_max_harmonics`` and ``options.auto_max_samples`` (:class:`~jointdyn.hb.options.HBOptions`,
+    None: the defaults) is one level; a samples retry after a failure is one too)."""
+    opts = hb_options(options)
     (h0, s0), grow_h, grow_s = disc.first, (lambda h: 2 * h + 1), (lambda s: 2 * s)
     k = 1 + _doublings(h0, level.harmonics, grow_h) + _doublings(s0, level.samples, grow_s)
-    most = 1 + (_doublings(h0, HB_AUTO_MAX_HARMONICS + 1, grow_h) - 1 if disc.harmonics_auto else 0) \
-        + (_doublings(s0, HB_AUTO_MAX_SAMPLES + 1, grow_s) - 1 if disc.samples_auto else 0)
+    most = 1 + (_doublings(h0, opts.auto_max_harmonics + 1, grow_h) - 1 if disc.harmonics_auto else 0) \
+        + (_doublings(s0, opts.auto_max_samples + 1, grow_s) - 1 if disc.samples_auto else 0)
     return k, max(k, most)
 
 
@@ -78,17 +70,20 @@ def check_levels(level: Level, disc: Discretisation):
     return by_h, (Level(H, 2 * Ns) if disc.samples_auto else None)
 
 
-def next_level(level: Level, disc: Discretisation, bad_h: bool, bad_s: bool) -> Level:
-    """The level the checks ask for, within ``HB_AUTO_MAX_*`` (equal to ``level``: no refinement).
+def next_level(level: Level, disc: Discretisation, bad_h: bool, bad_s: bool,
+               options: HBOptions | None = None) -> Level:
+    """The level the checks ask for, within ``options.auto_max_harmonics`` and ``options.auto_max_samples``
+    (:class:`~jointdyn.hb.options.HBOptions`, None: the defaults; equal to ``level``: no refinement).
 
     The samples first: with too few, the sampling error of the contact
     force also moves the solution with more harmonics, so H is raised
     only once the samples pass their check.
     """
+    opts = hb_options(options)
     by_h, by_s = check_levels(level, disc)
     if bad_s and by_s is not None:
-        return by_s if by_s.samples <= HB_AUTO_MAX_SAMPLES else level
-    if bad_h and by_h is not None and by_h.harmonics <= HB_AUTO_MAX_HARMONICS:
+        return by_s if by_s.samples <= opts.auto_max_samples else level
+    if bad_h and by_h is not None and by_h.harmonics <= opts.auto_max_harmonics:
         return by_h
     return level
 
@@ -97,7 +92,7 @@ def _at_level(req: _Request, condensed: bool, X, level: Level):
     """(tracker of the problem at ``level``, the harmonics X there in its scaled unknowns, zero above
     their H)."""
     problem = make_problem(req.system, condense=condensed, response_dofs=(req.dof,), harmonics=level.harmonics,
-                           samples=level.samples, parameter=req.parameter, gamma=req.gamma)
+                           samples=level.samples, parameter=req.parameter, gamma=req.gamma, options=req.hb)
     tr = _Tracker(problem, _scales(problem, req.start), req.dof, req.stability, req.progress)
     Xm = np.asarray(X).reshape(-1, problem.n)
     X0 = np.zeros((problem.nh, problem.n))
@@ -153,7 +148,7 @@ def _peak_levels(req: _Request, condensed: bool, pk, scale: float, level, disc):
         solved = {lv: _solve_at(req, condensed, pk.lam, X, lv) for lv in check_levels(at, disc) if lv}
         ch = tuple(_change(solved[lv][0], amp, scale) if lv else math.nan for lv in check_levels(at, disc))
         first = ch if first is None else first
-        nxt = next_level(at, disc, ch[0] > config.HB_AUTO_RTOL, ch[1] > config.HB_AUTO_RTOL)
+        nxt = next_level(at, disc, ch[0] > config.HB_AUTO_RTOL, ch[1] > config.HB_AUTO_RTOL, req.hb)
         if nxt == at:
             return at, first, not (ch[0] > config.HB_AUTO_RTOL or ch[1] > config.HB_AUTO_RTOL)
         amp, X = solved[nxt] if nxt in solved else _solve_at(req, condensed, pk.lam, X, nxt)
@@ -212,7 +207,7 @@ class _PeakWatch:
     they are passed.
 
     The highest accepted point of the segment so far is checked once the
-    amplitude has fallen below ``HB_AUTO_EARLY_DROP`` times its
+    amplitude has fallen below ``HBOptions.auto_early_drop`` times its
     amplitude (and again for a higher point later): one Newton step from
     it with twice the samples (with 2H + 1 harmonics where the samples are
     fixed), one evaluation, gives the change of its amplitude to first
@@ -254,7 +249,7 @@ class _PeakWatch:
         if g > self.checked and (self.top is None or g > pts[self.top][0]):
             self.top = len(pts) - 1
             return None
-        if self.top is None or g >= pts[self.top][0] + math.log(HB_AUTO_EARLY_DROP):
+        if self.top is None or g >= pts[self.top][0] + math.log(self.req.hb.auto_early_drop):
             return None
         i, self.top = self.top, None
         self.checked = pts[i][0]
@@ -319,7 +314,7 @@ def _watched_branch(req: _Request, level, disc, levels, retry_failed: bool, watc
         levels.append(level)
         br = _fixed_branch(req, level, disc)
     while retry_failed and br.status is ContinuationStatus.FAILED and disc.samples_auto \
-            and 2 * level.samples <= HB_AUTO_MAX_SAMPLES:
+            and 2 * level.samples <= req.hb.auto_max_samples:
         level = Level(level.harmonics, 2 * level.samples)
         levels.append(level)
         br = _fixed_branch(req, level, disc)

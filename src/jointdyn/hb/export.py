@@ -24,7 +24,7 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
     peak-to-peak of x(t) of ``response_dof``), ``amplitude_m`` (X, m),
     ``offset_m`` (mean, m), ``max_abs_m`` (m), ``stable``, ``fold``
     (turning points: the parameter is extremal along the computed branch,
-    beyond a dead band of ``jointdyn.hb.branch.HB_TURNING_BAND`` of the range, so that
+    beyond a dead band of ``HBOptions.turning_band`` of the range, so that
     the corners of a piecewise-smooth branch, where it keeps its
     direction, are not folds), ``point_status`` (:class:`PointStatus`:
     how the point joins the one before it; a line is drawn only to

@@ -23,12 +23,14 @@ from .._threads import blas_threads
 from ..continuation import START_EXTRAPOLATION, ContinuationOptions, make_options
 from ..damping import dense_damping
 from ..systems import System
-from .branch import HB_SOLVE_MAX_ITER, _forcing_problem, _Request, solve_point
+from .branch import _forcing_problem, _Request, solve_point
 from .discretisation import adaptive_branch
 from .export import branch_dataset
 from .hill_arnoldi import hill_arnoldi_exponents
 from .hill_condensed import condensed_hill_exponents
 from .levels import AUTO, Discretisation, Level, check_memory
+from .options import HBOptions
+from .options import hb_options as _hb_options
 from .parameters import GAMMA, parameter_named
 from .problem import HBProblem, reference_scales, stuck_stiffness
 from .results import HBBranch, HBSolution, SolveStatus
@@ -36,16 +38,6 @@ from .stability import hill_stability
 from .stability_options import StabilityOptions, stability_options
 
 __all__ = ["continue_hb", "frc_hb", "harmonic_balance", "check_mean_position"]
-
-#: harmonic balance in gamma: largest gamma spacing of a branch when the
-#: caller gives none (the command line passes the STEP of --gamma). The chord
-#: bound CONT_CHORD_TOL is a distance in (gamma, ln amplitude); on a steep flank a
-#: chord within it can still miss the amplitude at the same gamma by more
-#: than 1 % (1.4 % at 0.1 gamma spacing on the Jenkins benchmark branch,
-#: F1 = 5 N, docs/hb-comparison.md); 0.02 keeps it below 1 % (0.9 %) for
-#: about 25 % more points
-HB_MAX_GAMMA_STEP = 0.02
-
 
 def check_mean_position(system: System) -> None:
     """ValueError where the mean position of ``system`` is not defined with every contact stuck and every
@@ -113,7 +105,8 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
                 max_step: float | None = None, response_dof: int | None = None,
                 options: ContinuationOptions | None = None, backward_after_unbounded: bool = True,
                 progress: bool | None = None, condense: bool | None = None,
-                stability: StabilityOptions | bool | None = None, **overrides) -> HBBranch:
+                stability: StabilityOptions | bool | None = None, hb_options: HBOptions | None = None,
+                **overrides) -> HBBranch:
     """Continue harmonic-balance solutions in a scalar parameter.
 
     Parameters
@@ -135,17 +128,17 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         (default): start at ``config.HB_HARMONICS``; every refined peak is
         solved again with 2H + 1 harmonics and, where its amplitude changes
         by more than ``config.HB_AUTO_RTOL``, the branch is computed again
-        with more (up to ``jointdyn.hb.discretisation.HB_AUTO_MAX_HARMONICS``).
+        with more (up to ``hb_options.auto_max_harmonics``).
     samples : int or "auto"
         AFT time samples per period (>= 2H + 2). ``"auto"`` (default):
         start at ``config.HB_SAMPLES`` and double the same way, checked
-        with 2 Ns samples (up to ``jointdyn.hb.discretisation.HB_AUTO_MAX_SAMPLES``). The
+        with 2 Ns samples (up to ``hb_options.auto_max_samples``). The
         levels used and the check are in ``HBBranch.discretisation``; a
         converged branch costs two extra solves per peak.
     max_step : float, optional
         Largest change of the parameter between consecutive points (in its
         own unit, e.g. a gamma grid spacing); default
-        ``HB_MAX_GAMMA_STEP`` when the parameter is gamma, none
+        ``hb_options.max_gamma_step`` when the parameter is gamma, none
         beyond the chord bound otherwise.
     response_dof : int, optional
         DOF whose amplitude the step control follows and the peaks report
@@ -178,6 +171,10 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         up to its ``dense_max_rows`` companion rows, shift-invert Arnoldi
         beyond); False: not computed (``HBBranch.stability`` is
         ``not-computed``, growth NaN).
+    hb_options : HBOptions, optional
+        Harmonic balance's own numbers (:class:`~jointdyn.hb.options.HBOptions`: the Jacobian's form,
+        the bounds of the automatic discretisation, Newton iterations, the end of a branch, folds,
+        peaks, the condensation; None: the defaults).
 
     Returns
     -------
@@ -189,7 +186,8 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         raise ValueError("system must be a jointdyn.System")
     reference_scales(system)
     disc = Discretisation.of(harmonics, samples)
-    check_memory(system, disc)
+    hbo = _hb_options(hb_options)
+    check_memory(system, disc, options=hbo)
     check_mean_position(system)
     par = parameter_named(parameter)
     start = V.finite(par.name + " start", start)
@@ -206,19 +204,19 @@ def continue_hb(system: System, start: float, stop: float, *, parameter="gamma",
         # every force smooth at the onset of slip: the corrector starts from the branch's extrapolation
         opt = dataclasses.replace(opt, start_extrapolation=START_EXTRAPOLATION)
     if max_step is None and par is GAMMA:
-        max_step = HB_MAX_GAMMA_STEP
+        max_step = hbo.max_gamma_step
     if max_step is not None:
         V.positive("max_step", max_step)
     req = _Request(system=system, start=start, stop=stop, parameter=par, gamma=gamma, max_step=max_step, dof=dof,
                    options=opt, backward=backward_after_unbounded, progress=progress, condense=condense,
-                   stability=stability_options(stability))
+                   stability=stability_options(stability), hb=hbo)
     return adaptive_branch(req, disc)
 
 
 def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: int | str = AUTO,
            samples: int | str = AUTO, max_step: float | None = None, response_dof: int | None = None,
            options: ContinuationOptions | None = None, progress: bool | None = None, condense: bool | None = None,
-           stability: StabilityOptions | bool | None = None, **overrides):
+           stability: StabilityOptions | bool | None = None, hb_options: HBOptions | None = None, **overrides):
     """Frequency-response curve by harmonic balance and arc-length continuation.
 
     Harmonics 0..H of every DOF (normalised time tau = w t), contact forces
@@ -241,7 +239,7 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
         >= 2H + 2, or chosen likewise (default).
     max_step : float, optional
         Largest gamma spacing between consecutive points (e.g. the STEP of
-        a gamma grid; default ``HB_MAX_GAMMA_STEP``); the chord
+        a gamma grid; default ``hb_options.max_gamma_step``, 0.02); the chord
         bound (``chord_tol``) applies in any case.
     response_dof : int, optional
         DOF whose response is reported (default ``system.response_dof``).
@@ -253,6 +251,8 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
         :func:`continue_hb`).
     stability : StabilityOptions or False, optional
         How the stability is computed, or False for none (see :func:`continue_hb`).
+    hb_options : HBOptions, optional
+        Harmonic balance's own numbers (see :func:`continue_hb`).
 
     Returns
     -------
@@ -272,14 +272,15 @@ def frc_hb(system: System, gamma_start: float, gamma_stop: float, *, harmonics: 
     br = continue_hb(system, V.positive("gamma_start", gamma_start), V.positive("gamma_stop", gamma_stop),
                      parameter=GAMMA, harmonics=harmonics, samples=samples, max_step=max_step,
                      response_dof=response_dof, options=options, progress=progress, condense=condense,
-                     stability=stability, **overrides)
+                     stability=stability, hb_options=hb_options, **overrides)
     return branch_dataset(br)
 
 
 def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB_HARMONICS,
                      samples: int = config.HB_SAMPLES, guess=None, response_dof: int = 0,
-                     tol: float = config.CONT_TOL, max_iter: int = HB_SOLVE_MAX_ITER,
-                     condense: bool | None = None, stability: StabilityOptions | bool | None = None) -> HBSolution:
+                     tol: float = config.CONT_TOL, max_iter: int | None = None,
+                     condense: bool | None = None, stability: StabilityOptions | bool | None = None,
+                     hb_options: HBOptions | None = None) -> HBSolution:
     """Solve the HB equations at one frequency by damped Newton.
 
     Parameters
@@ -292,13 +293,13 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
     guess : ndarray, optional
         Starting coefficients (default: the stuck-contact linear solution;
         if Newton fails from it, a continuation in the forcing amplitude
-        from ``jointdyn.hb.branch.HB_HOMOTOPY_START`` F1 to F1 at this gamma).
+        from ``hb_options.homotopy_start`` F1 to F1 at this gamma).
     response_dof : int
         DOF reported in the amplitudes.
     tol : float
         Tolerance on the residual scaled by max(F1, fy).
-    max_iter : int
-        Newton iterations.
+    max_iter : int, optional
+        Newton iterations (default ``hb_options.solve_max_iter``, 50).
     condense : bool, optional
         Condense exactly onto the contact DOFs (None: by size; see
         :func:`continue_hb`). The unknowns X (and ``guess``) are then the
@@ -309,6 +310,9 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
         How the stability is computed, or False for none (see
         :func:`continue_hb`); by Arnoldi, ``multipliers`` are those of the
         exponents found near the imaginary axis.
+    hb_options : HBOptions, optional
+        Harmonic balance's own numbers (see :func:`continue_hb`); here the Newton iterations, the
+        homotopy start, the Jacobian's form and the condensation.
 
     Returns
     -------
@@ -318,10 +322,12 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
     gamma = V.positive("gamma", gamma)
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")
-    check_memory(system, Discretisation(Level.of(harmonics, samples), False, False))
+    hbo = _hb_options(hb_options)
+    max_iter = hbo.solve_max_iter if max_iter is None else max_iter
+    check_memory(system, Discretisation(Level.of(harmonics, samples), False, False), options=hbo)
     check_mean_position(system)
     # the forcing amplitude as the (fixed) parameter: a problem at this gamma
-    problem = _forcing_problem(system, gamma, harmonics, samples, condense)
+    problem = _forcing_problem(system, gamma, harmonics, samples, condense, hbo)
     X, ok, it = solve_point(problem, gamma, None if guess is None else V.finite_array("guess", guess), tol, max_iter)
     return _make_solution(problem, X, ok, it, response_dof, stability_options(stability))
 

@@ -27,12 +27,9 @@ import numpy as np
 from .. import _validate as V
 from .. import config
 from ..kinematics import NormalSpring
+from .options import HBOptions, hb_options
 
 __all__ = ["AUTO", "Level", "Discretisation", "hb_bytes", "check_memory"]
-
-#: the automatic choice condenses onto the contact DOFs (:mod:`jointdyn.hb.condense`) systems of at least
-#: this many DOFs whose retained DOFs are at most ``HB_CONDENSE_MAX_FRACTION`` of all DOFs (read there)
-HB_CONDENSE_MIN_DOFS = 12
 
 #: the value of ``harmonics`` or ``samples`` (and of ``--harmonics``, ``--samples``) asking for the
 #: automatic choice
@@ -104,11 +101,12 @@ _AFT_COPIES = 8
 _HISTORY_STATE = 16
 
 
-def _unknown_dofs(system) -> int:
-    """DOFs whose harmonics are unknowns: all of a small system; at least
-    the contact DOFs (and DOF 0) of one condensed onto them."""
+def _unknown_dofs(system, min_dofs: int) -> int:
+    """DOFs whose harmonics are unknowns: all of a system of fewer than ``min_dofs`` DOFs (the smallest
+    the automatic choice condenses, ``HBOptions.condense_min_dofs``); at least the contact DOFs (and
+    DOF 0) of one condensed onto them."""
     n = system.ndof
-    if n < HB_CONDENSE_MIN_DOFS:
+    if n < min_dofs:
         return n
     keep = {0, system.response_dof}
     for c in system.contacts:
@@ -120,16 +118,18 @@ def _unknown_dofs(system) -> int:
     return len(keep)
 
 
-def hb_bytes(system, harmonics: int, samples: int) -> float:
+def hb_bytes(system, harmonics: int, samples: int, options: HBOptions | None = None) -> float:
     """Estimated bytes of a harmonic-balance solution of ``system`` with
     ``harmonics`` harmonics and ``samples`` AFT samples per period (a float:
-    huge sizes give huge numbers, never an overflow)."""
+    huge sizes give huge numbers, never an overflow; ``options``: the
+    :class:`~jointdyn.hb.options.HBOptions` of the solution, None: the defaults)."""
+    min_dofs = hb_options(options).condense_min_dofs
     nh = 2.0 * float(harmonics) + 1.0
     ns = float(samples)
     nd = 2.0 * nh + 1.0
     ssz = float(max([c.law.state_size for c in system.contacts], default=1))
     nc = float(len(system.contacts))
-    words = (_JACOBIAN_COPIES * (_unknown_dofs(system) * nh) ** 2 + _AFT_COPIES * ns * nd
+    words = (_JACOBIAN_COPIES * (_unknown_dofs(system, min_dofs) * nh) ** 2 + _AFT_COPIES * ns * nd
              + 4.0 * ssz * nd + 4.0 * nc * ns + (ns * ssz * (nd + 1.0) if ssz <= _HISTORY_STATE else 0.0))
     return 8.0 * words
 
@@ -147,19 +147,21 @@ def _largest(nbytes, low: int) -> int:
     return lo
 
 
-def check_memory(system, disc: Discretisation, names=("harmonics", "samples")) -> None:
+def check_memory(system, disc: Discretisation, names=("harmonics", "samples"),
+                 options: HBOptions | None = None) -> None:
     """ValueError naming the fixed harmonics or samples of ``disc`` (with the largest value that fits)
     when the harmonic balance of ``system`` would exceed the memory bound
     (:func:`jointdyn._validate.memory_budget`); automatic values are bounded by
-    ``jointdyn.hb.discretisation.HB_AUTO_MAX_*`` and not checked here. Fixed harmonics are
-    estimated with the fewest samples they need (2H + 2), so that their own
+    ``HBOptions.auto_max_harmonics`` and ``auto_max_samples`` and not checked here (``options``:
+    the :class:`~jointdyn.hb.options.HBOptions` of the solution, None: the defaults). Fixed harmonics
+    are estimated with the fewest samples they need (2H + 2), so that their own
     size is what they are blamed for, never the default samples."""
     H, Ns = disc.first
     if not disc.harmonics_auto:
-        top = _largest(lambda h: hb_bytes(system, h, 2 * h + 2), 1)
-        V.memory_fits(f"{names[0]} {H}", hb_bytes(system, H, 2 * H + 2),
+        top = _largest(lambda h: hb_bytes(system, h, 2 * h + 2, options), 1)
+        V.memory_fits(f"{names[0]} {H}", hb_bytes(system, H, 2 * H + 2, options),
                       hint=f"{names[0]} must be at most {top} here")
     if not disc.samples_auto:
-        top = _largest(lambda ns: hb_bytes(system, H, ns), 2 * H + 2)
-        V.memory_fits(f"{names[1]} {Ns}", hb_bytes(system, H, Ns),
+        top = _largest(lambda ns: hb_bytes(system, H, ns, options), 2 * H + 2)
+        V.memory_fits(f"{names[1]} {Ns}", hb_bytes(system, H, Ns, options),
                       hint=f"{names[1]} must be at most {top} here (with {H} harmonics)")

@@ -44,12 +44,6 @@ from .. import _validate as V
 __all__ = ["HBParameter", "Gamma", "F1Amplitude", "LoadRatio", "StaticLoad", "LoadPhase", "SystemParameter",
            "GAMMA", "F1", "ETA", "N0", "DELTA", "PARAMETERS", "parameter_named"]
 
-#: central-difference step, relative to the parameter's scale, of dR/dp for
-#: a parameter that builds a System (:class:`SystemParameter`):
-#: about eps^(1/3), which balances the O(h^2) error and rounding
-HB_PARAMETER_FD_STEP = 6e-6
-
-
 class HBParameter:
     """Base of the continuation parameters of harmonic balance (protocol in the module docstring).
 
@@ -216,7 +210,7 @@ class SystemParameter(HBParameter):
     contacts, laws, forcing, loads) is that of ``build(p)``. The residual
     at p is the harmonic-balance residual of ``build(p)``; its derivative
     along p is the central difference
-    ``(R(p + h) - R(p - h)) / (2 h)`` with ``h = HB_PARAMETER_FD_STEP``
+    ``(R(p + h) - R(p - h)) / (2 h)`` with ``h = fd_step``
     times ``scale_value`` (or |p|; error O(h^2) plus rounding of order
     eps |R| / h), the
     only derivative of harmonic balance that is not exact: use a built-in
@@ -235,6 +229,9 @@ class SystemParameter(HBParameter):
         |start| for the continuation, |p| for the step; 1 at 0).
     lower, upper : float
         Allowed range of p (default unbounded).
+    fd_step : float
+        Central-difference step of dR/dp relative to the scale of p (default 6e-6: about eps^(1/3),
+        which balances the O(h^2) error and rounding; in (0, 1)).
     """
 
     name: str = field()  # no default (the base class's "p" is not one)
@@ -242,6 +239,10 @@ class SystemParameter(HBParameter):
     scale_value: float | None = None
     lower: float = -math.inf
     upper: float = math.inf
+    fd_step: float = 6e-6
+
+    def __post_init__(self) -> None:
+        V.in_range("fd_step", self.fd_step, 0.0, 1.0, lo_open=True, hi_open=True)
 
     enters_forcing = True
     enters_loads = True
@@ -256,6 +257,6 @@ class SystemParameter(HBParameter):
             V.in_range(f"{self.name} {what}", v, self.lower, self.upper)
 
     def step(self, p: float) -> float:
-        """Central-difference step h at p: ``HB_PARAMETER_FD_STEP`` times the scale (or |p|, or 1)."""
+        """Central-difference step h at p: ``fd_step`` times the scale (or |p|, or 1)."""
         unit = self.scale_value if self.scale_value is not None else (abs(p) if p != 0.0 else 1.0)
-        return HB_PARAMETER_FD_STEP * unit
+        return self.fd_step * unit

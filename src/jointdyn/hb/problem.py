@@ -51,18 +51,11 @@ from ._rigid import held_by_contacts, mean_gauge
 from ._aft_pairs import pair_directions, pairs_aft_kernel
 from ._sparse import linear_entries
 from .levels import Level
+from .options import HBOptions, hb_options
 from .parameters import SystemParameter, _FixedFrequency, parameter_named
 from .stability import hill_growth, hill_stability
 
 __all__ = ["HBProblem"]
-
-#: Hill stability of a (full) problem with at most this many companion rows (2 n (2H+1)); beyond, O(rows^3)
-#: costs more than the branch (a minute per point at 10^4 rows on 2 cores): not computed (growth NaN)
-HB_HILL_MAX_ROWS = 4000
-#: from ``config.CONT_KRYLOV_SOLVE`` unknowns, HB and EPMC Newton and tangent solves are GMRES preconditioned by
-#: per-harmonic factorisations of the Jacobian's diagonal harmonic blocks (:mod:`jointdyn.hb._precond`); False:
-#: the direct path (one LU of the bordered matrix, reused through GMRES), the reference of bench_hb_scale.py
-HB_BLOCK_PRECONDITIONER = True
 
 
 @dataclass(slots=True)
@@ -174,10 +167,15 @@ class HBProblem:
         Fixed w / w0 when the parameter is not ``gamma``.
     max_passes : int
         Bound on the periods marched per AFT evaluation.
+    options : HBOptions, optional
+        Harmonic balance's numbers (:class:`~jointdyn.hb.options.HBOptions`; None: the defaults): here
+        the size of Hill's method and the block preconditioner of the large solves.
     """
 
     def __init__(self, system: System, *, harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
-                 parameter="gamma", gamma: float | None = None, max_passes: int = config.HB_MAX_PASSES):
+                 parameter="gamma", gamma: float | None = None, max_passes: int = config.HB_MAX_PASSES,
+                 options: HBOptions | None = None):
+        self.options = hb_options(options)
         self._setup(system, harmonics, samples, parameter, gamma, max_passes, None)
         self._lin_blocks = None  # (AK, AC, AM), built at their first use (:attr:`_lin`)
         # what the parameter does not move is built once
@@ -527,8 +525,8 @@ class HBProblem:
     def block_preconditioner(self, columns=()):
         """The structured preconditioner of this problem's large solves (one factorisation per harmonic,
         :class:`jointdyn.hb._precond.HarmonicBlocks`; ``columns``: those of the Jacobian it takes exactly),
-        or None where ``HB_BLOCK_PRECONDITIONER`` is off or below ``config.CONT_KRYLOV_SOLVE`` unknowns."""
-        if not HB_BLOCK_PRECONDITIONER or self.size + 1 < config.CONT_KRYLOV_SOLVE:
+        or None where ``options.block_preconditioner`` is off or below ``config.CONT_KRYLOV_SOLVE`` unknowns."""
+        if not self.options.block_preconditioner or self.size + 1 < config.CONT_KRYLOV_SOLVE:
             return None
         from ._precond import HarmonicBlocks
 
@@ -609,13 +607,13 @@ class HBProblem:
         """How the Jacobian is evaluated from ``config.CONT_KRYLOV_SOLVE`` unknowns: ``"sparse"``
         (:meth:`evaluate_sparse`: at most ``config.CONT_SPARSE_DENSITY`` of its entries nonzero),
         ``"blocks"`` (:meth:`evaluate_blocks`: a structure dense on its DOFs, with
-        ``HB_BLOCK_PRECONDITIONER``) or ``"dense"`` (:meth:`evaluate`: smaller problems, scalar
+        ``options.block_preconditioner``) or ``"dense"`` (:meth:`evaluate`: smaller problems, scalar
         contacts, condensed problems, a SystemParameter)."""
         if (self.size < config.CONT_KRYLOV_SOLVE or self.contacts or not self.has_interfaces or self.condensed
                 or isinstance(self.parameter, SystemParameter)):
             return "dense"
         if self.gauge is not None:  # the gauge of the mean is dense on the DOFs
-            return "blocks" if HB_BLOCK_PRECONDITIONER else "dense"
+            return "blocks" if self.options.block_preconditioner else "dense"
         sys_ = self.system
         # an upper bound of the pattern's density without building it (np.unique of millions of keys for a
         # reduced model, only to find it dense); modal damping enters the pattern by its Rayleigh part
@@ -627,7 +625,7 @@ class HBProblem:
         if bound <= 4 * config.CONT_SPARSE_DENSITY * float(self.size) ** 2:
             if self.sparse_pattern().density <= config.CONT_SPARSE_DENSITY:
                 return "sparse"
-        return "blocks" if HB_BLOCK_PRECONDITIONER else "dense"
+        return "blocks" if self.options.block_preconditioner else "dense"
 
     def evaluate_blocks(self, X, p) -> _Eval:
         """:meth:`evaluate_sparse` with dR/dX as a :class:`jointdyn.hb._jacobian.HarmonicJacobian` (N/m): the
@@ -755,8 +753,8 @@ class HBProblem:
 
     # --- stability ----------------------------------------------------------
     def hill_affordable(self) -> bool:
-        """True when the companion matrix of Hill's method (2 n (2H+1) rows) has at most ``HB_HILL_MAX_ROWS``."""
-        return 2 * self.size <= HB_HILL_MAX_ROWS
+        """True when the companion matrix of Hill's method (2 n (2H+1) rows) has at most ``options.hill_max_rows``."""
+        return 2 * self.size <= self.options.hill_max_rows
 
     def hill_growth(self, JXs, ws):
         """max Re(s) / w of the Floquet exponents (Hill's method) at many points

@@ -10,6 +10,7 @@
 * :func:`single_mode_frc`: forced response near a resonance from one
   nonlinear mode (single-nonlinear-mode synthesis, Krack et al.);
 * :func:`backbone_dataset`: a backbone as an :class:`xarray.Dataset`;
+* :class:`EPMCOptions`, :class:`QSMAOptions`: the numbers of each method, with their defaults;
 * what a backbone requires, checked by :func:`epmc` and :func:`qsma` and by
   the command line before it computes: :func:`check_free_vibration`,
   :func:`amplitude_range`, :func:`output_dof_of`, :func:`linear_stuck_mode`.
@@ -18,8 +19,10 @@
 from ._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
 from .backbone import Backbone, ModeStatus, backbone_dataset
 from .epmc import EPMCProblem, epmc
+from .options import EPMCOptions, QSMAOptions
 from .qsma import qsma
 from .synthesis import single_mode_frc
 
 __all__ = ["epmc", "qsma", "single_mode_frc", "backbone_dataset", "Backbone", "ModeStatus", "EPMCProblem",
-           "amplitude_range", "check_free_vibration", "linear_stuck_mode", "output_dof_of"]
+           "EPMCOptions", "QSMAOptions", "amplitude_range", "check_free_vibration", "linear_stuck_mode",
+           "output_dof_of"]

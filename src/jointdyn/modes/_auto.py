@@ -11,8 +11,8 @@ backbone's largest) changes by more than ``config.HB_AUTO_RTOL``, the
 backbone is computed again at the finer level (the samples first: with
 too few, the sampling error of a contact force that jumps where the
 contact separates moves the solution with more harmonics too), up to
-``HB_AUTO_MAX_HARMONICS`` and ``HB_AUTO_MAX_SAMPLES`` of
-:mod:`jointdyn.hb.discretisation`. The
+``auto_max_harmonics`` and ``auto_max_samples`` of the
+:class:`~jointdyn.hb.options.HBOptions` given to :func:`~jointdyn.modes.epmc`. The
 levels used and the last check are said in the backbone's message and
 counters.
 """
@@ -31,17 +31,12 @@ from ..hb.levels import Discretisation
 
 __all__ = ["auto_backbone", "check_points", "level_changes"]
 
-#: points of an EPMC backbone (spread over it, plus its largest damping) where
-#: harmonics="auto" / samples="auto" check the discretisation (jointdyn.modes._auto)
-MODES_AUTO_CHECK_POINTS = 12
-
-
 def check_points(backbone) -> np.ndarray:
     """Indices of the points where a backbone's discretisation is checked:
-    ``MODES_AUTO_CHECK_POINTS`` spread evenly over its points, and
+    ``EPMCOptions.auto_check_points`` (those of its problem) spread evenly over its points, and
     the point of largest damping ratio."""
     p = backbone.points
-    idx = np.round(np.linspace(0, p - 1, min(p, MODES_AUTO_CHECK_POINTS))).astype(int)
+    idx = np.round(np.linspace(0, p - 1, min(p, backbone.problem.options.auto_check_points))).astype(int)
     zeta = np.where(np.isfinite(backbone.damping_ratio), backbone.damping_ratio, -np.inf)
     return np.unique(np.r_[idx, int(np.argmax(zeta))])
 
@@ -69,7 +64,8 @@ def level_changes(backbone, level, disc, mode: int) -> tuple:
             changes.append(math.nan)
             continue
         problem = type(b.problem)(system, mode=mode, output_dof=b.output_dof, harmonics=check.harmonics,
-                                   samples=check.samples)
+                                   samples=check.samples, hb_options=b.problem.hb.options,
+                                   epmc_options=b.problem.options)
         worst = 0.0
         for i in check_points(b):
             w, zeta = b.omega_rad_s[i], b.damping_ratio[i]
@@ -90,19 +86,19 @@ def level_changes(backbone, level, disc, mode: int) -> tuple:
 def auto_backbone(fixed, system, amplitude, *, harmonics, samples, mode: int = 1, **kw):
     """The backbone of ``fixed(system, amplitude, harmonics=H, samples=Ns, mode=mode, **kw)`` (the EPMC
     at one level) at the coarsest level whose check passes (see the module docstring); ``harmonics`` and
-    ``samples`` are integers or ``"auto"``."""
+    ``samples`` are integers or ``"auto"``; ``kw["hb_options"]`` bounds the levels."""
     disc = Discretisation.of(harmonics, samples)
     level = disc.first
     levels = [level]
     while True:
-        k, most = level_number(level, disc)
+        k, most = level_number(level, disc, kw.get("hb_options"))
         stage_note(f"EPMC level {k}/{most}: H = {level.harmonics}, Ns = {level.samples}", kw.get("progress"))
         b = fixed(system, amplitude, harmonics=level.harmonics, samples=level.samples, mode=mode, **kw)
         if not b.points:
             return b
         ch = level_changes(b, level, disc, mode)
         bad = tuple(c > config.HB_AUTO_RTOL for c in ch)  # NaN (no check) compares False
-        nxt = next_level(level, disc, *bad)
+        nxt = next_level(level, disc, *bad, kw.get("hb_options"))
         if nxt == level:
             break
         level = nxt

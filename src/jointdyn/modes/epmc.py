@@ -68,27 +68,17 @@ from ..fourier import derivative_matrix
 from ..hb import HBProblem
 from ..hb._sparse import linear_entries
 from ..hb.levels import AUTO, Discretisation, check_memory
+from ..hb.options import HBOptions
+from ..hb.options import hb_options as _hb_options
 from ..hb.problem import contacts_only
 from ..hb.results import sliding_as_a_whole
 from ..kinematics import contact_kinematics, selection_matrix
 from ._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
 from .backbone import Backbone, ModeStatus
+from .options import EPMCOptions
+from .options import epmc_options as _epmc_options
 
 __all__ = ["EPMCProblem", "epmc"]
-
-#: EPMC continuation in log10 of the amplitude (unknowns scaled by the
-#: amplitude, frequency and self-excitation by the linear frequency, residual
-#: by the stiffness times the amplitude): first and largest arc-length step
-#: (the largest bounds the spacing to 1/16 decade: at least 16 points per decade)
-MODES_DS_START = 0.02
-MODES_DS_MAX = 0.0625
-#: Newton tolerance of an EPMC point on that scaled residual; tight because
-#: the energy balance of a point (self-excitation against dissipation) holds
-#: to the residual relative to the damping ratio, which is small at small
-#: amplitudes
-MODES_TOL = 1e-12
-#: Newton iterations of the first EPMC point (from the linear stuck mode)
-MODES_START_MAX_ITER = 30
 
 _LN10 = math.log(10.0)
 
@@ -136,11 +126,18 @@ class EPMCProblem:
         AFT samples per period (>= 2H + 2).
     max_passes : int
         Bound on the periods marched per AFT evaluation.
+    hb_options : HBOptions, optional
+        Harmonic balance's numbers of the contact evaluation (:class:`~jointdyn.hb.options.HBOptions`;
+        None: the defaults).
+    epmc_options : EPMCOptions, optional
+        The EPMC's own numbers (:class:`~jointdyn.modes.options.EPMCOptions`; None: the defaults).
 
     Attributes
     ----------
     hb : HBProblem
         Harmonic balance of the unforced system (the contact evaluation).
+    options : EPMCOptions
+        The EPMC's own numbers.
     linear : LinearMode
         The linear stuck mode.
     i_omega, i_xi : int
@@ -152,7 +149,9 @@ class EPMCProblem:
 
     def __init__(self, system, *, mode: int = 1, output_dof: int | None = None,
                  harmonics: int = config.HB_HARMONICS, samples: int = config.HB_SAMPLES,
-                 max_passes: int = config.HB_MAX_PASSES):
+                 max_passes: int = config.HB_MAX_PASSES, hb_options: HBOptions | None = None,
+                 epmc_options: EPMCOptions | None = None):
+        self.options = _epmc_options(epmc_options)
         check_free_vibration(system, "EPMC", held=True)
         self.system = system
         self.output_dof = output_dof_of(system, output_dof)
@@ -161,7 +160,8 @@ class EPMCProblem:
         V.positive_int("samples", samples, 2 * H + 2)
         free = dataclasses.replace(system, force=np.zeros(n), force_phase_deg=np.zeros(n))
         try:
-            self.hb = HBProblem(free, harmonics=harmonics, samples=samples, max_passes=max_passes)
+            self.hb = HBProblem(free, harmonics=harmonics, samples=samples, max_passes=max_passes,
+                                options=hb_options)
         except ValueError as exc:
             raise ValueError(f"{exc} (EPMC evaluates the contacts by harmonic balance)") from None
         self.linear = linear_stuck_mode(system, mode, self.output_dof)
@@ -295,7 +295,7 @@ class EPMCProblem:
 
     def solve(self, amplitude: float, guess, options: ContinuationOptions | None = None, **overrides):
         """Newton at a fixed amplitude (m) from scaled unknowns ``guess``: ``(v, converged, iterations)``."""
-        opt = _options(options, overrides)
+        opt = _options(options, overrides, self.options)
         return newton(self.residual, np.asarray(guess, dtype=np.float64), math.log10(amplitude), opt)
 
     # --- per point ----------------------------------------------------------
@@ -337,10 +337,11 @@ def _repeated_note(linear) -> str:
             "slightly (e.g. the stiffness of one of the symmetric DOFs by 1e-4 of its value)")
 
 
-def _options(options, overrides) -> ContinuationOptions:
-    """The step control of EPMC: the defaults of this module, then ``options``, then ``overrides``."""
+def _options(options, overrides, eopts: EPMCOptions) -> ContinuationOptions:
+    """The step control of EPMC: the defaults of ``eopts`` (:class:`~jointdyn.modes.options.EPMCOptions`),
+    then ``options``, then ``overrides``."""
     if options is None:
-        options = ContinuationOptions(ds=MODES_DS_START, ds_max=MODES_DS_MAX, tol=MODES_TOL)
+        options = ContinuationOptions(ds=eopts.ds_start, ds_max=eopts.ds_max, tol=eopts.tol)
     return make_options(options, overrides)
 
 
@@ -400,7 +401,7 @@ def _reduce(system, n_modes: int, output_dof):
 def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None,
          harmonics: int | str = config.HB_HARMONICS, samples: int | str = config.HB_SAMPLES,
          options: ContinuationOptions | None = None, progress: bool | None = None, reduce: int | None = None,
-         **overrides) -> Backbone:
+         hb_options: HBOptions | None = None, epmc_options: EPMCOptions | None = None, **overrides) -> Backbone:
     """Backbone of a nonlinear mode by the extended periodic motion concept.
 
     Parameters
@@ -430,8 +431,8 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         ripple).
     options : ContinuationOptions, optional
         Step control in the scaled unknowns (arc length in decades of
-        amplitude); default ``ds = MODES_DS_START``,
-        ``ds_max = MODES_DS_MAX``, ``tol = MODES_TOL``;
+        amplitude); default ``ds``, ``ds_max`` and ``tol`` of ``epmc_options``
+        (``ds_start``, ``ds_max``, ``tol``);
         keyword arguments override its fields (``ds_max``, ``max_points``,
         ``tol``, ...).
     progress : bool, optional
@@ -444,6 +445,14 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         rounding). ``mode`` then counts the linear modes of the reduced
         model, the same as the full model's while the reduction resolves
         them (``Backbone.reduction.error``). Default: the full model.
+    hb_options : HBOptions, optional
+        Harmonic balance's numbers of the contact evaluation and of the automatic discretisation
+        (:class:`~jointdyn.hb.options.HBOptions`: the Jacobian's form, ``auto_max_harmonics``,
+        ``auto_max_samples``, ...; None: the defaults).
+    epmc_options : EPMCOptions, optional
+        The EPMC's own numbers (:class:`~jointdyn.modes.options.EPMCOptions`: default steps and
+        tolerance, Newton iterations of the start, check points of the automatic discretisation;
+        None: the defaults).
 
     Returns
     -------
@@ -456,20 +465,23 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
         modes against the full model's; :meth:`Backbone.full_shape`: the
         harmonics of the mode shape on the full model's DOFs).
     """
-    check_memory(system, Discretisation.of(harmonics, samples))
+    hbo, eopts = _hb_options(hb_options), _epmc_options(epmc_options)
+    check_memory(system, Discretisation.of(harmonics, samples), options=hbo)
     if harmonics == AUTO or samples == AUTO:
         from ._auto import auto_backbone
 
         return auto_backbone(epmc, system, amplitude, harmonics=harmonics, samples=samples, mode=mode,
-                             output_dof=output_dof, options=options, progress=progress, reduce=reduce, **overrides)
+                             output_dof=output_dof, options=options, progress=progress, reduce=reduce,
+                             hb_options=hbo, epmc_options=eopts, **overrides)
     check_free_vibration(system, "EPMC", held=True)
     lo, hi = amplitude_range(system, amplitude)
     reduction = None
     if reduce is not None:
         system, reduction = _reduce(system, reduce, output_dof)
         output_dof = None
-    problem = EPMCProblem(system, mode=mode, output_dof=output_dof, harmonics=harmonics, samples=samples)
-    opt = _options(options, overrides)
+    problem = EPMCProblem(system, mode=mode, output_dof=output_dof, harmonics=harmonics, samples=samples,
+                          hb_options=hbo, epmc_options=eopts)
+    opt = _options(options, overrides, eopts)
     lam0, lam1 = math.log10(lo), math.log10(hi)
     with preconditioned_by(problem.hb.block_preconditioner((problem.i_omega, problem.i_xi))):
         return _walked(problem, lam0, lam1, opt, progress, reduction)
@@ -477,7 +489,7 @@ def epmc(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
 
 def _walked(problem: EPMCProblem, lam0, lam1, opt, progress, reduction) -> Backbone:
     """The backbone of :func:`epmc` from log10 amplitudes lam0 to lam1."""
-    v0, ok, _ = newton(problem.residual, problem.linear_guess(), lam0, opt, max_iter=MODES_START_MAX_ITER)
+    v0, ok, _ = newton(problem.residual, problem.linear_guess(), lam0, opt, max_iter=problem.options.start_max_iter)
     if not ok:
         return _backbone(problem, ModeStatus.NO_START, f"Newton did not converge at the smallest amplitude "
                          f"{10.0 ** lam0:.6g} m from linear stuck mode {problem.linear.index}"

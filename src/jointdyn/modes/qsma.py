@@ -42,23 +42,12 @@ from ..continuation.linalg import lu_solve
 from ..kinematics import contact_kinematics, selection_matrix
 from ._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
 from .backbone import Backbone, ModeStatus
+from .options import QSMAOptions, qsma_options
 
 __all__ = ["qsma", "push_grid"]
 
-#: QSMA static push: steps per decade of the output-DOF displacement, and
-#: decades pushed below the smallest requested amplitude (the work integral
-#: starts at zero displacement)
-QSMA_STEPS_PER_DECADE = 40
-QSMA_DECADES_BELOW = 3
-#: push steps per backbone point: the work integrals use every step (their
-#: error at a kink of a law, e.g. the onset of slip of a Jenkins element,
-#: falls as the square of the step), the backbone reports every
-#: QSMA_SUBSTEPS-th
-QSMA_SUBSTEPS = 4
-#: QSMA equilibrium: Newton converged when max |residual| <= this times the
-#: largest elastic or applied force; iterations per step
-QSMA_TOL = 1e-12
-QSMA_MAX_ITER = 50
+#: the defaults of the push (:class:`~jointdyn.modes.options.QSMAOptions`)
+_DEFAULT = QSMAOptions()
 
 
 def _push_template(grid, lin, con, ctl, out):  # pragma: no cover - compiled
@@ -186,8 +175,8 @@ def _assemble(K, f, j, Bm, T, kT, x, alpha, a, A, r):  # pragma: no cover - comp
     return err / scale if scale > 0.0 else err
 
 
-def push_grid(lo: float, hi: float, steps_per_decade: int = QSMA_STEPS_PER_DECADE,
-              decades_below: int = QSMA_DECADES_BELOW, substeps: int = 1):
+def push_grid(lo: float, hi: float, steps_per_decade: int = _DEFAULT.steps_per_decade,
+              decades_below: int = _DEFAULT.decades_below, substeps: int = 1):
     """(grid, first): the push's displacements (m) and the index of ``lo`` in it.
 
     Geometric, from ``lo`` ``decades_below`` decades down to ``hi``, with
@@ -211,7 +200,7 @@ def _hermite_work(u, T, kT):
     return np.concatenate((np.zeros((1, u.shape[1])), np.cumsum(inc, axis=0)))
 
 
-def _push(system, grid, out_dof, linear):
+def _push(system, grid, out_dof, linear, opts: QSMAOptions):
     """The compiled push: ``(reached, xs, alpha, T, kT)`` with row 0 the origin."""
     kin = contact_kinematics(system)
     Bm = np.ascontiguousarray(selection_matrix(kin, system.ndof))
@@ -232,12 +221,12 @@ def _push(system, grid, out_dof, linear):
     f = np.ascontiguousarray(system.M @ linear.mass_normalised)
     kernel = specialize(_push_template, STEP_JVP=laws[0].step_jvp, INIT=laws[0].init)
     reached = kernel(grid, (K, f, int(out_dof)), (Bm, Pm, Nc, int(ssz)),
-                     (float(QSMA_TOL), int(QSMA_MAX_ITER)), (xs, als, Ts, kTs))
+                     (float(opts.tol), int(opts.max_iter)), (xs, als, Ts, kTs))
     return int(reached), xs, als, Ts, kTs, Bm
 
 
 def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None,
-         steps_per_decade: int = QSMA_STEPS_PER_DECADE) -> Backbone:
+         steps_per_decade: int | None = None, options: QSMAOptions | None = None) -> Backbone:
     """Backbone of a nonlinear mode by quasi-static modal analysis (module docstring).
 
     Parameters
@@ -254,9 +243,11 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     output_dof : int, optional
         DOF whose displacement is prescribed and reported (default: the
         system's response DOF).
-    steps_per_decade : int
-        Backbone points per decade of amplitude; the push takes
-        ``QSMA_SUBSTEPS`` steps per point.
+    steps_per_decade : int, optional
+        Backbone points per decade of amplitude (default ``options.steps_per_decade``, 40); the push
+        takes ``options.substeps`` steps per point.
+    options : QSMAOptions, optional
+        The push's numbers (:class:`~jointdyn.modes.options.QSMAOptions`; None: the defaults).
 
     Returns
     -------
@@ -270,11 +261,13 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     check_free_vibration(system, "QSMA", springs=False)
     lo, hi = amplitude_range(system, amplitude)
     out_dof = output_dof_of(system, output_dof)
-    spd = V.positive_int("steps_per_decade", steps_per_decade, 1)
+    opts = qsma_options(options)
+    spd = opts.steps_per_decade if steps_per_decade is None else steps_per_decade
+    spd = V.positive_int("steps_per_decade", spd, 1)
     linear = linear_stuck_mode(system, mode, out_dof)
-    sub = QSMA_SUBSTEPS
-    grid, first = push_grid(lo, hi, spd, substeps=sub)
-    reached, xs, als, Ts, kTs, Bm = _push(system, grid, out_dof, linear)
+    sub = opts.substeps
+    grid, first = push_grid(lo, hi, spd, opts.decades_below, substeps=sub)
+    reached, xs, als, Ts, kTs, Bm = _push(system, grid, out_dof, linear, opts)
     u = xs @ Bm.T
     W = _hermite_work(u[:reached + 1], Ts[:reached + 1], kTs[:reached + 1])
     sel = slice(first + 1, reached + 1, sub)  # backbone rows in the requested range (row 0 is the origin)
@@ -294,7 +287,7 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     status = ModeStatus.COMPLETE if ok else (ModeStatus.FAILED if x.shape[0] else ModeStatus.NO_START)
     message = ("pushed to the largest amplitude" if ok else
                f"the static equilibrium did not converge at {grid[reached]:.6g} m (Newton, "
-               f"{QSMA_MAX_ITER} iterations)")
+               f"{opts.max_iter} iterations)")
     return Backbone(method="qsma", status=status, message=message, system=system, linear=linear,
                     output_dof=out_dof, harmonics=1, samples=0, amplitude_m=x[:, out_dof].copy(), omega_rad_s=w,
                     xi_rad_s=2.0 * (Dc + Dv) * w, damping_ratio=Dc + Dv, damping_ratio_contacts=Dc,

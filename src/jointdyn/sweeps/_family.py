@@ -87,6 +87,9 @@ class LineSpec:
     loop_outputs : bool
         Whether per-DOF and per-contact outputs are computed (from the
         recorded steady period).
+    steady : SteadyStateOptions or None
+        The steady state's numbers (None: its defaults, left out of the JSON so that the key of a line
+        with the defaults does not change).
     """
 
     label: str
@@ -96,10 +99,15 @@ class LineSpec:
     steps_per_period: int | None = None
     dofs: tuple = ()
     loop_outputs: bool = False
+    steady: object = None
 
     def to_json(self) -> str:
         """Canonical JSON (exact floats via repr)."""
         d = dataclasses.asdict(self)
+        if self.steady is None:
+            d.pop("steady")
+        else:
+            d["steady"] = {k: repr(v) for k, v in d["steady"].items()}
         d["gammas"] = [repr(float(g)) for g in self.gammas]
         d["dofs"] = [int(i) for i in self.dofs]
         return json.dumps(d, sort_keys=True)

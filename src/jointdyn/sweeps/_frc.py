@@ -141,7 +141,8 @@ class _LineRun:
         return ChunkTask(line=self.index, system_index=self.system_index, first=self.next,
                          gammas=self.gammas[self.next:stop], start=self.start, rdof=self.rdof, dofs=self.dofs,
                          ncontacts=self.ncontacts, loop_outputs=self.spec.loop_outputs,
-                         steps_per_period=self.spec.steps_per_period, where=self.where, npairs=self.npairs)
+                         steps_per_period=self.spec.steps_per_period, where=self.where, npairs=self.npairs,
+                         steady=self.spec.steady)
 
     def accept(self, chunk) -> None:
         """Store a chunk that starts where the line stands."""
@@ -279,7 +280,7 @@ def _prepare_kernels(systems) -> None:
         prepare_kernels(systems)
 
 
-def _line_runs(family, directions, g, spp, dofs, loop_outputs) -> list:
+def _line_runs(family, directions, g, spp, dofs, loop_outputs, steady=None) -> list:
     nc = max((len(s.contacts) for _, _, s in family.entries), default=0)
     npairs = max((_npairs(s) for _, _, s in family.entries), default=0)
     runs = []
@@ -287,7 +288,7 @@ def _line_runs(family, directions, g, spp, dofs, loop_outputs) -> list:
         key = fingerprint(system)
         for d in directions:
             spec = LineSpec(label=label, system=key, direction=d, gammas=g, steps_per_period=spp, dofs=dofs,
-                            loop_outputs=loop_outputs)
+                            loop_outputs=loop_outputs, steady=steady)
             where = f"system {label!r}: " if family.dims else ""
             runs.append(_LineRun(len(runs), spec, i, system, nc, dofs, where, npairs))
     return runs
@@ -397,7 +398,8 @@ def frc_sweep(
         is False for a line loaded entirely from ``out``.
     options : SweepOptions, optional
         How the lines run (chunks, the local pool, the queue, the progress refresh; default
-        ``SweepOptions()``); none of it changes a result.
+        ``SweepOptions()``); none of it changes a result but its ``steady``, the numbers of every
+        point's steady state (:class:`~jointdyn.dynamics.options.SteadyStateOptions`).
 
     Returns
     -------
@@ -432,17 +434,20 @@ def frc_sweep(
     if n_workers is not None:
         n_workers = V.positive_int("n_workers", n_workers)
     _check_client(client)
-    _check_steps(family, g, spp, 1 if len(directions) == 1 or n_workers == 1 else 2)
+    opt = SweepOptions() if options is None else options
+    if not isinstance(opt, SweepOptions):
+        raise ValueError(f"options must be a SweepOptions, got {type(opt).__name__}")
+    spp_run = spp if spp is not None or opt.steady is None else opt.steady.steps_per_period
+    _check_steps(family, g, spp_run, 1 if len(directions) == 1 or n_workers == 1 else 2)
     dofs = _dofs(dofs, family)
     loop_outputs = (not family.dims or family.dims == ("system",)) if loop_outputs is None else bool(loop_outputs)
     if out is not None:  # before computing: no finished chunk is lost to an unwritable out
         V.output_dir("out", out, files=("frc.nc", "frc.csv"), subdirs=("lines",))
-    runs = _line_runs(family, directions, g, spp, dofs, loop_outputs)
-    opt = SweepOptions() if options is None else options
-    if not isinstance(opt, SweepOptions):
-        raise ValueError(f"options must be a SweepOptions, got {type(opt).__name__}")
+    runs = _line_runs(family, directions, g, spp, dofs, loop_outputs, opt.steady)
     reused, stale = _run(runs, family, client, n_workers, out, progress, on_line, opt)
     ds = _assemble(family, runs, directions, g, dofs, spp, loop_outputs)
+    if opt.steady is not None:
+        ds.attrs["steady_options"] = repr(opt.steady)
     ds.attrs["reused_points"] = int(reused)
     ds.attrs["stale_points"] = int(stale)
     if out is not None:

@@ -243,6 +243,8 @@ class ChunkTask:
         Record per-DOF and per-contact outputs (keeps the steady loop).
     steps_per_period : int or None
         Integration steps per forcing period (None: solver default).
+    steady : SteadyStateOptions or None
+        The steady state's numbers (None: its defaults).
     where : str
         Prefix of a solver's refusal (ValueError), naming the System in its
         family (``"system 'a': "``); empty for a System swept alone.
@@ -260,6 +262,7 @@ class ChunkTask:
     steps_per_period: int | None
     where: str = ""
     npairs: int = 0
+    steady: object = None
 
 
 @dataclass(frozen=True)
@@ -390,6 +393,8 @@ def solve_chunk(task: ChunkTask, system, ctx: Context | None = None) -> ChunkRes
     kwargs = {"keep_loop": bool(task.loop_outputs), "response_dof": task.rdof}
     if task.steps_per_period is not None:
         kwargs["steps_per_period"] = task.steps_per_period
+    if task.steady is not None:
+        kwargs["options"] = task.steady
     start, done, interrupted = task.start, 0, False
     try:
         for k, g in enumerate(task.gammas):
