@@ -24,7 +24,6 @@ from .problem import HBProblem
 from .monodromy import monodromy_multipliers
 from .options import HBOptions
 from .results import DiscretisationCheck, HBBranch, HBPeak, HBSolution, PointStatus, SolveStatus
-from .hill_arnoldi import ArnoldiExponents, hill_arnoldi_exponents, hill_arnoldi_growth
 from .stability import hill_exponents, hill_growth, hill_stability
 from .stability_options import StabilityOptions
 
@@ -70,3 +69,16 @@ __all__ = [
     "HBOptions",
     "monodromy_multipliers",
 ]
+
+
+#: names of the Arnoldi stability module, imported on first use (a process that never asks for Arnoldi
+#: stability does not import it: fresh-process start-up time)
+_LAZY = {"ArnoldiExponents", "hill_arnoldi_exponents", "hill_arnoldi_growth"}
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        from . import hill_arnoldi
+
+        return getattr(hill_arnoldi, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -75,8 +75,6 @@ from ..laws import MACROSLIP, SEPARATION
 from ..systems import System
 from ._aft import INFO_ERROR, INFO_PASSES, INFO_PERIOD
 from .condense import make_problem
-from .hill_arnoldi import hill_arnoldi_exponents
-from .hill_condensed import condensed_hill_exponents
 from .levels import Level
 from .options import HBOptions
 from .parameters import F1, GAMMA
@@ -215,6 +213,9 @@ def _dense_growth(problem: HBProblem, JXs, ws, options):
 def _arnoldi_growth(problem: HBProblem, JX, w, options) -> float:
     """max Re(s) / w of the exponents nearest the imaginary axis (:mod:`jointdyn.hb.hill_arnoldi`) of a point;
     a condensed problem's through its condensed form (:mod:`jointdyn.hb.hill_condensed`)."""
+    from .hill_arnoldi import hill_arnoldi_exponents  # Arnoldi's modules only where it runs
+    from .hill_condensed import condensed_hill_exponents
+
     if problem.condensed:
         return condensed_hill_exponents(problem, JX, w, options).growth
     return hill_arnoldi_exponents(JX, problem.system.M, dense_damping(problem.system.C), w, problem.H,

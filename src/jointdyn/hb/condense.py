@@ -78,7 +78,6 @@ from ..kinematics import contact_kinematics, selection_matrix
 from ..systems import System, free_modes
 from .options import HBOptions, hb_options
 from .problem import HBProblem, _linear_blocks, contacts_only, held_by_contacts
-from .hill_condensed import condensed_hill_exponents
 from .stability import hill_growth, hill_stability
 from .stability_options import StabilityOptions
 
@@ -760,6 +759,8 @@ class CondensedHBProblem(HBProblem):
         if self._hill_dense():
             full = np.array([self.full_jacobian(J, w) for J, w in zip(JXs, ws)])
             return hill_growth(full, self.system.M, dense_damping(self.system.C), ws, self.H)
+        from .hill_condensed import condensed_hill_exponents  # Arnoldi's modules only where it runs
+
         return np.array([condensed_hill_exponents(self, J, w).growth for J, w in zip(JXs, ws)])
 
     def hill_stability(self, JX, w):
@@ -768,6 +769,8 @@ class CondensedHBProblem(HBProblem):
         if self._hill_dense():
             return hill_stability(self.full_jacobian(JX, w), self.system.M, dense_damping(self.system.C), w,
                                   self.H)
+        from .hill_condensed import condensed_hill_exponents  # Arnoldi's modules only where it runs
+
         found = condensed_hill_exponents(self, JX, w)
         return found.growth <= StabilityOptions().rtol, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
 

@@ -26,8 +26,6 @@ from ..systems import System
 from .branch import _forcing_problem, _Request, solve_point
 from .discretisation import adaptive_branch
 from .export import branch_dataset
-from .hill_arnoldi import hill_arnoldi_exponents
-from .hill_condensed import condensed_hill_exponents
 from .levels import AUTO, Discretisation, Level, check_memory
 from .options import HBOptions
 from .options import hb_options as _hb_options
@@ -344,8 +342,12 @@ def _point_stability(problem: HBProblem, JX, w: float, opts: StabilityOptions):
         return hill_stability(np.asarray(J), s.M, dense_damping(s.C), w, problem.H, opts)
     with blas_threads():  # ARPACK's BLAS-2 work: 2 OpenBLAS threads on 2 busy cores are slower than one
         if problem.condensed:  # through the condensed form, nothing of the full size
+            from .hill_condensed import condensed_hill_exponents  # Arnoldi's modules only where it runs
+
             found = condensed_hill_exponents(problem, JX, w, opts)
         else:
+            from .hill_arnoldi import hill_arnoldi_exponents  # Arnoldi's modules only where it runs
+
             found = hill_arnoldi_exponents(JX, s.M, dense_damping(s.C), w, problem.H, opts)
     return found.growth <= opts.rtol, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
 
