@@ -13,9 +13,20 @@ how a piece is weighted in the force (uniformly, or by u^chi with a delta at
 u_max) and, for Segalman's law, a cache of the breakpoints' powers.
 
 This module holds that common march (:func:`march_pieces`) and the helpers
-it is made of; each law's kernel calls it and adds its own weights. Every
-helper is inlined into the law's kernel (``inline="always"``), which is
-itself inlined into the compiled loops that call it: the march costs no call.
+it is made of; each law's kernel calls it and adds its own weights. The
+helpers of the march itself and those that take arrays are inlined into the
+law's kernel by Numba (``inline="always"``), which is itself inlined into the
+compiled loops that call it: the march costs no call. The scalar helpers of
+the merges and of Segalman's powers (:func:`_removal_cost`, :func:`_vertex`,
+:func:`_line`, :func:`_stuck_part`, :func:`_line_jvp`, :func:`_held`,
+:func:`_right_power`, :func:`_pow1`) are ordinary compiled functions: Numba
+types each once, where its inliner types a copy at every call site of every
+kernel and loop that inlines them, and LLVM inlines them (no call is left in
+the compiled loops, and with scalar arguments no reference count either),
+so they cost no time at run time and a quarter to a third of the laws'
+compile time less (docs/performance.md, cold start). A helper that loops
+over an array argument is left as a real call by LLVM, with the reference
+counts of its arrays, which costs time in every step: those stay inlined.
 It is a private module of :mod:`jointdyn.laws` (its name starts with ``_``):
 it registers no law.
 
@@ -189,7 +200,7 @@ def _write_jvp(ds, ds_old, dx, dN, k, r_old, kind, qs, ia, end, c, b, alpha):
         ds[r + 2, j] = w * ds_old[r_old + 2, j] + sg * dN[j]
 
 
-@jit(inline="always")
+@jit
 def _removal_cost(u0, u1, u2, u3, p0, p1, p2, p3, area2, alpha):
     """Cost of replacing the breakpoints u1, u2 of three adjacent pieces by
     one vertex, as a fraction ``num / den`` (no division).
@@ -213,7 +224,7 @@ def _removal_cost(u0, u1, u2, u3, p0, p1, p2, p3, area2, alpha):
     return abs(e1) * right + abs(e2) * left, left * right
 
 
-@jit(inline="always")
+@jit
 def _vertex(u0, u1, u2, u3, p0, p3, area2, alpha):
     """The vertex (uw, pw) of :func:`_removal_cost`, pw clamped to the
     limits [-alpha uw, alpha uw] (only when no merge keeps the integral
@@ -275,7 +286,7 @@ def _least_triple(s, m, alpha):
     return best
 
 
-@jit(inline="always")
+@jit
 def _line(u0, p0, u1, p1, alpha):
     """Coefficients of the line through (u0, p0), (u1, p1); a line within
     ``SNAP alpha`` of a clip line on [0, u1] is put on it (a merged piece
@@ -287,7 +298,7 @@ def _line(u0, p0, u1, p1, alpha):
     return a, b
 
 
-@jit(inline="always")
+@jit
 def _stuck_part(lo, hi, a, b, alpha):
     """Measure of [lo, hi] if a + b u is not a clip line, else 0."""
     if a == 0.0 and (b == alpha or b == -alpha):
@@ -295,7 +306,7 @@ def _stuck_part(lo, hi, a, b, alpha):
     return hi - lo
 
 
-@jit(inline="always")
+@jit
 def _line_jvp(u0, dp0, du0, u1, dp1, du1, a, b, alpha, dal):
     """Derivative (da, db) of the line a + b u through its points at u0 and
     u1 when they move: values by dp0, dp1 and positions by du0, du1 (the
@@ -359,7 +370,7 @@ def _shift_down(s, ds, k, m):
                 ds[rr, j] = ds[rr + 3, j]
 
 
-@jit(inline="always")
+@jit
 def _held(count, room):
     """Pieces a state buffer held (its count entry), or 0 when that is not a count in [0, room]."""
     if count >= 0.0 and count <= room:
@@ -408,7 +419,7 @@ def _enforce_capacity(s, ds, m, cap, alpha, total, stuck, ia, dN):
     return m, total, stuck
 
 
-@jit(inline="always")
+@jit
 def _right_power(end, right, chi, p_hi, p_lo):
     """right^(chi+1) of a written segment: the cached power ``p_hi`` of the old piece's
     upper (end code _END_HI) or ``p_lo`` of its lower (_END_LO) breakpoint, computed for
@@ -420,7 +431,7 @@ def _right_power(end, right, chi, p_hi, p_lo):
     return _pow1(right, chi)
 
 
-@jit(inline="always")
+@jit
 def _pow1(u, chi):
     """u^(chi + 1) (u itself when chi = 0, so that the uniform law's bits are kept)."""
     if chi == 0.0:

@@ -147,8 +147,11 @@ def _jvp_force(s, ds, m, fy, dT):
 @jit(inline="always")
 def _exact_core(params, s_old, s_new, x, N, ds_old, ds_new, dx, dN, dT):
     # Derivative arguments are all arrays or all None (pruned at compile
-    # time). One exit and no call that is not inlined: either keeps Numba's
-    # reference-count updates of the arrays inside the caller's loop.
+    # time). One exit, and every helper that takes an array inlined by
+    # Numba: a second exit, or a call with arrays that LLVM does not inline,
+    # keeps Numba's reference-count updates of the arrays inside the caller's
+    # loop. The scalar helpers of the merges are ordinary compiled functions
+    # (typed once; LLVM inlines them: laws/_density_march.py).
     fy = params[_P_FY]
     cap = int(params[_P_CAP])
     alpha = N * params[_P_INV_NREF]
