@@ -74,6 +74,12 @@ class RingdownBackbone:
         The kept times, s, and the displacement envelope there, m (for figures).
     message : str
         One line on what was done.
+    windows : dict or None
+        The windows the decay model was fitted to: ``t`` (s), ``lna`` (ln of the displacement
+        amplitude), ``omega`` (rad/s) and their standard errors ``sigma_lna`` and
+        ``sigma_omega`` (rad/s), measured from the scatter; None where the decay was not of
+        the microslip form (the spline). The points above come from one smooth model, so they
+        are not independent data: :func:`jointdyn.identify.fit_ringdown` fits these instead.
     """
 
     amplitude_m: np.ndarray
@@ -84,6 +90,7 @@ class RingdownBackbone:
     t: np.ndarray
     envelope_m: np.ndarray
     message: str
+    windows: dict | None = None
 
 
 def epmc_factor(p, omega0, omega):
@@ -277,7 +284,7 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
         raise ValueError(f"no decay: the envelope falls by less than {100 * options.min_decay:g} % over "
                          f"the record above the noise; a ring-down is a free decay")
     power = {"x": 0, "v": 1, "a": 2}[kind]  # displacement amplitude = amplitude / omega^power
-    keep_w, lna, rate, w, expo, w0, _, misfit = smooth_envelope(centre, np.log(amp) - power * np.log(w), w, options)
+    keep_w, lna, rate, w, expo, w0, _, misfit, windows = smooth_envelope(centre, np.log(amp) - power * np.log(w), w, options)
     if keep_w < centre.size:
         dropped = max(dropped, float(tk[-1] - centre[keep_w]))
     centre = centre[:keep_w]
@@ -298,4 +305,4 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
            f"(end effects: {trim / period:.3g} periods each{'; and the tail within the noise' if dropped else ''}); "
            f"{A.size} points")
     return RingdownBackbone(amplitude_m=A, omega_rad_s=w, damping_ratio=D, band_rad_s=(low, high),
-                            trimmed_s=trimmed, t=tk, envelope_m=env, message=msg)
+                            trimmed_s=trimmed, t=tk, envelope_m=env, message=msg, windows=windows)
