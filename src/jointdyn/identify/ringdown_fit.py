@@ -119,7 +119,7 @@ def _ends(sol, params, win, m, chi0) -> dict:
         for i, (key, unit, what) in enumerate(((f"omega_{tag}_rad_s", "rad/s", "natural frequency"),
                                                 (f"damping_ratio_{tag}", "-", "damping ratio (EPMC's)"))):
             ok = bool(np.isfinite(sd[i]))
-            out[key] = {"value": float(f0[i]),
+            out[key] = {"value": float(f0[i]), "amplitude_m": a,
                         "interval": {"low": float(f0[i] - z * sd[i]) if ok else None,
                                      "high": float(f0[i] + z * sd[i]) if ok else None, "level": 0.95,
                                      "method": "linearised (delta method)"},
@@ -170,19 +170,37 @@ def fit_ringdown(ringdown, *, mass: float, model: str = "iwan", law_params: dict
                          f"{type(ringdown).__name__}")
     res = fit_backbone(ringdown.amplitude_m, ringdown.omega_rad_s, ringdown.damping_ratio, mass=mass, model=model,
                        law_params=law_params, start=start)
-    if ringdown.windows is None or not res.determined_combinations:
+    from ._microslip import MICROSLIP_MODELS, microslip_constants
+
+    if ringdown.windows is None or model not in MICROSLIP_MODELS:
         note = ("; the backbone's points come from one smooth model of the decay, so these intervals, which "
                 "treat them as independent, are narrower than the record justifies")
         return replace(res, message=res.message + note)
     c = res.determined_combinations
-    chi0 = c["chi"]["value"] if "chi" in c else 0.0
-    start = {"K": c["k_plus_kt"]["value"], "R": c["R"]["value"], "zeta": c["zeta"]["value"], "chi": chi0}
-    sol, params = _window_fit(ringdown.windows, float(mass), start, "chi" in c)
+    if c:
+        chi0 = c["chi"]["value"] if "chi" in c else 0.0
+        start = {"K": c["k_plus_kt"]["value"], "R": c["R"]["value"], "zeta": c["zeta"]["value"], "chi": chi0}
+    else:  # the full model fitted the points better, but the decay is of the microslip form throughout
+        chi0, R, _ = microslip_constants(res.law)
+        v = res.parameters
+        start = {"K": v["k"] + v["kt"], "R": R, "zeta": v["zeta"], "chi": chi0}
+        why = ("the decay is of the microslip form throughout (its decay model held: see the ring-down's "
+               "message): over its amplitudes the modal model depends on k + kt, R and chi only; release from "
+               "higher, into macroslip")
+        gone = ("k", "kt", "fy_N") + (("beta",) if model == "segalman" else ())
+        res = replace(res, parameters={**res.parameters, **{k: None for k in gone}},
+                      standard_errors={**res.standard_errors, **{k: None for k in gone}},
+                      intervals={**res.intervals, **{k: None for k in gone}},
+                      not_identifiable={**res.not_identifiable, **{k: why for k in gone}})
+    sol, params = _window_fit(ringdown.windows, float(mass), start, model == "segalman")
     return _result(res, sol, params, ringdown.windows, float(mass), chi0)
 
 
 def _result(res, sol, params, win, m, chi0):
     names = {"K": "k_plus_kt", "R": "R", "chi": "chi", "zeta": "zeta"}
+    meaning = {"k_plus_kt": ("N/m", "stuck stiffness of the mode, k + kt"),
+               "R": ("N/m^(chi+2)", "microslip coefficient: F = kt u - R u^(chi+2) / ((chi+1)(chi+2))"),
+               "chi": ("-", "microslip exponent"), "zeta": ("-", "linear damping ratio at the stuck frequency")}
     combos = {}
     reasons = dict(res.not_identifiable)
     parameters, errors, intervals = dict(res.parameters), dict(res.standard_errors), dict(res.intervals)
@@ -191,7 +209,8 @@ def _result(res, sol, params, win, m, chi0):
             continue
         iv = sol.intervals[p.name]
         key = names[p.name]
-        combos[key] = dict(res.determined_combinations[key], value=sol.values[p.name], interval=iv.to_dict())
+        combos[key] = {"value": sol.values[p.name], "interval": iv.to_dict(), "unit": meaning[key][0],
+                       "meaning": meaning[key][1]}
         why = open_reason(iv) if not iv.closed else _span_reason(p.name, iv)
         if why is not None:
             combos[key]["not_determined"] = why
