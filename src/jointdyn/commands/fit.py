@@ -268,7 +268,8 @@ def _print_console(args, fit) -> None:
         print(f"  (standard errors with {', '.join(fit.conditional_on)} held; the intervals are not conditional)")
     for k, c in fit.determined_combinations.items():
         lo, hi = c["interval"]["low"], c["interval"]["high"]
-        print(f"  determined: {k} = {c['value']:.6g} {c['unit']} (95 %: [{lo if lo is None else f'{lo:.5g}'}, "
+        word = "not determined" if "not_determined" in c else "determined"
+        print(f"  {word}: {k} = {c['value']:.6g} {c['unit']} (95 %: [{lo if lo is None else f'{lo:.5g}'}, "
               f"{hi if hi is None else f'{hi:.5g}'}]): {c['meaning']}")
     unit = "N" if fit.kind == "loops" else "(relative)"
     print(f"  rms residual {fit.rms_residual:.4g} {unit}")

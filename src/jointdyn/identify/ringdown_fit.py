@@ -28,55 +28,13 @@ from dataclasses import replace
 import numpy as np
 
 from ._lsq import Param, open_reason, solve, status_of
-from ._microslip import _c1, microslip_model
+from ._microslip import decay_fit, decay_model, microslip_model
 
 __all__ = ["fit_ringdown"]
 
 #: a parameter of a ring-down fit whose 95 % interval spans more than this factor (high / low;
 #: for chi, more than this minus one in absolute terms) is reported as not determined (-)
 RINGDOWN_FIT_MAX_SPAN = 1.2
-#: ln A steps of the quadrature of the decay (-)
-RINGDOWN_FIT_GRID = 600
-
-
-def decay_model(v: dict, m: float, t: np.ndarray, lna_end: float) -> tuple:
-    """(ln A, omega rad/s) at the times ``t`` (s, from t[0]) of the microslip model ``v`` (K N/m,
-    R, chi, zeta, lna0) released at ln A = lna0 at t[0] (module docstring)."""
-    K, R, chi, zeta = v["K"], v["R"], v["chi"], v["zeta"]
-    lev = np.linspace(v["lna0"], min(lna_end, v["lna0"]) - 1.0, RINGDOWN_FIT_GRID)
-    A = np.exp(lev)
-    w, D = microslip_model(K, R, chi, zeta, m, A)
-    ap = R * A ** (chi + 1.0)
-    ratio = np.maximum(K - _c1(chi) * ap, 1e-6 * K) / np.maximum(K - ap / (chi + 1.0), 1e-6 * K)
-    inv = 1.0 / np.maximum(w * D * ratio, 1e-300)
-    tl = np.concatenate(([0.0], np.cumsum(0.5 * (inv[1:] + inv[:-1]) * (lev[:-1] - lev[1:]))))
-    span = float(t[-1] - t[0])
-    if tl[-1] < span:  # beyond the grid: the last rate
-        lev = np.append(lev, lev[-1] - (span - tl[-1]) / inv[-1])
-        tl = np.append(tl, span)
-        w = np.append(w, w[-1])
-    lna = np.interp(t - t[0], tl, lev)
-    return lna, np.interp(t - t[0], tl, w)
-
-
-def _window_fit(win: dict, m: float, start: dict, fit_chi: bool):
-    t, lna, om = win["t"], win["lna"], win["omega"]
-    sl, so = win["sigma_lna"], win["sigma_omega"]
-    params = [Param("lna0", float(lna[0]), False, float(lna[0]) - 1.0, float(lna[0]) + 1.0),
-              Param("K", start["K"], True, 1e-3 * start["K"], 1e3 * start["K"]),
-              Param("R", start["R"], True, 1e-4 * start["R"], 1e4 * start["R"]),
-              Param("zeta", max(start["zeta"], 1e-6), True, 0.0, 1.0 / max(start["zeta"], 1e-6))]
-    if fit_chi:
-        from ..laws.segalman import CHI_MAX, CHI_MIN
-
-        params.append(Param("chi", start["chi"], False, CHI_MIN, CHI_MAX))
-
-    def fun(v):
-        v = dict(v, chi=v.get("chi", start["chi"]))
-        lf, wf = decay_model(v, m, t, float(lna[-1]))
-        return np.concatenate(((lf - lna) / sl, (wf - om) / so))
-
-    return solve(fun, params, profile=True), params
 
 
 def _span_reason(name, iv) -> str | None:
@@ -192,7 +150,7 @@ def fit_ringdown(ringdown, *, mass: float, model: str = "iwan", law_params: dict
                       standard_errors={**res.standard_errors, **{k: None for k in gone}},
                       intervals={**res.intervals, **{k: None for k in gone}},
                       not_identifiable={**res.not_identifiable, **{k: why for k in gone}})
-    sol, params = _window_fit(ringdown.windows, float(mass), start, model == "segalman")
+    sol, params = decay_fit(ringdown.windows, float(mass), start, model == "segalman")
     return _result(res, sol, params, ringdown.windows, float(mass), chi0)
 
 
