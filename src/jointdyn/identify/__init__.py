@@ -27,4 +27,5 @@ from .ringdown import RingdownBackbone, RingdownOptions, backbone_from_ringdown
 from .ringdown_fit import fit_ringdown
 
 __all__ = ["fit_loops", "fit_backbone", "fit_frc", "describing_function", "FitResult", "FitStatus", "Interval",
-           "backbone_from_ringdown", "fit_ringdown", "RingdownBackbone", "RingdownOptions", "LOOP_MODELS", "BACKBONE_MODELS"]
+           "backbone_from_ringdown", "fit_ringdown", "RingdownBackbone", "RingdownOptions", "LOOP_MODELS",
+           "BACKBONE_MODELS"]

@@ -31,6 +31,9 @@ The ring-down practice of the modal-Iwan literature (docs/guide/identify.md):
    :func:`epmc_factor` (the decay rate counts the energy stored at a turning
    point, EPMC the first-harmonic stiffness: 2.7 % apart at a quarter of the
    slip displacement of Iwan's law);
+   where that model holds, the microslip joint's own decay (k + kt, R, chi, zeta of a unit
+   modal mass: dissipation and softening tied by Masing's rule) is fitted to the windows
+   next and gives the points (:func:`_masing_decay`);
 8. a velocity or acceleration signal is turned into displacement amplitude
    by dividing by omega or omega^2 before the model is fitted.
 
@@ -331,7 +334,8 @@ def backbone_from_ringdown(t, signal, kind: str = "x", *, band=None, trim_period
     msg = (f"band {low:.4g} to {high:.4g} rad/s (zero-phase Butterworth, order {options.filter_order}); "
            f"amplitudes of {cycles}-cycle windows between zero crossings, " + (
            f"decay -d ln A/dt = a0 + a1 A^p fitted (p = {expo:.3g}; misfit {misfit:.3g} of a spline's), then a "
-           f"microslip joint's own decay (Masing) to the windows, damping in EPMC's definition;" if expo is not None else
+           f"microslip joint's own decay (Masing) to the windows, damping in EPMC's definition;"
+           if expo is not None else
            f"not a microslip decay (misfit {misfit:.3g} of a spline's): ln A(t) by a cubic spline, damping the "
            f"decay's own -(d ln A/dt)/omega, not EPMC's;") + f" {trimmed[0]:.4g} s trimmed at the start and "
            f"{trimmed[1]:.4g} s at the end "
