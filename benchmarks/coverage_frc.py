@@ -23,6 +23,9 @@ if str(ROOT / "src") not in sys.path:
     sys.path.insert(0, str(ROOT / "src"))
 
 TRUE = {"k": 4e5, "kt": 1e5, "fy_N": 20.0, "zeta": 0.002}
+#: AFT samples of the curves: with the automatic choice (128) harmonic balance's response differs
+#: from the exact one-harmonic model by up to 0.1 % in amplitude, systematically (at 1024: 1.3e-5)
+SAMPLES = 1024
 
 
 def curves():
@@ -34,7 +37,7 @@ def curves():
     cols = []
     for F in (5.0, 15.0, 30.0):
         s = jd.System.sdof(m=2.0, k=4e5, law=law, f1=F, c=2 * 0.002 * math.sqrt(5e5 * 2.0), n0=100.0)
-        ds = frc_hb(s, 0.85, 1.1, harmonics=1)
+        ds = frc_hb(s, 0.85, 1.1, harmonics=1, samples=SAMPLES, progress=False)
         g, A = np.asarray(ds["gamma"]), np.asarray(ds["amplitude_m"])
         pick = np.linspace(0, g.size - 1, 50).astype(int)
         cols.append(np.column_stack([np.full(50, F), g[pick] * s.w0, A[pick]]))

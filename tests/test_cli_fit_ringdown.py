@@ -37,12 +37,15 @@ def test_a_linear_ringdown_is_written_as_a_backbone_and_fitted(tmp_path, capsys)
     assert d["determined_combinations"]["zeta"]["value"] == pytest.approx(0.0025, rel=0.01)
     bb = (out / "ringdown_backbone.csv").read_text().splitlines()
     assert bb[0] == "amplitude_m,omega_rad_s,damping_ratio" and len(bb) > 10
-    # the written backbone, fitted with --backbone, gives the same result
+    # --ringdown fits the decay's windows (fit_ringdown), and says so; the written backbone,
+    # fitted with --backbone, gives the same stiffness (measured 2.4e-9 apart) and its own
+    # narrower interval (its points come from one smooth model)
+    assert "windows" in d["message"]
     assert main(["fit", "--backbone", str(out / "ringdown_backbone.csv"), "--model", "iwan", "--mass", "2",
                  "--json"]) == 3
     again = json.loads(capsys.readouterr().out)
     assert again["determined_combinations"]["k_plus_kt"]["value"] == pytest.approx(
-        d["determined_combinations"]["k_plus_kt"]["value"], rel=1e-9)
+        d["determined_combinations"]["k_plus_kt"]["value"], rel=1e-6)
 
 
 @pytest.mark.parametrize("kw,word", [

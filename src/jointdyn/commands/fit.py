@@ -17,7 +17,9 @@ with a modal Iwan model by the describing function
 (:func:`jointdyn.fit_backbone`). ``--ringdown``: columns ``t`` and one of
 ``x``, ``v``, ``a`` of a free decay, turned into such a backbone
 (:func:`jointdyn.backbone_from_ringdown`; with ``--out``, also written as
-``ringdown_backbone.csv``) and fitted the same way. ``--frc``: columns
+``ringdown_backbone.csv``) and fitted the same way, the determined combinations then again
+to the decay's windows (:func:`jointdyn.identify.fit_ringdown`: intervals the record
+justifies). ``--frc``: columns
 ``force_N, omega_rad_s, amplitude_m`` of stepped-sine response curves at
 several force levels (:func:`jointdyn.fit_frc`).
 
@@ -152,8 +154,9 @@ def _fit(args):
         d = {"amplitude_m": b.amplitude_m, "omega_rad_s": b.omega_rad_s, "damping_ratio": b.damping_ratio}
         _plausible("--ringdown", args.ringdown, "x (amplitude)", d["amplitude_m"], FIT_PLAUSIBLE_AMPLITUDE_M,
                    "m")
-        return fit_backbone(d["amplitude_m"], d["omega_rad_s"], d["damping_ratio"], mass=args.mass,
-                            model=args.model, law_params=held, start=start)
+        from ..identify import fit_ringdown
+
+        return fit_ringdown(b, mass=args.mass, model=args.model, law_params=held, start=start)
     d = read_backbone(args.backbone, "--backbone", mass=args.mass)
     _plausible("--backbone", args.backbone, "amplitude_m", d["amplitude_m"], FIT_PLAUSIBLE_AMPLITUDE_M, "m")
     return fit_backbone(d["amplitude_m"], d["omega_rad_s"], d["damping_ratio"], mass=args.mass, model=args.model,
@@ -265,7 +268,8 @@ def _print_console(args, fit) -> None:
         print(f"  (standard errors with {', '.join(fit.conditional_on)} held; the intervals are not conditional)")
     for k, c in fit.determined_combinations.items():
         lo, hi = c["interval"]["low"], c["interval"]["high"]
-        print(f"  determined: {k} = {c['value']:.6g} {c['unit']} (95 %: [{lo if lo is None else f'{lo:.5g}'}, "
+        word = "not determined" if "not_determined" in c else "determined"
+        print(f"  {word}: {k} = {c['value']:.6g} {c['unit']} (95 %: [{lo if lo is None else f'{lo:.5g}'}, "
               f"{hi if hi is None else f'{hi:.5g}'}]): {c['meaning']}")
     unit = "N" if fit.kind == "loops" else "(relative)"
     print(f"  rms residual {fit.rms_residual:.4g} {unit}")

@@ -6,7 +6,8 @@
   linear damping ratio) from a measured backbone (amplitude, frequency,
   damping ratio against amplitude) by the one-harmonic describing function.
 
-* :func:`backbone_from_ringdown`: the backbone of one mode from its free decay;
+* :func:`backbone_from_ringdown`: the backbone of one mode from its free decay, and
+  :func:`fit_ringdown`: the modal model fitted to that decay's windows;
 * :func:`fit_frc`: the modal Iwan model from stepped-sine response curves at several
   force levels.
 
@@ -23,6 +24,8 @@ from .loops import LOOP_MODELS, fit_loops
 from ._profile import Interval
 from .result import FitResult, FitStatus
 from .ringdown import RingdownBackbone, RingdownOptions, backbone_from_ringdown
+from .ringdown_fit import fit_ringdown
 
 __all__ = ["fit_loops", "fit_backbone", "fit_frc", "describing_function", "FitResult", "FitStatus", "Interval",
-           "backbone_from_ringdown", "RingdownBackbone", "RingdownOptions", "LOOP_MODELS", "BACKBONE_MODELS"]
+           "backbone_from_ringdown", "fit_ringdown", "RingdownBackbone", "RingdownOptions", "LOOP_MODELS",
+           "BACKBONE_MODELS"]

@@ -255,6 +255,11 @@ def smooth_envelope(t, lna, omega, options: RingdownOptions) -> tuple:
     misfit : float
         The rms of the weighted residual of ln A over that of a cubic spline with knots every
         0.25 of ln A (near 1: the model is adequate; above: the decay is not of this form).
+    windows : dict or None
+        What the decay model was fitted to (None for the spline): ``t`` (s), ``lna`` (ln A with
+        the noise's bias removed), ``omega`` (rad/s), and their standard errors ``sigma_lna``
+        (-, per window: the amplitude's noise over A) and ``sigma_omega`` (rad/s), for fits of a
+        model to the windows themselves (:func:`jointdyn.identify.fit_ringdown`).
     """
     amp = np.exp(lna)
     x, r, rw = _fit_decay(t, lna, omega, amp)
@@ -264,7 +269,7 @@ def smooth_envelope(t, lna, omega, options: RingdownOptions) -> tuple:
         misfit = math.sqrt((float(r @ r) / max(t.size - 4, 1)) / max(rs / (t.size - inner.size - 4), 1e-300))
         if misfit > options.misfit_limit:
             keep, lf, rate, wfit, noise = _spline_envelope(t, lna, omega, options)
-            return keep, lf, rate, wfit, None, None, noise, misfit
+            return keep, lf, rate, wfit, None, None, noise, misfit, None
     noise = 1.4826 * float(np.median(np.abs(r - np.median(r))))  # robust scale (MAD)
     fit0 = power_decay(t - t[0], *x[:4])
     bad = np.flatnonzero(noise / np.exp(fit0) > options.amplitude_rtol)
@@ -290,4 +295,6 @@ def smooth_envelope(t, lna, omega, options: RingdownOptions) -> tuple:
     rs = _fit(t, lna, amp, inner)[1] if t.size - inner.size - 4 >= 2 else float(r @ r)
     dof_m, dof_s = max(keep - 4, 1), max(keep - inner.size - 4, 1)
     misfit = math.sqrt((float(r @ r) / dof_m) / max(rs / dof_s, 1e-300))
-    return keep, lf, rate, wfit, float(x[3]), float(x[4]), noise, misfit
+    windows = {"t": t, "lna": lna, "omega": omega, "sigma_lna": noise / amp,
+               "sigma_omega": np.full(keep, max(noise_w, 1e-12 * float(np.max(omega))))}
+    return keep, lf, rate, wfit, float(x[3]), float(x[4]), noise, misfit, windows

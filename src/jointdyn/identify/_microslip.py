@@ -27,7 +27,10 @@ import numpy as np
 from ..laws.segalman import CHI_MAX, CHI_MIN, segalman_constants
 from ._lsq import Param, solve
 
-__all__ = ["microslip_backbone", "microslip_constants", "MICROSLIP_MODELS"]
+__all__ = ["microslip_backbone", "microslip_constants", "decay_model", "MICROSLIP_MODELS"]
+
+#: ln A steps of the quadrature of a free decay (:func:`decay_model`) (-)
+DECAY_GRID = 600
 
 #: backbone models whose microslip is the power law above (jenkins has none; discrete is a staircase)
 MICROSLIP_MODELS = ("iwan", "iwan-closed", "segalman")
@@ -57,6 +60,52 @@ def microslip_model(K, R, chi, zeta, m, A) -> tuple:
     w = np.sqrt(w2)
     en = 4.0 * R * A ** (chi + 3.0) / ((chi + 2.0) * (chi + 3.0))
     return w, en / (2.0 * math.pi * m * w2 * A * A) + zeta * math.sqrt(K / m) / w
+
+
+def decay_model(v: dict, m: float, t: np.ndarray, lna_end: float) -> tuple:
+    """(ln A, omega rad/s) at the times ``t`` (s, from t[0]) of the free decay of the microslip model
+    ``v`` (K N/m, R, chi, zeta, lna0) released at ln A = lna0 at t[0]: -d ln A / dt =
+    omega D (k + K1) / (k + F'), D in EPMC's definition and (k + K1) / (k + F') the ratio of
+    :func:`jointdyn.identify.ringdown.epmc_factor`, integrated by quadrature over ln A down to
+    ``lna_end`` - 1."""
+    K, R, chi, zeta = v["K"], v["R"], v["chi"], v["zeta"]
+    lev = np.linspace(v["lna0"], min(lna_end, v["lna0"]) - 1.0, DECAY_GRID)
+    A = np.exp(lev)
+    w, D = microslip_model(K, R, chi, zeta, m, A)
+    ap = R * A ** (chi + 1.0)
+    ratio = np.maximum(K - _c1(chi) * ap, 1e-6 * K) / np.maximum(K - ap / (chi + 1.0), 1e-6 * K)
+    inv = 1.0 / np.maximum(w * D * ratio, 1e-300)
+    tl = np.concatenate(([0.0], np.cumsum(0.5 * (inv[1:] + inv[:-1]) * (lev[:-1] - lev[1:]))))
+    span = float(t[-1] - t[0])
+    if tl[-1] < span:  # beyond the grid: the last rate
+        lev = np.append(lev, lev[-1] - (span - tl[-1]) / inv[-1])
+        tl = np.append(tl, span)
+        w = np.append(w, w[-1])
+    lna = np.interp(t - t[0], tl, lev)
+    return lna, np.interp(t - t[0], tl, w)
+
+
+def decay_fit(win: dict, m: float, start: dict, fit_chi: bool, *, profile: bool = True, chi_bounds=None):
+    """Least squares of :func:`decay_model` to a ring-down's windows ``win`` (``t``, ``lna``,
+    ``omega`` and their standard errors ``sigma_lna``, ``sigma_omega``): (Solution, params) for
+    lna0, K, R, zeta and, when ``fit_chi``, chi (within ``chi_bounds``, default Segalman's
+    range), from ``start`` (K, R, zeta, chi); ``profile``: with profile-likelihood intervals."""
+    t, lna, om = win["t"], win["lna"], win["omega"]
+    sl, so = win["sigma_lna"], win["sigma_omega"]
+    params = [Param("lna0", float(lna[0]), False, float(lna[0]) - 1.0, float(lna[0]) + 1.0),
+              Param("K", start["K"], True, 1e-3 * start["K"], 1e3 * start["K"]),
+              Param("R", start["R"], True, 1e-4 * start["R"], 1e4 * start["R"]),
+              Param("zeta", max(start["zeta"], 1e-6), True, 0.0, 1.0 / max(start["zeta"], 1e-6))]
+    if fit_chi:
+        lo, hi = chi_bounds if chi_bounds is not None else (CHI_MIN, CHI_MAX)
+        params.append(Param("chi", min(max(start["chi"], lo), hi), False, lo, hi))
+
+    def fun(v):
+        v = dict(v, chi=v.get("chi", start["chi"]))
+        lf, wf = decay_model(v, m, t, float(lna[-1]))
+        return np.concatenate(((lf - lna) / sl, (wf - om) / so))
+
+    return solve(fun, params, profile=profile), params
 
 
 def microslip_backbone(A, w, D, m, start: dict, *, fit_chi: bool, dscale: float, weights=(1.0, 1.0)) -> tuple:
