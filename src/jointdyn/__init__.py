@@ -69,6 +69,7 @@ _LAZY = {
     "fit_loops": "identify",
     "fit_backbone": "identify",
     "backbone_from_ringdown": "identify",
+    "fit_ringdown": "identify",
     "fit_frc": "identify",
     "FitResult": "identify",
 }
