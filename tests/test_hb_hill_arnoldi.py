@@ -15,8 +15,8 @@ from jointdyn.hb import (
     harmonic_balance,
     hill_arnoldi_exponents,
     hill_exponents,
-    monodromy_multipliers,
 )
+from hill_checks import assert_period_map_confirms
 
 ARNOLDI = StabilityOptions(method="arnoldi")
 DENSE = StabilityOptions(method="dense")
@@ -126,18 +126,7 @@ def test_time_integration_confirms_an_unstable_and_a_stable_point_beyond_the_den
     br = continue_hb(s, 1.1, 1.3, harmonics=7, samples=128, progress=False)
     assert 2 * s.ndof * (2 * br.problem.H + 1) > StabilityOptions().dense_max_rows
     assert br.status.ok and br.stability == "hill-arnoldi"
-    u = np.flatnonzero(~br.stable)
-    assert u.size
-    worst = u[np.argmax(br.growth[u])]
-    calm = int(np.argmin(np.abs(br.lam - 1.27)))
-    assert br.stable[calm]
-    mono = {}
-    for i in (worst, calm):
-        mu_mono = float(np.max(np.abs(monodromy_multipliers(br.problem, br.X[i], br.lam[i]))))
-        mu_hill = math.exp(2.0 * math.pi * br.growth[i])
-        assert abs(mu_mono - mu_hill) < 1e-2
-        mono[i] = mu_mono
-    assert mono[worst] > 1.0 + 2e-3 and mono[calm] < 1.0
+    assert_period_map_confirms(br, 1.27)
 
 
 def test_modal_damping_as_an_operator_gives_the_exponents_of_its_dense_matrix():

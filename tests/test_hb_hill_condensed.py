@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 import pytest
-from test_hb_hill_arnoldi import _damper_with_a_chain
+from test_hb_hill_arnoldi import ARNOLDI, DENSE, _damper_with_a_chain
 
 import jointdyn as jd
 from jointdyn import System
@@ -19,12 +19,10 @@ from jointdyn.hb import (
     harmonic_balance,
     hill_arnoldi_exponents,
     hill_exponents,
-    monodromy_multipliers,
 )
 from jointdyn.hb.hill_condensed import condensed_hill_exponents
+from hill_checks import assert_period_map_confirms
 
-ARNOLDI = StabilityOptions(method="arnoldi")
-DENSE = StabilityOptions(method="dense")
 #: exponents agree to this relative to their modulus (and growth Re(s)/w to this)
 RTOL = 1e-6
 
@@ -121,17 +119,7 @@ def test_condensed_branch_labels_equal_dense_hill(condensed_branches):
 
 def test_time_integration_confirms_an_unstable_and_a_stable_condensed_point(condensed_branches):
     br, _ = condensed_branches
-    u = np.flatnonzero(~br.stable)
-    worst = u[np.argmax(br.growth[u])]
-    calm = int(np.argmin(np.abs(br.lam - 1.27)))
-    assert br.stable[calm]
-    mono = {}
-    for i in (worst, calm):
-        mu_mono = float(np.max(np.abs(monodromy_multipliers(br.problem, br.X[i], br.lam[i]))))
-        mu_hill = math.exp(2.0 * math.pi * br.growth[i])
-        assert abs(mu_mono - mu_hill) < 1e-2
-        mono[i] = mu_mono
-    assert mono[worst] > 1.0 + 2e-3 and mono[calm] < 1.0
+    assert_period_map_confirms(br, 1.27)
 
 
 def test_single_condensed_point_by_either_method():
