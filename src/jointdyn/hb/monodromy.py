@@ -50,7 +50,8 @@ def _section_phase(problem, X, p) -> float:
 
 
 def monodromy_multipliers(problem, X, p, *, steps_per_period: int | None = None, eps: float | None = None,
-                          warm_periods: int | None = None, warm_samples: int | None = None) -> np.ndarray:  # fmt: skip
+                          warm_periods: int | None = None, warm_samples: int | None = None,
+                          march=None) -> np.ndarray:  # fmt: skip
     """Floquet multipliers from finite differences of the period map.
 
     Parameters
@@ -62,8 +63,8 @@ def monodromy_multipliers(problem, X, p, *, steps_per_period: int | None = None,
     p : float
         Parameter value.
     steps_per_period : int, optional
-        RK4 base steps per period (default ``dynamics._model.TI_STEPS_PER_PERIOD``;
-        events and reversals add steps).
+        RK4 base steps per period (default ``march.steps_per_period``, 256; events and reversals add
+        steps); replaces that field.
     eps : float, optional
         Relative perturbation of positions (scaled by the amplitude) and
         velocities (scaled by w times the amplitude); default
@@ -72,6 +73,9 @@ def monodromy_multipliers(problem, X, p, *, steps_per_period: int | None = None,
         Periods of the HB displacement, and samples per period, marched
         through each contact law to obtain the contact state at the section
         (defaults ``config.MONODROMY_WARM_PERIODS``, ``config.MONODROMY_WARM_SAMPLES``).
+    march : MarchOptions, optional
+        The numbers of the time march that integrates the period map
+        (:class:`~jointdyn.dynamics.options.MarchOptions`; None: the defaults).
 
     Returns
     -------
@@ -100,5 +104,6 @@ def monodromy_multipliers(problem, X, p, *, steps_per_period: int | None = None,
     amp = max(float(np.max(np.abs(xs))), 1e-12)
     from ..dynamics import monodromy_matrix  # the RK4 march of the time-domain layer
 
-    J = monodromy_matrix(system, w, tau0 / w, x0, v0, S, amplitude=amp, eps=eps, steps_per_period=steps_per_period)
+    J = monodromy_matrix(system, w, tau0 / w, x0, v0, S, amplitude=amp, eps=eps, steps_per_period=steps_per_period,
+                         march=march)
     return np.linalg.eigvals(J)
