@@ -186,7 +186,7 @@ def test_the_march_takes_its_numbers_from_its_options():
 
     import numpy as np
 
-    from jointdyn.dynamics import integrate, steady_state
+    from jointdyn.dynamics import check_period_steps, integrate, steady_state
     from jointdyn.dynamics._model import make_model, pack_system, recontact_load
     from jointdyn.systems import System
 
@@ -200,6 +200,10 @@ def test_the_march_takes_its_numbers_from_its_options():
     assert tight.xcap0 == pytest.approx(1e-4 * base.xcap0, rel=1e-14)
     assert make_model(s, w, MarchOptions(max_splits=2)).max_split == 2
     assert make_model(s, w, MarchOptions(max_splits=2), events=False).max_split == 0
+    spp16 = MarchOptions(steps_per_period=16, max_omega_h=0.05, spring_omega_h=0.05)
+    need = math.ceil(2 * math.pi * pack.w_max / (w * 0.05))
+    assert check_period_steps(s, w, march=spp16) == need > 16  # the sweeps' and the CLI's check, same march
+    assert check_period_steps(s, w, 4 * need, march=spp16) == 4 * need  # the keyword replaces the field
     n0 = s.contacts[0].n0
     assert recontact_load(pack.kin, 0, MarchOptions(recontact_alpha=1e-6)) == 1e-6 * n0
     a = integrate(s, 1.1, periods=2, steps_per_period=512)

@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ..drivers import march
+from ..drivers import march as march_law
 from ..fourier import basis, derivative_matrix
 from ..kinematics import HarmonicLoad, contact_kinematics, normal_load_samples, tangential_history
 from ..laws import MACROSLIP, SEPARATION
@@ -99,7 +99,7 @@ def monodromy_multipliers(problem, X, p, *, steps_per_period: int | None = None,
     N = normal_load_samples(kin, tt)
     S = np.zeros((len(system.contacts), max([c.law.state_size for c in system.contacts], default=1)))
     for i, c in enumerate(system.contacts):
-        s = march(c.law, np.ascontiguousarray(U[:, i]), N[i])[3]
+        s = march_law(c.law, np.ascontiguousarray(U[:, i]), N[i])[3]
         S[i, : s.size] = s
     amp = max(float(np.max(np.abs(xs))), 1e-12)
     from ..dynamics import monodromy_matrix  # the RK4 march of the time-domain layer
