@@ -280,7 +280,7 @@ class Model:
     xcap: np.ndarray
     grid: Grid | None
     period: float
-    march: MarchOptions = MarchOptions()
+    march: MarchOptions
     refined: bool = False
 
     @property
