@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 import jointdyn as jd
-from jointdyn.dynamics._model import TI_STEPS_PER_PERIOD
+from jointdyn.dynamics import MarchOptions
 from jointdyn.hb import continue_hb
 from jointdyn.interfaces import Interface
 
@@ -47,7 +47,7 @@ def run(quick: bool = False) -> dict:
     jd.integrate(s, g, periods=1)  # compiled before timing
     jd.integrate(lin, g, periods=1)
     periods = 5 if quick else 20
-    out = {"ndof": s.ndof, "pairs": 20, "steps_per_period": TI_STEPS_PER_PERIOD}
+    out = {"ndof": s.ndof, "pairs": 20, "steps_per_period": MarchOptions().steps_per_period}
     t0 = cpu()
     jd.integrate(s, g, periods=periods)
     out["td_cpu_per_period_s"] = (cpu() - t0) / periods

@@ -17,7 +17,7 @@ against a plain ``scipy.integrate.solve_ivp``-style integration.
   jointdyn then one of the reference; 1 round in quick mode).
 
 Reference integrator: scipy's explicit Runge-Kutta (RK45, rtol 1e-8, step at
-most the period / TI_STEPS_PER_PERIOD like jointdyn's base step) stepped
+most the period / ``MarchOptions().steps_per_period`` like jointdyn's base step) stepped
 from Python; every right-hand-side evaluation calls the contact law's
 compiled trial kernel from Python (``law.step`` from the committed state),
 and the law's state is committed after every accepted step -- the textbook
@@ -48,13 +48,14 @@ BASELINE_POINTS = (  # (eta, beta, gamma)
 def _reference_periods(system, gamma, periods):
     """Integrate ``periods`` forcing periods with scipy RK45 + Python law calls.
 
-    Step size capped at the period / ``TI_STEPS_PER_PERIOD`` (the
+    Step size capped at the period / ``MarchOptions().steps_per_period`` (the
     base step of jointdyn's integrator: the same time resolution), rtol 1e-8.
     """
     from scipy.integrate import RK45
 
-    from jointdyn.dynamics._model import TI_STEPS_PER_PERIOD
+    from jointdyn.dynamics import MarchOptions
 
+    steps = MarchOptions().steps_per_period
     c = system.contacts[0]
     law = c.law
     step = law.step
@@ -74,7 +75,7 @@ def _reference_periods(system, gamma, periods):
         return np.array([y[1], (f1 * math.sin(w * t) - k * y[0] - cv * y[1] - T) / m])
 
     t_end = periods * 2.0 * math.pi / w
-    solver = RK45(rhs, 0.0, np.zeros(2), t_end, rtol=1e-8, atol=1e-12, max_step=(2 * math.pi / w) / TI_STEPS_PER_PERIOD)
+    solver = RK45(rhs, 0.0, np.zeros(2), t_end, rtol=1e-8, atol=1e-12, max_step=(2 * math.pi / w) / steps)
     nsteps = 0
     while solver.status == "running":
         solver.step()
@@ -118,7 +119,7 @@ def run(quick: bool = False) -> dict:
     out["status_counts"] = {str(k): int(v) for k, v in df.status_name.value_counts().items()}
     out["mean_periods_per_point"] = float(df.periods.mean())
 
-    from jointdyn.dynamics._model import TI_STEPS_PER_PERIOD
+    from jointdyn.dynamics import MarchOptions
 
     _reference_periods(System.paper_damper(eta=0.5, beta=2.0), 1.0, 1)  # warm the Python-side dispatch
     rows = []
@@ -146,7 +147,7 @@ def run(quick: bool = False) -> dict:
     out["baseline_speedup_geomean"] = math.exp(sum(math.log(r["speedup"]) for r in rows) / len(rows))
     out["baseline_note"] = ("reference = scipy RK45 stepped from Python, law kernel called from Python at every "
                             "RHS evaluation, law state committed at accepted steps, max step = period/"
-                            f"{TI_STEPS_PER_PERIOD}, rtol 1e-8; time scaled from baseline_periods_run to "
+                            f"{MarchOptions().steps_per_period}, rtol 1e-8; time scaled from baseline_periods_run to "
                             "the periods jointdyn used for the point")
     out["load_average_after"] = list(os.getloadavg())
     out["load_note"] = ("the machine is shared: a 1-minute load average above the core count means other "

@@ -29,7 +29,6 @@ from jointdyn import config
 from jointdyn.cli import main
 from jointdyn.files import read_matrices, read_system
 from jointdyn.sweeps import _points
-from jointdyn.dynamics._model import TI_MAX_OMEGA_H
 from test_bad_input import _Reached, _boom, _cli, _tree, no_compute, refused  # noqa: F401 (no_compute: a fixture)
 
 SRC = str(Path(__file__).resolve().parents[1] / "src")
@@ -475,14 +474,16 @@ def test_the_stiffest_mode_sets_the_step_and_is_named(no_compute, capsys, tmp_pa
 
 def test_period_steps_unchanged_where_memory_allows():
     """The steps of a period are those the solver always took (the bound only refuses)."""
+    from jointdyn.dynamics import MarchOptions
     from jointdyn.dynamics._model import make_model, pack_system, period_steps
 
     s = jd.System.paper_damper(normal="spring")
     pack = pack_system(s)
     w = 0.5 * s.w0
-    J = period_steps(pack, w, 64)
-    assert J == max(64, int(math.ceil(2 * math.pi * pack.w_max / (w * TI_MAX_OMEGA_H))))
-    assert make_model(s, w, 64).J == J
+    march = MarchOptions(steps_per_period=64)
+    J = period_steps(pack, w, march)
+    assert J == max(64, int(math.ceil(2 * math.pi * pack.w_max / (w * march.max_omega_h))))
+    assert make_model(s, w, march).J == J
 
 
 # --- a backbone that never starts ------------------------------------------------------------------

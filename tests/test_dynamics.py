@@ -24,8 +24,7 @@ from jointdyn.dynamics import (
 )
 from jointdyn.dynamics._core import LOADS_HARMONIC, RUN_BLOWUP, RUN_OK, RUN_OVERFLOW
 from jointdyn.dynamics._model import make_model, run
-from jointdyn.dynamics._model import TI_STEPS_PER_PERIOD
-from jointdyn.dynamics import SteadyStateOptions
+from jointdyn.dynamics import MarchOptions, SteadyStateOptions
 
 #: the steady state's defaults
 SS = SteadyStateOptions()
@@ -180,7 +179,7 @@ def test_energy_balance_at_steady_state(kw, gamma):
 def test_step_halving_changes_amplitude_little(eta, gamma):
     s = System.paper_damper(eta=eta, beta=2.0)
     a = steady_state(s, gamma, keep_loop=False)
-    b = steady_state(s, gamma, steps_per_period=2 * TI_STEPS_PER_PERIOD, start=a, keep_loop=False)
+    b = steady_state(s, gamma, steps_per_period=2 * SS.march.steps_per_period, start=a, keep_loop=False)
     assert a.status == b.status == "periodic"
     assert b.amplitude_m == pytest.approx(a.amplitude_m, rel=tolerances.TEST_TI_STEP_HALVING_RTOL)
 
@@ -248,7 +247,7 @@ def test_event_at_the_period_boundary(delta):
     assert np.max(np.abs(T - tr.T[:, 0])) <= tolerances.TEST_TI_MARCH_ATOL_FY * law.fy
     assert 0.0 <= tr.N[0, 0] <= 1e-9 * law.n_ref
     a = steady_state(s, 1.1, keep_loop=False)
-    b = steady_state(s, 1.1, steps_per_period=2 * TI_STEPS_PER_PERIOD, keep_loop=False)
+    b = steady_state(s, 1.1, steps_per_period=2 * SS.march.steps_per_period, keep_loop=False)
     assert a.status.ok and b.status.ok
     assert b.amplitude_m == pytest.approx(a.amplitude_m, rel=tolerances.TEST_TI_STEP_HALVING_RTOL)
 
@@ -364,7 +363,7 @@ def test_blow_up_is_reported():
 
 def test_full_sample_buffer_is_enlarged_and_the_run_repeated():
     s = System.paper_damper(eta=1.5, beta=2.0)
-    model = make_model(s, 1.1 * s.w0, 64)
+    model = make_model(s, 1.1 * s.w0, MarchOptions(steps_per_period=64))
     x0, v0 = np.array([1e-4]), np.zeros(1)
     S0 = model.initial_states(x0)
     runs = []

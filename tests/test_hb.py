@@ -10,6 +10,7 @@ from scipy.optimize import brentq
 
 import tolerances
 from jointdyn import System
+from jointdyn.dynamics import MarchOptions
 from jointdyn.continuation import continuation, turning_points
 from jointdyn.hb import (
     HBProblem,
@@ -233,6 +234,11 @@ def test_hill_agrees_with_monodromy():
             assert (mu_mono > 1) == (not br.stable[i])
         seen.add(bool(br.stable[i]))
     assert seen == {True, False}
+    # the march of the period map from its options: the steps as the field or the keyword, bit for bit
+    i = picks[-1]
+    by_kw = monodromy_multipliers(br.problem, br.X[i], br.lam[i], steps_per_period=512)
+    by_options = monodromy_multipliers(br.problem, br.X[i], br.lam[i], march=MarchOptions(steps_per_period=512))
+    assert np.array_equal(by_kw, by_options)
 
 
 def test_unbounded_below_den_hartog_limit():

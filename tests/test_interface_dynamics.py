@@ -16,6 +16,7 @@ import pytest
 
 import jointdyn as jd
 from jointdyn.cli import main
+from jointdyn.dynamics import MarchOptions
 from jointdyn.dynamics._model import make_model, sliders
 from jointdyn.kinematics import NormalSpring
 
@@ -105,7 +106,7 @@ def test_one_dimensional_patch_is_the_discrete_iwan_law_under_a_normal_spring(fo
     for events, tol in ((True, 1e-5),) if opened else ((False, 1e-13), (True, 1e-8)):
         out = []
         for s in (iwan, patch):
-            model = make_model(s, 40.0, 256, events=events)
+            model = make_model(s, 40.0, MarchOptions(steps_per_period=256), events=events)
             x, v = np.zeros(2), np.zeros(2)
             S = model.initial_states(x)
             res = model.run_periods(x, v, S, 6, rec=True)
@@ -145,7 +146,7 @@ def test_interfaces_mix_with_contacts_and_warm_start():
                   w0_rad_s=30.0)  # fmt: skip
     r = jd.steady_state(s, 1.0)
     assert r.status.ok
-    model = make_model(s, 30.0, 256)
+    model = make_model(s, 30.0, MarchOptions(steps_per_period=256))
     assert r.restart.states.shape == (model.pack.state_rows, model.pack.slen)
     assert sliders(model.pack, r.restart.states).shape == (2, 2)
     again = jd.steady_state(s, 1.0, start=r)

@@ -21,7 +21,7 @@ from jointdyn.kinematics import (
 from jointdyn.kinematics import HarmonicLoad
 from jointdyn.laws import make_law
 from jointdyn.systems import Contact, System
-from jointdyn.dynamics._model import TI_RECONTACT_ALPHA
+from jointdyn.dynamics import MarchOptions
 
 
 def _three_dof():
@@ -95,8 +95,9 @@ def test_sampled_grid_inserts_crossings_exactly():
     t = np.array([0.0, 1.0, 2.0, 3.0])
     F = np.array([[0.0], [1.0], [2.0], [3.0]])
     N = np.array([[2.0], [-2.0], [-1.0], [3.0]])
-    tg, Fg, Ng = sampled_load_grid(t, F, N, TI_RECONTACT_ALPHA)
+    alpha = MarchOptions().recontact_alpha
+    tg, Fg, Ng = sampled_load_grid(t, F, N, alpha)
     np.testing.assert_allclose(tg, [0.0, 0.5, 1.0, 2.0, 2.25, 3.0])
     np.testing.assert_allclose(Fg[:, 0], tg)  # F = t is linear: interpolated exactly
     assert Ng[1, 0] == 0.0  # separation: exactly open
-    assert Ng[4, 0] == TI_RECONTACT_ALPHA * 3.0  # re-contact: tiny positive load
+    assert Ng[4, 0] == alpha * 3.0  # re-contact: tiny positive load

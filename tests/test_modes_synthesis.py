@@ -87,3 +87,6 @@ def test_bad_input():
         single_mode_frc(b, jd.System.paper_damper(eta=0.0, f1=0.0))
     with pytest.raises(ValueError, match="1 DOFs"):
         single_mode_frc(b, jd.System(np.eye(2), None, np.eye(2), force=[1.0, 0.0]))
+    for bad in (0.0, 1.0, float("nan")):
+        with pytest.raises(ValueError, match="peak_rtol"):
+            single_mode_frc(b, peak_rtol=bad)

@@ -7,7 +7,7 @@ import pytest
 from scipy.linalg import expm
 
 import tolerances
-from jointdyn.dynamics import fd_monodromy, monodromy_matrix
+from jointdyn.dynamics import MarchOptions, fd_monodromy, monodromy_matrix
 from jointdyn.laws import make_law
 from jointdyn.kinematics import HarmonicLoad
 from jointdyn.systems import Contact, System
@@ -66,6 +66,9 @@ def test_stuck_contact_monodromy_is_the_stuck_linear_system():
     B = np.array([1.0, -1.0])
     want = _exact(M, C, K + kt * np.outer(B, B), w, 1e-4)
     assert np.max(np.abs(J - want)) <= tolerances.TEST_MONODROMY_LINEAR_RTOL * np.max(np.abs(want))
+    # the steps as a field of the march's options: the same matrix, bit for bit
+    by_options = monodromy_matrix(s, w, 0.0, x, v, S, amplitude=1e-4, march=MarchOptions(steps_per_period=1024))
+    assert np.array_equal(J, by_options)
 
 
 def test_bad_input_names_the_parameter():
@@ -74,3 +77,9 @@ def test_bad_input_names_the_parameter():
         monodromy_matrix(s, 1.0, 0.0, [0.0], [0.0], np.zeros((0, 1)), amplitude=0.0)
     with pytest.raises(ValueError, match="w"):
         monodromy_matrix(s, -1.0, 0.0, [0.0], [0.0], np.zeros((0, 1)), amplitude=1.0)
+
+
+def test_a_march_that_is_not_march_options_is_refused():
+    s = System(M=np.eye(1), C=np.zeros((1, 1)), K=np.eye(1), force=[1.0])
+    with pytest.raises(ValueError, match="march must be a MarchOptions"):
+        monodromy_matrix(s, 1.0, 0.0, [0.0], [0.0], np.zeros((0, 1)), amplitude=1.0, march=256)

@@ -10,7 +10,7 @@ import re
 
 import pytest
 
-from jointdyn.dynamics import SteadyStateOptions
+from jointdyn.dynamics import MarchOptions, SteadyStateOptions
 from jointdyn.hb import HBOptions
 from jointdyn.modes import EPMCOptions, QSMAOptions
 
@@ -30,7 +30,12 @@ BAD = {
                   "start_max_iter": (0, ">= 1"), "auto_check_points": (0, ">= 1")},
     QSMAOptions: {"steps_per_decade": (0, ">= 1"), "decades_below": (0, ">= 1"), "substeps": (0, ">= 1"),
                   "tol": (0.0, "(0, inf)"), "max_iter": (0, ">= 1")},
-    SteadyStateOptions: {"steps_per_period": (3, ">= 4"), "amp_rtol": (0.0, "(0, inf)"),
+    MarchOptions: {"steps_per_period": (3, ">= 4"), "max_omega_h": (3.0, "(0.0, 2.8284271247461903]"),
+                   "spring_omega_h": (1.5, "(0.0, 1.0]"), "max_splits": (-1, ">= 0"),
+                   "event_merge": (0.5, "[0.0, 0.5)"), "recontact_alpha": (0.0, "(0.0, 1.0)"),
+                   "blowup_factor": (1.0, "(1.0, inf)")},
+    SteadyStateOptions: {"march": (256, "MarchOptions"), "linear_iters": (0, ">= 1"),
+                         "linear_rtol": (0.0, "(0, inf)"), "amp_rtol": (0.0, "(0, inf)"),
                          "energy_rtol": (-1e-3, "(0, inf)"), "balance_rtol": (0.0, "(0, inf)"),
                          "check_periods": (1, ">= 2"), "max_multiple": (0, ">= 1"),
                          "detect_multiple": (3, ">= max_multiple = 4"), "multiple_decay": (0.0, "(0.0, 1.0]"),
@@ -54,8 +59,11 @@ def documented_defaults(cls) -> dict:
     for entry in re.split(r"\n(?=\w)", doc):
         head, _, body = entry.strip("\n").partition(" : ")
         names = [n.strip() for n in head.split(",")]
-        said = re.search(r"\(defaults? ([^;)]*)", body.replace("\n", " "))
+        said = re.search(r"\(defaults? (``\w+\(\)``|[^;)]*)", body.replace("\n", " "))
         if not said:
+            continue
+        if said.group(1).startswith("``"):  # an options object within another: its defaults, by class name
+            out[names[0]] = said.group(1).strip("`")
             continue
         values = [eval(v) for v in _NUMBER.findall(said.group(1))]  # noqa: S307 (literals of our docstring)
         for name, value in zip(names, values):
@@ -69,8 +77,12 @@ def test_defaults_are_the_documented_values(cls):
     documented = documented_defaults(cls)
     assert set(documented) == set(fields), f"fields without a documented default: {set(fields) - set(documented)}"
     for name, value in fields.items():
+        if dataclasses.is_dataclass(value):  # an options object within another: documented by class name
+            assert documented[name] == f"{type(value).__name__}()" and value == type(value)(), name
+            continue
         assert documented[name] == value and isinstance(documented[name], bool) == isinstance(value, bool), name
-    assert dataclasses.asdict(cls()) == fields
+    made = cls()
+    assert {name: getattr(made, name) for name in fields} == fields
 
 
 def test_documented_defaults_parser_reads_what_it_is_shown():
@@ -164,3 +176,46 @@ def test_a_sweep_passes_its_steady_options_to_every_point(tmp_path):
     assert LineSpec(label="a", system="k", direction="up", gammas=(1.0,), steady=capped).key != plain.key
     with pytest.raises(ValueError, match="steady must be a SteadyStateOptions"):
         SweepOptions(steady=HBOptions())
+
+
+def test_the_march_takes_its_numbers_from_its_options():
+    """Each field of MarchOptions reaches the march it is given to (closed forms of the step grid, the
+    blow-up caps, the re-contact load, the splits), and integrate's and steady_state's steps_per_period
+    keyword is the same number as the options' field: bit for bit the same run either way."""
+    import math
+
+    import numpy as np
+
+    from jointdyn.dynamics import check_period_steps, integrate, steady_state
+    from jointdyn.dynamics._model import make_model, pack_system, recontact_load
+    from jointdyn.systems import System
+
+    s = System.paper_damper(eta=0.5, beta=2.0)
+    w = 1.1 * s.w0
+    pack = pack_system(s)
+    for wh in (0.5, 0.05):
+        m = make_model(s, w, MarchOptions(steps_per_period=8, max_omega_h=wh, spring_omega_h=wh))
+        assert m.J == max(8, math.ceil(2 * math.pi * pack.w_max / (w * wh)))
+    base, tight = make_model(s, w, MarchOptions()), make_model(s, w, MarchOptions(blowup_factor=1e4))
+    assert tight.xcap0 == pytest.approx(1e-4 * base.xcap0, rel=1e-14)
+    assert make_model(s, w, MarchOptions(max_splits=2)).max_split == 2
+    assert make_model(s, w, MarchOptions(max_splits=2), events=False).max_split == 0
+    spp16 = MarchOptions(steps_per_period=16, max_omega_h=0.05, spring_omega_h=0.05)
+    need = math.ceil(2 * math.pi * pack.w_max / (w * 0.05))
+    assert check_period_steps(s, w, march=spp16) == need > 16  # the sweeps' and the CLI's check, same march
+    assert check_period_steps(s, w, 4 * need, march=spp16) == 4 * need  # the keyword replaces the field
+    n0 = s.contacts[0].n0
+    assert recontact_load(pack.kin, 0, MarchOptions(recontact_alpha=1e-6)) == 1e-6 * n0
+    a = integrate(s, 1.1, periods=2, steps_per_period=512)
+    b = integrate(s, 1.1, periods=2, options=MarchOptions(steps_per_period=512))
+    assert np.array_equal(a.t, b.t) and np.array_equal(a.x, b.x) and np.array_equal(a.T, b.T)
+    c = integrate(s, 1.1, periods=2, steps_per_period=512, options=MarchOptions(steps_per_period=64))
+    assert np.array_equal(a.x, c.x)  # the keyword replaces the field
+    by_kw = steady_state(s, 1.1, steps_per_period=512, max_periods=8, keep_loop=False)
+    by_options = steady_state(s, 1.1, keep_loop=False, options=SteadyStateOptions(
+        max_periods=8, march=MarchOptions(steps_per_period=512)))
+    assert (by_kw.steps, by_kw.last_amplitude_m) == (by_options.steps, by_options.last_amplitude_m)
+    with pytest.raises(ValueError, match="options must be a MarchOptions"):
+        integrate(s, 1.1, options=SteadyStateOptions())
+    with pytest.raises(ValueError, match="steps_per_period must be an integer >= 4"):
+        steady_state(s, 1.1, steps_per_period=2)

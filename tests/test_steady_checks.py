@@ -11,6 +11,7 @@ import numpy as np
 
 from jointdyn.dynamics import SteadyStateOptions
 from jointdyn.dynamics._core import N_SUMMARY, S_EC, S_EV, S_W, S_XMAX, S_XMIN
+from jointdyn.dynamics import MarchOptions
 from jointdyn.dynamics._model import make_model
 from jointdyn.dynamics.steady import _History, _check_periodic
 from jointdyn.systems import System
@@ -45,7 +46,7 @@ def _reference(summ, Z, p, K, n, w, K_stuck, M, floor, amp_rtol, energy_rtol, ba
 
 def test_compiled_periodicity_check_equals_reference():
     system = System.paper_damper(eta=0.5, beta=2.0)
-    model = make_model(system, 1.1 * system.w0, 64)
+    model = make_model(system, 1.1 * system.w0, MarchOptions(steps_per_period=64))
     rng = np.random.default_rng(7)
     defaults = SteadyStateOptions()
     amp_rtol, energy_rtol = defaults.amp_rtol, defaults.energy_rtol

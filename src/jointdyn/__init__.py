@@ -52,6 +52,7 @@ _LAZY = {
     "steady_state": "dynamics",
     "SteadyState": "dynamics",
     "SteadyStateOptions": "dynamics",
+    "MarchOptions": "dynamics",
     "Trajectory": "dynamics",
     "Restart": "dynamics",
     "harmonic_balance": "hb",

@@ -34,34 +34,12 @@ from ..kinematics import (
     tangential_history,
 )
 from ..laws import law_dispatch
+from .options import MarchOptions, march_with_steps
 from ._core import LOADS_HARMONIC, N_SUMMARY, RUN_OVERFLOW, S_OPEN, compiled_runner, grid_trig
 from .status import RunStatus, run_status
 
 __all__ = ["PackedSystem", "pack_system", "check_period_steps", "Model", "make_model", "refine_if_opened", "Grid", "RunResult", "run",
            "recontact_load", "pair_relative", "sliders", "set_sliders"]  # fmt: skip
-
-#: RK4 steps per forcing period (before events and reversal splits)
-TI_STEPS_PER_PERIOD = 256
-#: steps per period are raised so that w_max * h <= this (w_max: stiffest
-#: linear mode with every contact stuck); RK4 is stable up to ~2.8
-TI_MAX_OMEGA_H = 1.0
-#: once a normal spring opens, the steps are refined so that w_max * h <=
-#: this (w_max with the springs closed): every re-contact sets the normal
-#: DOFs ringing at their own frequency, and RK4 at w h = 1 damps that
-#: ringing numerically by about 0.3 % of its energy per step, which shows in
-#: the energy balance (measured on the coupled paper damper, eta 1.5: 6e-3
-#: at w h = 0.85, 2e-6 at 0.21)
-TI_SPRING_OMEGA_H = 0.3
-#: at most this many reversal splits inside one grid step
-TI_MAX_SPLITS = 4
-#: an event closer than this fraction of a step to a grid point moves it
-TI_EVENT_MERGE = 1e-6
-#: normal load put at a re-contact instant, as a fraction of n0 (> 0 so that
-#: the committed law state is "in contact, virgin at the re-contact point")
-TI_RECONTACT_ALPHA = 1e-12
-#: a state larger than this factor times (|f|/k_min + fy/kt) is a blow-up
-TI_BLOWUP_FACTOR = 1e8
-
 
 @dataclass(frozen=True)
 class PackedSystem:
@@ -229,18 +207,18 @@ def _harmonic_tables(pack: PackedSystem, tg, Ng, w) -> Grid:
     return (tg, Ng, pack.no_forcing_table, trig, N_mid)
 
 
-def recontact_load(kin: ContactKinematics, c: int) -> float:
+def recontact_load(kin: ContactKinematics, c: int, march: MarchOptions) -> float:
     """Load (N) a prescribed load is snapped to at a re-contact instant:
-    ``TI_RECONTACT_ALPHA`` times n0 (harmonic) or times the largest |sample| (sampled)."""
+    ``march.recontact_alpha`` times n0 (harmonic) or times the largest |sample| (sampled)."""
     if kin.normal_kind[c] == NORMAL_SAMPLED:
-        return TI_RECONTACT_ALPHA * float(np.max(np.abs(kin.normal_table[c])))
-    return TI_RECONTACT_ALPHA * kin.normal_par[c, 0]
+        return march.recontact_alpha * float(np.max(np.abs(kin.normal_table[c])))
+    return march.recontact_alpha * kin.normal_par[c, 0]
 
 
-def _period_grid(pack: PackedSystem, w: float, J: int, events: bool):
+def _period_grid(pack: PackedSystem, w: float, J: int, events: bool, march: MarchOptions):
     """Step grid of one forcing period with the separation/re-contact instants, and its normal loads.
 
-    J uniform steps; an instant within ``TI_EVENT_MERGE`` of a step of a
+    J uniform steps; an instant within ``march.event_merge`` of a step of a
     grid point moves that point, else it is inserted. The load is snapped
     to exactly 0 at a separation and to :func:`recontact_load` at a
     re-contact. The slope changes of sampled loads (their sample phases)
@@ -249,7 +227,7 @@ def _period_grid(pack: PackedSystem, w: float, J: int, events: bool):
     Tp = 2 * math.pi / w
     t = np.arange(J + 1) * (Tp / J)  # np.linspace(0, Tp, J + 1), bit for bit, cheaper
     t[J] = Tp
-    tol = TI_EVENT_MERGE * Tp / J
+    tol = march.event_merge * Tp / J
     tg = t
     ev_at = {}
     instants = list(load_events(pack.kin, w, Tp)) if events else []
@@ -272,7 +250,7 @@ def _period_grid(pack: PackedSystem, w: float, J: int, events: bool):
     N = load_table(pack.kin.arrays, tg, w)
     for k, lst in ev_at.items():
         for ci, rising in lst:
-            N[k, ci] = recontact_load(pack.kin, ci) if rising else 0.0
+            N[k, ci] = recontact_load(pack.kin, ci, march) if rising else 0.0
             if k == 0:
                 N[tg.size - 1, ci] = N[0, ci]
             if k == tg.size - 1:
@@ -286,9 +264,10 @@ class Model:
 
     Built by :func:`make_model`. ``grid`` is the period grid (None when
     ``w == 0``: sampled loads); ``xcap0`` and ``xcap`` are the blow-up caps
-    of the displacements (m) and of (x, v); ``steps_per_period`` is the
-    requested base and ``refined`` says whether the steps follow
-    ``TI_SPRING_OMEGA_H`` (a normal spring opened).
+    of the displacements (m) and of (x, v); ``march`` holds the numbers of
+    the march (its ``steps_per_period`` the requested base) and ``refined``
+    says whether the steps follow ``march.spring_omega_h`` (a normal spring
+    opened).
     """
 
     pack: PackedSystem
@@ -301,7 +280,7 @@ class Model:
     xcap: np.ndarray
     grid: Grid | None
     period: float
-    steps_per_period: int = 0
+    march: MarchOptions
     refined: bool = False
 
     @property
@@ -313,13 +292,14 @@ class Model:
         return self.pack.ncontacts
 
     def cap(self, x, v) -> np.ndarray:
-        """Blow-up caps, never below TI_BLOWUP_FACTOR times the starting state."""
+        """Blow-up caps, never below ``march.blowup_factor`` times the starting state."""
         wv = max(self.pack.w_max, self.w, 1.0)
         xs = float(np.max(np.abs(x))) + float(np.max(np.abs(v))) / wv
-        if TI_BLOWUP_FACTOR * xs <= self.xcap0:
+        factor = self.march.blowup_factor
+        if factor * xs <= self.xcap0:
             return self.xcap  # the usual case: the start is far below the caps
         n = self.n
-        return np.maximum(self.xcap, TI_BLOWUP_FACTOR * np.concatenate([np.full(n, xs), np.full(n, xs * wv)]))
+        return np.maximum(self.xcap, factor * np.concatenate([np.full(n, xs), np.full(n, xs * wv)]))
 
     def segment_grid(self, ta: float, tb: float) -> Grid:
         """Grid for ta < t <= tb (0 <= ta < tb <= ta + period), from the period grid."""
@@ -401,13 +381,14 @@ class Model:
         return run(self, self.grid, LOADS_HARMONIC, x, v, S, nper, rdof=rdof, record=rec, capacity=cap)
 
 
-def make_model(system, w: float, steps_per_period: int, *, events: bool = True,
+def make_model(system, w: float, march: MarchOptions, *, events: bool = True,
                force_scale: float | None = None, refined: bool = False) -> Model:  # fmt: skip
-    """A :class:`Model` of ``system`` at forcing frequency ``w`` (rad/s; 0: sampled loads).
+    """A :class:`Model` of ``system`` at forcing frequency ``w`` (rad/s; 0: sampled loads, where the
+    steps are the samples' and ``march.steps_per_period`` is not used) marched with ``march``.
 
-    ``steps_per_period`` is raised so that w_max h <= ``TI_MAX_OMEGA_H``
+    ``march.steps_per_period`` is raised so that w_max h <= ``march.max_omega_h``
     (w_max: every contact stuck, every normal spring closed), and with
-    ``refined`` (a normal spring opens) so that w_max h <= ``TI_SPRING_OMEGA_H``.
+    ``refined`` (a normal spring opens) so that w_max h <= ``march.spring_omega_h``.
     ``events=False`` (for the convergence study only): no step boundaries
     at separation/re-contact and no splits at velocity reversals.
     ``force_scale`` (N, default the largest forcing amplitude) sets the
@@ -416,19 +397,19 @@ def make_model(system, w: float, steps_per_period: int, *, events: bool = True,
     pack = pack_system(system)
     w = float(w)
     refined = bool(refined) and pack.springs
-    J = period_steps(pack, w, steps_per_period, refined=refined)
+    J = period_steps(pack, w, march, refined=refined)
     fs = pack.fmax if force_scale is None else force_scale
-    xcap0 = TI_BLOWUP_FACTOR * (fs / pack.kmin + pack.xlin + 1e-12)
+    xcap0 = march.blowup_factor * (fs / pack.kmin + pack.xlin + 1e-12)
     xcap = np.empty(2 * pack.ndof)
     xcap[: pack.ndof] = xcap0
     xcap[pack.ndof :] = xcap0 * max(pack.w_max, w, 1.0)
     grid, period = None, math.nan
     if w > 0:
-        tg, Ng = _period_grid(pack, w, J, events)
+        tg, Ng = _period_grid(pack, w, J, events, march)
         grid, period = _harmonic_tables(pack, tg, Ng, w), 2 * math.pi / w
     return Model(pack=pack, system=system, w=w, events=bool(events),
-                 max_split=TI_MAX_SPLITS if events else 0, J=J, xcap0=xcap0, xcap=xcap,
-                 grid=grid, period=period, steps_per_period=int(steps_per_period), refined=refined)  # fmt: skip
+                 max_split=march.max_splits if events else 0, J=J, xcap0=xcap0, xcap=xcap,
+                 grid=grid, period=period, march=march, refined=refined)  # fmt: skip
 
 
 #: float64 words per step of a period held by a run (the grid, its loads and trigonometric tables,
@@ -438,16 +419,17 @@ _STEP_WORDS_PER_DOF = 4
 _STEP_WORDS_PER_CONTACT = 8
 
 
-def period_steps(pack: PackedSystem, w: float, steps_per_period: int, *, refined: bool = False,
+def period_steps(pack: PackedSystem, w: float, march: MarchOptions, *, refined: bool = False,
                  lines: int = 1, name: str = "steps_per_period") -> int:  # fmt: skip
-    """Steps of one forcing period at ``w`` (rad/s): ``steps_per_period``,
-    raised so that w_max h <= ``TI_MAX_OMEGA_H`` (``TI_SPRING_OMEGA_H`` when
+    """Steps of one forcing period at ``w`` (rad/s): ``march.steps_per_period``,
+    raised so that w_max h <= ``march.max_omega_h`` (``march.spring_omega_h`` when
     ``refined``), checked against the memory bound for ``lines`` runs at once
     before anything is allocated (ValueError saying which of the two sets it,
     ``name`` for the first)."""
+    steps_per_period = march.steps_per_period
     J = float(steps_per_period)
     if w > 0:
-        wh = TI_SPRING_OMEGA_H if refined else TI_MAX_OMEGA_H
+        wh = march.spring_omega_h if refined else march.max_omega_h
         with np.errstate(over="ignore", divide="ignore"):
             need = float(np.ceil(np.float64(2 * math.pi) * pack.w_max / (np.float64(w) * wh)))
         J = max(J, need)
@@ -466,25 +448,26 @@ def period_steps(pack: PackedSystem, w: float, steps_per_period: int, *, refined
     return int(J)
 
 
-def check_period_steps(system, w: float, steps_per_period: int | None = None, *, lines: int = 1,
-                       name: str = "steps_per_period") -> int:
+def check_period_steps(system, w: float, steps_per_period: int | None = None, *, march: MarchOptions | None = None,
+                       lines: int = 1, name: str = "steps_per_period") -> int:  # fmt: skip
     """The steps of one forcing period of ``system`` at ``w`` (rad/s), refused before anything is computed
     (ValueError naming ``name`` where ``steps_per_period`` sets the step, else the stiffest mode) when
-    ``lines`` runs at once would exceed the memory bound: :func:`period_steps` with the solver's default
-    steps (``TI_STEPS_PER_PERIOD``) where ``steps_per_period`` is None, refined where the system
-    has normal springs. The lowest frequency of a sweep needs the most."""
+    ``lines`` runs at once would exceed the memory bound: :func:`period_steps` with the march ``march``
+    (:class:`~jointdyn.dynamics.options.MarchOptions`, None: the defaults), its steps per period
+    replaced by ``steps_per_period`` where given, refined where the system has normal springs. The
+    lowest frequency of a sweep needs the most."""
+    march = march_with_steps(march, steps_per_period, steps_name=name)
     pack = pack_system(system)
-    spp = TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period
-    return period_steps(pack, w, spp, refined=pack.springs, lines=lines, name=name)
+    return period_steps(pack, w, march, refined=pack.springs, lines=lines, name=name)
 
 
 def refine_if_opened(model: Model, summary) -> Model | None:
-    """The refined model (``TI_SPRING_OMEGA_H``) if a normal spring of
+    """The refined model (``march.spring_omega_h``) if a normal spring of
     ``model`` opened during the repetitions of ``summary`` and the model is
     not refined yet; else None."""
     if model.refined or not model.pack.springs or not np.any(summary[:, S_OPEN] > 0):
         return None
-    return make_model(model.system, model.w, model.steps_per_period, events=model.events, refined=True)
+    return make_model(model.system, model.w, model.march, events=model.events, refined=True)
 
 
 @dataclass(frozen=True, slots=True)
@@ -519,7 +502,7 @@ def run(model: Model, grid: Grid, mode: int, x, v, S, nper: int, *, rdof: int = 
     summ = np.zeros((nper, N_SUMMARY))
     zend = np.zeros((nper, 2 * pack.ndof))
     psum = np.zeros((nper, pack.npairs, 4))
-    control = (mode, nper, 0.0, model.w, rdof, model.max_split, record, TI_RECONTACT_ALPHA)
+    control = (mode, nper, 0.0, model.w, rdof, model.max_split, record, model.march.recontact_alpha)
     io = (x, v, S, model.cap(x, v))
     if record:
         x0, v0, S0 = x.copy(), v.copy(), S.copy()

@@ -24,12 +24,6 @@ from ..kinematics import load_table, tangential_history
 
 __all__ = ["linear_start", "clean_states", "free_body_start"]
 
-#: describing-function iterations of the linear start
-SS_LINEAR_ITERS = 30
-#: relative change of the describing-function amplitude that ends that
-#: iteration (it only seeds the integration, which does the rest)
-SS_LINEAR_RTOL = 1e-2
-
 
 @jit
 def _df_matrix(Z0, B, kc):  # pragma: no cover - compiled
@@ -141,7 +135,7 @@ _DF_TH = np.append(2 * math.pi * np.arange(2 * _DF_NS) / _DF_NS - 4 * math.pi, 0
 _DF_GRID = (_DF_NS, _DF_TH, np.sin(_DF_TH), np.cos(_DF_TH))
 
 
-def linear_start(model):
+def linear_start(model, iters: int, rtol: float):
     """Equivalent-linearisation estimate of the periodic state at phase 0.
 
     Solves (K + Kn - w^2 M + i w C + sum_c k_c B_c B_c^T) X = f e^{i phi}
@@ -150,8 +144,8 @@ def linear_start(model):
     u = Im(U e^{i w t}) with the prescribed N_c(t), a spring contact at its
     preload, marched with the real law),
     started from the stuck stiffness kt and iterated with relaxation 1/2
-    until X changes by less than ``SS_LINEAR_RTOL`` (at most
-    ``SS_LINEAR_ITERS`` solves). Each iteration is a LAPACK solve
+    until X changes by less than ``rtol``, relative (at most ``iters``
+    solves; ``SteadyStateOptions.linear_rtol`` and ``linear_iters``). Each iteration is a LAPACK solve
     (:func:`_df_solve`) and one compiled call marching every contact
     (``_df_template``). Returns x, v (m, m/s) and law states at t = 0 (law
     marched over the last two cycles of the estimate), or None if the
@@ -167,7 +161,7 @@ def linear_start(model):
     X = np.zeros(pk.ndof, dtype=np.complex128)
     run = specialize(_df_template, INIT=pk.init, MARCH=law_marcher(pk.step))
     xmax = 1e3 * (pk.fmax / pk.kmin + pk.xlin)
-    iters = SS_LINEAR_ITERS if pk.ncontacts else 1
+    iters = iters if pk.ncontacts else 1
     kc = pk.kt.astype(np.complex128)
     have, final, it = False, False, 0
     while True:
@@ -175,7 +169,7 @@ def linear_start(model):
             Xn = _df_solve(_df_matrix(Z0, pk.B, kc), f)
             if Xn is None:
                 return None
-            ok, conv = _df_accept(Xn, X, have, SS_LINEAR_RTOL, xmax)
+            ok, conv = _df_accept(Xn, X, have, rtol, xmax)
             if not ok:
                 return None
             have, it = True, it + 1

@@ -21,9 +21,9 @@ from .. import _validate as V
 from ..kinematics import sampled_load_grid
 from ..systems import System
 from ._core import LOADS_SAMPLED
-from ._model import (TI_MAX_OMEGA_H, TI_RECONTACT_ALPHA, TI_SPRING_OMEGA_H, TI_STEPS_PER_PERIOD, Model, make_model,
-                     refine_if_opened, run)
+from ._model import Model, make_model, refine_if_opened, run
 from ._start import free_body_start
+from .options import MarchOptions, march_options, march_with_steps
 from .status import RunStatus
 
 __all__ = ["Trajectory", "Restart", "integrate", "integrate_sampled"]
@@ -127,6 +127,7 @@ def integrate(
     v0=None,
     states=None,
     start: Restart | None = None,
+    options: MarchOptions | None = None,
 ) -> Trajectory:
     """Integrate the harmonically forced system over whole forcing periods.
 
@@ -142,12 +143,12 @@ def integrate(
     periods : int
         Number of forcing periods (>= 1).
     steps_per_period : int, optional
-        Base steps per forcing period (default ``TI_STEPS_PER_PERIOD``);
-        raised automatically so that w_max h <= ``TI_MAX_OMEGA_H``
-        for the stiffest mode with every contact stuck and every normal
-        spring closed, and (the run repeated) so that w_max h <=
-        ``TI_SPRING_OMEGA_H`` when a normal spring opens; events and
-        reversals add steps.
+        Base steps per forcing period (default ``options.steps_per_period``,
+        256; replaces that field); raised automatically so that w_max h <=
+        ``options.max_omega_h`` for the stiffest mode with every contact
+        stuck and every normal spring closed, and (the run repeated) so that
+        w_max h <= ``options.spring_omega_h`` when a normal spring opens;
+        events and reversals add steps.
     x0, v0 : array_like, optional
         Initial displacements (m) and velocities (m/s); default rest (the preloaded static state); for
         a free-free structure (rigid-body modes with every contact stuck) the default starts its
@@ -157,6 +158,9 @@ def integrate(
         Committed law states (one row per contact); default virgin at x0.
     start : Restart, optional
         Initial state from a previous run (overrides x0, v0, states).
+    options : MarchOptions, optional
+        The numbers of the time march (:class:`~jointdyn.dynamics.options.MarchOptions`; None: the
+        defaults).
 
     Returns
     -------
@@ -166,10 +170,10 @@ def integrate(
     """
     if not isinstance(system, System):
         raise ValueError(f"system must be a System, got {type(system).__name__}")
-    spp = V.positive_int("steps_per_period", TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period, 4)
+    march = march_with_steps(options, steps_per_period, name="options")
     periods = V.positive_int("periods", periods)
     w = _omega(system, gamma)
-    model = make_model(system, w, spp)
+    model = make_model(system, w, march)
     rest = start is None and x0 is None and v0 is None
     if start is not None:
         x0, v0, states = start.x, start.v, start.states
@@ -214,6 +218,7 @@ def integrate_sampled(
     v0=None,
     states=None,
     start: Restart | None = None,
+    options: MarchOptions | None = None,
 ) -> Trajectory:
     """Integrate with forcing and normal loads given at sample times.
 
@@ -238,6 +243,8 @@ def integrate_sampled(
         comes from the state).
     x0, v0, states, start
         As in :func:`integrate`.
+    options : MarchOptions, optional
+        As in :func:`integrate`; the steps are the samples' (``steps_per_period`` is not used).
 
     Returns
     -------
@@ -251,11 +258,12 @@ def integrate_sampled(
     n, nc = system.ndof, len(system.contacts)
     F = _as_samples("force", force, t, n)
     N = _as_samples("normal", normal, t, nc) if nc else np.zeros((t.size, 0))
-    model = make_model(system, 0.0, 4, force_scale=float(np.max(np.abs(F))))
+    march = march_options(options, "options")
+    model = make_model(system, 0.0, march, force_scale=float(np.max(np.abs(F))))
     N = N.copy()
     for c in model.pack.kin.springs:  # a spring's load comes from the state: its column is not read
         N[:, c] = model.pack.kin.normal_par[c, 0]
-    tg, Fg, Ng = sampled_load_grid(t, F, N, TI_RECONTACT_ALPHA)
+    tg, Fg, Ng = sampled_load_grid(t, F, N, march.recontact_alpha)
     if start is not None:
         x0, v0, states = start.x, start.v, start.states
     fresh = states is None

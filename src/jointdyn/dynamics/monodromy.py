@@ -19,7 +19,8 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _validate as V
-from ._model import TI_STEPS_PER_PERIOD, Model, make_model
+from ._model import Model, make_model
+from .options import MarchOptions, march_with_steps
 
 __all__ = ["fd_monodromy", "period_map", "monodromy_matrix"]
 
@@ -98,7 +99,8 @@ def period_map(model: Model, grid, states, rdof: int = 0, book=None):
 
 
 def monodromy_matrix(system, w: float, t0: float, x, v, states, *, amplitude: float,
-                     eps: float | None = None, steps_per_period: int | None = None) -> np.ndarray:  # fmt: skip
+                     eps: float | None = None, steps_per_period: int | None = None,
+                     march: MarchOptions | None = None) -> np.ndarray:  # fmt: skip
     """Monodromy matrix of the harmonically forced system over one period from time t0.
 
     Parameters
@@ -119,7 +121,10 @@ def monodromy_matrix(system, w: float, t0: float, x, v, states, *, amplitude: fl
     eps : float, optional
         Relative step of the central differences (default ``MONODROMY_FD_STEP``).
     steps_per_period : int, optional
-        RK4 base steps per period (default ``TI_STEPS_PER_PERIOD``).
+        RK4 base steps per period (default ``march.steps_per_period``, 256); replaces that field.
+    march : MarchOptions, optional
+        The numbers of the time march (:class:`~jointdyn.dynamics.options.MarchOptions`; None: the
+        defaults).
 
     Returns
     -------
@@ -135,9 +140,7 @@ def monodromy_matrix(system, w: float, t0: float, x, v, states, *, amplitude: fl
     w = V.positive("w", w)
     amp = V.positive("amplitude", amplitude)
     eps = V.positive("eps", MONODROMY_FD_STEP if eps is None else eps)
-    spp = TI_STEPS_PER_PERIOD if steps_per_period is None else steps_per_period
-    spp = V.positive_int("steps_per_period", spp, 4)
-    model = make_model(system, w, spp)
+    model = make_model(system, w, march_with_steps(march, steps_per_period))
     n = model.n
     ta = float(t0) % model.period
     grid = model.segment_grid(ta, ta + model.period)

@@ -30,7 +30,7 @@ from ._model import Model, make_model, pack_system, refine_if_opened
 from ._start import clean_states, free_body_start, linear_start
 from .integrate import Restart, Trajectory, _omega, _trajectory
 from .monodromy import fd_monodromy
-from .options import SteadyStateOptions, steady_options
+from .options import SteadyStateOptions, march_with_steps, steady_options
 from .status import SS_DISSIPATION_FLOOR, EnergyCheck, SteadyStatus
 
 __all__ = ["SteadyState", "energy_check", "prepare_kernels", "steady_state"]
@@ -668,7 +668,7 @@ def steady_state(
     gamma : float
         w / w0 (> 0).
     steps_per_period : int, optional
-        Base RK4 steps per forcing period (default ``options.steps_per_period``, 256).
+        Base RK4 steps per forcing period (default ``options.march.steps_per_period``, 256).
     start : SteadyState or Restart, optional
         Warm start (state at a period boundary, e.g. the previous sweep
         point). Default: equivalent-linearisation estimate (stuck stiffness
@@ -699,14 +699,16 @@ def steady_state(
     """
     if not isinstance(system, System):
         raise ValueError(f"system must be a System, got {type(system).__name__}")
-    o = _resolved(steady_options(options), steps_per_period=steps_per_period, amp_rtol=amp_rtol,
-                  energy_rtol=energy_rtol, check_periods=check_periods, max_periods=max_periods)
+    o = steady_options(options)
+    march = None if steps_per_period is None else march_with_steps(o.march, steps_per_period)
+    o = _resolved(o, march=march, amp_rtol=amp_rtol, energy_rtol=energy_rtol, check_periods=check_periods,
+                  max_periods=max_periods)
     rdof = V.positive_int("response_dof", system.response_dof if response_dof is None else response_dof, 0)
     if rdof >= system.ndof:
         raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {rdof}")
     w = _omega(system, gamma)
-    model = make_model(system, w, o.steps_per_period, events=_events)
-    x, v, S = _first_state(model, start)
+    model = make_model(system, w, o.march, events=_events)
+    x, v, S = _first_state(model, start, o)
     st = _March(x, v, S, _History(np.concatenate([x, v])), {"periods": 0, "steps": 0, "shoot": 0}, o)
     status, detail, p_found, model = _settle(model, st, rdof, shooting)
     if status is None:
@@ -777,10 +779,10 @@ def prepare_kernels(systems) -> None:
             continue
         seen.add((pack.runner, pack.init))
         try:
-            model = make_model(system, _omega(system, 1.0), o.steps_per_period)
+            model = make_model(system, _omega(system, 1.0), o.march)
         except ValueError:
             continue
-        x, v, S = _first_state(model, None)
+        x, v, S = _first_state(model, None, o)
         clean_states(model, x, v, S, 0, lambda res: None)
         _periodic_arrays(np.empty((0, N_SUMMARY)), np.zeros((1, 2 * model.n)), 1, o.check_periods, model.n,
                          model.w, model.pack.K_stuck, model.pack.M, _amplitude_scale(model, 0.0), o.amp_rtol,
@@ -793,14 +795,14 @@ def _resolved(o: SteadyStateOptions, **given) -> SteadyStateOptions:
     return dataclasses.replace(o, **given) if given else o
 
 
-def _first_state(model, start):
+def _first_state(model, start, o: SteadyStateOptions):
     """(x, v, S) to start from: the warm start, else the equivalent-linearisation
     estimate, else rest with virgin law states; a free-free structure's rigid-body part, whatever the
     start, at the periodic motion of the free body at this frequency (:func:`free_body_start`: no drift)."""
     if start is not None:
         x, v, S = _unpack_start(start, model)
     else:
-        est = linear_start(model)
+        est = linear_start(model, o.linear_iters, o.linear_rtol)
         if est is None:
             x = np.zeros(model.n)
             x, v, S = x, np.zeros(model.n), model.initial_states(x)

@@ -24,8 +24,8 @@ NO_EVENT = -1.0
 
 #: load at which the AFT restarts a contact law at a re-contact phase between
 #: two samples, as a fraction of the contact's largest |N| (> 0: the law is
-#: in contact and at rest there, as the time integrator's ``TI_RECONTACT_ALPHA``
-#: of :mod:`jointdyn.dynamics._model`)
+#: in contact and at rest there, as the time integrator's default
+#: ``MarchOptions.recontact_alpha`` of :mod:`jointdyn.dynamics.options`)
 HB_RECONTACT_ALPHA = 1e-12
 #: Newton iterations and relative step (of the sampling interval) of a spring's re-contact root
 _ROOT_MAX_ITER, _ROOT_TOL = 50, 1e-14

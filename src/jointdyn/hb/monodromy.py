@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from ..drivers import march
+from ..drivers import march as march_law
 from ..fourier import basis, derivative_matrix
 from ..kinematics import HarmonicLoad, contact_kinematics, normal_load_samples, tangential_history
 from ..laws import MACROSLIP, SEPARATION
@@ -50,7 +50,8 @@ def _section_phase(problem, X, p) -> float:
 
 
 def monodromy_multipliers(problem, X, p, *, steps_per_period: int | None = None, eps: float | None = None,
-                          warm_periods: int | None = None, warm_samples: int | None = None) -> np.ndarray:  # fmt: skip
+                          warm_periods: int | None = None, warm_samples: int | None = None,
+                          march=None) -> np.ndarray:  # fmt: skip
     """Floquet multipliers from finite differences of the period map.
 
     Parameters
@@ -62,8 +63,8 @@ def monodromy_multipliers(problem, X, p, *, steps_per_period: int | None = None,
     p : float
         Parameter value.
     steps_per_period : int, optional
-        RK4 base steps per period (default ``dynamics._model.TI_STEPS_PER_PERIOD``;
-        events and reversals add steps).
+        RK4 base steps per period (default ``march.steps_per_period``, 256; events and reversals add
+        steps); replaces that field.
     eps : float, optional
         Relative perturbation of positions (scaled by the amplitude) and
         velocities (scaled by w times the amplitude); default
@@ -72,6 +73,9 @@ def monodromy_multipliers(problem, X, p, *, steps_per_period: int | None = None,
         Periods of the HB displacement, and samples per period, marched
         through each contact law to obtain the contact state at the section
         (defaults ``config.MONODROMY_WARM_PERIODS``, ``config.MONODROMY_WARM_SAMPLES``).
+    march : MarchOptions, optional
+        The numbers of the time march that integrates the period map
+        (:class:`~jointdyn.dynamics.options.MarchOptions`; None: the defaults).
 
     Returns
     -------
@@ -95,10 +99,11 @@ def monodromy_multipliers(problem, X, p, *, steps_per_period: int | None = None,
     N = normal_load_samples(kin, tt)
     S = np.zeros((len(system.contacts), max([c.law.state_size for c in system.contacts], default=1)))
     for i, c in enumerate(system.contacts):
-        s = march(c.law, np.ascontiguousarray(U[:, i]), N[i])[3]
+        s = march_law(c.law, np.ascontiguousarray(U[:, i]), N[i])[3]
         S[i, : s.size] = s
     amp = max(float(np.max(np.abs(xs))), 1e-12)
     from ..dynamics import monodromy_matrix  # the RK4 march of the time-domain layer
 
-    J = monodromy_matrix(system, w, tau0 / w, x0, v0, S, amplitude=amp, eps=eps, steps_per_period=steps_per_period)
+    J = monodromy_matrix(system, w, tau0 / w, x0, v0, S, amplitude=amp, eps=eps, steps_per_period=steps_per_period,
+                         march=march)
     return np.linalg.eigvals(J)

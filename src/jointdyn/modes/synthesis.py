@@ -19,7 +19,7 @@ the two flanks of the response curve at that amplitude. The response of
 the output DOF is then the backbone's amplitude itself. The flanks meet at
 the peak, where ``g = r^2 - xi^2 (omega^2 - xi^2 / 4)`` changes sign, at
 ``Omega^2 = omega^2 - xi^2 / 2``; it is located between two backbone
-points to ``SYNTHESIS_PEAK_RTOL`` in amplitude, by solving the EPMC
+points to ``peak_rtol`` (a keyword of :func:`single_mode_frc`) in amplitude, by solving the EPMC
 at intermediate amplitudes (the QSMA backbone is interpolated instead).
 """
 
@@ -30,15 +30,11 @@ import math
 
 import numpy as np
 
+from .. import _validate as V
 from ..systems import System
 from .backbone import Backbone, ModeStatus
 
 __all__ = ["single_mode_frc", "modal_forcing"]
-
-#: single-nonlinear-mode synthesis: the resonance peak is located on the
-#: backbone to this relative tolerance in amplitude
-SYNTHESIS_PEAK_RTOL = 1e-10
-
 
 def _forcing_vector(system: System) -> np.ndarray:
     """Complex amplitudes F_j = -i f_j exp(i phi_j) of the forcing f_j sin(Omega t + phi_j), N."""
@@ -69,8 +65,9 @@ def _flanks(r, w, xi):
     return np.sqrt(np.where(lo > 0.0, lo, np.nan)), np.sqrt(mid + root)
 
 
-def _refine(backbone: Backbone, system: System, i: int):
-    """(amplitude m, omega rad/s, xi 1/s) of the peak between backbone points i and i + 1."""
+def _refine(backbone: Backbone, system: System, i: int, rtol: float):
+    """(amplitude m, omega rad/s, xi 1/s) of the peak between backbone points i and i + 1, located to
+    ``rtol`` in amplitude (relative)."""
     from scipy.optimize import brentq
 
     b = backbone
@@ -99,15 +96,16 @@ def _refine(backbone: Backbone, system: System, i: int):
         return float(_gap(abs(psi.conj() @ F) / q2, w, xi))
 
     try:
-        lm = brentq(g_at, lam[0], lam[1], xtol=SYNTHESIS_PEAK_RTOL / math.log(10.0))
+        lm = brentq(g_at, lam[0], lam[1], xtol=rtol / math.log(10.0))
         if lm not in found:
             g_at(lm)
     except ArithmeticError:  # Newton failed between the points: interpolate instead
-        return _refine(dataclasses.replace(b, problem=None), system, i)
+        return _refine(dataclasses.replace(b, problem=None), system, i, rtol)
     return (10.0 ** lm, *found[lm])
 
 
-def single_mode_frc(backbone: Backbone, system: System | None = None, *, refine: bool = True):
+def single_mode_frc(backbone: Backbone, system: System | None = None, *, refine: bool = True,
+                    peak_rtol: float = 1e-10):  # fmt: skip
     """Forced response curve near the backbone's resonance from the single nonlinear mode (module docstring).
 
     Parameters
@@ -121,6 +119,9 @@ def single_mode_frc(backbone: Backbone, system: System | None = None, *, refine:
     refine : bool
         Locate the peak between backbone points (else: the last backbone
         point below it).
+    peak_rtol : float
+        Relative tolerance in amplitude to which ``refine`` locates the peak between two EPMC backbone
+        points, each try an EPMC solve (default 1e-10; in (0, 1)).
 
     Returns
     -------
@@ -143,6 +144,7 @@ def single_mode_frc(backbone: Backbone, system: System | None = None, *, refine:
         raise ValueError(f"system must be a jointdyn.System with the backbone's {backbone.system.ndof} DOFs")
     if not np.any(system.force != 0.0):
         raise ValueError("system.force must have a non-zero entry: the synthesis needs a forcing")
+    peak_rtol = V.in_range("peak_rtol", peak_rtol, 0.0, 1.0, lo_open=True, hi_open=True)
     b = backbone
     r = modal_forcing(b, system)
     g = _gap(r, b.omega_rad_s, b.xi_rad_s)
@@ -158,8 +160,10 @@ def single_mode_frc(backbone: Backbone, system: System | None = None, *, refine:
     peak = (math.nan, math.nan)
     mid = ([], [], [])
     if status is ModeStatus.COMPLETE:
-        a_p, w_p, xi_p = _refine(b, system, end - 1) if refine else (amp[-1], b.omega_rad_s[end - 1],
-                                                                     b.xi_rad_s[end - 1])
+        if refine:
+            a_p, w_p, xi_p = _refine(b, system, end - 1, peak_rtol)
+        else:
+            a_p, w_p, xi_p = amp[-1], b.omega_rad_s[end - 1], b.xi_rad_s[end - 1]
         peak = (a_p, math.sqrt(w_p * w_p - 0.5 * xi_p * xi_p))
         mid = ([peak[1]], [a_p], [0])
     keep = np.isfinite(lo)

@@ -185,15 +185,15 @@ def _family(system_or_grid, gammas, paper: dict):
     return fam, system_or_grid
 
 
-def _check_steps(family, grid, spp, lines: int) -> None:
+def _check_steps(family, grid, spp, lines: int, march=None) -> None:
     """The steps of a forcing period at the lowest gamma (the most) of every System fit the memory bound
-    for ``lines`` lines run at once (:func:`jointdyn.dynamics.check_period_steps`): refused before
-    anything is computed, not point by point."""
+    for ``lines`` lines run at once (:func:`jointdyn.dynamics.check_period_steps` with the points' march
+    ``march``, None: the defaults): refused before anything is computed, not point by point."""
     from ..dynamics import check_period_steps
 
     for _, label, system in family.entries:
         try:
-            check_period_steps(system, float(min(grid)) * system.w0, spp, lines=lines)
+            check_period_steps(system, float(min(grid)) * system.w0, spp, march=march, lines=lines)
         except ValueError as exc:
             raise ValueError(f"system {label!r}: {exc}" if len(family.entries) > 1 else str(exc)) from None
 
@@ -437,8 +437,8 @@ def frc_sweep(
     opt = SweepOptions() if options is None else options
     if not isinstance(opt, SweepOptions):
         raise ValueError(f"options must be a SweepOptions, got {type(opt).__name__}")
-    spp_run = spp if spp is not None or opt.steady is None else opt.steady.steps_per_period
-    _check_steps(family, g, spp_run, 1 if len(directions) == 1 or n_workers == 1 else 2)
+    march = None if opt.steady is None else opt.steady.march
+    _check_steps(family, g, spp, 1 if len(directions) == 1 or n_workers == 1 else 2, march)
     dofs = _dofs(dofs, family)
     loop_outputs = (not family.dims or family.dims == ("system",)) if loop_outputs is None else bool(loop_outputs)
     if out is not None:  # before computing: no finished chunk is lost to an unwritable out
