@@ -12,7 +12,7 @@ Measured, each beside its reference in the same run:
   samples, warm (second call), target <= 2 s;
 * a backbone fit (``jointdyn.fit_backbone``, iwan, 50 points), warm, target <= 1 s;
 * a ring-down of 10^6 samples to a fitted model (``jointdyn.backbone_from_ringdown`` then
-  ``fit_backbone``, iwan), warm, target <= 5 s (issue 32), beside one zero-phase band-pass
+  ``fit_ringdown``, iwan: what ``jointdyn fit --ringdown`` runs), warm, target <= 5 s (issue 32), beside one zero-phase band-pass
   of the same signal;
 * a response-curve fit (``jointdyn.fit_frc``, iwan) of 3 x 50 points, warm, target <= 30 s
   (issue 32), beside one describing-function evaluation of its amplitudes.
@@ -138,7 +138,7 @@ def _ringdown_signal(n):
 
 
 def _ringdown_fit(n, repeats):
-    """backbone_from_ringdown then fit_backbone, beside one zero-phase band-pass of the same
+    """backbone_from_ringdown then fit_ringdown (the fit ``jointdyn fit --ringdown`` makes), beside one zero-phase band-pass of the same
     signal (scipy.signal.sosfiltfilt, the reference) in the same run."""
     from scipy.signal import butter, sosfiltfilt
 
@@ -149,7 +149,7 @@ def _ringdown_fit(n, repeats):
 
     def chain():
         b = jd.backbone_from_ringdown(t, x, "x")
-        out.append((b, jd.fit_backbone(b.amplitude_m, b.omega_rad_s, b.damping_ratio, mass=2.0, model="iwan")))
+        out.append((b, jd.fit_ringdown(b, mass=2.0, model="iwan")))
 
     s = _warm(chain, repeats)
     sos = butter(4, (0.4, 0.6), btype="band", output="sos")
