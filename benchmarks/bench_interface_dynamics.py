@@ -58,9 +58,10 @@ def _chain(npairs, rng):
 
 
 def _period_cost(system, periods):
+    from jointdyn.dynamics import MarchOptions
     from jointdyn.dynamics._model import make_model
 
-    model = make_model(system, 40.0, 256)
+    model = make_model(system, 40.0, MarchOptions(steps_per_period=256))
     x, v = np.zeros(system.ndof), np.zeros(system.ndof)
     S = model.initial_states(x)
     model.run_periods(x, v, S, 2)  # transient (and compilation on the first call)
@@ -74,6 +75,7 @@ def _period_cost(system, periods):
 def _lap_joint_cost():
     import jointdyn as jd
     from jointdyn import fe
+    from jointdyn.dynamics import MarchOptions
     from jointdyn.dynamics._model import make_model
 
     L = fe.lap_joint()
@@ -82,7 +84,7 @@ def _lap_joint_cost():
     w1 = 2 * math.pi * L.frequencies_hz["stuck"][0]
     itf = jd.Interface(kt=L.kt, kn=L.kn, mu=L.mu, preload=L.preload, pairs=L.pairs)
     s = jd.System(M=L.M, C=0.02 * w1 * L.M, K=L.K, force=f, interfaces=(itf,), w0_rad_s=w1)
-    model = make_model(s, w1, 256)
+    model = make_model(s, w1, MarchOptions(steps_per_period=256))
     grid = model.segment_grid(0.0, model.period / 50)
     x, v = np.zeros(s.ndof), np.zeros(s.ndof)
     S = model.initial_states(x)

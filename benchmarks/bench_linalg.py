@@ -124,6 +124,7 @@ def _best(fn, budget):
 
 
 def _hill_row(n, eta, budget):
+    from jointdyn.hb import StabilityOptions
     from jointdyn.hb import stability as S
 
     p, JX, w = _jacobian(n, eta)
@@ -131,7 +132,7 @@ def _hill_row(n, eta, budget):
     D2iJ, B1, _, parity = S._hill_parts(M, C, H)
     compiled = _best(lambda: S._hill_eigvals(D2iJ, JX, B1[0], B1[1], w, parity), budget)
     lapack = _best(lambda: S._hill_eigvals_lapack(JX, M, C, w, H), budget)
-    chosen = _best(lambda: S._hill_all(JX, M, C, w, H), budget)
+    chosen = _best(lambda: S._hill_all(JX, M, C, w, H, StabilityOptions().small_eig), budget)
     split = S._parity_blocks(S._hill_matrix(JX, M, C, w, H), parity) is not None
     return {"dofs": n, "companion_rows": 2 * JX.shape[0], "parity_split": split, "compiled_s": compiled,
             "lapack_s": lapack, "lapack_over_compiled": lapack / compiled, "default_path_s": chosen}
