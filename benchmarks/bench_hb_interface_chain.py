@@ -95,22 +95,27 @@ def _branch(s):
     from jointdyn.hb import continue_hb
 
     hill = [0.0]
-    orig = hb_branch.HBProblem.hill_growth
+    # the branch's two stability paths (dense Hill on chunks of points, Arnoldi point by point), timed
+    origs = {name: getattr(hb_branch, name) for name in ("_dense_growth", "_arnoldi_growth")}
 
-    def timed(self, JXs, ws):
-        t = time.perf_counter()
-        out = orig(self, JXs, ws)
-        hill[0] += time.perf_counter() - t
-        return out
+    def timed(f):
+        def run(*args):
+            t = time.perf_counter()
+            out = f(*args)
+            hill[0] += time.perf_counter() - t
+            return out
+        return run
 
-    hb_branch.HBProblem.hill_growth = timed
+    for name, f in origs.items():
+        setattr(hb_branch, name, timed(f))
     try:
         t0 = time.perf_counter()
         br = continue_hb(s, 0.8, 1.2, harmonics=H, samples=NS, condense=False)
         return (time.perf_counter() - t0, br.status.value, int(br.lam.size), hill[0],
                 _factorisations(br.counters))
     finally:
-        hb_branch.HBProblem.hill_growth = orig
+        for name, f in origs.items():
+            setattr(hb_branch, name, f)
 
 
 def _factorisations(counters) -> int:
