@@ -14,7 +14,7 @@ Reported: CPU seconds per branch with the stability of every point (best
 of ``ROUNDS`` rounds alternating the two, each branch on a freshly built
 System so that the 1000-DOF branch includes its eigen-decomposition), of
 which the stability (the CPU seconds spent in the stability functions of
-:mod:`jointdyn.hb.branch`, ``_dense_growth`` and ``_arnoldi_growth``, timed
+:func:`jointdyn.hb.floquet.growths` where :mod:`jointdyn.hb.branch` calls it, timed
 around each call: dense Hill for the 2-DOF model, Arnoldi through the
 condensed form for the 1000-DOF rod) and the rest (``*_branch_only_seconds``:
 continuation, AFT diagnostics, peaks), points, the stability method, the
@@ -98,8 +98,7 @@ def timed(fn):
     return wrapper
 
 
-hb_branch._dense_growth = timed(hb_branch._dense_growth)
-hb_branch._arnoldi_growth = timed(hb_branch._arnoldi_growth)
+hb_branch.growths = timed(hb_branch.growths)
 
 
 def branch(s, condense, dof):

@@ -20,8 +20,9 @@ each on 2 cores), 5511 unknowns. There the Jacobian stays sparse from the
 evaluation on (``jointdyn.hb._sparse``: this chain's K, M and C are sparse
 and each pair couples only its own DOFs), the Newton systems are factorised
 by SuperLU and the factors reused through GMRES (``factorisations`` counts
-the dense and sparse ones), and Hill's method is beyond
-``HBOptions.hill_max_rows`` (stability not computed). Both backbones run
+the dense and sparse ones), and the branch's stability is computed by
+shift-invert Arnoldi (:mod:`jointdyn.hb.floquet`: dense Hill is beyond
+``StabilityOptions.dense_max_rows`` here). Both backbones run
 over the three decades, bounded to ``MAX_POINTS`` points.
 """
 
@@ -95,8 +96,9 @@ def _branch(s):
     from jointdyn.hb import continue_hb
 
     hill = [0.0]
-    # the branch's two stability paths (dense Hill on chunks of points, Arnoldi point by point), timed
-    origs = {name: getattr(hb_branch, name) for name in ("_dense_growth", "_arnoldi_growth")}
+    # the branch's stability (jointdyn.hb.floquet.growths: dense Hill on chunks of points, Arnoldi point by
+    # point), timed where the branch calls it
+    origs = {"growths": hb_branch.growths}
 
     def timed(f):
         def run(*args):

@@ -59,7 +59,7 @@ def _lower(quick: bool) -> dict:
         return {}
     config.CONT_KRYLOV_SOLVE = 0
     config.CONT_SPARSE_DENSITY = 0.1
-    return {"linear": LinearSolveOptions(small_solve=0), "hb_options": HBOptions(hill_max_rows=0)}
+    return {"linear": LinearSolveOptions(small_solve=0), "hb_options": HBOptions(dense_max_unknowns=0)}
 
 
 def _counters(c) -> dict:

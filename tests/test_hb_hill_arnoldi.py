@@ -171,15 +171,46 @@ def test_stability_numbers_are_options(damper_branches):
 
 def test_confirm_band_decides_by_the_period_map_only_inside_it():
     """A growth between rtol and confirm goes to the time-domain period map; confirm at rtol sends none."""
-    from jointdyn.hb.branch import _confirmed_stability
+    from jointdyn.hb.floquet import confirmed_stability
 
     br = continue_hb(System.paper_damper(eta=10.0, beta=2.0, model="iwan-closed"), 0.5, 0.6, harmonics=3,
                      samples=64, progress=False)
     i = np.array([0, br.lam.size - 1])
     opt = StabilityOptions()
     growth = np.array([0.5 * (opt.rtol + opt.confirm), 2.0 * opt.confirm])
-    stable, checked = _confirmed_stability(br.problem, br.X[i], br.lam[i], growth, opt)
+    stable, checked = confirmed_stability(br.problem, br.X[i], br.lam[i], growth, opt)
     assert checked == 1 and stable[0] and not stable[1]  # the period map of a stable point says stable
-    stable, checked = _confirmed_stability(br.problem, br.X[i], br.lam[i], growth,
+    stable, checked = confirmed_stability(br.problem, br.X[i], br.lam[i], growth,
                                            StabilityOptions(confirm=opt.rtol))
     assert checked == 0 and not stable.any()
+
+
+def test_single_solution_decides_a_marginal_growth_by_the_period_map_as_the_branch_does(monkeypatch):
+    """One dispatcher (jointdyn.hb.floquet) for branches and single solutions: a single solution whose growth
+    lies between rtol and confirm goes to the period map, and gets the branch's label at the same point."""
+    import jointdyn.hb.frc as frc
+
+    s = System.paper_damper(eta=10.0, beta=2.0, model="iwan-closed")
+    br = continue_hb(s, 1.17, 1.19, harmonics=5, samples=64, progress=False)
+    opt = StabilityOptions()
+    band = np.flatnonzero((br.growth > opt.rtol) & (br.growth < opt.confirm))
+    assert band.size and br.counters["monodromy_checks"] == band.size
+    i = int(band[0])
+    sol = harmonic_balance(s, br.lam[i], harmonics=5, samples=64, guess=br.X[i])
+    assert sol.status.ok and sol.growth == pytest.approx(br.growth[i], rel=1e-6)
+    assert sol.stable == br.stable[i]
+    calls = []
+    real = frc.confirmed_stability
+
+    def spy(problem, X, lam, growth, options):
+        stable, checked = real(problem, X, lam, growth, options)
+        calls.append((float(growth[0]), checked))
+        return (~stable if checked else stable), checked  # what the period map says is what is reported
+
+    monkeypatch.setattr(frc, "confirmed_stability", spy)
+    flipped = harmonic_balance(s, br.lam[i], harmonics=5, samples=64, guess=br.X[i])
+    assert calls == [(pytest.approx(br.growth[i], rel=1e-6), 1)] and flipped.stable == (not br.stable[i])
+    calls.clear()
+    kept = harmonic_balance(s, br.lam[i], harmonics=5, samples=64, guess=br.X[i],
+                            stability=StabilityOptions(confirm=opt.rtol))  # an empty band: Hill's label stands
+    assert [c for _, c in calls] == [0] and not kept.stable

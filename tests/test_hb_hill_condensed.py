@@ -20,6 +20,7 @@ from jointdyn.hb import (
     hill_arnoldi_exponents,
     hill_exponents,
 )
+from jointdyn.hb.floquet import point_stability
 from jointdyn.hb.hill_condensed import condensed_hill_exponents
 from hill_checks import assert_period_map_confirms
 
@@ -129,6 +130,6 @@ def test_single_condensed_point_by_either_method():
     assert d.problem.condensed and d.status.ok and d.stable == r.stable
     assert abs(d.growth - r.growth) <= RTOL * abs(d.growth)
     assert np.max(np.abs(r.multipliers)) == pytest.approx(np.max(np.abs(d.multipliers)), rel=RTOL)
-    stable, growth, _ = r.problem.hill_stability(r.problem.evaluate(r.X, r.problem.f1_ref).JX,
-                                                 r.problem.omega(r.problem.f1_ref))
+    stable, growth, _ = point_stability(r.problem, r.problem.evaluate(r.X, r.problem.f1_ref).JX,
+                                        r.problem.omega(r.problem.f1_ref))
     assert stable == r.stable and growth == pytest.approx(r.growth, rel=RTOL)

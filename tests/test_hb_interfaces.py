@@ -281,11 +281,11 @@ def test_marginal_hill_growth_with_interfaces_keeps_hills_criterion():
     """A growth in the band where contacts are confirmed by the time-domain period map: that map does not
     march interfaces, so a system with interfaces keeps Hill's criterion (no monodromy check)."""
     from jointdyn.hb import StabilityOptions
-    from jointdyn.hb.branch import _confirmed_stability
+    from jointdyn.hb.floquet import confirmed_stability
 
     opt = StabilityOptions()
     q = HBProblem(_system(_patch()), harmonics=2, samples=32)
     X = np.zeros((2, q.size))
     growth = np.array([0.5 * opt.rtol, 0.5 * (opt.rtol + opt.confirm)])
-    stable, checked = _confirmed_stability(q, X, np.array([1.0, 1.0]), growth, opt)
+    stable, checked = confirmed_stability(q, X, np.array([1.0, 1.0]), growth, opt)
     assert stable.tolist() == [True, False] and checked == 0

@@ -19,6 +19,7 @@ from jointdyn.hb.condense import (
     retained_dofs,
     use_condensed,
 )
+from jointdyn.hb.floquet import point_stability
 from jointdyn.hb.problem import HBProblem
 from jointdyn.kinematics import HarmonicLoad
 from jointdyn.laws import Iwan, Jenkins
@@ -193,7 +194,7 @@ def test_condensed_branch_solves_the_uncondensed_equations():
         X = br.problem.full_coefficients(br.X[i], br.lam[i])
         ev = full.evaluate(X, br.lam[i])
         assert np.max(np.abs(ev.R)) <= 10 * config.CONT_TOL * fs
-        stable, growth, _ = full.hill_stability(ev.JX, full.omega(br.lam[i]))
+        stable, growth, _ = point_stability(full, ev.JX, full.omega(br.lam[i]))
         assert stable == br.stable[i] and abs(growth - br.growth[i]) <= 1e-7
     ds = frc_hb(s, 0.7, 0.8, harmonics=5, samples=128, condense=True, response_dof=4, progress=False)
     assert ds.attrs["condensed"] == 1 and ds.attrs["stability"] == "hill"

@@ -107,7 +107,7 @@ def _large(monkeypatch, on: bool):
     # EPMC give their Jacobians): patched here so that both take the large path at this small size
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     return {"linear": LinearSolveOptions(small_solve=0),
-            "hb_options": HBOptions(hill_max_rows=0, block_preconditioner=on)}
+            "hb_options": HBOptions(dense_max_unknowns=0, block_preconditioner=on)}
 
 
 def test_hb_branch_on_a_dense_reduced_model_equals_the_direct_path(monkeypatch):

@@ -263,7 +263,7 @@ def test_stability_beyond_the_dense_size_is_computed_and_not_computed_only_when_
 
     s = _chain(2)
     kw = dict(harmonics=2, samples=32, condense=False)
-    kw["hb_options"] = HBOptions(hill_max_rows=2 * 6 * 5 - 1)  # 2 n (2H+1) rows with n = 6, H = 2
+    kw["hb_options"] = HBOptions(dense_max_unknowns=6 * 5 - 1)  # n (2H+1) unknowns with n = 6, H = 2
     br = continue_hb(s, 0.8, 1.2, stability=StabilityOptions(method="arnoldi"), **kw)
     assert br.status.ok and br.lam.size > 5 and br.stability == "hill-arnoldi"
     assert branch_dataset(br).attrs["stability"] == "hill-arnoldi"

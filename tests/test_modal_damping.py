@@ -190,7 +190,7 @@ def test_hb_branch_and_solution_with_the_operator_equal_those_with_dense_c(monke
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
     b = continue_hb(so, 0.7, 1.3, harmonics=2, samples=32, condense=False, linear=LinearSolveOptions(small_solve=0),
-                    hb_options=HBOptions(hill_max_rows=0))  # harmonic balance's own bound, its option
+                    hb_options=HBOptions(dense_max_unknowns=0))  # harmonic balance's own bound, its option
     assert a.status.ok and b.status.ok
     assert b.counters["sparse_factorisations"] > 0 and b.counters["krylov_solves"] > 0
     assert b.response()[0].max() == pytest.approx(a.response()[0].max(), rel=1e-8)
@@ -318,7 +318,7 @@ def test_arnoldi_stability_of_a_branch_with_the_operator_equals_dense_c(monkeypa
     monkeypatch.setattr(config, "CONT_KRYLOV_SOLVE", 0)  # shared: the large-solve paths at this size
     monkeypatch.setattr(config, "CONT_SPARSE_DENSITY", 1.0)
     b = continue_hb(so, 0.9, 1.1, harmonics=2, samples=32, condense=False, stability=arnoldi,
-                    linear=LinearSolveOptions(small_solve=0), hb_options=HBOptions(hill_max_rows=0))
+                    linear=LinearSolveOptions(small_solve=0), hb_options=HBOptions(dense_max_unknowns=0))
     assert a.status.ok and b.status.ok and b.stability == a.stability
     assert np.all(np.isfinite(b.growth))
     peak_a, peak_b = np.argmax(a.response()[0]), np.argmax(b.response()[0])

@@ -16,7 +16,7 @@ from jointdyn.modes import EPMCOptions, QSMAOptions
 
 #: one bad value per field of each options class, and a word of the message that says the allowed range
 BAD = {
-    HBOptions: {"hill_max_rows": (-1, ">= 0"), "block_preconditioner": (1, "True or False"),
+    HBOptions: {"dense_max_unknowns": (-1, ">= 0"), "block_preconditioner": (1, "True or False"),
                 "auto_early_drop": (0.0, "(0.0, 1.0]"), "auto_max_harmonics": (0, ">= 1"),
                 "auto_max_samples": (3, ">= 4"), "start_max_iter": (0, ">= 1"), "solve_max_iter": (2.5, ">= 1"),
                 "homotopy_start": (1.0, "(0.0, 1.0)"), "unbounded_q": (0.0, "(0, inf)"),

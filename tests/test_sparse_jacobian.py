@@ -159,7 +159,7 @@ def test_hb_branch_with_sparse_jacobians_has_the_same_peak(monkeypatch):
 
     monkeypatch.setattr(HBProblem, "evaluate_sparse", counted)
     b = continue_hb(s, 0.7, 1.3, harmonics=2, samples=32, condense=False,
-                    linear=LinearSolveOptions(small_solve=0), hb_options=HBOptions(hill_max_rows=0))
+                    linear=LinearSolveOptions(small_solve=0), hb_options=HBOptions(dense_max_unknowns=0))
     assert a.status.ok and b.status.ok and calls
     assert b.counters["sparse_factorisations"] > 0
     pa, pb = a.response()[0].max(), b.response()[0].max()

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._cache import by_identity
-from ..systems import System, free_modes, rigid_body_modes, rigid_mode_dof, stuck_stiffness
+from ..systems import System, free_modes, rigid_body_modes, rigid_mode_dof
 
 __all__ = ["held_by_contacts", "mean_gauge"]
 

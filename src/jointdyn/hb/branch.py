@@ -69,7 +69,7 @@ from ..continuation import (
     refine_maximum,
     turning_points,
 )
-from ..damping import dense_damping, has_damping
+from ..damping import has_damping
 from ..fourier import derivative_matrix
 from ..laws import MACROSLIP, SEPARATION
 from ..systems import System
@@ -79,8 +79,8 @@ from .levels import Level
 from .options import HBOptions
 from .parameters import F1, GAMMA
 from .problem import HBProblem, reference_scales
+from .floquet import companion_rows, confirmed_stability, growths, stability_method
 from .results import HBBranch, HBPeak, PointStatus, sliding_as_a_whole
-from .stability import hill_growth
 from .stability_options import StabilityOptions
 
 __all__ = ["continued_branch", "solve_point"]
@@ -159,11 +159,11 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     growth = np.full(n, np.nan)
     # the Floquet exponents of every point: dense Hill on chunks of points whose Jacobians fit in
     # HBOptions.jacobian_budget_bytes, or shift-invert Arnoldi point by point (StabilityOptions.method_for)
-    method = tr.stability.method_for(2 * problem.system.ndof * problem.nh)
+    method = stability_method(problem, tr.stability)
     dense, need = method == "dense", method != "none"
     chunk = max(1, min(n, problem.options.jacobian_budget_bytes // (8 * problem.size * problem.size))) if dense else 1
     JXs = np.empty((chunk, problem.size, problem.size) if dense else (1, 0, 0))
-    lapack = method == "arnoldi" or (dense and 2 * problem.system.ndof * problem.nh > tr.stability.small_eig)
+    lapack = method == "arnoldi" or (dense and companion_rows(problem) > tr.stability.small_eig)
     with stage_progress(n if need else 0, f"stability ({method})", tr.progress, unit="point") as bar, \
             (blas_threads() if lapack else contextlib.nullcontext()):
         for i in range(n):
@@ -178,15 +178,15 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
             periodic_error[i] = ev.info[INFO_ERROR]
             force_period[i] = int(ev.info[INFO_PERIOD])
             if method == "arnoldi":
-                growth[i] = _arnoldi_growth(problem, ev.JX, ws[i], tr.stability)
+                growth[i] = growths(problem, (ev.JX,), ws[i:i + 1], tr.stability, method)[0]
                 bar.update(1)
             elif dense:
                 JXs[i % chunk] = ev.JX if isinstance(ev.JX, np.ndarray) else ev.JX.toarray()  # kept sparse
                 if i % chunk == chunk - 1 or i == n - 1:
                     lo = i - i % chunk
-                    growth[lo:i + 1] = _dense_growth(problem, JXs[:i + 1 - lo], ws[lo:i + 1], tr.stability)
+                    growth[lo:i + 1] = growths(problem, JXs[:i + 1 - lo], ws[lo:i + 1], tr.stability, method)
                     bar.update(i + 1 - lo)
-    stable, checked = _confirmed_stability(problem, X, lam, growth, tr.stability)
+    stable, checked = confirmed_stability(problem, X, lam, growth, tr.stability)
     counters = {**parts.counters, "monodromy_checks": checked}
     # folds need the stability on both sides; without it (no stability asked for) the turning points stand
     fold = (_saddle_nodes(parts.fold, stable, parts.segment, problem.options.fold_window)
@@ -201,25 +201,6 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
 
 #: the name of each stability method in an HBBranch (and the ``stability`` attribute of its Dataset)
 _STABILITY_NAMES = {"dense": "hill", "arnoldi": "hill-arnoldi", "none": "not-computed"}
-
-
-def _dense_growth(problem: HBProblem, JXs, ws, options):
-    """max Re(s) / w by dense Hill (:func:`~jointdyn.hb.stability.hill_growth`) of the points ``JXs``."""
-    if problem.condensed:
-        JXs = np.array([problem.full_jacobian(J, w) for J, w in zip(JXs, ws)])
-    return hill_growth(JXs, problem.system.M, dense_damping(problem.system.C), ws, problem.H, options)
-
-
-def _arnoldi_growth(problem: HBProblem, JX, w, options) -> float:
-    """max Re(s) / w of the exponents nearest the imaginary axis (:mod:`jointdyn.hb.hill_arnoldi`) of a point;
-    a condensed problem's through its condensed form (:mod:`jointdyn.hb.hill_condensed`)."""
-    from .hill_arnoldi import hill_arnoldi_exponents  # Arnoldi's modules only where it runs
-    from .hill_condensed import condensed_hill_exponents
-
-    if problem.condensed:
-        return condensed_hill_exponents(problem, JX, w, options).growth
-    return hill_arnoldi_exponents(JX, problem.system.M, dense_damping(problem.system.C), w, problem.H,
-                                  options).growth
 
 
 def _saddle_nodes(turning, stable, segment, window: int):
@@ -245,32 +226,6 @@ def _saddle_nodes(turning, stable, segment, window: int):
             hi = tp[j + 1] if j + 1 < tp.size else min(i + k, idx.size - 1)
             out[idx[i]] = not stable[idx[lo:hi + 1]].all()
     return out
-
-
-def _confirmed_stability(problem: HBProblem, X, lam, growth, options: StabilityOptions):
-    """(stable, number of monodromy checks): Hill's criterion, with marginal growth decided by the monodromy.
-
-    Hill's method truncated to H harmonics is only approximate where the
-    contact force has a corner (the onset of slip of a Jenkins element on
-    an otherwise undamped oscillator gives Re(s)/w of a few 1e-6 at
-    points whose period map is contracting). A growth between
-    ``options.rtol`` and ``options.confirm`` (StabilityOptions) is
-    therefore decided by the Floquet multipliers of the time-domain period
-    map (:func:`~jointdyn.hb.monodromy.monodromy_multipliers`): unstable
-    when one lies outside the unit circle by more than
-    ``2 pi options.rtol``. Systems with interfaces keep Hill's criterion there: the
-    time-domain period map does not march interfaces yet.
-    """
-    from .monodromy import monodromy_multipliers
-
-    stable = growth <= options.rtol
-    if problem.has_interfaces:
-        return stable, 0
-    marginal = np.flatnonzero(~stable & (growth < options.confirm))
-    for i in marginal:
-        mu = np.max(np.abs(monodromy_multipliers(problem, X[i], lam[i])))
-        stable[i] = mu <= 1.0 + 2.0 * math.pi * options.rtol
-    return stable, int(marginal.size)
 
 
 def _scales(problem: HBProblem, start: float):
@@ -334,10 +289,10 @@ class _Tracker:
         self._amps = {}
         #: the amplitudes of every accepted point (the branch's observable asks for them again)
         self._accepted_amps = {}
-        #: how the Jacobian is evaluated (:meth:`HBProblem.large_jacobian`): sparse or by harmonic blocks from
-        #: the size where the continuation's solves go large, where Hill's method (which needs the dense
-        #: Jacobians) is beyond its size anyway
-        self.kind = "dense" if problem.hill_affordable() else problem.large_jacobian()
+        #: how the Jacobian is evaluated: dense up to ``HBOptions.dense_max_unknowns``, beyond as
+        #: :meth:`HBProblem.large_jacobian` says (sparse or harmonic blocks); the stability's dense Hill
+        #: re-evaluates the points it needs densely (:meth:`evaluate`)
+        self.kind = "dense" if problem.dense_jacobians() else problem.large_jacobian()
 
     def residual(self, y, lam_s):
         xs, fs, ps = self.scales

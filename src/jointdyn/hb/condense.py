@@ -58,7 +58,8 @@ assembled exactly (:meth:`CondensedHBProblem.full_jacobian`) for dense
 Hill; beyond, shift-invert Arnoldi solves Hill's problem through the
 condensed form, the receptance at complex frequencies plus the contact part
 of the condensed Jacobian (:mod:`jointdyn.hb.hill_condensed`), without
-forming anything of the full size.
+forming anything of the full size. The choice between the two, for branches and
+single solutions alike: :mod:`jointdyn.hb.floquet`.
 """
 
 from __future__ import annotations
@@ -78,8 +79,6 @@ from ..kinematics import contact_kinematics, selection_matrix
 from ..systems import System, free_modes
 from .options import HBOptions, hb_options
 from .problem import HBProblem, _linear_blocks, contacts_only, held_by_contacts
-from .stability import hill_growth, hill_stability
-from .stability_options import StabilityOptions
 
 __all__ = ["Receptance", "receptance", "retained_dofs", "CondensedHBProblem", "make_problem", "use_condensed"]
 
@@ -744,35 +743,9 @@ class CondensedHBProblem(HBProblem):
         J[np.ix_(idx, idx)] += G.reshape(nh * m, nh * m)
         return J
 
-    def hill_affordable(self) -> bool:
-        """True: Hill's method runs at any size here (dense on the full Jacobian where its companion matrix is
-        small, else Arnoldi through the condensed form, :mod:`jointdyn.hb.hill_condensed`)."""
+    def dense_jacobians(self) -> bool:
+        """True: a condensed branch is continued with dense condensed Jacobians at any size."""
         return True
-
-    def _hill_dense(self) -> bool:
-        """Whether the default StabilityOptions take dense Hill for the full companion matrix."""
-        return StabilityOptions().method_for(2 * self.system.ndof * self.nh) == "dense"
-
-    def hill_growth(self, JXs, ws):
-        """max Re(s) / w of the Floquet exponents at many points: dense Hill on the full Jacobians, or Arnoldi
-        through the condensed form, by size (:meth:`hill_affordable`)."""
-        if self._hill_dense():
-            full = np.array([self.full_jacobian(J, w) for J, w in zip(JXs, ws)])
-            return hill_growth(full, self.system.M, dense_damping(self.system.C), ws, self.H)
-        from .hill_condensed import condensed_hill_exponents  # Arnoldi's modules only where it runs
-
-        return np.array([condensed_hill_exponents(self, J, w).growth for J, w in zip(JXs, ws)])
-
-    def hill_stability(self, JX, w):
-        """(stable, growth, multipliers) by dense Hill on the full Jacobian, or by Arnoldi through the
-        condensed form (the multipliers of the exponents found near the imaginary axis), by size."""
-        if self._hill_dense():
-            return hill_stability(self.full_jacobian(JX, w), self.system.M, dense_damping(self.system.C), w,
-                                  self.H)
-        from .hill_condensed import condensed_hill_exponents  # Arnoldi's modules only where it runs
-
-        found = condensed_hill_exponents(self, JX, w)
-        return found.growth <= StabilityOptions().rtol, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
 
 
 def use_condensed(system: System, condense=None, response_dofs=(), options: HBOptions | None = None) -> bool:

@@ -17,7 +17,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as V
 from .. import config
 from ..continuation import ContinuationOptions, ContinuationStatus, newton, refine_maximum, stage_note
 from .branch import _Request, _scales, _Tracker, continued_branch

@@ -19,9 +19,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
-from .._threads import blas_threads
 from ..continuation import START_EXTRAPOLATION, ContinuationOptions, make_options
-from ..damping import dense_damping
 from ..systems import System
 from .branch import _forcing_problem, _Request, solve_point
 from .discretisation import adaptive_branch
@@ -31,8 +29,8 @@ from .options import HBOptions
 from .options import hb_options as _hb_options
 from .parameters import GAMMA, parameter_named
 from .problem import HBProblem, reference_scales, stuck_stiffness
+from .floquet import confirmed_stability, point_stability
 from .results import HBBranch, HBSolution, SolveStatus
-from .stability import hill_stability
 from .stability_options import StabilityOptions, stability_options
 
 __all__ = ["continue_hb", "frc_hb", "harmonic_balance", "check_mean_position"]
@@ -330,35 +328,15 @@ def harmonic_balance(system: System, gamma: float, *, harmonics: int = config.HB
     return _make_solution(problem, X, ok, it, response_dof, stability_options(stability))
 
 
-def _point_stability(problem: HBProblem, JX, w: float, opts: StabilityOptions):
-    """(stable, max Re(s) / w, Floquet multipliers) of one solution by the method of ``opts``
-    ((False, NaN, empty) when it is ``none``)."""
-    method = opts.method_for(2 * problem.system.ndof * problem.nh)
-    if method == "none":
-        return False, math.nan, np.empty(0, dtype=complex)
-    s = problem.system
-    if method == "dense":
-        J = problem.full_jacobian(JX, w) if problem.condensed else JX
-        return hill_stability(np.asarray(J), s.M, dense_damping(s.C), w, problem.H, opts)
-    with blas_threads():  # ARPACK's BLAS-2 work: 2 OpenBLAS threads on 2 busy cores are slower than one
-        if problem.condensed:  # through the condensed form, nothing of the full size
-            from .hill_condensed import condensed_hill_exponents  # Arnoldi's modules only where it runs
-
-            found = condensed_hill_exponents(problem, JX, w, opts)
-        else:
-            from .hill_arnoldi import hill_arnoldi_exponents  # Arnoldi's modules only where it runs
-
-            found = hill_arnoldi_exponents(JX, s.M, dense_damping(s.C), w, problem.H, opts)
-    return found.growth <= opts.rtol, found.growth, np.exp(found.exponents * (2.0 * math.pi / w))
-
-
 def _make_solution(problem: HBProblem, X, converged, iterations, response_dof, opts=None) -> HBSolution:
     """HBSolution at X: residual, amplitudes of ``response_dof`` and Hill stability."""
     lam = problem.f1_ref
     ev = problem.evaluate(X, lam)
     amp, off, mx = problem.amplitudes(X, response_dof, lam)
-    stable, growth, mult = _point_stability(problem, ev.JX, problem.omega(lam),
-                                            StabilityOptions() if opts is None else opts)
+    opts = StabilityOptions() if opts is None else opts
+    stable, growth, mult = point_stability(problem, ev.JX, problem.omega(lam), opts)
+    if converged and not stable and math.isfinite(growth):  # a marginal growth: the period map, as on a branch
+        stable = bool(confirmed_stability(problem, X[None, :], np.array([lam]), np.array([growth]), opts)[0][0])
     status = SolveStatus.CONVERGED if converged else SolveStatus.NOT_CONVERGED
     return HBSolution(problem=problem, X=X, status=status, iterations=int(iterations),
                       residual_norm=float(np.max(np.abs(ev.R))), amplitude_m=amp, offset_m=off, max_abs_m=mx,

@@ -25,10 +25,11 @@ class HBOptions:
 
     Attributes
     ----------
-    hill_max_rows : int
-        Hill stability of a (full) problem with at most this many companion rows (2 n (2H+1)); beyond,
-        O(rows^3) costs more than the branch (a minute per point at 10^4 rows on 2 cores) and the
-        branch is evaluated by the large-problem path (default 4000; >= 0).
+    dense_max_unknowns : int
+        A branch of a (full) problem with at most this many unknowns n (2H+1) is continued with dense
+        Jacobians; beyond, by the large-problem path (:meth:`~jointdyn.hb.problem.HBProblem.large_jacobian`:
+        sparse, or harmonic blocks for a structure dense on its DOFs). Stability is chosen apart, by
+        :class:`~jointdyn.hb.stability_options.StabilityOptions` (default 2000; >= 0).
     block_preconditioner : bool
         From ``config.CONT_KRYLOV_SOLVE`` unknowns, HB and EPMC Newton and tangent solves are GMRES
         preconditioned by per-harmonic factorisations of the Jacobian's diagonal harmonic blocks
@@ -94,7 +95,7 @@ class HBOptions:
         (default 0.5; in (0, 1]).
     """
 
-    hill_max_rows: int = 4000
+    dense_max_unknowns: int = 2000
     block_preconditioner: bool = True
     auto_early_drop: float = 0.5
     auto_max_harmonics: int = 15
@@ -116,7 +117,7 @@ class HBOptions:
     condense_max_fraction: float = 0.5
 
     def __post_init__(self) -> None:
-        ints = {"hill_max_rows": 0, "auto_max_harmonics": 1, "auto_max_samples": 4, "start_max_iter": 1,
+        ints = {"dense_max_unknowns": 0, "auto_max_harmonics": 1, "auto_max_samples": 4, "start_max_iter": 1,
                 "solve_max_iter": 1, "fold_window": 1, "jacobian_budget_bytes": 1, "condense_min_dofs": 1}
         for name, least in ints.items():
             object.__setattr__(self, name, V.positive_int(name, getattr(self, name), least))

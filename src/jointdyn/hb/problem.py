@@ -53,7 +53,6 @@ from ._sparse import linear_entries
 from .levels import Level
 from .options import HBOptions, hb_options
 from .parameters import SystemParameter, _FixedFrequency, parameter_named
-from .stability import hill_growth, hill_stability
 
 __all__ = ["HBProblem"]
 
@@ -751,24 +750,10 @@ class HBProblem:
                 "stick": np.mean(code == STICK_SLIP, axis=1), "slip": np.mean(code == MACROSLIP, axis=1),
                 "open": np.mean(code == SEPARATION, axis=1)}
 
-    # --- stability ----------------------------------------------------------
-    def hill_affordable(self) -> bool:
-        """True when the companion matrix of Hill's method (2 n (2H+1) rows) has at most ``options.hill_max_rows``."""
-        return 2 * self.size <= self.options.hill_max_rows
-
-    def hill_growth(self, JXs, ws):
-        """max Re(s) / w of the Floquet exponents (Hill's method) at many points
-        (:func:`~jointdyn.hb.stability.hill_growth`); NaN when not :meth:`hill_affordable`."""
-        if not self.hill_affordable():
-            return np.full(len(ws), np.nan)
-        return hill_growth(JXs, self.system.M, dense_damping(self.system.C), ws, self.H)
-
-    def hill_stability(self, JX, w):
-        """(stable, growth, multipliers) of one solution (:func:`~jointdyn.hb.stability.hill_stability`), or
-        (False, NaN, empty) when not :meth:`hill_affordable`."""
-        if not self.hill_affordable():
-            return False, math.nan, np.empty(0, dtype=complex)
-        return hill_stability(JX, self.system.M, dense_damping(self.system.C), w, self.H)
+    def dense_jacobians(self) -> bool:
+        """True when a branch of this problem is continued with dense Jacobians: at most
+        ``options.dense_max_unknowns`` unknowns (else :meth:`large_jacobian` decides)."""
+        return self.size <= self.options.dense_max_unknowns
 
 
 def contacts_only(system: System) -> System:
