@@ -311,3 +311,54 @@ def test_rigid_body_modes_large_path_agrees(monkeypatch):
     Kg = K.copy()
     Kg[0, 0] += 1e3
     assert rigid_body_modes(Kg, M).shape == (n, 1)
+
+
+def test_qsma_of_a_free_free_body_is_the_free_equilibrium_with_its_rigid_body_part_at_zero():
+    """QSMA of a free-free body (its inner contact between DOFs 0 and 2): at every point of the push the free
+    structure's equilibrium K x + b T = M phi alpha holds with |T| <= fy (the gauge adds nothing there) and the
+    rigid-body part of x is zero; the backbone starts at the first elastic mode and goes through macroslip."""
+    from jointdyn.modes import qsma
+
+    s = _body()
+    b = qsma(s, (1e-5, 1e-2))
+    assert b.status.ok
+    n = s.ndof
+    x = b.X[:, n:2 * n]
+    phi = b.linear.mass_normalised
+    alpha = b.omega_rad_s ** 2 * (x @ (s.M @ phi))
+    r = x @ s.K_reference - alpha[:, None] * (s.M @ phi)[None, :]  # = -b T at an equilibrium
+    bvec = np.array([1.0, 0.0, -1.0])
+    T = -(r @ bvec) / (bvec @ bvec)
+    scale = np.abs(alpha)[:, None] * np.abs(s.M @ phi).max()
+    assert np.abs(r + T[:, None] * bvec[None, :]).max() <= 1e-9 * scale.max()
+    assert np.abs(T).max() <= MU * N0 * (1.0 + 1e-9) and np.abs(T[-1]) >= MU * N0 * (1.0 - 1e-9)  # macroslip
+    rigid = free_modes(s)
+    assert np.abs(x @ (s.M @ rigid)).max() <= 1e-9 * np.abs(x).max()  # to the push's Newton tolerance
+    w_elastic = math.sqrt(eigh(stuck_stiffness(s), s.M, eigvals_only=True)[1])
+    assert b.omega_rad_s[0] == pytest.approx(w_elastic, rel=1e-9) and b.omega_rad_s[-1] < 0.9 * w_elastic
+
+
+def test_qsma_of_a_free_free_assembly_through_macroslip():
+    """Two free parts joined by a Jenkins contact, pushed along their first elastic mode (output DOF 0).
+    While the contact sticks, the same assembly grounded by ever softer springs converges to it, in
+    proportion; once it slips, each part is balanced by the slip force alone: the modal force is
+    alpha = mu N / |sum over part A of (M phi)| (closed form), and the rigid-body part stays at zero."""
+    from jointdyn.modes import qsma
+
+    b = qsma(_chain(), (1e-5, 1e-2), output_dof=0)
+    assert b.status.ok
+    s, phi = b.system, b.linear.mass_normalised
+    x = b.X[:, 4:8]
+    alpha = b.omega_rad_s ** 2 * (x @ (s.M @ phi))
+    u = x[:, 1] - x[:, 2]
+    stuck = np.abs(u) < 0.999 * MU * N0 / KT
+    slipping = np.abs(u) > 1.001 * MU * N0 / KT
+    assert stuck.sum() > 20 and slipping.sum() > 20 and abs(u[-1]) > 10.0 * MU * N0 / KT
+    np.testing.assert_allclose(np.abs(alpha[slipping]), MU * N0 / abs((s.M @ phi)[:2].sum()), rtol=1e-9)
+    assert np.abs(x @ (s.M @ free_modes(s))).max() <= 1e-9 * np.abs(x).max()
+    errors = []
+    for ground in (1e2, 1e1, 1e0):
+        g = qsma(_chain(ground=ground), (1e-5, 1e-2), mode=2, output_dof=0)  # mode 1: the soft springs' own
+        assert g.status.ok
+        errors.append(np.max(np.abs(g.omega_rad_s[stuck] / b.omega_rad_s[stuck] - 1.0)))
+    assert errors[2] < 1e-4 and 5.0 < errors[0] / errors[1] < 20.0 and 5.0 < errors[1] / errors[2] < 20.0

@@ -156,12 +156,26 @@ def test_part_held_only_by_stuck_pairs_equals_the_stuck_linear_frf():
         assert np.abs(X[0]).max() <= 1e-10 * np.abs(z).max()
 
 
-def test_qsma_keeps_refusing_a_part_held_only_through_its_contacts():
+def test_qsma_of_a_part_held_only_through_its_contacts_goes_through_macroslip():
+    """QSMA pushes the hanging part while its contact holds it, and on through macroslip (the load held at the
+    slip force, the prescribed displacement carrying the part). Oracle: the same structure grounded by ever
+    softer springs converges to it, in proportion."""
     from jointdyn.modes import qsma
 
     s = jd.System(M2, None, K2, contacts=_hanging("iwan", 0.0).contacts)
-    with pytest.raises(ValueError, match="K must be positive definite with the tangential contacts free"):
-        qsma(s)
+    scale = MU * N0 / KT
+    b = qsma(s, (1e-3 * scale, 30.0 * scale), mode=2, output_dof=1)
+    assert b.status.ok
+    w = np.asarray(b.omega_rad_s)
+    x = b.X[:, 2:4]
+    assert abs(x[-1, 0] - x[-1, 1]) > 10.0 * scale and w[-1] < 0.3 * w[0]  # the part slides
+    errors = []
+    for ground in (1e1, 1e0, 1e-1):
+        g = jd.System(M2, None, K2 + np.diag([0.0, ground]), contacts=s.contacts)
+        bg = qsma(g, (1e-3 * scale, 30.0 * scale), mode=2, output_dof=1)
+        assert bg.status.ok
+        errors.append(np.max(np.abs(np.asarray(bg.omega_rad_s) / w - 1.0)))
+    assert errors[2] < 1e-3 and 5.0 < errors[0] / errors[1] < 20.0 and 5.0 < errors[1] / errors[2] < 20.0
 
 
 def test_a_part_sliding_as_a_whole_is_named_where_newton_fails():

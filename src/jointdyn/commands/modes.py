@@ -111,7 +111,7 @@ def _validate(args):
         system = System.paper_damper(eta=0.0, model=args.model, law_params=args.law_params)
         label = f"paper's damper, {args.model}"
         args.title = args.figure_label = label
-    check_free_vibration(system, args.method.upper(), springs=args.method == "epmc", held=args.method == "epmc")
+    check_free_vibration(system, args.method.upper(), springs=args.method == "epmc", held=True)
     with option_names(amplitude="--amplitude", output_dof="--output-dof", mode="--mode"):
         amps = amplitude_range(system, None if args.amplitude is None else parse_amplitude(args.amplitude))
         args.output_dof = output_dof_of(system, args.output_dof)

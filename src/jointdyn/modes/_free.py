@@ -98,8 +98,8 @@ def check_free_vibration(system, method: str, *, springs: bool = True, held: boo
         free singular, the stuck stiffness not: :func:`jointdyn.hb.problem.held_by_contacts`) and a free-free
         one (the stuck stiffness has rigid-body modes, :func:`jointdyn.systems.free_modes`, and no DOF is
         joined to nothing): EPMC does (its harmonic balance restarts the laws at the preloaded static state
-        and gauges the rigid-body part of the mean), QSMA does not (its static equilibrium of the slipping
-        structure needs K with the contacts free).
+        and gauges the rigid-body part of the mean), and so does QSMA (its push starts from the stuck
+        structure and holds the rigid-body part of the push at zero by the same gauge).
     """
     if not isinstance(system, System):
         raise ValueError("system must be a jointdyn.System")

@@ -25,6 +25,16 @@ one compiled call, :func:`_push_template`). Per amplitude a:
 * damping ratio D = E / (2 pi alpha q), and the viscous part
   ``omega x^T C x / (2 alpha q)``.
 
+A free-free structure (the stuck stiffness has rigid-body modes Phi_r,
+:func:`jointdyn.systems.free_modes`) is pushed with K + (M Phi_r)(M Phi_r)^T:
+the load M phi and the contact forces do no work on Phi_r, so this is the
+free structure's equilibrium with its rigid-body part at zero. A part held
+only through its contacts is held by them while they stick; where they
+slip as a whole the load along the mode is held at their slip force and
+the prescribed displacement carries the push on (the part slides), so the
+quasi-static backbone continues through macroslip with a falling secant
+frequency.
+
 It assumes what the EPMC does not: a motion that stays on the static
 deflection shape, harmonic in time, and Masing loops (constant normal
 loads). docs/modes.md compares it with the EPMC and says where it holds.
@@ -36,10 +46,10 @@ import math
 
 import numpy as np
 
-from .. import config
 from .._jit import jit, specialize
 from ..continuation.linalg import lu_solve
 from ..kinematics import contact_kinematics, selection_matrix
+from ..systems import free_modes
 from ._free import amplitude_range, check_free_vibration, linear_stuck_mode, output_dof_of
 from .backbone import Backbone, ModeStatus
 from .options import QSMAOptions, qsma_options
@@ -200,6 +210,18 @@ def _hermite_work(u, T, kT):
     return np.concatenate((np.zeros((1, u.shape[1])), np.cumsum(inc, axis=0)))
 
 
+def _gauged_stiffness(system) -> np.ndarray:
+    """K (N/m), plus (M Phi_r)(M Phi_r)^T for the rigid-body modes Phi_r of a free-free structure
+    (:func:`jointdyn.systems.free_modes`, M-orthonormal): the push's load M phi is M-orthogonal to them and
+    the contacts cannot act on them (b^T Phi_r = 0), so the gauged equilibrium is the free structure's with
+    the rigid-body part of x at zero (Phi_r^T M x = 0), the gauge harmonic balance puts on the mean."""
+    K = np.array(system.K_reference, dtype=np.float64)
+    MP = system.M @ free_modes(system)
+    if MP.shape[1]:
+        K += MP @ MP.T
+    return K
+
+
 def _push(system, grid, out_dof, linear, opts: QSMAOptions):
     """The compiled push: ``(reached, xs, alpha, T, kT)`` with row 0 the origin."""
     kin = contact_kinematics(system)
@@ -217,7 +239,7 @@ def _push(system, grid, out_dof, linear, opts: QSMAOptions):
     als = np.zeros(p + 1)
     Ts = np.zeros((p + 1, nc))
     kTs = np.zeros((p + 1, nc))
-    K = np.ascontiguousarray(system.K_reference)
+    K = np.ascontiguousarray(_gauged_stiffness(system))
     f = np.ascontiguousarray(system.M @ linear.mass_normalised)
     kernel = specialize(_push_template, STEP_JVP=laws[0].step_jvp, INIT=laws[0].init)
     reached = kernel(grid, (K, f, int(out_dof)), (Bm, Pm, Nc, int(ssz)),
@@ -233,7 +255,8 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     ----------
     system : System
         Structure with frictional contacts at constant normal loads; its
-        forcing is ignored.
+        forcing is ignored. Held in place, held only through its contacts,
+        or free-free (the rigid-body part of the push held at zero).
     amplitude : (float, float), optional
         Range (min, max) of the output DOF's displacement at the turning
         point of the push, m (default: ``config.MODES_AMPLITUDE_Q`` times
@@ -258,7 +281,7 @@ def qsma(system, amplitude=None, *, mode: int = 1, output_dof: int | None = None
     """
     from .. import _validate as V
 
-    check_free_vibration(system, "QSMA", springs=False)
+    check_free_vibration(system, "QSMA", springs=False, held=True)
     lo, hi = amplitude_range(system, amplitude)
     out_dof = output_dof_of(system, output_dof)
     opts = qsma_options(options)
