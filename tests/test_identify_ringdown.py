@@ -315,3 +315,29 @@ def test_ringdown_options_set_the_band_the_filter_and_the_checks():
 def test_bad_ringdown_options_are_refused(name, value):
     with pytest.raises(ValueError, match=name):
         jd.identify.RingdownOptions(**{name: value})
+
+
+def test_law_decay_rate_is_the_microslip_one_below_slip_and_the_stuck_one_above():
+    """The whole law's decay rate (jointdyn.identify._lawdecay) against closed forms: below the
+    slip displacement of Iwan's law it is the microslip decay's omega D (k + K1)/(k + F') with
+    K1, F' of the power law (_microslip); above it, where F' = 0, omega D (k + K1)/k; and with
+    no joint force left to dissipate (fy huge) the viscous zeta omega_0."""
+    from jointdyn.identify._lawdecay import law_rates
+    from jointdyn.identify._microslip import _c1, microslip_constants, microslip_model
+
+    law = jd.make_law("iwan", kt=1e5, mu=0.2, n_ref=100.0)
+    m, k, zeta = 2.0, 4e5, 0.002
+    chi, R, pm = microslip_constants(law)
+    A = pm * np.array([0.05, 0.3, 0.9])
+    w, D, rate = law_rates(law, k, zeta, m, A)
+    wm, Dm = microslip_model(k + law.kt, R, chi, zeta, m, A)
+    ratio = (k + law.kt - _c1(chi) * R * A) / (k + law.kt - R * A)
+    np.testing.assert_allclose(w, wm, rtol=1e-9)
+    np.testing.assert_allclose(D, Dm, rtol=1e-6)
+    np.testing.assert_allclose(rate, wm * Dm * ratio, rtol=1e-5)
+    A = pm * np.array([1.5, 4.0])
+    w, D, rate = law_rates(law, k, zeta, m, A)
+    np.testing.assert_allclose(rate, w * D * m * w * w / k, rtol=1e-9)
+    stiff = jd.make_law("iwan", kt=1e5, mu=1e6, n_ref=100.0)
+    w, D, rate = law_rates(stiff, k, zeta, m, np.array([1e-4]))
+    np.testing.assert_allclose(rate, zeta * math.sqrt((k + 1e5) / m), rtol=1e-6)
