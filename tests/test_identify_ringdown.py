@@ -136,9 +136,12 @@ def test_iwan_free_decay_fitted_parameters_within_3_percent_and_covered():
 def test_segalman_free_decay_names_what_it_does_not_determine():
     """The Segalman decay (chi = -0.5) in microslip: R, chi and zeta trade against each other over
     the amplitudes it covers (fitted to the backbone's points, R came out 50 to 80 % off with an
-    interval of +-1 %). fit_ringdown gives k + kt and chi with intervals that cover, names R (and
-    zeta, whose interval spans more than a factor 1.2) not determined, and gives the frequency
-    and damping ratio at the ends of the decay, which it does determine."""
+    interval of +-1 %). fit_ringdown gives k + kt with an interval that covers, names R (and
+    zeta, whose interval spans more than a factor 1.2) not determined, and chi too: over 20
+    seeds it scattered by 0.020 about -0.507 (up to 0.039, 8 %, off; a spread, not a bias) with
+    intervals of +-0.03 to +-0.08, never within the 3 % that calling it determined asks
+    (RINGDOWN_FIT_BAR_SPAN); it gives the frequency and damping ratio at the ends of the decay,
+    which it does determine."""
     from jointdyn.identify import fit_ringdown
     from jointdyn.identify._microslip import microslip_constants
 
@@ -152,6 +155,9 @@ def test_segalman_free_decay_names_what_it_does_not_determine():
     assert _covers(c["R"], R) and c["R"]["interval"]["high"] / c["R"]["interval"]["low"] > 1.2
     assert abs(c["k_plus_kt"]["value"] / 5e5 - 1.0) < 0.03 and _covers(c["k_plus_kt"], 5e5)
     assert abs(c["chi"]["value"] - chi) < 0.1 and _covers(c["chi"], chi)
+    iv = c["chi"]["interval"]
+    assert (iv["high"] + 1.0) / (iv["low"] + 1.0) > 1.06 and "not_determined" in c["chi"]
+    assert fit.parameters["chi"] is None and "chi" in fit.not_identifiable
     assert _covers(c["zeta"], 0.002)
     if "not_determined" in c["zeta"]:
         assert fit.parameters["zeta"] is None and "zeta" in fit.not_identifiable
@@ -164,6 +170,44 @@ def test_segalman_free_decay_names_what_it_does_not_determine():
         ref = np.interp(math.log(d["amplitude_m"]), np.log(bb.amplitude_m), bb.damping_ratio)
         assert abs(d["value"] / ref - 1.0) < 0.05, (tag, d["value"], ref)
         assert d["interval"]["low"] < d["value"] < d["interval"]["high"]
+
+
+def test_iwan_decay_through_macroslip_fits_the_whole_model_to_the_windows():
+    """The Iwan SDOF released from 5 slip displacements (150 periods, 64 samples per period, 1 %
+    noise, seed 0): the kept decay starts at twice the slip displacement, in macroslip, where the
+    microslip decay does not hold (fitted with it, the damping ratio came out 15 % off EPMC's at
+    the top of a decay from 3 slip displacements). fit_ringdown fits k, kt, fy and zeta to the
+    windows' falls of ln A (:mod:`jointdyn.identify._lawdecay`): the fitted model's frequency
+    within 0.5 % and damping ratio within 5 % of EPMC's over the decay's amplitudes, every
+    parameter it determines (its interval within about +-3 %) within 3 % with an interval that
+    covers, the others named not determined with intervals that cover (over 20 seeds:
+    benchmarks/coverage_ringdown.py macroslip). The band is passed: the frequency drifts from
+    the slipping to the stuck one, two peaks of the spectrum."""
+    from jointdyn.identify import fit_ringdown
+    from jointdyn.modes import epmc
+
+    system, law = _sdof("iwan")
+    t, x = _decay(system, law, [5.0 * law.x_slip], 0, math.sqrt(5e5 / 2.0), 150, 64)
+    b = backbone_from_ringdown(t, x, "x", band=(300.0, 750.0))
+    assert b.amplitude_m.max() > 1.5 * law.x_slip  # starts in macroslip (x_slip = 2 fy / kt)
+    fit = fit_ringdown(b, mass=2.0, model="iwan")
+    assert "through macroslip" in fit.message and fit.status.value in ("identified", "partly-identified")
+    true = {"k": 4e5, "kt": 1e5, "fy_N": 20.0, "zeta": 0.002}
+    determined = [n for n in true if fit.parameters[n] is not None]
+    # k from the slipping frequency; kt, fy (intervals of +-4 to +-7 %) and zeta (+-40 %) are named
+    # not determined by the rule that a determined interval lies within +-3 %
+    assert "k" in determined, fit.message
+    for n in determined:
+        assert abs(fit.parameters[n] / true[n] - 1.0) < 0.03, (n, fit.parameters[n])
+        assert fit.intervals[n].covers(true[n]), (n, fit.intervals[n])
+    for n in set(true) - set(determined):
+        assert n in fit.not_identifiable and fit.intervals[n].covers(true[n])
+    bb = epmc(system, (0.3 * b.amplitude_m.min(), 1.5 * b.amplitude_m.max()), harmonics=3, progress=False)
+    la, at = np.log(bb.amplitude_m), np.log(b.amplitude_m)
+    assert np.max(np.abs(fit.fitted["omega_rad_s"] / np.interp(at, la, bb.omega_rad_s) - 1.0)) < 0.005
+    assert np.max(np.abs(fit.fitted["damping_ratio"] / np.interp(at, la, bb.damping_ratio) - 1.0)) < 0.05
+    top = fit.determined_combinations["damping_ratio_top"]
+    assert top["interval"]["low"] < top["value"] < top["interval"]["high"]
 
 
 def test_three_dof_free_decay_with_other_modes_matches_its_epmc_backbone():
@@ -271,3 +315,29 @@ def test_ringdown_options_set_the_band_the_filter_and_the_checks():
 def test_bad_ringdown_options_are_refused(name, value):
     with pytest.raises(ValueError, match=name):
         jd.identify.RingdownOptions(**{name: value})
+
+
+def test_law_decay_rate_is_the_microslip_one_below_slip_and_the_stuck_one_above():
+    """The whole law's decay rate (jointdyn.identify._lawdecay) against closed forms: below the
+    slip displacement of Iwan's law it is the microslip decay's omega D (k + K1)/(k + F') with
+    K1, F' of the power law (_microslip); above it, where F' = 0, omega D (k + K1)/k; and with
+    no joint force left to dissipate (fy huge) the viscous zeta omega_0."""
+    from jointdyn.identify._lawdecay import law_rates
+    from jointdyn.identify._microslip import _c1, microslip_constants, microslip_model
+
+    law = jd.make_law("iwan", kt=1e5, mu=0.2, n_ref=100.0)
+    m, k, zeta = 2.0, 4e5, 0.002
+    chi, R, pm = microslip_constants(law)
+    A = pm * np.array([0.05, 0.3, 0.9])
+    w, D, rate = law_rates(law, k, zeta, m, A)
+    wm, Dm = microslip_model(k + law.kt, R, chi, zeta, m, A)
+    ratio = (k + law.kt - _c1(chi) * R * A) / (k + law.kt - R * A)
+    np.testing.assert_allclose(w, wm, rtol=1e-9)
+    np.testing.assert_allclose(D, Dm, rtol=1e-6)
+    np.testing.assert_allclose(rate, wm * Dm * ratio, rtol=1e-5)
+    A = pm * np.array([1.5, 4.0])
+    w, D, rate = law_rates(law, k, zeta, m, A)
+    np.testing.assert_allclose(rate, w * D * m * w * w / k, rtol=1e-9)
+    stiff = jd.make_law("iwan", kt=1e5, mu=1e6, n_ref=100.0)
+    w, D, rate = law_rates(stiff, k, zeta, m, np.array([1e-4]))
+    np.testing.assert_allclose(rate, zeta * math.sqrt((k + 1e5) / m), rtol=1e-6)

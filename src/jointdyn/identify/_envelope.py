@@ -151,7 +151,14 @@ def _spline_envelope(t, lna, omega, options):
     t, lna, omega, amp = t[:keep], lna[:keep], omega[:keep], amp[:keep]
     spl, inner = best(t, lna, amp)
     wfit = _fit(t, omega, amp, inner)[0]
-    return keep, spl(t), spl.derivative()(t), wfit(t), noise
+    rw = wfit(t) - omega
+    noise_w = max(1.4826 * float(np.median(np.abs(rw - np.median(rw)))), 1e-12 * float(np.max(omega)))
+    # the windows for a fit of a law's own decay (through macroslip): ln A with the noise's bias
+    # removed as in smooth_envelope, standard errors from the scatter about the splines
+    lnc = 0.5 * np.log(np.maximum(amp * amp - 2.0 * noise * noise, 0.25 * amp * amp))
+    windows = {"t": t, "lna": lnc, "omega": omega, "sigma_lna": noise / np.exp(lnc),
+               "sigma_omega": np.full(keep, noise_w), "form": "spline"}
+    return keep, spl(t), spl.derivative()(t), wfit(t), noise, windows
 
 
 def power_decay(t, lna0, a0, b, p):
@@ -255,11 +262,13 @@ def smooth_envelope(t, lna, omega, options: RingdownOptions) -> tuple:
     misfit : float
         The rms of the weighted residual of ln A over that of a cubic spline with knots every
         0.25 of ln A (near 1: the model is adequate; above: the decay is not of this form).
-    windows : dict or None
-        What the decay model was fitted to (None for the spline): ``t`` (s), ``lna`` (ln A with
-        the noise's bias removed), ``omega`` (rad/s), and their standard errors ``sigma_lna``
-        (-, per window: the amplitude's noise over A) and ``sigma_omega`` (rad/s), for fits of a
-        model to the windows themselves (:func:`jointdyn.identify.fit_ringdown`).
+    windows : dict
+        The kept windows: ``t`` (s), ``lna`` (ln A with the noise's bias removed), ``omega``
+        (rad/s), and their standard errors ``sigma_lna`` (-, per window: the amplitude's noise
+        over A) and ``sigma_omega`` (rad/s), for fits of a model to the windows themselves
+        (:func:`jointdyn.identify.fit_ringdown`); ``form`` is ``"microslip"`` where the decay
+        model held and ``"spline"`` where it did not (a decay through macroslip: errors from the
+        scatter about the splines).
     """
     amp = np.exp(lna)
     x, r, rw = _fit_decay(t, lna, omega, amp)
@@ -268,8 +277,8 @@ def smooth_envelope(t, lna, omega, options: RingdownOptions) -> tuple:
         rs = _fit(t, lna, amp, inner)[1]
         misfit = math.sqrt((float(r @ r) / max(t.size - 4, 1)) / max(rs / (t.size - inner.size - 4), 1e-300))
         if misfit > options.misfit_limit:
-            keep, lf, rate, wfit, noise = _spline_envelope(t, lna, omega, options)
-            return keep, lf, rate, wfit, None, None, noise, misfit, None
+            keep, lf, rate, wfit, noise, windows = _spline_envelope(t, lna, omega, options)
+            return keep, lf, rate, wfit, None, None, noise, misfit, windows
     noise = 1.4826 * float(np.median(np.abs(r - np.median(r))))  # robust scale (MAD)
     fit0 = power_decay(t - t[0], *x[:4])
     bad = np.flatnonzero(noise / np.exp(fit0) > options.amplitude_rtol)
@@ -296,5 +305,5 @@ def smooth_envelope(t, lna, omega, options: RingdownOptions) -> tuple:
     dof_m, dof_s = max(keep - 4, 1), max(keep - inner.size - 4, 1)
     misfit = math.sqrt((float(r @ r) / dof_m) / max(rs / dof_s, 1e-300))
     windows = {"t": t, "lna": lna, "omega": omega, "sigma_lna": noise / amp,
-               "sigma_omega": np.full(keep, max(noise_w, 1e-12 * float(np.max(omega))))}
+               "sigma_omega": np.full(keep, max(noise_w, 1e-12 * float(np.max(omega)))), "form": "microslip"}
     return keep, lf, rate, wfit, float(x[3]), float(x[4]), noise, misfit, windows

@@ -27,7 +27,7 @@ import numpy as np
 from ..laws.segalman import CHI_MAX, CHI_MIN, segalman_constants
 from ._lsq import Param, solve
 
-__all__ = ["microslip_backbone", "microslip_constants", "decay_model", "MICROSLIP_MODELS"]
+__all__ = ["microslip_backbone", "microslip_constants", "decay_model", "decay_times", "MICROSLIP_MODELS"]
 
 #: ln A steps of the quadrature of a free decay (:func:`decay_model`) (-)
 DECAY_GRID = 600
@@ -74,7 +74,15 @@ def decay_model(v: dict, m: float, t: np.ndarray, lna_end: float) -> tuple:
     w, D = microslip_model(K, R, chi, zeta, m, A)
     ap = R * A ** (chi + 1.0)
     ratio = np.maximum(K - _c1(chi) * ap, 1e-6 * K) / np.maximum(K - ap / (chi + 1.0), 1e-6 * K)
-    inv = 1.0 / np.maximum(w * D * ratio, 1e-300)
+    return decay_times(lev, w, w * D * ratio, t)
+
+
+def decay_times(lev: np.ndarray, w: np.ndarray, rate: np.ndarray, t: np.ndarray) -> tuple:
+    """(ln A, omega rad/s) at the times ``t`` (s, from t[0]) of a decay whose -d ln A / dt is
+    ``rate`` (1/s) and frequency ``w`` at the falling levels ``lev`` of ln A (from the release):
+    the time to each level by the trapezoidal rule on 1 / rate; beyond the last level at the
+    last rate."""
+    inv = 1.0 / np.maximum(rate, 1e-300)
     tl = np.concatenate(([0.0], np.cumsum(0.5 * (inv[1:] + inv[:-1]) * (lev[:-1] - lev[1:]))))
     span = float(t[-1] - t[0])
     if tl[-1] < span:  # beyond the grid: the last rate

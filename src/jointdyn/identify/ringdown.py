@@ -80,9 +80,11 @@ class RingdownBackbone:
     windows : dict or None
         The windows the decay model was fitted to: ``t`` (s), ``lna`` (ln of the displacement
         amplitude), ``omega`` (rad/s) and their standard errors ``sigma_lna`` and
-        ``sigma_omega`` (rad/s), measured from the scatter; None where the decay was not of
-        the microslip form (the spline). The points above come from one smooth model, so they
-        are not independent data: :func:`jointdyn.identify.fit_ringdown` fits these instead.
+        ``sigma_omega`` (rad/s), measured from the scatter, and ``form``: ``"microslip"`` where
+        the decay model held, ``"spline"`` where it did not (a decay through macroslip). The
+        points above come from one smooth model, so they are not independent data:
+        :func:`jointdyn.identify.fit_ringdown` fits these instead (None: a RingdownBackbone made
+        without windows, which fit_ringdown fits through its points).
     """
 
     amplitude_m: np.ndarray
