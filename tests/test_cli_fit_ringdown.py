@@ -64,6 +64,29 @@ def test_bad_ringdowns_one_line_exit_2_no_file(tmp_path, capsys, kw, word):
     assert not out.exists()
 
 
+def test_band_picks_one_mode_of_two_and_bad_bands_are_refused(tmp_path, capsys):
+    """Two modes 8 % apart: refused without --band (the message names it), fitted with a band around the
+    first (Hz); a bad band is one line naming --band, exit 2, no file."""
+    src = _decay(tmp_path / "decay.csv", two=True)
+    base = ["fit", "--ringdown", str(src), "--model", "iwan", "--mass", "2"]
+    assert main(base) == 2
+    assert "--band LOW:HIGH" in capsys.readouterr().err
+    hz = W0 / (2.0 * math.pi)
+    rc = main(base + ["--band", f"{0.93 * hz}:{1.03 * hz}", "--json"])
+    d = json.loads(capsys.readouterr().out)
+    assert rc == 3 and d["determined_combinations"]["k_plus_kt"]["value"] == pytest.approx(2.0 * W0 ** 2, rel=1e-2)
+    out = tmp_path / "out"
+    for band, word in (("80", "LOW:HIGH"), ("90:80", "HIGH must be > LOW"), ("-1:80", "--band LOW"),
+                       ("a:b", "numbers")):
+        assert main(base + [f"--band={band}", "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert word in err and "--band" in err and len(err.strip().splitlines()) == 1 and not out.exists()
+    loops = tmp_path / "loops.csv"
+    loops.write_text("t,x,N,T\n0,0,1,0\n1,1,1,1\n2,0,1,0\n3,-1,1,-1\n")
+    assert main(["fit", "--input", str(loops), "--band", "70:80"]) == 2
+    assert "--band applies to ring-down fits" in capsys.readouterr().err
+
+
 def _curves(path, levels=(5.0, 15.0, 30.0), n=50):
     import jointdyn as jd
     from jointdyn.hb import frc_hb

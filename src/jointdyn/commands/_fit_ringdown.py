@@ -4,7 +4,9 @@ The CSV has a header row and the columns ``t`` (s) and one of ``x`` (m),
 ``v`` (m/s) or ``a`` (m/s^2), uniformly sampled. The backbone is extracted
 by :func:`jointdyn.backbone_from_ringdown` and fitted as ``--backbone`` would
 be (``--mass``, ``--model``); with ``--out DIR`` it is also written as
-``ringdown_backbone.csv`` with the ``--backbone`` columns.
+``ringdown_backbone.csv`` with the ``--backbone`` columns. ``--band LOW:HIGH``
+(Hz) gives the mode's pass band where the spectrum's peak does not (a decay
+through macroslip drifts in frequency enough to show two peaks).
 """
 
 from __future__ import annotations
@@ -43,16 +45,38 @@ def read_ringdown(path, read_columns) -> tuple:
     return d["t"], d[kind], kind
 
 
+def parse_band(text: str) -> tuple[float, float]:
+    """``--band LOW:HIGH`` (Hz) -> (low, high) rad/s with 0 < low < high."""
+    from .. import _validate as V
+
+    parts = str(text).split(":")
+    if len(parts) != 2:
+        raise ValueError(f"--band must be LOW:HIGH (Hz), got {text!r}")
+    try:
+        lo, hi = (float(s) for s in parts)
+    except ValueError:
+        raise ValueError(f"--band must be LOW:HIGH of numbers (Hz), got {text!r}") from None
+    V.positive("--band LOW", lo)
+    V.positive("--band HIGH", hi)
+    if not hi > lo:
+        raise ValueError(f"--band HIGH must be > LOW ({lo:g} Hz), got {hi:g} Hz")
+    return 2.0 * np.pi * lo, 2.0 * np.pi * hi
+
+
 def backbone_of(args, read_columns):
-    """The extracted :class:`~jointdyn.identify.RingdownBackbone` of ``args.ringdown``
-    (ValueError naming the file on bad data)."""
+    """The extracted :class:`~jointdyn.identify.RingdownBackbone` of ``args.ringdown``, in the pass band
+    ``args.band`` (rad/s) when given (ValueError naming the file, or ``--band``, on bad data)."""
     from ..identify import backbone_from_ringdown
 
     t, y, kind = read_ringdown(args.ringdown, read_columns)
+    band = getattr(args, "band", None)
     try:
-        return backbone_from_ringdown(t, y, kind)
+        return backbone_from_ringdown(t, y, kind, band=band)
     except ValueError as exc:
-        raise ValueError(f"--ringdown {str(args.ringdown)!r}: {exc}") from None
+        msg = str(exc).replace("pass band=", "give the mode's pass band as --band LOW:HIGH (Hz)")
+        if band is not None and "band" in msg:
+            msg = msg.replace("band must be", "--band must be")
+        raise ValueError(f"--ringdown {str(args.ringdown)!r}: {msg}") from None
 
 
 def backbone_csv(b) -> str:

@@ -80,6 +80,9 @@ def add_arguments(p) -> None:
                    help=f"joint law to fit (default {config.MODEL})")
     add_law_arguments(p)
     p.add_argument("--mass", type=float, default=None, help="modal mass of the backbone's mode, kg (--backbone)")
+    p.add_argument("--band", default=None, metavar="LOW:HIGH",
+                   help="pass band of the ring-down's mode, Hz (--ringdown; default: around the spectrum's "
+                        "peak); give it when the decay's frequency drifts enough to show two peaks")
     p.add_argument("--n-ref", type=float, default=None, dest="n_ref",
                    help="reference normal load of a loop fit, N (default: mean N in contact); fy_N = mu n_ref")
     p.add_argument("--out", default=None, metavar="DIR", help="write fit.json, fit.csv and fit.png here")
@@ -116,6 +119,12 @@ def _validate_args(args) -> None:
         raise ValueError("--mass applies to modal fits (--backbone, --ringdown, --frc) only")
     if args.n_ref is not None:
         V.positive("--n-ref", args.n_ref)
+    if args.band is not None:
+        if args.ringdown is None:
+            raise ValueError("--band applies to ring-down fits (--ringdown) only")
+        from ._fit_ringdown import parse_band
+
+        args.band = parse_band(args.band)
     if args.out is not None:
         V.output_dir("--out", args.out, files=_FILES + (("ringdown_backbone.csv",) if args.ringdown else ()))
 

@@ -31,7 +31,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ._lsq import Param, open_reason, solve, status_of
+from ._lsq import open_reason, status_of
 from ._microslip import decay_fit, decay_model, microslip_model
 
 __all__ = ["fit_ringdown"]
