@@ -7,11 +7,13 @@ first mass, forced at the first mass; H = 7 harmonics, 128 samples; the HB
 Jacobian at a response where the contact slips part of the period.
 
 * Hill eigenvalues: all eigenvalues of the companion matrix (2 n (2H+1)
-  rows: 30 to 1500) with the parity split, by the compiled EISPACK port
-  (``jointdyn.hb._eig`` through ``stability._hill_eigvals``) and by LAPACK
-  (``stability._hill_eigvals_lapack`` with every block given to LAPACK),
-  for a constant normal load (the split applies: two blocks of half the
-  rows) and a varying one (the whole matrix).
+  rows: 30 to 1500) with the parity split, by LAPACK in the two paths of
+  ``jointdyn.hb.stability``: the batch (``_hill_growth_batch``: the
+  companions of a branch's points as one stack, one ``numpy.linalg.eigvals``
+  call per parity block; here 32 copies of the matrix, the time per point)
+  and one point at a time (``_hill_eigvals_lapack``), for a constant normal
+  load (the split applies: two blocks of half the rows) and a varying one
+  (the whole matrix).
 * Bordered solves: one Newton correction of the continuation
   (n (2H+1) + 1 unknowns: 16 to 751), by the compiled Gaussian elimination
   and by LAPACK ``dgesv`` (``numpy.linalg.solve``).
@@ -28,10 +30,8 @@ Jacobian at a response where the contact slips part of the period.
   subprocess), the cost they add to a first run.
 
 Each timing is the best of repeats (CPU time), both paths measured in the
-same process one after the other. The thresholds ``StabilityOptions.small_eig``
-(rows of a matrix handed to the QR iteration: the companion or one parity
-block) and ``LinearSolveOptions.small_solve`` (largest size given to the compiled
-path) are set from this table, measured with ``OPENBLAS_NUM_THREADS=1``
+same process one after the other. The threshold ``LinearSolveOptions.small_solve`` (largest size given to the
+compiled path) is set from this table, measured with ``OPENBLAS_NUM_THREADS=1``
 (on a shared machine a threaded BLAS spins on busy cores and its CPU time
 says nothing about the algorithm).
 """
@@ -56,13 +56,7 @@ which = sys.argv[1]
 from jointdyn.hb import stability as S
 from jointdyn.continuation import linalg as K
 t = time.process_time()
-if which == "eig":
-    M = np.eye(1); C = np.zeros((1, 1))
-    D2iJ, B1, _, parity = S._hill_parts(M, C, 1)
-    JX = np.eye(3)
-    S._hill_eigvals(D2iJ, JX, B1[0], B1[1], 1.0, parity)
-    S._hill_growth_batch(D2iJ, JX[None], B1[0], B1[1], np.ones(1), parity, 2)
-else:
+if which == "lu":
     Jy = np.eye(3); Jl = np.ones(3); d = np.ones(4)
     K._newton_direction_small(Jy, Jl, d, np.ones(3), np.ones(4), np.ones(4))
     K._tangent_small(Jy, Jl, d)
@@ -124,18 +118,23 @@ def _best(fn, budget):
 
 
 def _hill_row(n, eta, budget):
+    import numpy as np
+
     from jointdyn.hb import StabilityOptions
     from jointdyn.hb import stability as S
 
     p, JX, w = _jacobian(n, eta)
     M, C = p.system.M, p.system.C
     D2iJ, B1, _, parity = S._hill_parts(M, C, H)
-    compiled = _best(lambda: S._hill_eigvals(D2iJ, JX, B1[0], B1[1], w, parity), budget)
+    JXs = np.repeat(JX[None], 32, axis=0)
+    ws = np.full(32, w)
+    batched = _best(lambda: S._hill_growth_batch(D2iJ, JXs, B1[0], B1[1], ws, parity, 2 * n), budget) / 32
     lapack = _best(lambda: S._hill_eigvals_lapack(JX, M, C, w, H), budget)
     chosen = _best(lambda: S._hill_all(JX, M, C, w, H, StabilityOptions().small_eig), budget)
     split = S._parity_blocks(S._hill_matrix(JX, M, C, w, H), parity) is not None
-    return {"dofs": n, "companion_rows": 2 * JX.shape[0], "parity_split": split, "compiled_s": compiled,
-            "lapack_s": lapack, "lapack_over_compiled": lapack / compiled, "default_path_s": chosen}
+    return {"dofs": n, "companion_rows": 2 * JX.shape[0], "parity_split": split,
+            "batch_per_point_s": batched, "lapack_s": lapack, "lapack_over_batch": lapack / batched,
+            "default_path_s": chosen}
 
 
 def _solve_row(n, budget):
@@ -246,7 +245,7 @@ def run(quick: bool = False) -> dict:
         "thresholds": {"small_eig": StabilityOptions().small_eig, "CONT_SMALL_SOLVE": LinearSolveOptions().small_solve},
     }
     if not quick:
-        out["cold_compile_s"] = {"hill_eisport": _cold_compile("eig"), "bordered_lu": _cold_compile("lu")}
+        out["cold_compile_s"] = {"bordered_lu": _cold_compile("lu")}
     return out
 
 

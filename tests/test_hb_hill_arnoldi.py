@@ -159,7 +159,7 @@ def test_stability_numbers_are_options(damper_branches):
     JX, w = p.evaluate(a.X[i], a.lam[i]).JX, p.omega(a.lam[i])
     stable, growth, mult = hill_stability(JX, s.M, s.C, w, p.H)
     assert not stable and growth == a.growth[i] > opt.rtol
-    # LAPACK (small_eig 0) for the compiled eigenvalue path of this 30-row companion: the same growth
+    # one point at a time (small_eig 0) for the batched path of this 30-row companion: the same growth
     lap = hill_stability(JX, s.M, s.C, w, p.H, StabilityOptions(small_eig=0))
     assert abs(lap[1] - growth) <= 1e-12 and not lap[0]
     # the growth is compared with rtol: a bound above it labels the point stable

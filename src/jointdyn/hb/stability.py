@@ -14,10 +14,10 @@ with J_X the HB Jacobian dR/dX (the contact part is the AFT-derived
 derivative of the periodic force coefficients, the standard choice for
 hysteretic forces, which are not differentiable in velocity) and nabla the
 d/dtau operator on the coefficients. It is solved in first-order (companion)
-form, size 2 n (2H+1) (all its eigenvalues by LAPACK ``dgeev``, except
-for matrices (or parity blocks, below) of at most
-``StabilityOptions.small_eig`` rows: the compiled EISPACK QR iteration of :mod:`jointdyn.hb._eig` is
-faster there, ``benchmarks/bench_linalg.py``).
+form, size 2 n (2H+1), all its eigenvalues by LAPACK ``dgeev``
+(``numpy.linalg.eigvals``; companions of at most ``StabilityOptions.small_eig``
+rows of many points assembled as one stack and solved in one call, its loop
+over the points in C, so that nothing here is compiled by Numba).
 Each Floquet exponent s appears there as a family
 s + i k w (k = -H..H), of which the truncation resolves well only the
 members whose eigenvectors are centred on the low harmonics. Following
@@ -44,9 +44,7 @@ import math
 import numpy as np
 
 from .._cache import by_value
-from .._jit import jit
 from ..fourier import derivative_matrix
-from ._eig import eigvals_inplace
 from .stability_options import StabilityOptions
 
 __all__ = ["hill_exponents", "hill_stability", "hill_growth"]
@@ -92,72 +90,73 @@ def _hill_parts_of(Mb: bytes, Cb: bytes, n: int, H: int):
 _EPS = float(np.finfo(np.float64).eps)
 
 
-@jit
-def _hill_eigvals(D2iJ, JX, B1c, B1w, w, parity):  # pragma: no cover - compiled
-    """All eigenvalues of the companion matrix of Hill's quadratic problem.
+def _hill_batch(D2iJ, JXs, B1c, B1w, ws):
+    """The companion matrices ``A = [[0, I], [-D2i JX, -(B1c + w B1w)]]`` of many points (see
+    :func:`_hill_parts`), a stack (points, 2N, 2N) built with NumPy (batched matrix products)."""
+    P, N = JXs.shape[0], JXs.shape[1]
+    A = np.zeros((P, 2 * N, 2 * N))
+    A[:, :N, N:] = np.eye(N)
+    A[:, N:, :N] = -(D2iJ @ JXs)
+    A[:, N:, N:] = -(B1c + ws[:, None, None] * B1w)
+    return A
 
-    ``A = [[0, I], [-D2i JX, -(B1c + w B1w)]]`` (see :func:`_hill_parts`),
-    eigenvalues by :func:`jointdyn.hb._eig.eigvals_inplace`. ``parity[j]``
-    is the parity of the harmonic of unknown j.
 
-    Parity split: the linear terms couple only equal harmonics, and the
-    contact Jacobian of a half-wave symmetric orbit (x(t + T/2) = -x(t):
-    an odd contact law and no even-harmonic excitation, e.g. a constant
-    normal load) couples only harmonics of equal parity, so that A is
-    block diagonal after grouping even and odd harmonics. The blocks are
-    then solved separately (sizes about N each instead of 2N: a quarter of
-    the QR work). The split is made only when the dropped cross-parity
-    entries have a Frobenius norm of at most ``2N eps ||A||_F``, the order
-    of the backward error of the QR iteration itself (on a symmetric orbit
-    they are AFT rounding, ~1e-17 ||A||; otherwise they are of order
-    ||A||), so the eigenvalues are as accurate as from the whole matrix.
-    Returns ``(eigenvalues, ok)``.
+def _stack_eigvals(A):
+    """Eigenvalues of each matrix of the stack ``A`` (points, m, m) by LAPACK ``dgeev`` (one NumPy call,
+    its loop over the stack in C); ``(values complex (points, m), ok (points,))``, ok False (values NaN)
+    for a matrix whose QR iteration did not converge or that holds a NaN or an infinity."""
+    try:
+        return np.linalg.eigvals(A).astype(np.complex128, copy=False), np.ones(A.shape[0], dtype=bool)
+    except np.linalg.LinAlgError:  # one matrix failed: NumPy refuses the whole stack, redo them one by one
+        lam = np.full(A.shape[:2], np.nan, dtype=np.complex128)
+        ok = np.zeros(A.shape[0], dtype=bool)
+        for k in range(A.shape[0]):
+            try:
+                lam[k], ok[k] = np.linalg.eigvals(A[k]), True
+            except np.linalg.LinAlgError:
+                pass
+        return lam, ok
+
+
+def _hill_eigvals_batch(D2iJ, JXs, B1c, B1w, ws, parity):
+    """All eigenvalues of the companion matrices of Hill's quadratic problem at many points.
+
+    ``parity[j]`` is the parity of the harmonic of unknown j. Parity split:
+    the linear terms couple only equal harmonics, and the contact Jacobian of
+    a half-wave symmetric orbit (x(t + T/2) = -x(t): an odd contact law and
+    no even-harmonic excitation, e.g. a constant normal load) couples only
+    harmonics of equal parity, so that A is block diagonal after grouping
+    even and odd harmonics. The blocks are then solved separately (sizes
+    about N each instead of 2N: a quarter of the QR work). The split is made,
+    point by point, only when the dropped cross-parity entries have a
+    Frobenius norm of at most ``2N eps ||A||_F``, the order of the backward
+    error of the QR iteration itself (on a symmetric orbit they are AFT
+    rounding, ~1e-17 ||A||; otherwise they are of order ||A||), so the
+    eigenvalues are as accurate as from the whole matrix (even block's
+    eigenvalues first). Returns ``(eigenvalues complex (points, 2N), ok
+    (points,))``, ok False where LAPACK failed (:func:`_stack_eigvals`).
     """
-    N = JX.shape[0]
-    M2 = 2 * N
-    A = np.zeros((M2, M2))
-    for i in range(N):
-        A[i, N + i] = 1.0
-        for k in range(N):  # A[N:, :N] = -(D2i JX), written out (no BLAS binding to compile)
-            dik = D2iJ[i, k]
-            if dik != 0.0:
-                for j in range(N):
-                    A[N + i, j] -= dik * JX[k, j]
-        for j in range(N):
-            A[N + i, N + j] = -(B1c[i, j] + w * B1w[i, j])
-    nrm2 = 0.0
-    cross2 = 0.0
-    n_even = 0
-    for i in range(M2):
-        pi = parity[i % N]
-        n_even += 1 - pi
-        for j in range(M2):
-            a2 = A[i, j] * A[i, j]
-            nrm2 += a2
-            if parity[j % N] != pi:
-                cross2 += a2
-    if 0 < n_even < M2 and np.sqrt(cross2) <= M2 * _EPS * np.sqrt(nrm2):
-        out = np.empty(M2, dtype=np.complex128)
-        ok = True
-        k = 0
-        for g in range(2):
-            idx = np.empty(n_even if g == 0 else M2 - n_even, dtype=np.int64)
-            m = 0
-            for i in range(M2):
-                if parity[i % N] == g:
-                    idx[m] = i
-                    m += 1
-            sub = np.empty((m, m))
-            for a in range(m):
-                for b in range(m):
-                    sub[a, b] = A[idx[a], idx[b]]
-            lam, ok_g = eigvals_inplace(sub)
-            ok = ok and ok_g
-            for a in range(m):
-                out[k] = lam[a]
-                k += 1
-        return out, ok
-    return eigvals_inplace(A)
+    A = _hill_batch(D2iJ, JXs, B1c, B1w, np.asarray(ws, dtype=np.float64))
+    P, M2 = A.shape[0], A.shape[1]
+    par2 = np.concatenate((parity, parity))
+    even, odd = np.flatnonzero(par2 == 0), np.flatnonzero(par2 == 1)
+    split = np.zeros(P, dtype=bool)
+    if even.size and odd.size:
+        nrm2 = np.einsum("pij,pij->p", A, A)
+        eo, oe = A[:, even[:, None], odd], A[:, odd[:, None], even]
+        cross2 = np.einsum("pij,pij->p", eo, eo) + np.einsum("pij,pij->p", oe, oe)
+        split = np.sqrt(cross2) <= M2 * _EPS * np.sqrt(nrm2)
+    lam = np.empty((P, M2), dtype=np.complex128)
+    ok = np.empty(P, dtype=bool)
+    if split.any():
+        As = A[split]
+        le, oke = _stack_eigvals(As[:, even[:, None], even])
+        lo, oko = _stack_eigvals(As[:, odd[:, None], odd])
+        lam[split] = np.concatenate((le, lo), axis=1)
+        ok[split] = oke & oko
+    if not split.all():
+        lam[~split], ok[~split] = _stack_eigvals(A[~split])
+    return lam, ok
 
 
 def _parity(n, H):
@@ -165,44 +164,34 @@ def _parity(n, H):
     return np.array([((j // n + 1) // 2) % 2 for j in range(n * (2 * H + 1))], dtype=np.int64)
 
 
-@jit
-def _select(lam, w, m):  # pragma: no cover - compiled
-    """The m eigenvalues with the smallest |Im| / w (rounded to 1e-8), by decreasing real part.
+def _select_batch(lam, ws, m):
+    """For each row of ``lam`` (points, N), the m eigenvalues with the smallest |Im| / w (rounded to
+    1e-8), by decreasing real part.
 
-    Returns ``(selected, tie)``; ``tie`` is True when the m-th and the
-    (m+1)-th smallest keys are equal (the caller then breaks the tie by the
-    eigenvector centroid). Keys are ``numpy.round(|Im| / w, 8)`` (NumPy's
-    rule: ``rint(x * 1e8) / 1e8``); both orderings are stable (insertion
-    sorts: the arrays hold 2 n (2H+1) and m entries).
+    Returns ``(selected (points, m), tie (points,))``; ``tie`` is True when the m-th and the (m+1)-th
+    smallest keys are equal (the caller then breaks the tie by the eigenvector centroid). Keys are
+    ``numpy.round(|Im| / w, 8)``; both orderings are stable.
     """
-    N = lam.shape[0]
-    key = np.empty(N)
-    for i in range(N):
-        key[i] = np.rint(abs(lam[i].imag) / w * 1e8) / 1e8
-    order = np.arange(N)
-    for i in range(1, N):
-        j = i
-        while j > 0 and key[order[j - 1]] > key[order[j]]:
-            t = order[j - 1]
-            order[j - 1] = order[j]
-            order[j] = t
-            j -= 1
-    tie = N > m and key[order[m]] == key[order[m - 1]]
-    sel = np.empty(m, dtype=np.complex128)
-    for i in range(m):
-        sel[i] = lam[order[i]]
-    for i in range(1, m):
-        j = i
-        while j > 0 and -sel[j - 1].real > -sel[j].real:
-            t = sel[j - 1]
-            sel[j - 1] = sel[j]
-            sel[j] = t
-            j -= 1
+    lam = np.atleast_2d(lam)
+    key = np.round(np.abs(lam.imag) / np.reshape(ws, (-1, 1)), 8)
+    order = np.argsort(key, axis=1, kind="stable")
+    keys = np.take_along_axis(key, order, axis=1)
+    N = lam.shape[1]
+    tie = keys[:, m] == keys[:, m - 1] if N > m else np.zeros(lam.shape[0], dtype=bool)
+    sel = np.take_along_axis(lam, order[:, :m], axis=1)
+    sel = np.take_along_axis(sel, np.argsort(-sel.real, axis=1, kind="stable"), axis=1)
     return sel, tie
 
 
+def _select(lam, w, m):
+    """The m eigenvalues of ``lam`` with the smallest |Im| / w, by decreasing real part, and whether
+    the cut is a tie (:func:`_select_batch` of one point)."""
+    sel, tie = _select_batch(np.asarray(lam)[None, :], np.array([float(w)]), m)
+    return sel[0], bool(tie[0])
+
+
 def _hill_matrix(JX, M, C, w, H):
-    """The companion matrix of :func:`_hill_eigvals`, built with NumPy."""
+    """The companion matrix of :func:`_hill_batch` of one point, built with NumPy."""
     N = M.shape[0] * (2 * H + 1)
     D2iJ_pre, B1, A0, _ = _hill_parts(M, C, H)
     A = A0.copy()
@@ -214,7 +203,7 @@ def _hill_matrix(JX, M, C, w, H):
 def _parity_blocks(A, parity):
     """Index arrays of the even- and odd-harmonic rows of the companion matrix A, or None.
 
-    The split criterion of :func:`_hill_eigvals`: the cross-parity entries
+    The split criterion of :func:`_hill_eigvals_batch`: the cross-parity entries
     have a Frobenius norm of at most ``2N eps ||A||_F``.
     """
     M2 = A.shape[0]
@@ -231,39 +220,30 @@ def _parity_blocks(A, parity):
 
 
 def _hill_eigvals_lapack(JX, M, C, w, H, small: int = 0):
-    """All eigenvalues of the companion matrix assembled with NumPy, with the parity split of
-    :func:`_hill_eigvals`: blocks of at most ``small`` rows by the compiled EISPACK port (LAPACK
-    if its QR fails), larger ones by LAPACK ``dgeev``."""
+    """All eigenvalues of the companion matrix of one point assembled with NumPy, with the parity split
+    of :func:`_hill_eigvals_batch`, each block by LAPACK ``dgeev`` (the path of companions above
+    ``StabilityOptions.small_eig`` rows, one point at a time; ``small`` is not used and kept for the
+    callers' signature)."""
     A = _hill_matrix(JX, M, C, w, H)
     blocks = _parity_blocks(A, _hill_parts(M, C, H)[3]) or (np.arange(A.shape[0]),)
-    out = []
-    for b in blocks:
-        sub = A[np.ix_(b, b)]
-        if sub.shape[0] <= small:
-            lam, ok = eigvals_inplace(sub)
-            if ok:
-                out.append(lam)
-                continue
-            sub = A[np.ix_(b, b)]
-        out.append(np.linalg.eigvals(sub))
-    return np.concatenate(out)
+    return np.concatenate([np.linalg.eigvals(A[np.ix_(b, b)]) for b in blocks]).astype(np.complex128)
 
 
 def _small_eig(JX, small: int) -> bool:
-    """True when the whole companion matrix of JX (twice its rows) has at most ``small`` rows (the compiled
+    """True when the whole companion matrix of JX (twice its rows) has at most ``small`` rows (the batched
     path, ``StabilityOptions.small_eig``)."""
     return 2 * JX.shape[0] <= small
 
 
 def _hill_all(JX, M, C, w, H, small: int):
-    """All Hill eigenvalues: compiled for companions of at most ``small`` rows (LAPACK if its QR fails),
-    else assembled with NumPy and solved by blocks (:func:`_hill_eigvals_lapack`)."""
+    """All Hill eigenvalues: for companions of at most ``small`` rows by :func:`_hill_eigvals_batch` of one
+    point, else by :func:`_hill_eigvals_lapack` (both LAPACK, parity blocks where they split)."""
     JX = np.ascontiguousarray(JX, dtype=np.float64)
     if _small_eig(JX, small):
         D2iJ_pre, B1, _, parity = _hill_parts(M, C, H)
-        lam, ok = _hill_eigvals(D2iJ_pre, JX, B1[0], B1[1], float(w), parity)
-        if ok:
-            return lam
+        lam, ok = _hill_eigvals_batch(D2iJ_pre, JX[None], B1[0], B1[1], np.array([float(w)]), parity)
+        if ok[0]:
+            return lam[0]
     return _hill_eigvals_lapack(JX, M, C, w, H, small)
 
 
@@ -281,7 +261,7 @@ def hill_exponents(JX, M, C, w, H, options: StabilityOptions | None = None):
     H : int
         Number of harmonics.
     options : StabilityOptions, optional
-        ``small_eig``: the size of the compiled eigenvalue path.
+        ``small_eig``: the size up to which the companions go through the batched path.
 
     Returns
     -------
@@ -292,13 +272,8 @@ def hill_exponents(JX, M, C, w, H, options: StabilityOptions | None = None):
     Notes
     -----
     The eigenvalues of the 2 n (2H+1) companion matrix (or of its parity
-    blocks) are computed by LAPACK (``numpy.linalg.eigvals``), up to
-    ``StabilityOptions.small_eig`` rows by the compiled EISPACK sequence of
-    :mod:`jointdyn.hb._eig` (balancing,
-    Hessenberg reduction, Francis double-shift QR), which agrees with
-    LAPACK to rounding and is faster there (LAPACK is used if its QR
-    iteration does not converge); the eigenvectors of the tie-break come
-    from LAPACK.
+    blocks) are computed by LAPACK (``numpy.linalg.eigvals``); the
+    eigenvectors of the tie-break also come from LAPACK.
     """
     n = M.shape[0]
     lam = _hill_all(JX, M, C, w, H, (StabilityOptions() if options is None else options).small_eig)
@@ -314,19 +289,18 @@ def hill_exponents(JX, M, C, w, H, options: StabilityOptions | None = None):
     return sel, lam
 
 
-@jit
-def _hill_growth_batch(D2iJ, JXs, B1c, B1w, ws, parity, m):  # pragma: no cover - compiled
+def _hill_growth_batch(D2iJ, JXs, B1c, B1w, ws, parity, m):
     """max Re(s) / w of the selected exponents of many points; (growth, ok) with ok False where
-    the QR iteration failed or the selection has a tie (the caller recomputes those)."""
-    P = JXs.shape[0]
-    growth = np.empty(P)
-    ok = np.empty(P, dtype=np.bool_)
-    for k in range(P):
-        lam, good = _hill_eigvals(D2iJ, JXs[k], B1c, B1w, ws[k], parity)
-        sel, tie = _select(lam, ws[k], m)
-        ok[k] = good and not tie
-        growth[k] = sel[0].real / ws[k]
-    return growth, ok
+    LAPACK failed or the selection has a tie (the caller recomputes those).
+
+    The companions of all points are assembled as one stack and their eigenvalues taken in one
+    LAPACK call per parity block (:func:`_hill_eigvals_batch`): no compiled code, no Python loop
+    over the points.
+    """
+    ws = np.asarray(ws, dtype=np.float64)
+    lam, good = _hill_eigvals_batch(D2iJ, JXs, B1c, B1w, ws, parity)
+    sel, tie = _select_batch(lam, ws, m)
+    return sel[:, 0].real / ws, good & ~tie
 
 
 def hill_growth(JXs, M, C, ws, H, options: StabilityOptions | None = None):

@@ -67,10 +67,10 @@ class StabilityOptions:
         ``rtol``: never).
     small_eig : int
         Hill companion matrices (2 n (2H+1) rows), or their parity blocks,
-        of at most this many rows go through the compiled EISPACK
-        eigenvalue solver of the dense method, larger ones through LAPACK
-        (``benchmarks/bench_linalg.py``: the compiled solver is 1.3-3.7x
-        faster up to 150 rows, LAPACK 1.1-1.3x faster from 300); >= 0.
+        of at most this many rows of the points of a branch are assembled
+        as one stack and solved by one LAPACK call per parity block (the
+        loop over the points in C), larger ones one point at a time (the
+        stack's memory grows as points x rows^2); >= 0.
     """
 
     method: str = "auto"
