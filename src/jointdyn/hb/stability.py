@@ -309,7 +309,8 @@ def hill_growth(JXs, M, C, ws, H, options: StabilityOptions | None = None):
     ``JXs`` (points, N, N) are the HB Jacobians and ``ws`` (points,) the
     angular frequencies; the same exponents as :func:`hill_exponents`
     (points with a tie at the selection cut or a QR failure go through it).
-    Small companions (``StabilityOptions.small_eig``, of ``options``) in one compiled loop.
+    Small companions (``StabilityOptions.small_eig``, of ``options``) as one stack of LAPACK calls
+    (:func:`_hill_growth_batch`), larger ones point by point.
     """
     opt = StabilityOptions() if options is None else options
     JXs = np.ascontiguousarray(JXs, dtype=np.float64)
