@@ -219,11 +219,10 @@ def _parity_blocks(A, parity):
     return None
 
 
-def _hill_eigvals_lapack(JX, M, C, w, H, small: int = 0):
+def _hill_eigvals_lapack(JX, M, C, w, H):
     """All eigenvalues of the companion matrix of one point assembled with NumPy, with the parity split
     of :func:`_hill_eigvals_batch`, each block by LAPACK ``dgeev`` (the path of companions above
-    ``StabilityOptions.small_eig`` rows, one point at a time; ``small`` is not used and kept for the
-    callers' signature)."""
+    ``StabilityOptions.small_eig`` rows, one point at a time)."""
     A = _hill_matrix(JX, M, C, w, H)
     blocks = _parity_blocks(A, _hill_parts(M, C, H)[3]) or (np.arange(A.shape[0]),)
     return np.concatenate([np.linalg.eigvals(A[np.ix_(b, b)]) for b in blocks]).astype(np.complex128)
@@ -244,7 +243,7 @@ def _hill_all(JX, M, C, w, H, small: int):
         lam, ok = _hill_eigvals_batch(D2iJ_pre, JX[None], B1[0], B1[1], np.array([float(w)]), parity)
         if ok[0]:
             return lam[0]
-    return _hill_eigvals_lapack(JX, M, C, w, H, small)
+    return _hill_eigvals_lapack(JX, M, C, w, H)
 
 
 def hill_exponents(JX, M, C, w, H, options: StabilityOptions | None = None):
@@ -324,7 +323,7 @@ def hill_growth(JXs, M, C, ws, H, options: StabilityOptions | None = None):
     else:
         growth, ok = np.empty(JXs.shape[0]), np.empty(JXs.shape[0], dtype=bool)
         for k in range(JXs.shape[0]):
-            sel, tie = _select(_hill_eigvals_lapack(JXs[k], M, C, ws[k], H, opt.small_eig), ws[k], 2 * n)
+            sel, tie = _select(_hill_eigvals_lapack(JXs[k], M, C, ws[k], H), ws[k], 2 * n)
             growth[k], ok[k] = sel[0].real / ws[k], not tie
     for k in np.flatnonzero(~ok):
         sel, _ = hill_exponents(JXs[k], M, C, ws[k], H, opt)
