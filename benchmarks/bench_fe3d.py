@@ -123,7 +123,8 @@ def _branch(path: str, H: int, samples: int, blocks: bool) -> dict:
             "stability_computed": int(np.sum(np.isfinite(np.asarray(br.growth)))),
             "peak_hz": None if peak is None else peak.gamma * s.w0 / (2.0 * math.pi),
             "peak_m": None if peak is None else peak.amplitude_m,
-            "gamma": np.asarray(br.lam).tolist(), "amplitude_m": np.asarray(br.response()[0]).tolist(), "stability": br.stability}
+            "stability": br.stability, "gamma": np.asarray(br.lam).tolist(),
+            "amplitude_m": np.asarray(br.response()[0]).tolist()}
 
 
 def _child(conn, fn, args):
