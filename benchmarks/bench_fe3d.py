@@ -35,7 +35,9 @@ from __future__ import annotations
 import math
 import multiprocessing
 import os
+import json
 import resource
+import sys
 import tempfile
 import time
 
@@ -113,7 +115,7 @@ def _branch(path: str, H: int, samples: int, blocks: bool) -> dict:
     f_slip, f_stuck = j.natural_frequencies_hz("slip", 1)[0], j.natural_frequencies_hz("stuck", 1)[0]
     g0, g1 = 2.0 * math.pi * BAND[0] * f_slip / s.w0, 2.0 * math.pi * BAND[1] * f_stuck / s.w0
     t0, c0 = time.perf_counter(), time.process_time()
-    br = continue_hb(s, g0, g1, harmonics=H, samples=samples, condense=False, progress=False, stability=True,
+    br = continue_hb(s, g0, g1, harmonics=H, samples=samples, condense=False, progress=False, stability=None,
                      hb_options=HBOptions(block_preconditioner=blocks))
     peak = max(br.peaks, key=lambda p: p.amplitude_m) if br.peaks else None
     return {"s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0, "status": br.status.value,
@@ -128,7 +130,10 @@ def _branch(path: str, H: int, samples: int, blocks: bool) -> dict:
 
 
 def _child(conn, fn, args):
-    out = fn(*args)
+    try:
+        out = fn(*args)
+    except Exception as exc:  # the parent reports it and goes on with the other side
+        out = {"error": f"{type(exc).__name__}: {exc}", "points": 0}
     out["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     conn.send(out)
     conn.close()
@@ -142,6 +147,8 @@ def _isolated(fn, *args) -> dict:
     p.start()
     out = a.recv()
     p.join()
+    print(f"bench_fe3d: {fn.__name__}{args[1:]}: " + json.dumps({k: v for k, v in out.items() if not isinstance(v, list)}),
+          file=sys.stderr, flush=True)  # fmt: skip
     return out
 
 
@@ -184,7 +191,4 @@ def run(quick: bool) -> dict:
 
 
 if __name__ == "__main__":
-    import json
-    import sys
-
     print(json.dumps(run("--full" not in sys.argv), indent=1))
