@@ -101,3 +101,14 @@ def test_system_has_the_stuck_modal_damping(joint):
 def test_bad_input_names_the_parameter(kwargs, match):
     with pytest.raises(ValueError, match=match):
         bolted_lap(**{**SMALL, **kwargs})
+
+
+def test_system_springs_are_the_pair_springs(joint):
+    # the System's stuck stiffness (every pair stuck) and reference stiffness (normal springs only) against the
+    # pair springs assembled by jointdyn.fe.pair_springs
+    from jointdyn.systems import stuck_stiffness
+
+    s = joint.system(1.0, 0.002)
+    scale = np.max(np.abs(joint.linear_K("stuck")))
+    np.testing.assert_allclose(stuck_stiffness(s), joint.linear_K("stuck"), rtol=0, atol=1e-14 * scale)
+    np.testing.assert_allclose(s.K_reference, joint.linear_K("slip"), rtol=0, atol=1e-14 * scale)
