@@ -36,7 +36,7 @@ MAX_MODULE_LINES = 900
 #: layer of each top-level module or package of jointdyn (higher imports lower)
 LAYERS = {
     "laws": 0,
-    "systems": 1, "damping": 1, "kinematics": 1, "interfaces": 1, "fourier": 1, "reduction": 1, "files": 1, "fe": 1,
+    "systems": 1, "bolted": 1, "damping": 1, "kinematics": 1, "interfaces": 1, "fourier": 1, "reduction": 1, "files": 1, "fe": 1,
     "continuation": 2, "drivers": 2,
     "dynamics": 3, "hb": 3, "modes": 3, "identify": 3,
     "sweeps": 4, "validation": 4,
