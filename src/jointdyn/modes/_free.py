@@ -27,6 +27,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import config
+from .._cache import by_identity
 from ..kinematics import HarmonicLoad, NormalSpring
 from ..hb.problem import stuck_stiffness
 from ..systems import System, free_modes, loose_dofs
@@ -127,13 +128,11 @@ def check_free_vibration(system, method: str, *, springs: bool = True, held: boo
                 f"contact {i}: {method} takes constant normal loads only (its Masing construction holds when "
                 "the slip limits do not change), and a normal spring makes the load follow the motion: use "
                 "EPMC for this system")
-    from scipy.linalg import eigh
-
-    lam = eigh(system.K_reference, system.M, eigvals_only=True)
+    lam = _reference_eigenvalues(system)
     if held and not _resolved(lam):
         # held only through the contacts: the stuck structure must be held (a DOF held by nothing is refused)
         Ks = stuck_stiffness(system)
-        lam = eigh(Ks, system.M, eigvals_only=True)
+        lam = stuck_modes(system)[0]
         if _resolved(lam):
             return system
         r = free_modes(system).shape[1]
@@ -183,6 +182,24 @@ def output_dof_of(system: System, output_dof) -> int:
     return d
 
 
+@by_identity
+def _reference_eigenvalues(system: System) -> np.ndarray:
+    """Eigenvalues of (K_reference, M), (rad/s)^2, ascending (cached per System: the checks of a
+    backbone ask for them more than once, a dense eigensolve each at the size of a reduced model)."""
+    from scipy.linalg import eigh
+
+    return eigh(system.K_reference, system.M, eigvals_only=True)
+
+
+@by_identity
+def stuck_modes(system: System) -> tuple[np.ndarray, np.ndarray]:
+    """(eigenvalues (rad/s)^2 ascending, M-orthonormal eigenvectors) of the stuck structure
+    (:func:`~jointdyn.hb.problem.stuck_stiffness`, M), cached per System; callers must not modify them."""
+    from scipy.linalg import eigh
+
+    return eigh(stuck_stiffness(system), system.M)
+
+
 def linear_stuck_mode(system: System, mode: int, output_dof: int) -> LinearMode:
     """Mode ``mode`` (1-based) of the stuck structure, scaled to 1 at ``output_dof``.
 
@@ -191,8 +208,6 @@ def linear_stuck_mode(system: System, mode: int, output_dof: int) -> LinearMode:
     ValueError
         ``mode`` out of [1, n], or the output DOF does not move in that mode.
     """
-    from scipy.linalg import eigh
-
     n = system.ndof
     r = free_modes(system).shape[1]  # rigid-body modes of a free-free structure: never chosen, not counted
     k = V.positive_int("mode", mode, 1)
@@ -200,9 +215,9 @@ def linear_stuck_mode(system: System, mode: int, output_dof: int) -> LinearMode:
         what = f"{n} DOFs" if r == 0 else f"{n - r} elastic modes beside its {r} rigid-body modes"
         raise ValueError(f"mode must be in [1, {n - r}] (the system has {what}), got {mode!r}")
     Ks = stuck_stiffness(system)
-    lam, phi = eigh(Ks, system.M)
+    lam, phi = stuck_modes(system)
     lam, phi = lam[r:], phi[:, r:]  # the elastic modes, in increasing frequency
-    v = phi[:, k - 1]
+    v = phi[:, k - 1].copy()
     big = float(np.max(np.abs(v)))
     if not abs(v[output_dof]) > MODES_MIN_PARTICIPATION * big:
         raise ValueError(f"output_dof: DOF {output_dof} does not move in linear stuck mode {k} "
