@@ -11,6 +11,7 @@ import numpy as np
 
 __all__ = [
     "positive",
+    "positive_interval",
     "nonnegative",
     "finite",
     "positive_int",
@@ -59,6 +60,24 @@ def positive(name: str, value) -> float:
     if not v > 0.0:
         raise ValueError(f"{name} must be > 0 (allowed range (0, inf)), got {v!r}")
     return v
+
+
+def positive_interval(name: str, text, ends=("MIN", "MAX"), unit: str = "m", unit_name: str = "metres"):
+    """``LO:HI`` of a command-line option ``name`` -> (lo, hi) with 0 < lo < hi (``ends`` name the two
+    numbers, ``unit`` and ``unit_name`` their unit, in the messages)."""
+    low, high = ends
+    parts = str(text).split(":")
+    if len(parts) != 2:
+        raise ValueError(f"{name} must be {low}:{high} ({unit_name}), got {text!r}")
+    try:
+        lo, hi = (float(s) for s in parts)
+    except ValueError:
+        raise ValueError(f"{name} must be {low}:{high} of numbers ({unit_name}), got {text!r}") from None
+    positive(f"{name} {low}", lo)
+    positive(f"{name} {high}", hi)
+    if not hi > lo:
+        raise ValueError(f"{name} {high} must be > {low} ({lo:g} {unit}), got {hi:g} {unit}")
+    return lo, hi
 
 
 def nonnegative(name: str, value) -> float:

@@ -49,17 +49,7 @@ def parse_band(text: str) -> tuple[float, float]:
     """``--band LOW:HIGH`` (Hz) -> (low, high) rad/s with 0 < low < high."""
     from .. import _validate as V
 
-    parts = str(text).split(":")
-    if len(parts) != 2:
-        raise ValueError(f"--band must be LOW:HIGH (Hz), got {text!r}")
-    try:
-        lo, hi = (float(s) for s in parts)
-    except ValueError:
-        raise ValueError(f"--band must be LOW:HIGH of numbers (Hz), got {text!r}") from None
-    V.positive("--band LOW", lo)
-    V.positive("--band HIGH", hi)
-    if not hi > lo:
-        raise ValueError(f"--band HIGH must be > LOW ({lo:g} Hz), got {hi:g} Hz")
+    lo, hi = V.positive_interval("--band", text, ("LOW", "HIGH"), "Hz", "Hz")
     return 2.0 * np.pi * lo, 2.0 * np.pi * hi
 
 

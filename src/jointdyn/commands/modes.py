@@ -71,18 +71,7 @@ def add_arguments(p) -> None:
 
 def parse_amplitude(text: str) -> tuple[float, float]:
     """``MIN:MAX`` (m) -> (min, max) with 0 < min < max."""
-    parts = str(text).split(":")
-    if len(parts) != 2:
-        raise ValueError(f"--amplitude must be MIN:MAX (metres), got {text!r}")
-    try:
-        lo, hi = (float(s) for s in parts)
-    except ValueError:
-        raise ValueError(f"--amplitude must be MIN:MAX of numbers (metres), got {text!r}") from None
-    V.positive("--amplitude MIN", lo)
-    V.positive("--amplitude MAX", hi)
-    if not hi > lo:
-        raise ValueError(f"--amplitude MAX must be > MIN ({lo:g} m), got {hi:g} m")
-    return lo, hi
+    return V.positive_interval("--amplitude", text)
 
 
 def _validate(args):
