@@ -57,6 +57,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import eigsh, spsolve
 
+from jointdyn.bolted import hex_elastic, simpson_weights
 from jointdyn.fe import interface_from_triplets, match_nodes, pair_springs
 from jointdyn.reduction import reduce_interface
 
@@ -93,38 +94,15 @@ def plate(lower: bool):
     Lower plate A: x in [0, LENGTH], z in [0, THICK], overlap at its right end; upper plate B: shifted by
     LENGTH - OVERLAP in x and THICK in z, overlap at its left end.
     """
-    from skfem import Basis, BilinearForm, ElementHex2, ElementVector, MeshHex, asm
-    from skfem.helpers import dot
-    from skfem.models.elasticity import lame_parameters, linear_elasticity
-
     free = _grid(0.0, LENGTH - OVERLAP, ELEMENTS["free"])
     over = _grid(LENGTH - OVERLAP, LENGTH, ELEMENTS["overlap"])
     xs = np.concatenate([free, over[1:]])
     if not lower:
         xs = (LENGTH - OVERLAP) + np.concatenate([over - over[0], OVERLAP + free[1:]])
     zs = _grid(0.0, THICK, ELEMENTS["thick"]) + (0.0 if lower else THICK)
-    mesh = MeshHex.init_tensor(xs, _grid(0.0, WIDTH, ELEMENTS["width"]), zs)
-    basis = Basis(mesh, ElementVector(ElementHex2()), intorder=4)
-    K = asm(linear_elasticity(*lame_parameters(E, NU)), basis)
-
-    @BilinearForm
-    def mass(u, v, w):
-        return RHO * dot(u, v)
-
-    M = asm(mass, basis)
-    nodes = np.stack(basis.split_indices(), axis=1).astype(np.int64)
-    locs = basis.doflocs.T
+    M, K, locs, nodes = hex_elastic(xs, _grid(0.0, WIDTH, ELEMENTS["width"]), zs, E, NU, RHO)
     assert np.allclose(locs[nodes[:, 0]], locs[nodes[:, 2]])  # one location per triplet
-    return M.tocsr(), K.tocsr(), locs, nodes
-
-
-def simpson_weights(xs: np.ndarray) -> np.ndarray:
-    """Integrals of the 1-D quadratic shape functions of the nodes xs (element ends and midpoints)."""
-    w = np.zeros(xs.size)
-    for e in range(0, xs.size - 2, 2):
-        h = xs[e + 2] - xs[e]
-        w[e : e + 3] += h * np.array([1.0, 4.0, 1.0]) / 6.0
-    return w
+    return M, K, locs, nodes
 
 
 def assemble():

@@ -156,18 +156,15 @@ class BoltedJoint:
         return System(M=self.M, C=C, K=self.K, interfaces=(itf,), force=force, output_dof=self.output_dof)
 
 
-def _plate(lower: bool, g: dict):
-    """(M, K sparse, DOF locations (n, 3), x, y, z DOFs per node) of one plate (scikit-fem, 27-node hexes)."""
+def hex_elastic(xs, ys, zs, E: float, nu: float, rho: float):
+    """(M, K sparse, DOF locations (n, 3), x, y, z DOFs per node (nodes, 3)) of a linear-elastic block on the
+    tensor grid ``xs`` x ``ys`` x ``zs`` (m; element ends and midpoints come from scikit-fem's 27-node
+    hexahedra), Young's modulus ``E`` (Pa), Poisson's ratio ``nu``, density ``rho`` (kg/m^3)."""
     from skfem import Basis, BilinearForm, ElementHex2, ElementVector, MeshHex, asm
     from skfem.helpers import dot
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-    E, nu, rho = STEEL
-    free = np.linspace(0.0, g["free"], g["elements"][1] + 1)
-    over = np.linspace(g["free"], g["free"] + g["overlap"], g["elements"][0] + 1)
-    xs = np.concatenate([free, over[1:]]) if lower else np.concatenate([over, over[-1] + free[1:]])
-    zs = np.linspace(0.0, g["thick"], g["elements"][3] + 1) + (0.0 if lower else g["thick"])
-    mesh = MeshHex.init_tensor(xs, np.linspace(0.0, g["width"], g["elements"][2] + 1), zs)
+    mesh = MeshHex.init_tensor(np.asarray(xs, float), np.asarray(ys, float), np.asarray(zs, float))
     basis = Basis(mesh, ElementVector(ElementHex2()), intorder=4)
     K = asm(linear_elasticity(*lame_parameters(E, nu)), basis)
 
@@ -178,6 +175,15 @@ def _plate(lower: bool, g: dict):
     M = asm(mass, basis)
     nodes = np.stack(basis.split_indices(), axis=1).astype(np.int64)
     return M.tocsr(), K.tocsr(), basis.doflocs.T, nodes
+
+
+def _plate(lower: bool, g: dict):
+    """(M, K sparse, DOF locations (n, 3), x, y, z DOFs per node) of one plate (:func:`hex_elastic`)."""
+    free = np.linspace(0.0, g["free"], g["elements"][1] + 1)
+    over = np.linspace(g["free"], g["free"] + g["overlap"], g["elements"][0] + 1)
+    xs = np.concatenate([free, over[1:]]) if lower else np.concatenate([over, over[-1] + free[1:]])
+    zs = np.linspace(0.0, g["thick"], g["elements"][3] + 1) + (0.0 if lower else g["thick"])
+    return hex_elastic(xs, np.linspace(0.0, g["width"], g["elements"][2] + 1), zs, *STEEL)
 
 
 def _assemble(g: dict):
