@@ -35,15 +35,14 @@ seconds (the machine is shared).
 from __future__ import annotations
 
 import math
-import multiprocessing
 import os
 import json
-import resource
 import sys
 import tempfile
 import time
 
 import numpy as np
+from _isolated import isolated
 
 ZETA = 0.002
 MAX_POINTS = 400
@@ -131,29 +130,6 @@ def _branch(path: str, H: int, samples: int, blocks: bool) -> dict:
             "amplitude_m": np.asarray(br.response()[0]).tolist()}
 
 
-def _child(conn, fn, args):
-    try:
-        out = fn(*args)
-    except Exception as exc:  # the parent reports it and goes on with the other side
-        out = {"error": f"{type(exc).__name__}: {exc}", "points": 0}
-    out["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-    conn.send(out)
-    conn.close()
-
-
-def _isolated(fn, *args) -> dict:
-    """fn(*args) in a child process (its own peak memory); the parent waits."""
-    ctx = multiprocessing.get_context("fork")
-    a, b = ctx.Pipe(duplex=False)
-    p = ctx.Process(target=_child, args=(b, fn, args))
-    p.start()
-    out = a.recv()
-    p.join()
-    print(f"bench_fe3d: {fn.__name__}{args[1:]}: " + json.dumps({k: v for k, v in out.items() if not isinstance(v, list)}),
-          file=sys.stderr, flush=True)  # fmt: skip
-    return out
-
-
 def _compare(a: dict, b: dict, x: str, names, log: bool) -> float:
     """max relative difference of b's values against a's curve (interpolated in x, or log x)."""
     xa, xb = np.asarray(a[x]), np.asarray(b[x])
@@ -174,20 +150,20 @@ def _strip(r: dict, keys) -> dict:
 def run(quick: bool) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "bolted.npz")
-        out = {"model": _isolated(_build, path), "zeta": ZETA}
+        out = {"model": isolated(_build, path, label="bench_fe3d"), "zeta": ZETA}
         _, _, a1, alast = _setup(path, False)[:4]
         out["model"].update(first_onset_m=a1, last_onset_m=alast, backbone_m=[a1 / BELOW, a1 * ABOVE])
         for H, samples in (((1, 32),) if quick else ((1, 32), (3, 64), (5, 64))):
-            blk = _isolated(_backbone, path, H, samples, True)
-            ref = _isolated(_backbone, path, H, samples, False)
+            blk = isolated(_backbone, path, H, samples, True, label="bench_fe3d")
+            ref = isolated(_backbone, path, H, samples, False, label="bench_fe3d")
             curve = ("amplitude_m", "omega_rad_s", "damping_ratio")
             out[f"H{H}_epmc_blocks"], out[f"H{H}_epmc_direct"] = _strip(blk, curve), _strip(ref, curve)
             if ref["points"] and blk["points"]:
                 out[f"H{H}_epmc_max_rel_diff"] = _compare(ref, blk, "amplitude_m", curve[1:], True)
             if quick:
                 continue
-            ref = _isolated(_branch, path, H, samples, False)
-            blk = _isolated(_branch, path, H, samples, True)
+            ref = isolated(_branch, path, H, samples, False, label="bench_fe3d")
+            blk = isolated(_branch, path, H, samples, True, label="bench_fe3d")
             out[f"H{H}_hb_direct"], out[f"H{H}_hb_blocks"] = (_strip(r, ("gamma", "amplitude_m")) for r in (ref, blk))
             if ref["points"] and blk["points"]:
                 out[f"H{H}_hb_max_rel_diff"] = _compare(ref, blk, "gamma", ("amplitude_m",), False)

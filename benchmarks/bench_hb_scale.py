@@ -32,11 +32,10 @@ asks for the branch "with stability". Every row reports its wall seconds
 from __future__ import annotations
 
 import math
-import multiprocessing
-import resource
 import time
 
 import numpy as np
+from _isolated import isolated
 
 SAMPLES = 32
 AMPLITUDE_M = (2e-6, 2e-3)
@@ -81,26 +80,6 @@ def _branch(H: int, blocks: bool, stability: bool = False) -> dict:
             "peak_m": None if peak is None else peak.amplitude_m}
 
 
-def _child(conn, fn, args):
-    out = fn(*args)
-    usage = resource.getrusage(resource.RUSAGE_SELF)
-    out["cpu_s"] = usage.ru_utime + usage.ru_stime
-    out["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-    conn.send(out)
-    conn.close()
-
-
-def _isolated(fn, *args) -> dict:
-    """fn(*args) in a child process (its own peak memory); the parent waits."""
-    ctx = multiprocessing.get_context("fork")
-    a, b = ctx.Pipe(duplex=False)
-    p = ctx.Process(target=_child, args=(b, fn, args))
-    p.start()
-    out = a.recv()
-    p.join()
-    return out
-
-
 def _compare_backbones(a: dict, b: dict) -> float:
     """max relative difference of omega and damping of b's points against a's curve (interpolated in log a)."""
     la, lb = np.log(a["amplitude_m"]), np.log(b["amplitude_m"])
@@ -114,18 +93,18 @@ def _compare_backbones(a: dict, b: dict) -> float:
 def run(quick: bool) -> dict:
     out = {"model": "lap joint (733 DOFs, 120 pairs, modal damping)", "samples": SAMPLES}
     for H in ((1,) if quick else (3, 5)):
-        blk = _isolated(_backbone, H, True)
-        ref = _isolated(_backbone, H, False)
+        blk = isolated(_backbone, H, True)
+        ref = isolated(_backbone, H, False)
         for name, r in (("blocks", blk), ("direct", ref)):
             out[f"H{H}_epmc_{name}"] = {k: v for k, v in r.items() if k not in ("amplitude_m", "omega_rad_s",
                                                                                   "damping_ratio")}
         out[f"H{H}_epmc_max_rel_diff"] = _compare_backbones(ref, blk) if ref["points"] and blk["points"] else None
         if quick:
             continue
-        ref = _isolated(_branch, H, False)
-        blk = _isolated(_branch, H, True)
+        ref = isolated(_branch, H, False)
+        blk = isolated(_branch, H, True)
         out[f"H{H}_hb_direct"], out[f"H{H}_hb_blocks"] = ref, blk
-        out[f"H{H}_hb_blocks_stability"] = _isolated(_branch, H, True, True)
+        out[f"H{H}_hb_blocks_stability"] = isolated(_branch, H, True, True)
     return out
 
 
