@@ -48,7 +48,7 @@ RINGDOWN_FIT_MAX_SPAN = 1.2
 #: to +-0.08: the scatter, not a bias, put it up to 0.039 (8 %) off, which such a decay cannot
 #: narrow; at the span of the microslip scales (1.2) five of the 20 seeds would have called it
 #: determined, two of them 5 % off. Through macroslip, at 1.2, fy_N came out 3.6 % off (seed 1
-#: of the decay from 5 slip displacements), its interval covering
+#: of the decay from 5 slip displacements) while its interval covered the truth.
 RINGDOWN_FIT_BAR_SPAN = 1.06
 
 
