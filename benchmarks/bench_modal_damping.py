@@ -94,18 +94,19 @@ def _backbone(nodes: int, operator: bool, quick: bool) -> dict:
 
 
 def run(quick: bool) -> dict:
-    from bench_hb_scale import _compare_backbones, _isolated
+    from _isolated import isolated
+    from bench_hb_scale import _compare_backbones
 
     nodes = 40 if quick else 167
     out = {"model": f"chain of {nodes} nodes ({3 * nodes} DOFs, {nodes} pairs), zeta {ZETA} (stuck modes)",
            "H": H, "samples": NS}
-    dense = _isolated(_branch, nodes, False, quick)
-    op = _isolated(_branch, nodes, True, quick)
+    dense = isolated(_branch, nodes, False, quick)
+    op = isolated(_branch, nodes, True, quick)
     out["hb_dense"], out["hb_operator"] = dense, op
     out["hb_speedup"] = dense["s"] / op["s"]
     out["hb_peak_rel_diff"] = abs(op["peak_m"] / dense["peak_m"] - 1.0)
-    op = _isolated(_backbone, nodes, True, quick)
-    dense = _isolated(_backbone, nodes, False, quick)
+    op = isolated(_backbone, nodes, True, quick)
+    dense = isolated(_backbone, nodes, False, quick)
     drop = ("amplitude_m", "omega_rad_s", "damping_ratio")
     out["epmc_operator"] = {k: v for k, v in op.items() if k not in drop}
     out["epmc_dense"] = {k: v for k, v in dense.items() if k not in drop}

@@ -1,5 +1,6 @@
 """The benchmarks (and docs/scripts) still name what jointdyn has: every jointdyn name they import or
-reach by attribute exists, and every keyword they pass to a jointdyn function or class is one it takes.
+reach by attribute exists, every keyword they pass to a jointdyn function or class is one it takes, and
+every name they import from a module beside them is defined there.
 
 The benchmarks call private functions and options objects by name; when a name moves (a module constant
 into an options object, a function into another module) a benchmark breaks only when it is run, which takes
@@ -38,10 +39,32 @@ def _import(module: str, name: str | None = None):
         raise LookupError(f"{module}.{name}") from None
 
 
+def _sibling_errors(node) -> list[str]:
+    """Names imported from another module beside the benchmarks (``from bench_hb_scale import _system``,
+    ``from _isolated import isolated``) that it does not define at its top level."""
+    if not (isinstance(node, ast.ImportFrom) and node.level == 0 and node.module):
+        return []
+    for folder in {p.parent for p in SOURCES}:
+        path = folder / f"{node.module}.py"
+        if path.exists():
+            top = set()
+            for n in ast.parse(path.read_text()).body:
+                if isinstance(n, (ast.FunctionDef, ast.ClassDef, ast.AsyncFunctionDef)):
+                    top.add(n.name)
+                elif isinstance(n, (ast.Assign, ast.AnnAssign)):
+                    targets = n.targets if isinstance(n, ast.Assign) else [n.target]
+                    top |= {e.id for t in targets for e in ast.walk(t) if isinstance(e, ast.Name)}
+                elif isinstance(n, (ast.Import, ast.ImportFrom)):
+                    top |= {(a.asname or a.name).split(".")[0] for a in n.names}
+            return [f"line {node.lineno}: no {node.module}.{a.name}" for a in node.names if a.name not in top]
+    return []
+
+
 def _bindings(tree):
     """(local name -> [objects], errors) from the jointdyn imports anywhere in the file."""
     names, errors = {}, []
     for node in ast.walk(tree):
+        errors += _sibling_errors(node)
         try:
             if isinstance(node, ast.Import):
                 for a in node.names:
@@ -126,3 +149,6 @@ def test_the_check_finds_a_moved_name_and_a_renamed_keyword():
     text = "; ".join(_problems(ast.parse(src)))
     assert "jointdyn.hb.branch._dense_growth" in text and "jointdyn.hb.branch._arnoldi_growth" in text
     assert "takes no hill_max_rows" in text and "fold_window" not in text
+    # a helper that moved out of a sibling benchmark (what broke bench_modal_damping once)
+    text = "; ".join(_problems(ast.parse("from bench_hb_scale import _compare_backbones, _isolated\n")))
+    assert "bench_hb_scale._isolated" in text and "_compare_backbones" not in text
