@@ -160,9 +160,12 @@ def hex_elastic(xs, ys, zs, E: float, nu: float, rho: float):
     """(M, K sparse, DOF locations (n, 3), x, y, z DOFs per node (nodes, 3)) of a linear-elastic block on the
     tensor grid ``xs`` x ``ys`` x ``zs`` (m; element ends and midpoints come from scikit-fem's 27-node
     hexahedra), Young's modulus ``E`` (Pa), Poisson's ratio ``nu``, density ``rho`` (kg/m^3)."""
-    from skfem import Basis, BilinearForm, ElementHex2, ElementVector, MeshHex, asm
-    from skfem.helpers import dot
-    from skfem.models.elasticity import lame_parameters, linear_elasticity
+    try:
+        from skfem import Basis, BilinearForm, ElementHex2, ElementVector, MeshHex, asm
+        from skfem.helpers import dot
+        from skfem.models.elasticity import lame_parameters, linear_elasticity
+    except ImportError:
+        raise ImportError("jointdyn.bolted meshes with scikit-fem: pip install 'jointdyn[fe]'") from None
 
     mesh = MeshHex.init_tensor(np.asarray(xs, float), np.asarray(ys, float), np.asarray(zs, float))
     basis = Basis(mesh, ElementVector(ElementHex2()), intorder=4)
