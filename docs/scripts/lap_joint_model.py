@@ -57,7 +57,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import eigsh, spsolve
 
-from jointdyn.bolted import hex_elastic, simpson_weights
+from jointdyn.bolted import clamped_pair, hex_elastic, simpson_weights
 from jointdyn.fe import interface_from_triplets, match_nodes, pair_springs
 from jointdyn.reduction import reduce_interface
 
@@ -106,22 +106,8 @@ def plate(lower: bool):
 
 
 def assemble():
-    """Both plates, clamped: M, K (free DOFs), node locations and triplets (free DOF indices)."""
-    parts = [plate(True), plate(False)]
-    offset = parts[0][0].shape[0]
-    M = sp.block_diag([parts[0][0], parts[1][0]], format="csr")
-    K = sp.block_diag([parts[0][1], parts[1][1]], format="csr")
-    locs = np.concatenate([parts[0][2], parts[1][2]])
-    nodes = np.concatenate([parts[0][3], parts[1][3] + offset])
-    side = np.concatenate([np.zeros(len(parts[0][3]), int), np.ones(len(parts[1][3]), int)])
-    x = locs[nodes[:, 0], 0]
-    clamped = ((side == 0) & np.isclose(x, 0.0)) | ((side == 1) & np.isclose(x, 2 * LENGTH - OVERLAP))
-    free = np.setdiff1d(np.arange(M.shape[0]), nodes[clamped].ravel())
-    index = np.full(M.shape[0], -1)
-    index[free] = np.arange(free.size)
-    keep = ~clamped
-    return (M[free][:, free].tocsr(), K[free][:, free].tocsr(), locs[nodes[keep, 0]], index[nodes[keep]],
-            side[keep])  # fmt: skip
+    """Both plates, clamped: M, K (free DOFs), node locations and triplets (free DOF indices), sides."""
+    return clamped_pair(plate(True), plate(False), 2 * LENGTH - OVERLAP)
 
 
 def patch(points, triplets, side):

@@ -59,7 +59,7 @@ import numpy as np
 from . import _validate as V
 from .fe import interface_from_triplets, match_nodes, pair_springs
 
-__all__ = ["BoltedJoint", "bolted_lap", "MINDLIN"]
+__all__ = ["BoltedJoint", "bolted_lap", "MINDLIN", "clamped_pair", "hex_elastic", "simpson_weights"]
 
 #: steel: Young's modulus (Pa), Poisson's ratio, density (kg/m^3)
 STEEL = (210e9, 0.3, 7850.0)
@@ -189,11 +189,14 @@ def _plate(lower: bool, g: dict):
     return hex_elastic(xs, np.linspace(0.0, g["width"], g["elements"][2] + 1), zs, *STEEL)
 
 
-def _assemble(g: dict):
-    """Both plates clamped at their far ends: M, K (free DOFs), node locations, x/y/z DOFs, side (0 A, 1 B)."""
+def clamped_pair(lower, upper, x_far: float):
+    """Two plates (each ``(M, K, DOF locations, x/y/z DOFs per node)``, :func:`hex_elastic`) side by side,
+    plate A (``lower``) clamped at x = 0 and plate B (``upper``) at x = ``x_far`` (m): M, K on the free
+    DOFs, node locations, x/y/z free-DOF indices per node and each node's side (0 A, 1 B), clamped nodes
+    left out."""
     import scipy.sparse as sp
 
-    parts = [_plate(True, g), _plate(False, g)]
+    parts = [lower, upper]
     offset = parts[0][0].shape[0]
     M = sp.block_diag([parts[0][0], parts[1][0]], format="csr")
     K = sp.block_diag([parts[0][1], parts[1][1]], format="csr")
@@ -201,12 +204,17 @@ def _assemble(g: dict):
     nodes = np.concatenate([parts[0][3], parts[1][3] + offset])
     side = np.concatenate([np.zeros(len(parts[0][3]), int), np.ones(len(parts[1][3]), int)])
     x = locs[nodes[:, 0], 0]
-    clamped = ((side == 0) & np.isclose(x, 0.0)) | ((side == 1) & np.isclose(x, 2 * g["free"] + g["overlap"]))
+    clamped = ((side == 0) & np.isclose(x, 0.0)) | ((side == 1) & np.isclose(x, x_far))
     free = np.setdiff1d(np.arange(M.shape[0]), nodes[clamped].ravel())
     index = np.full(M.shape[0], -1)
     index[free] = np.arange(free.size)
     keep = ~clamped
     return M[free][:, free].tocsr(), K[free][:, free].tocsr(), locs[nodes[keep, 0]], index[nodes[keep]], side[keep]
+
+
+def _assemble(g: dict):
+    """Both plates clamped at their far ends (:func:`clamped_pair`)."""
+    return clamped_pair(_plate(True, g), _plate(False, g), 2 * g["free"] + g["overlap"])
 
 
 def simpson_weights(xs: np.ndarray) -> np.ndarray:
