@@ -57,7 +57,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _validate as V
-from .fe import interface_from_triplets, match_nodes, pair_springs
+from .fe import ReducedJoint, interface_from_triplets, match_nodes, pair_springs
 
 __all__ = ["BoltedJoint", "bolted_lap", "MINDLIN", "clamped_pair", "hex_elastic", "simpson_weights"]
 
@@ -65,12 +65,10 @@ __all__ = ["BoltedJoint", "bolted_lap", "MINDLIN", "clamped_pair", "hex_elastic"
 STEEL = (210e9, 0.3, 7850.0)
 #: kt / kn of two elastic bodies of one material (Mindlin), nu = 0.3
 MINDLIN = 2.0 * (1.0 - STEEL[1]) / (2.0 - STEEL[1])
-#: the linear states of :meth:`BoltedJoint.linear_K`
-STATES = ("stuck", "slip", "open")
 
 
 @dataclass(frozen=True)
-class BoltedJoint:
+class BoltedJoint(ReducedJoint):
     """The bolted lap joint of :func:`bolted_lap`, reduced onto its interface.
 
     Attributes
@@ -103,15 +101,6 @@ class BoltedJoint:
         (G x overlap area / thickness).
     """
 
-    M: np.ndarray
-    K: np.ndarray
-    pairs: np.ndarray
-    kt: np.ndarray
-    kn: np.ndarray
-    mu: np.ndarray
-    preload: np.ndarray
-    area: np.ndarray
-    xy: np.ndarray
     bolt_xy: np.ndarray
     bolt_force_n: float
     output_dof: int
@@ -119,20 +108,6 @@ class BoltedJoint:
     reduction_error: float
     stiffness_ratio: float
     frequencies_hz: dict = field(default_factory=dict)
-
-    @property
-    def npairs(self) -> int:
-        """Number of node pairs."""
-        return self.pairs.shape[0]
-
-    def linear_K(self, state: str = "stuck") -> np.ndarray:
-        """Stiffness of a linear state, N/m: "stuck" (every pair stuck: springs kt, kt, kn), "slip" (every
-        pair slipping: the normal springs kn only, no tangential stiffness) or "open" (none)."""
-        V.choice("state", state, STATES)
-        if state == "open":
-            return self.K.copy()
-        kt = self.kt if state == "stuck" else 0.0
-        return self.K + pair_springs(self.pairs, kt, self.kn, self.K.shape[0]).toarray()
 
     def natural_frequencies_hz(self, state: str = "stuck", count: int = 4) -> np.ndarray:
         """The ``count`` lowest natural frequencies (Hz) of a linear state (:meth:`linear_K`)."""
@@ -324,7 +299,7 @@ def bolted_lap(*, length_m: float = 0.09, width_m: float = 0.025, thick_m: float
                         area=area, xy=xy, bolt_xy=np.asarray(g["bolt"]), bolt_force_n=force,
                         output_dof=int(red.kept[0]), full_dofs=int(M.shape[0]), reduction_error=float("nan"),
                         stiffness_ratio=float(kn.sum() / (G * g["overlap"] * g["width"] / g["thick"])))  # fmt: skip
-    freq = {s: joint.natural_frequencies_hz(s) for s in STATES}
+    freq = {s: joint.natural_frequencies_hz(s) for s in BoltedJoint.STATES}
     err = float("nan")
     if check:
         freq["stuck_full"] = _sparse_frequencies(M, K + pair_springs(table.pairs, kt, kn, M.shape[0]), 4)

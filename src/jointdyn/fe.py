@@ -36,12 +36,13 @@ sets of a mesh file read by meshio, matched by nearest node).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 from pathlib import Path
 
 import numpy as np
 
 
-__all__ = ["LapJoint", "PairTable", "interface_from_mesh", "interface_from_triplets", "lap_joint", "match_nodes",
+__all__ = ["LapJoint", "PairTable", "ReducedJoint", "interface_from_mesh", "interface_from_triplets", "lap_joint", "match_nodes",
            "pair_frames", "pair_springs", "read_node_sets"]  # fmt: skip
 
 #: two mesh nodes are the same point (a node pair) when their distance is
@@ -447,7 +448,57 @@ def pair_springs(pairs, kt, kn, ndof: int, *, stuck=None, closed=None):
 
 
 @dataclass(frozen=True)
-class LapJoint:
+class ReducedJoint:
+    """A bolted joint's structure reduced onto its interface, with its node pairs: what the shipped lap
+    joint (:class:`LapJoint`) and a joint built from scratch (:class:`jointdyn.bolted.BoltedJoint`) share.
+
+    Attributes
+    ----------
+    M, K : ndarray (r, r)
+        Reduced mass (kg) and stiffness (N/m), every pair open.
+    pairs : ndarray of int (npairs, 6)
+        Reduced coordinates a_t1, a_t2, a_n, b_t1, b_t2, b_n of each pair.
+    kt, kn, mu, preload : ndarray (npairs,)
+        Tangential and normal stiffness (N/m), friction coefficient and
+        normal load at rest (N) of each pair.
+    area : ndarray (npairs,)
+        Contact area of each pair, m^2.
+    xy : ndarray (npairs, 2)
+        Position of each pair in the patch, m.
+    """
+
+    #: the linear states :meth:`linear_K` takes
+    STATES: ClassVar[tuple[str, ...]] = ("stuck", "slip", "open")
+
+    M: np.ndarray
+    K: np.ndarray
+    pairs: np.ndarray
+    kt: np.ndarray
+    kn: np.ndarray
+    mu: np.ndarray
+    preload: np.ndarray
+    area: np.ndarray
+    xy: np.ndarray
+
+    @property
+    def npairs(self) -> int:
+        """Number of node pairs."""
+        return self.pairs.shape[0]
+
+    def linear_K(self, state: str = "stuck") -> np.ndarray:
+        """Stiffness of a linear state (one of ``STATES``), N/m: "stuck" (every pair stuck: springs kt, kt,
+        kn), "slip" (every pair slipping: the normal springs kn only) or "open" (none)."""
+        from . import _validate as V
+
+        V.choice("state", state, self.STATES)
+        if state == "open":
+            return self.K.copy()
+        kt = self.kt if state == "stuck" else 0.0
+        return self.K + pair_springs(self.pairs, kt, self.kn, self.K.shape[0]).toarray()
+
+
+@dataclass(frozen=True)
+class LapJoint(ReducedJoint):
     """The bolted lap joint shipped with jointdyn, reduced onto its interface (:func:`lap_joint`).
 
     Two steel plates (100 x 25 x 5 mm each, clamped at their far ends)
@@ -488,33 +539,13 @@ class LapJoint:
         pair open ("open").
     """
 
-    M: np.ndarray
-    K: np.ndarray
-    pairs: np.ndarray
-    kt: np.ndarray
-    kn: np.ndarray
-    mu: np.ndarray
-    preload: np.ndarray
-    area: np.ndarray
-    xy: np.ndarray
+    #: the linear states :meth:`linear_K` takes: every pair of the model stuck, or open
+    STATES: ClassVar[tuple[str, ...]] = ("stuck", "open")
+
     open_xy: np.ndarray
     open_area: np.ndarray
     output_dof: int
     frequencies_hz: dict
-
-    @property
-    def npairs(self) -> int:
-        """Number of node pairs."""
-        return self.pairs.shape[0]
-
-    def linear_K(self, state: str = "stuck") -> np.ndarray:
-        """Stiffness of a linear state, N/m: "stuck" (every pair of the model stuck: springs kt, kt, kn) or
-        "open" (none)."""
-        if state == "open":
-            return self.K.copy()
-        if state != "stuck":
-            raise ValueError(f"state must be 'stuck' or 'open', got {state!r}")
-        return self.K + pair_springs(self.pairs, self.kt, self.kn, self.K.shape[0]).toarray()
 
 
 #: the linear states of :attr:`LapJoint.frequencies_hz`, in the order stored
