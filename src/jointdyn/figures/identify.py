@@ -41,7 +41,8 @@ def ringdown_data() -> dict:
     rng = fit.damping_range
     bb = epmc(system, (0.5 * b.amplitude_m.min(), 1.5 * b.amplitude_m.max()), harmonics=3, progress=False)
     signal = pd.DataFrame({"t_s": t, "x_m": x})
-    envelope = pd.DataFrame({"t_s": b.t, "envelope_m": b.envelope_m})
+    kept = b.t <= t[-1] - b.trimmed_s[1]  # without the tail dropped within the noise
+    envelope = pd.DataFrame({"t_s": b.t[kept], "envelope_m": b.envelope_m[kept]})
     backbone = pd.DataFrame({"amplitude_m": b.amplitude_m, "omega_rad_s": b.omega_rad_s,
                              "damping_ratio": b.damping_ratio, "omega_fit_rad_s": fit.fitted["omega_rad_s"],
                              "damping_fit": fit.fitted["damping_ratio"],
