@@ -19,7 +19,8 @@ with a modal Iwan model by the describing function
 (:func:`jointdyn.backbone_from_ringdown`; with ``--out``, also written as
 ``ringdown_backbone.csv``) and fitted the same way, the determined combinations then again
 to the decay's windows (:func:`jointdyn.identify.fit_ringdown`: intervals the record
-justifies). ``--frc``: columns
+justifies, and the amplitudes over which it determines the damping ratio within 5 %, to which
+``ringdown_backbone.csv`` is trimmed; ``damping_range`` in ``fit.json``). ``--frc``: columns
 ``force_N, omega_rad_s, amplitude_m`` of stepped-sine response curves at
 several force levels (:func:`jointdyn.fit_frc`).
 
