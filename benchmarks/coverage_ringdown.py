@@ -45,7 +45,7 @@ def one(name: str, seeds: int) -> dict:
     hits = {k: 0 for k in true}
     named = {k: 0 for k in true}
     worst = {k: 0.0 for k in true}
-    ew_max, eD_max, seconds = [], [], []
+    ew_max, eD_max, seconds, trimmed, half = [], [], [], [], []
     for seed in range(seeds):
         t, x = _decay(system, law, [0.4 * law.x_slip], 0, math.sqrt(5e5 / 2.0), 150, 64, seed=seed)
         b = backbone_from_ringdown(t, x, "x")
@@ -56,6 +56,8 @@ def one(name: str, seeds: int) -> dict:
         fit = fit_ringdown(b, mass=2.0, model=name)
         seconds.append(time.perf_counter() - t0)
         c = fit.determined_combinations
+        trimmed.append(fit.damping_range["trimmed_top"] + fit.damping_range["trimmed_bottom"])
+        half.append(max(h if h is not None else math.inf for h in fit.damping_range["half_width"]))
         for k, v in true.items():
             iv = c[k]["interval"]
             if "not_determined" in c[k]:
@@ -71,6 +73,7 @@ def one(name: str, seeds: int) -> dict:
     return {"seeds": seeds, "omega_error_max": max(ew_max), "damping_error_max": max(eD_max),
             "damping_error_by_seed": eD_max, "coverage": {k: h / seeds for k, h in hits.items()},
             "named_not_determined": named, "largest_error_determined": worst,
+            "damping_range_trimmed_by_seed": trimmed, "damping_half_width_max": max(half),
             "fit_seconds_median": float(np.median(seconds))}
 
 

@@ -137,6 +137,9 @@ def damping_range(fun, values: dict, params, A, damping_of, bound: float = RINGD
     """
     from scipy.stats import norm
 
+    from ._lsq import FIT_XTOL
+    from .result import covariance
+
     names = [p.name for p in params]
     r0 = fun(values)
     d0 = np.asarray(damping_of(values, A), float)
@@ -147,9 +150,12 @@ def damping_range(fun, values: dict, params, A, damping_of, bound: float = RINGD
         v = dict(values, **{p.name: values[p.name] + h})
         J[:, j] = (fun(v) - r0) / h
         G[:, j] = (np.asarray(damping_of(v, A), float) - d0) / h
-    s2 = max(float(r0 @ r0) / max(r0.size - len(names), 1), 1.0)
-    cov = s2 * np.linalg.pinv(J.T @ J)
-    half = float(norm.ppf(0.975)) * np.sqrt(np.abs(np.einsum("ij,jk,ik->i", G, cov, G))) / np.abs(d0)
+    s2 = float(r0 @ r0) / max(r0.size - len(names), 1)
+    # the residual's covariance (a direction the windows do not see: infinite, so no point is
+    # determined through it), at the measured noise where the residual is smaller than that
+    cov = covariance(J, r0, np.ones(len(names), bool), FIT_XTOL) * (max(s2, 1.0) / max(s2, 1e-300))
+    with np.errstate(invalid="ignore"):
+        half = float(norm.ppf(0.975)) * np.sqrt(np.abs(np.einsum("ij,jk,ik->i", G, cov, G))) / np.abs(d0)
     ok = np.isfinite(half) & (half <= bound)
     best, run = (0, 0), 0
     for i, good in enumerate(ok):  # the longest run of consecutive determined points
@@ -163,7 +169,8 @@ def damping_range(fun, values: dict, params, A, damping_of, bound: float = RINGD
     return {"amplitude_high_m": float(np.max(A[lo:hi])) if hi > lo else None,
             "amplitude_low_m": float(np.min(A[lo:hi])) if hi > lo else None,
             "points": int(hi - lo), "trimmed_top": int(lo), "trimmed_bottom": int(ok.size - hi),
-            "bound": float(bound), "level": 0.95, "half_width": [float(x) for x in half],
+            "bound": float(bound), "level": 0.95,
+            "half_width": [float(x) if np.isfinite(x) else None for x in half],
             "determined": [bool(x) for x in inside],
             "meaning": f"amplitudes over which the fitted model's damping ratio is determined within "
                        f"+-{100 * bound:g} % (95 %, linearised from the windows' measured noise); the points "
@@ -175,6 +182,9 @@ def _range_text(rng: dict) -> str:
     if rng["points"] == 0:
         return (f"the damping ratio is determined within +-{100 * rng['bound']:g} % at no amplitude of the decay "
                 f"(95 %, from the windows' noise): a longer or less noisy record")
+    if rng["trimmed_top"] + rng["trimmed_bottom"] == 0:
+        return (f"damping ratio determined within +-{100 * rng['bound']:g} % (95 %) at every point, "
+                f"{rng['amplitude_high_m']:.4g} down to {rng['amplitude_low_m']:.4g} m")
     return (f"damping ratio determined within +-{100 * rng['bound']:g} % (95 %) from {rng['amplitude_high_m']:.4g} "
             f"down to {rng['amplitude_low_m']:.4g} m: {rng['trimmed_top']} point(s) trimmed at the top and "
             f"{rng['trimmed_bottom']} at the bottom, where the windows' noise fixes it less well")
