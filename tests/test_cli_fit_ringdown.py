@@ -37,6 +37,9 @@ def test_a_linear_ringdown_is_written_as_a_backbone_and_fitted(tmp_path, capsys)
     assert d["determined_combinations"]["zeta"]["value"] == pytest.approx(0.0025, rel=0.01)
     bb = (out / "ringdown_backbone.csv").read_text().splitlines()
     assert bb[0] == "amplitude_m,omega_rad_s,damping_ratio" and len(bb) > 10
+    # a noise-free linear decay determines its damping ratio everywhere: no point trimmed
+    rng = d["damping_range"]
+    assert rng["points"] == len(bb) - 1 and rng["trimmed_top"] == rng["trimmed_bottom"] == 0
     # --ringdown fits the decay's windows (fit_ringdown), and says so; the written backbone,
     # fitted with --backbone, gives the same stiffness (measured 2.4e-9 apart) and its own
     # narrower interval (its points come from one smooth model)
@@ -46,6 +49,36 @@ def test_a_linear_ringdown_is_written_as_a_backbone_and_fitted(tmp_path, capsys)
     again = json.loads(capsys.readouterr().out)
     assert again["determined_combinations"]["k_plus_kt"]["value"] == pytest.approx(
         d["determined_combinations"]["k_plus_kt"]["value"], rel=1e-6)
+
+
+def test_a_ringdown_through_macroslip_says_and_writes_its_damping_range(tmp_path, capsys):
+    """The Iwan oscillator released from 5 slip displacements with 1 % noise (seed 0, as
+    tests/test_identify_ringdown.py): the fit determines the damping ratio within 5 % over part of
+    the decay only; the JSON says which, the console prints it, fit.csv marks the points and
+    ringdown_backbone.csv holds those of the range."""
+    from test_identify_ringdown import _decay as decay
+    from test_identify_ringdown import _sdof
+
+    system, law = _sdof("iwan")
+    t, x = decay(system, law, [5.0 * law.x_slip], 0, math.sqrt(5e5 / 2.0), 150, 64)
+    src = tmp_path / "decay.csv"
+    np.savetxt(src, np.column_stack([t, x]), delimiter=",", header="t,x", comments="")
+    out = tmp_path / "out"
+    base = ["fit", "--ringdown", str(src), "--model", "iwan", "--mass", "2", "--band",
+            f"{300 / (2 * math.pi)}:{750 / (2 * math.pi)}", "--out", str(out)]
+    assert main(base) == 3
+    text = capsys.readouterr().out
+    assert "damping range: determined within +-5 % (95 %)" in text
+    d = json.loads((out / "fit.json").read_text())
+    rng = d["damping_range"]
+    assert rng["points"] >= 2 and rng["trimmed_top"] + rng["trimmed_bottom"] > 0
+    assert rng["points"] + rng["trimmed_top"] + rng["trimmed_bottom"] == len(rng["determined"])
+    rows = np.loadtxt(out / "ringdown_backbone.csv", delimiter=",", skiprows=1, ndmin=2)
+    assert rows.shape[0] == rng["points"]
+    assert rows[:, 0].max() == pytest.approx(rng["amplitude_high_m"], rel=1e-12)
+    assert rows[:, 0].min() == pytest.approx(rng["amplitude_low_m"], rel=1e-12)
+    header = (out / "fit.csv").read_text().splitlines()[0].split(",")
+    assert "damping_determined" in header
 
 
 @pytest.mark.parametrize("kw,word", [

@@ -4,7 +4,8 @@ The CSV has a header row and the columns ``t`` (s) and one of ``x`` (m),
 ``v`` (m/s) or ``a`` (m/s^2), uniformly sampled. The backbone is extracted
 by :func:`jointdyn.backbone_from_ringdown` and fitted as ``--backbone`` would
 be (``--mass``, ``--model``); with ``--out DIR`` it is also written as
-``ringdown_backbone.csv`` with the ``--backbone`` columns. ``--band LOW:HIGH``
+``ringdown_backbone.csv`` with the ``--backbone`` columns, trimmed to the amplitudes where the
+fit determines the damping ratio within its bound (``damping_range`` of ``fit.json``). ``--band LOW:HIGH``
 (Hz) gives the mode's pass band where the spectrum's peak does not (a decay
 through macroslip drifts in frequency enough to show two peaks).
 """
@@ -69,16 +70,28 @@ def backbone_of(args, read_columns):
         raise ValueError(f"--ringdown {str(args.ringdown)!r}: {msg}") from None
 
 
-def backbone_csv(b) -> str:
-    """The backbone as CSV text with the ``--backbone`` columns."""
+def backbone_rows(b, damping_range) -> np.ndarray:
+    """The backbone points written: those of the fit's damping range (``FitResult.damping_range``:
+    where the ring-down determines the damping ratio within its bound), or every point where the
+    range was not assessed (None) or holds fewer than two points (the JSON says so)."""
+    keep = np.ones(b.amplitude_m.size, bool)
+    if damping_range is not None and damping_range["points"] >= 2:
+        keep = np.array(damping_range["determined"], bool)
+    return keep
+
+
+def backbone_csv(b, damping_range=None) -> str:
+    """The backbone as CSV text with the ``--backbone`` columns, trimmed to the fit's damping range
+    (:func:`backbone_rows`)."""
+    keep = backbone_rows(b, damping_range)
     lines = ["amplitude_m,omega_rad_s,damping_ratio"]
-    for row in zip(b.amplitude_m, b.omega_rad_s, b.damping_ratio):
+    for row in zip(b.amplitude_m[keep], b.omega_rad_s[keep], b.damping_ratio[keep]):
         lines.append(",".join(f"{float(v):.17g}" for v in row))
     return "\n".join(lines) + "\n"
 
 
-def write_backbone(out, b) -> None:
+def write_backbone(out, b, damping_range=None) -> None:
     from .._io import atomic_path
 
     with atomic_path(Path(out) / BACKBONE_FILE) as tmp:
-        Path(tmp).write_text(backbone_csv(b))
+        Path(tmp).write_text(backbone_csv(b, damping_range))

@@ -19,7 +19,8 @@ with a modal Iwan model by the describing function
 (:func:`jointdyn.backbone_from_ringdown`; with ``--out``, also written as
 ``ringdown_backbone.csv``) and fitted the same way, the determined combinations then again
 to the decay's windows (:func:`jointdyn.identify.fit_ringdown`: intervals the record
-justifies). ``--frc``: columns
+justifies, and the amplitudes over which it determines the damping ratio within 5 %, to which
+``ringdown_backbone.csv`` is trimmed; ``damping_range`` in ``fit.json``). ``--frc``: columns
 ``force_N, omega_rad_s, amplitude_m`` of stepped-sine response curves at
 several force levels (:func:`jointdyn.fit_frc`).
 
@@ -248,7 +249,7 @@ def _write_files(args, fit, text: str) -> None:
     if getattr(args, "ringdown_backbone", None) is not None:
         from ._fit_ringdown import write_backbone
 
-        write_backbone(out, args.ringdown_backbone)
+        write_backbone(out, args.ringdown_backbone, fit.damping_range)
 
 
 def _interval_text(iv) -> str:
@@ -259,11 +260,23 @@ def _interval_text(iv) -> str:
     return f"  ({100 * iv.level:.3g} %: [{lo}, {hi}])"
 
 
+def _range_line(rng: dict) -> str:
+    """The fit's damping range (``FitResult.damping_range``) in one line."""
+    if rng["points"] == 0:
+        return f"determined within +-{100 * rng['bound']:g} % at no amplitude: every point kept, none determined"
+    written = "ringdown_backbone.csv holds these" if rng["points"] >= 2 else "every point kept"
+    return (f"determined within +-{100 * rng['bound']:g} % (95 %) from {rng['amplitude_high_m']:.4g} to "
+            f"{rng['amplitude_low_m']:.4g} m, {rng['points']} points; {rng['trimmed_top']} trimmed at the top, "
+            f"{rng['trimmed_bottom']} at the bottom ({written})")
+
+
 def _print_console(args, fit) -> None:
     src = next(s for s in (args.input, args.backbone, args.ringdown, args.frc) if s is not None)
     print(f"jointdyn fit: {fit.model} from {fit.kind} {src}: {fit.status.value}")
     if getattr(args, "ringdown_backbone", None) is not None:
         print(f"  ring-down: {args.ringdown_backbone.message}")
+        if fit.damping_range is not None:
+            print(f"  damping range: {_range_line(fit.damping_range)}")
     if fit.record_start is not None:
         print(f"  record {fit.record_start}")
     for k, v in fit.parameters.items():

@@ -25,7 +25,7 @@ import numpy as np
 from ._lsq import solve
 from ._microslip import DECAY_GRID
 
-__all__ = ["law_rates", "law_decay_steps", "law_decay_fit"]
+__all__ = ["law_rates", "law_decay_steps", "law_decay_fit", "law_decay_residual"]
 
 #: relative step of the central difference of the virgin curve's tangent F'(A) (-)
 TANGENT_STEP = 1e-6
@@ -84,6 +84,13 @@ def law_decay_fit(win: dict, m: float, law_of, params: list):
     noise is correlated (each window's error enters two falls) and each carries that model
     error, ``AVERAGING_ERROR`` delta^2 of itself: the residual is whitened by the Cholesky
     factor of that covariance."""
+    return solve(law_decay_residual(win, m, law_of), params, profile=True)
+
+
+def law_decay_residual(win: dict, m: float, law_of):
+    """The whitened residual of :func:`law_decay_fit` as a function of a dict of values (the
+    falls of ln A through the Cholesky factor of their covariance, the frequencies over their
+    standard errors): unit variance where the windows' measured noise is right."""
     lna, om = win["lna"], win["omega"]
     sl, so = win["sigma_lna"], win["sigma_omega"]
     fall_meas = np.diff(lna)
@@ -99,4 +106,4 @@ def law_decay_fit(win: dict, m: float, law_of, params: list):
         fall, wf = law_decay_steps(law_of(v), v["k"], v["zeta"], m, win)
         return np.concatenate((solve_triangular(chol, fall - fall_meas, lower=True), (wf - om) / so))
 
-    return solve(fun, params, profile=True)
+    return fun

@@ -77,6 +77,13 @@ class FitResult:
     record_start : str or None
         Loops: how the initial slip state was set (from rest, or by the record's first
         stroke, whose samples are then not fitted).
+    damping_range : dict or None
+        Ring-downs (:func:`jointdyn.identify.fit_ringdown`): the amplitudes over which the fitted
+        model's damping ratio is determined within ``bound`` (relative half-width of its 95 %
+        interval, from the windows' measured noise): ``amplitude_high_m``, ``amplitude_low_m``
+        (None: nowhere), ``points``, ``trimmed_top``, ``trimmed_bottom`` (backbone points outside),
+        ``bound``, ``level``, ``half_width`` and ``determined`` (per point), ``meaning``. None:
+        not a ring-down fit, or one whose range was not assessed.
     """
 
     kind: str
@@ -98,6 +105,7 @@ class FitResult:
     conditional_on: tuple = ()
     determined_combinations: dict = field(default_factory=dict)
     record_start: str | None = None
+    damping_range: dict | None = None
 
     def to_dict(self) -> dict:
         """The result as JSON-ready values (keys ``parameters``, ``standard_errors``,
@@ -120,6 +128,7 @@ class FitResult:
             "standard_errors_conditional_on": list(self.conditional_on),
             "determined_combinations": {k: dict(v) for k, v in self.determined_combinations.items()},
             "record_start": self.record_start,
+            "damping_range": None if self.damping_range is None else dict(self.damping_range),
         }
 
 

@@ -22,6 +22,11 @@ damping ratio at the top and the bottom of the decay) are given with their inter
 A decay through macroslip is not of that form: there the whole modal model (k, kt, fy, zeta;
 chi, beta) is fitted to the windows by the same energy balance with the law's describing
 function and virgin curve (:mod:`._lawdecay`), fall by fall of ln A between windows.
+
+Either way the fit says over which amplitudes it determines the damping ratio within
+``RINGDOWN_DAMPING_RTOL`` (:func:`damping_range`): at the bottom of a decay the windows' noise
+leaves it loose (a decay through macroslip with 1 % noise: up to 8 % off EPMC's at its last
+windows), and the backbone's points outside are trimmed and said so.
 """
 
 from __future__ import annotations
@@ -34,7 +39,7 @@ import numpy as np
 from ._lsq import open_reason, status_of
 from ._microslip import decay_fit, decay_model, microslip_model
 
-__all__ = ["fit_ringdown"]
+__all__ = ["fit_ringdown", "damping_range"]
 
 #: a parameter of a ring-down fit whose 95 % interval spans more than this factor (high / low)
 #: is reported as not determined (-)
@@ -50,6 +55,13 @@ RINGDOWN_FIT_MAX_SPAN = 1.2
 #: determined, two of them 5 % off. Through macroslip, at 1.2, fy_N came out 3.6 % off (seed 1
 #: of the decay from 5 slip displacements) while its interval covered the truth.
 RINGDOWN_FIT_BAR_SPAN = 1.06
+#: the fitted model's damping ratio is reported as determined by a ring-down (``damping_range``)
+#: at the amplitudes where its 95 % interval lies within this fraction of it on each side (-):
+#: the accuracy asked of a ring-down's damping ratio. At the noisy bottom of a decay and at its
+#: fast-falling top the windows fix it less well; there the backbone is trimmed and says so.
+RINGDOWN_DAMPING_RTOL = 0.05
+#: relative step of the forward differences of the damping range's Jacobians (-)
+RINGDOWN_RANGE_STEP = 1e-5
 
 
 def _span_reason(name, iv, span: float = RINGDOWN_FIT_MAX_SPAN) -> str | None:
@@ -106,6 +118,78 @@ def _ends_of(sol, params, win, at) -> dict:
     return out
 
 
+def damping_range(fun, values: dict, params, A, damping_of, bound: float = RINGDOWN_DAMPING_RTOL) -> dict:
+    """Where a fitted ring-down model determines its damping ratio within ``bound``.
+
+    The 95 % interval of the model's damping ratio at each amplitude ``A`` (m) is linearised
+    (the delta method) from the Jacobian of the whitened window residual ``fun`` at the optimum
+    ``values``: its covariance is that of the windows' measured noise, scaled up (never down) by
+    the residual variance where the fit leaves more than the noise; ``damping_of(values, A)``
+    gives the damping ratios. The kept range is the longest run of consecutive points whose
+    interval's half-width is at most ``bound`` of the value: the noise of the windows at the
+    bottom of a decay (and the averaging error of its fast-falling top) set where it ends, not a
+    fixed count of windows.
+
+    Returns
+    -------
+    dict
+        As :attr:`jointdyn.identify.FitResult.damping_range` (JSON-ready).
+    """
+    from scipy.stats import norm
+
+    from ._lsq import FIT_XTOL
+    from .result import covariance
+
+    names = [p.name for p in params]
+    r0 = fun(values)
+    d0 = np.asarray(damping_of(values, A), float)
+    J = np.empty((r0.size, len(names)))
+    G = np.empty((d0.size, len(names)))
+    for j, p in enumerate(params):
+        h = RINGDOWN_RANGE_STEP * (max(abs(values[p.name]), 1e-300) if p.positive else 1.0)
+        v = dict(values, **{p.name: values[p.name] + h})
+        J[:, j] = (fun(v) - r0) / h
+        G[:, j] = (np.asarray(damping_of(v, A), float) - d0) / h
+    s2 = float(r0 @ r0) / max(r0.size - len(names), 1)
+    # the residual's covariance (a direction the windows do not see: infinite, so no point is
+    # determined through it), at the measured noise where the residual is smaller than that
+    cov = covariance(J, r0, np.ones(len(names), bool), FIT_XTOL) * (max(s2, 1.0) / max(s2, 1e-300))
+    with np.errstate(invalid="ignore"):
+        half = float(norm.ppf(0.975)) * np.sqrt(np.abs(np.einsum("ij,jk,ik->i", G, cov, G))) / np.abs(d0)
+    ok = np.isfinite(half) & (half <= bound)
+    best, run = (0, 0), 0
+    for i, good in enumerate(ok):  # the longest run of consecutive determined points
+        run = run + 1 if good else 0
+        if run > best[1] - best[0]:
+            best = (i + 1 - run, i + 1)
+    lo, hi = best
+    inside = np.zeros(ok.size, bool)
+    inside[lo:hi] = True
+    A = np.asarray(A, float)
+    return {"amplitude_high_m": float(np.max(A[lo:hi])) if hi > lo else None,
+            "amplitude_low_m": float(np.min(A[lo:hi])) if hi > lo else None,
+            "points": int(hi - lo), "trimmed_top": int(lo), "trimmed_bottom": int(ok.size - hi),
+            "bound": float(bound), "level": 0.95,
+            "half_width": [float(x) if np.isfinite(x) else None for x in half],
+            "determined": [bool(x) for x in inside],
+            "meaning": f"amplitudes over which the fitted model's damping ratio is determined within "
+                       f"+-{100 * bound:g} % (95 %, linearised from the windows' measured noise); the points "
+                       f"outside are trimmed"}
+
+
+def _range_text(rng: dict) -> str:
+    """One clause of a fit's message on its damping range."""
+    if rng["points"] == 0:
+        return (f"the damping ratio is determined within +-{100 * rng['bound']:g} % at no amplitude of the decay "
+                f"(95 %, from the windows' noise): a longer or less noisy record")
+    if rng["trimmed_top"] + rng["trimmed_bottom"] == 0:
+        return (f"damping ratio determined within +-{100 * rng['bound']:g} % (95 %) at every point, "
+                f"{rng['amplitude_high_m']:.4g} down to {rng['amplitude_low_m']:.4g} m")
+    return (f"damping ratio determined within +-{100 * rng['bound']:g} % (95 %) from {rng['amplitude_high_m']:.4g} "
+            f"down to {rng['amplitude_low_m']:.4g} m: {rng['trimmed_top']} point(s) trimmed at the top and "
+            f"{rng['trimmed_bottom']} at the bottom, where the windows' noise fixes it less well")
+
+
 def fit_ringdown(ringdown, *, mass: float, model: str = "iwan", law_params: dict | None = None,
                  start: dict | None = None):
     """Fit a modal Iwan model to a ring-down (module docstring).
@@ -137,7 +221,9 @@ def fit_ringdown(ringdown, *, mass: float, model: str = "iwan", law_params: dict
         fitted to the windows' falls of ln A and frequencies (:mod:`._lawdecay`), each parameter
         whose interval spans more than ``RINGDOWN_FIT_BAR_SPAN`` named not determined; a
         RingdownBackbone without windows is the backbone fit's, and its message says that its
-        intervals treat the points as independent.
+        intervals treat the points as independent. A fit to the windows has ``damping_range``
+        (:func:`damping_range`: the amplitudes where its damping ratio is determined within
+        ``RINGDOWN_DAMPING_RTOL``) and ``measured["damping_determined"]`` (1 inside, 0 outside).
 
     Raises
     ------
@@ -202,7 +288,7 @@ def _through_macroslip(ringdown, m, model, law_params, res):
     the windows' falls of ln A and frequencies (:mod:`._lawdecay`), from the fit ``res`` of the
     backbone's points, with profile intervals; a parameter whose
     interval is open or wider than ``RINGDOWN_FIT_BAR_SPAN`` is named not determined."""
-    from ._lawdecay import law_decay_fit, law_rates
+    from ._lawdecay import law_decay_fit, law_decay_residual, law_rates
     from .backbone import _params, modal_law
 
     win = ringdown.windows
@@ -232,12 +318,16 @@ def _through_macroslip(ringdown, m, model, law_params, res):
     combos = _ends_of(sol, params, win, at)
     A, w, D = (res.measured[k] for k in ("amplitude_m", "omega_rad_s", "damping_ratio"))
     wf, Df, _ = law_rates(law, sol.values["k"], sol.values["zeta"], m, A)
+    rng = damping_range(law_decay_residual(win, m, law_of), sol.values, params, A,
+                        lambda v, a: law_rates(law_of(v), v["k"], v["zeta"], m, a)[1])
     rb = np.concatenate(((wf - w) / w, (Df - D) / max(float(np.max(D)), 1e-300)))
     message = (f"{message}; a decay through macroslip: the whole model fitted to the ring-down's {win['t'].size} "
                f"windows (the falls of ln A between them and their frequencies, each weighted by its measured "
                f"noise: rms weighted residual {math.sqrt(float(np.mean(sol.residual ** 2))):.3g}); the damping "
-               f"ratio fitted is EPMC's, the backbone's points the decay's own")
+               f"ratio fitted is EPMC's, the backbone's points the decay's own; {_range_text(rng)}")
+    measured = dict(res.measured, damping_determined=np.array(rng["determined"], float))
     return replace(res, status=status, message=message, parameters=parameters, standard_errors=errors,
+                   measured=measured, damping_range=rng,
                    intervals=intervals, not_identifiable=reasons, determined_combinations=combos, law=law,
                    names=tuple(ren.get(p.name, p.name) for p in params), correlation=sol.correlation,
                    conditional_on=(), evaluations=res.evaluations + sol.evaluations,
@@ -290,7 +380,17 @@ def _result(res, sol, params, win, m, chi0):
     A, w, D = (res.measured[k] for k in ("amplitude_m", "omega_rad_s", "damping_ratio"))
     wf, Df = microslip_model(v["K"], v["R"], v.get("chi", chi0), v["zeta"], m, A)
     rb = np.concatenate(((wf - w) / w, (Df - D) / max(float(np.max(D)), 1e-300)))
+
+    def fun(u):  # the window residual of decay_fit
+        lf_, wf_ = decay_model(dict(u, chi=u.get("chi", chi0)), m, win["t"], float(win["lna"][-1]))
+        return np.concatenate(((lf_ - win["lna"]) / win["sigma_lna"], (wf_ - win["omega"]) / win["sigma_omega"]))
+
+    rng = damping_range(fun, v, params, A,
+                        lambda u, a: microslip_model(u["K"], u["R"], u.get("chi", chi0), u["zeta"], m, a)[1])
+    message += "; " + _range_text(rng)
     return replace(res, status=status, message=message, parameters=parameters, standard_errors=errors,
+                   measured=dict(res.measured, damping_determined=np.array(rng["determined"], float)),
+                   damping_range=rng,
                    intervals=intervals, not_identifiable=reasons, determined_combinations=combos,
                    evaluations=res.evaluations + sol.evaluations, fitted={"omega_rad_s": wf, "damping_ratio": Df},
                    rms_residual=math.sqrt(float(np.mean(rb * rb))))
