@@ -66,13 +66,14 @@ def _modes(problem):
     """(Phi_c (m, n) real, Psi_c (m, R), w_r^2 (n,) or None, c (n,) or None, Ct (n, n) or None, Y (n, R)
     or None, lambda (R,) or None) of a condensed problem (module docstring): modal damping with w_r^2 and
     c, a state-space expansion with Ct, Y and lambda."""
-    rec = problem.receptance
-    Psi_c = np.ascontiguousarray(rec.rows(problem.dofs))
+    rec, coords = problem.receptance, problem.coordinates
+    Psi_c = np.ascontiguousarray(rec.rows_of(coords))
     if rec.modes is None:  # modal: Psi = Phi
         return Psi_c, Psi_c, np.asarray(rec.a, dtype=np.float64), np.asarray(rec.b, dtype=np.float64), None, \
             None, None
     Phi, Ct, Y = rec.modes
-    return (np.ascontiguousarray(Phi[problem.dofs]), Psi_c, None, None, np.asarray(Ct), np.asarray(Y),
+    Phi_c = Phi[coords.dofs] if coords.unit else coords.S @ Phi
+    return (np.ascontiguousarray(Phi_c), Psi_c, None, None, np.asarray(Ct), np.asarray(Y),
             np.asarray(rec.a, dtype=np.complex128))
 
 
