@@ -50,7 +50,11 @@ Retained DOFs: every DOF of a contact's tangential selection, DOF 0 (the
 DOF the branch monitor of :mod:`jointdyn.hb.frc` measures) and the
 response DOFs asked for; any other DOF's response is recovered from the
 solution (:meth:`CondensedHBProblem.dof_coefficients` with the parameter
-value, :meth:`CondensedHBProblem.full_coefficients`).
+value, :meth:`CondensedHBProblem.full_coefficients`). Where the contacts and
+pairs act on relative coordinates (a pair's x_a - x_b) that are fewer than
+those DOFs, the problem keeps the coordinates y = S x instead
+(:mod:`jointdyn.hb._coordinates`): everything above holds with the rows of
+the retained DOFs c replaced by S (H_cc = S H S^T, Psi_c = S Psi).
 
 Stability: Hill's method on the full structure. Where its companion matrix
 is small (``StabilityOptions.dense_max_rows``) the full Jacobian is

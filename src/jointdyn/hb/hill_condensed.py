@@ -1,14 +1,15 @@
 """Hill's method for a condensed harmonic-balance problem, at the cost of the condensed solve.
 
 A condensed problem (:class:`~jointdyn.hb.condense.CondensedHBProblem`)
-solves for the harmonics of the m retained DOFs c only; its stability is
+solves for the harmonics of the m retained coordinates y = S x only (DOFs, or
+relative coordinates: :mod:`jointdyn.hb._coordinates`); its stability is
 that of the full structure, Hill's quadratic problem of n DOFs::
 
     Q(s) = J_X + s D1 + s^2 D2 = Lin(s) + S^T G S,
 
 Lin the linear terms (the full structure's J_X without its contacts, with
-D1 = I (x) C + 2 w nabla (x) M and D2 = I (x) M), S the selection of the
-retained DOFs of every harmonic and G = JX_c - Z_red(w) the contact part of
+D1 = I (x) C + 2 w nabla (x) M and D2 = I (x) M), S the retained
+coordinates' rows for every harmonic and G = JX_c - Z_red(w) the contact part of
 the condensed Jacobian (m (2H+1) square, it couples harmonics).
 Shift-invert Arnoldi (:func:`~jointdyn.hb.hill_arnoldi.shift_invert_exponents`:
 the shifts, ARPACK and Hill's selection of the full method) needs one solve
@@ -25,7 +26,7 @@ Z_q(sigma + i k w) and Z_q(sigma - i k w), with::
 
 the receptance of :func:`~jointdyn.hb.condense.receptance` at a complex
 frequency (Y, lambda_r the damped eigenpairs in modal coordinates, Psi =
-Phi Y). With P = I (x) Phi_c (the rows of the retained DOFs) the solve of
+Phi Y). With P = I (x) Phi_c (Phi_c = S Phi: the coordinates' rows) the solve of
 (Lin + P^T G P) x = r is, by the Woodbury identity::
 
     u = Lin^-1 r,   (I + H_cc G) x_c = P u,   x = u - Lin^-1 P^T G x_c,
@@ -179,7 +180,7 @@ def condensed_hill_exponents(problem, JX, w, options: StabilityOptions | None = 
     Parameters
     ----------
     problem : CondensedHBProblem
-        The condensed problem (its receptance and retained DOFs).
+        The condensed problem (its receptance and retained coordinates).
     JX : ndarray (m(2H+1), m(2H+1))
         Its Jacobian dR/dX at the solution, N/m.
     w : float

@@ -91,8 +91,8 @@ class HBOptions:
         The automatic choice condenses onto the contact DOFs (:mod:`jointdyn.hb.condense`) systems of at
         least this many DOFs (default 12; >= 1) ...
     condense_max_fraction : float
-        ... whose retained DOFs (contacts, DOF 0, response DOFs) are at most this fraction of all DOFs
-        (default 0.5; in (0, 1]).
+        ... whose retained unknowns per harmonic (the contacts' DOFs or relative coordinates, DOF 0,
+        response DOFs) are at most this fraction of all DOFs (default 0.5; in (0, 1]).
     condense_relative : bool
         A condensed problem keeps relative coordinates (a contact's selection row, a node pair's
         ``x_a - x_b``: three unknowns per pair and harmonic instead of six) where they are fewer than the
