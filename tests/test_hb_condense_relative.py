@@ -11,9 +11,23 @@ import pytest
 
 import jointdyn as jd
 from jointdyn.damping import dense_damping
-from jointdyn.hb import HBOptions, StabilityOptions, continue_hb, harmonic_balance, hill_exponents
+from jointdyn.hb import (
+    HBOptions,
+    StabilityOptions,
+    continue_hb,
+    harmonic_balance,
+    hill_arnoldi_exponents,
+    hill_exponents,
+)
 from jointdyn.hb._coordinates import Coordinates, retained_coordinates, static_cholesky
-from jointdyn.hb.condense import _blas_blocks, _condensed_blocks, _static_parts, make_problem, receptance
+from jointdyn.hb.condense import (
+    _blas_blocks,
+    _condensed_blocks,
+    _static_parts,
+    make_problem,
+    receptance,
+    use_condensed,
+)
 from jointdyn.hb.hill_condensed import condensed_hill_exponents
 from jointdyn.hb.problem import HBProblem
 from jointdyn.interfaces import Interface
@@ -86,6 +100,8 @@ def test_two_sided_pairs_keep_their_relative_coordinates():
     # the same pair written the other way round is minus the coordinate: side b
     a, b = q.coordinates.position(3 * NODES, 0)
     assert a == -1 and b == q.pair_positions[0, 0]
+    # the automatic choice counts the retained DOFs (24 of 30: not condensed), not the 13 coordinates
+    assert not use_condensed(s) and use_condensed(s, options=HBOptions(condense_max_fraction=0.9))
     # HBOptions(condense_relative=False): the DOFs, today's form
     qd = make_problem(s, condense=True, harmonics=2, samples=16, options=HBOptions(condense_relative=False))
     assert qd.coordinates.unit and qd.n == 6 * CONTACT
@@ -173,18 +189,24 @@ def test_branch_on_coordinates_equals_the_direct_solves_and_dense_hill():
 def test_condensed_arnoldi_on_coordinates_equals_dense_hill(damping):
     s = _plates(damping)
     H, Ns = 3, 32
-    qc = make_problem(s, condense=True, harmonics=H, samples=Ns)
-    q = _direct(s, H, Ns)
     C = dense_damping(s.C)
-    for gamma in (0.9, 1.1):
-        Xc = _newton(qc, gamma, qc.linear_guess(gamma))
-        w = qc.omega(gamma)
-        got = condensed_hill_exponents(qc, qc.evaluate(Xc, gamma).JX, w, StabilityOptions(method="arnoldi"))
-        X = _newton(q, gamma, qc.full_coefficients(Xc, gamma))
-        sel, every = hill_exponents(q.evaluate(X, gamma).JX, s.M, C, w, H)
+    for gamma in (0.95, 1.04):
+        sol = harmonic_balance(s, gamma, harmonics=H, samples=Ns, condense=True, stability=False)
+        qc, p = sol.problem, sol.problem.f1_ref
+        Xc = _newton(qc, p, sol.X)
+        w = qc.omega(p)
+        got = condensed_hill_exponents(qc, qc.evaluate(Xc, p).JX, w, StabilityOptions(method="arnoldi"))
+        q = HBProblem(s, harmonics=H, samples=Ns, parameter="f1", gamma=gamma)
+        X = _newton(q, p, qc.full_coefficients(Xc, p))
+        _, every = hill_exponents(q.evaluate(X, p).JX, s.M, C, w, H)
         scale = float(np.max(np.abs(got.exponents)))
+        # every exponent found is an eigenvalue of dense Hill's matrix of the direct problem ...
         assert max(float(np.min(np.abs(every - z))) for z in got.exponents) <= HILL_RTOL * scale
-        assert abs(got.growth - sel[0].real / w) <= HILL_RTOL * abs(sel[0].real / w) + 1e-12
+        # ... and the same Arnoldi on the direct Jacobian finds the same ones, with the same growth
+        ref = hill_arnoldi_exponents(q.evaluate(X, p).JX, s.M, C, w, H, StabilityOptions(method="arnoldi"))
+        assert got.exponents.size == ref.exponents.size > 0
+        assert max(float(np.min(np.abs(ref.exponents - z))) for z in got.exponents) <= HILL_RTOL * scale
+        assert abs(got.growth - ref.growth) <= HILL_RTOL * abs(ref.growth) + 1e-12
 
 
 def test_blas_blocks_equal_the_compiled_pass():

@@ -506,14 +506,10 @@ def _static_parts(K, c, rec: Receptance | None = None):
     (a :class:`~jointdyn.hb._coordinates.Coordinates`, or DOFs: their unit rows) and the static recovery:
     x = S0(rows) y for a static load S^T lambda on them.
 
-    With a receptance ``rec`` whose static factors g(0) are all finite and no
-    smaller than ``HB_CONDENSE_STATIC_RTOL`` of the largest (K positive
-    definite), Z0 = H_yy(0)^-1 from the expansion and S0 is a function
-    ``rows -> H(0)[rows] S^T Z0`` (O(n^2) per row, nothing O(n^3)). Otherwise by
-    a Cholesky factorisation of K on the motions that leave the coordinates at zero
-    (:func:`~jointdyn.hb._coordinates.static_cholesky`; for DOFs, of K_oo); ValueError naming
-    ``condense`` when K is not positive definite there (a static load on the other
-    DOFs would have no unique response).
+    With a receptance ``rec`` whose static factors g(0) are all finite and no smaller than
+    ``HB_CONDENSE_STATIC_RTOL`` of the largest (K positive definite), Z0 = H_yy(0)^-1 from the
+    expansion and S0 ``rows -> H(0)[rows] S^T Z0`` (O(n^2) per row). Otherwise by a Cholesky
+    factorisation of K on null(S) (:func:`~jointdyn.hb._coordinates.static_cholesky`, which refuses).
     """
     coords = c if isinstance(c, Coordinates) else Coordinates.of_dofs(c, K.shape[0])
     if rec is not None:
@@ -796,8 +792,10 @@ def use_condensed(system: System, condense=None, response_dofs=(), options: HBOp
 
     Automatic: condensed when the system has at least
     ``options.condense_min_dofs`` DOFs, retains at most
-    ``options.condense_max_fraction`` of them (:class:`~jointdyn.hb.options.HBOptions`), and K is positive definite
-    on the DOFs that are not retained. A structure held only through its
+    ``options.condense_max_fraction`` of them (:class:`~jointdyn.hb.options.HBOptions`; its retained DOFs,
+    even where the problem then keeps fewer relative coordinates: the lap joint's 362 coordinates of 733
+    DOFs condensed cost more than the harmonic blocks, docs/performance.md), and K is positive definite
+    on the motions that keep the retained coordinates at zero. A structure held only through its
     contacts (:func:`~jointdyn.hb.problem.held_by_contacts`) is never
     condensed: the receptance and the static Schur complement are those of K,
     which has a rigid-body mode there (ValueError naming ``condense`` when it
@@ -827,11 +825,11 @@ def use_condensed(system: System, condense=None, response_dofs=(), options: HBOp
     opts = hb_options(options)
     if system.ndof < opts.condense_min_dofs:
         return False
-    c = retained_coordinates(system, response_dofs, opts.condense_relative)
-    if c.m > opts.condense_max_fraction * system.ndof:
-        return False
+    if retained_dofs(system, response_dofs).size > opts.condense_max_fraction * system.ndof:
+        return False  # the DOFs, not the relative coordinates (docs/performance.md: the lap joint)
     try:
-        _static_parts(system.K, c, receptance(system))
+        _static_parts(system.K, retained_coordinates(system, response_dofs, opts.condense_relative),
+                      receptance(system))
     except ValueError:
         return False
     return True

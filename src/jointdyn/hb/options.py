@@ -91,8 +91,11 @@ class HBOptions:
         The automatic choice condenses onto the contact DOFs (:mod:`jointdyn.hb.condense`) systems of at
         least this many DOFs (default 12; >= 1) ...
     condense_max_fraction : float
-        ... whose retained unknowns per harmonic (the contacts' DOFs or relative coordinates, DOF 0,
-        response DOFs) are at most this fraction of all DOFs (default 0.5; in (0, 1]).
+        ... whose retained DOFs (contacts, DOF 0, response DOFs) are at most this fraction of all DOFs
+        (default 0.5; in (0, 1]). The DOFs even where the condensed problem keeps fewer relative
+        coordinates (``condense_relative``): on the shipped lap joint (362 coordinates of 733 DOFs) the
+        condensed branch took about twice the CPU seconds of the full problem's harmonic blocks
+        (docs/performance.md), so the automatic choice leaves it to them.
     condense_relative : bool
         A condensed problem keeps relative coordinates (a contact's selection row, a node pair's
         ``x_a - x_b``: three unknowns per pair and harmonic instead of six) where they are fewer than the
