@@ -27,6 +27,19 @@ full run then adds the branch with the blocks and its stability as
 :mod:`jointdyn.hb.hill_arnoldi`), the model unchanged: the issue's target
 asks for the branch "with stability". Every row reports its wall seconds
 (``s``), its CPU seconds (``cpu_s``, the child's) and its peak resident memory.
+
+Condensation onto relative coordinates (:mod:`jointdyn.hb._coordinates`: a
+pair's three ``x_a - x_b``, 362 unknowns per harmonic instead of 733), fixed
+before measuring: the same branch across ``BAND_HZ`` at H = 1 and H = 3
+without stability, condensed (``condense=True``) against today's path
+(``condense=False``, the harmonic blocks), the sides alternated (condensed
+first at H = 1, blocks first at H = 3), each in its own child process (the
+condensed side's CPU seconds include the receptance's eigen-decomposition);
+the peaks of the two compared; and the CPU seconds of ONE point's stability
+at H = 3 (the point at ``STABILITY_HZ`` solved by each side, then
+:func:`jointdyn.hb.floquet.point_stability`: Arnoldi through the condensed
+form against the full Jacobian's shift-invert Arnoldi), with the growths
+compared. Full run, or alone with ``--condensed``.
 """
 
 from __future__ import annotations
@@ -41,6 +54,8 @@ SAMPLES = 32
 AMPLITUDE_M = (2e-6, 2e-3)
 MAX_POINTS = 400
 BAND_HZ = (750.0, 805.0)
+#: the point whose stability is timed, Hz (inside BAND_HZ)
+STABILITY_HZ = 780.0
 
 
 def _system():
@@ -64,13 +79,13 @@ def _backbone(H: int, blocks: bool) -> dict:
             "damping_ratio": b.damping_ratio.tolist()}
 
 
-def _branch(H: int, blocks: bool, stability: bool = False) -> dict:
+def _branch(H: int, blocks: bool, stability: bool = False, condense: bool = False) -> dict:
     from jointdyn.hb import HBOptions, continue_hb
 
     s = _system()
     g0, g1 = (2.0 * math.pi * f / s.w0 for f in BAND_HZ)
     t0 = time.perf_counter()
-    br = continue_hb(s, g0, g1, harmonics=H, samples=SAMPLES, condense=False, progress=False,
+    br = continue_hb(s, g0, g1, harmonics=H, samples=SAMPLES, condense=condense, progress=False,
                      stability=None if stability else False, hb_options=HBOptions(block_preconditioner=blocks))
     peak = max(br.peaks, key=lambda p: p.amplitude_m) if br.peaks else None
     return {"s": time.perf_counter() - t0, "status": br.status.value, "points": int(br.lam.size),
@@ -78,6 +93,44 @@ def _branch(H: int, blocks: bool, stability: bool = False) -> dict:
             "stability": br.stability, "unstable_points": int(np.sum(~br.stable)) if stability else None,
             "peak_hz": None if peak is None else peak.gamma * s.w0 / (2.0 * math.pi),
             "peak_m": None if peak is None else peak.amplitude_m}
+
+
+def _stability_point(H: int, condense: bool) -> dict:
+    """One point's stability at STABILITY_HZ: the solve, then point_stability timed alone (CPU s)."""
+    from jointdyn.hb import StabilityOptions, harmonic_balance
+    from jointdyn.hb.floquet import point_stability
+
+    s = _system()
+    sol = harmonic_balance(s, 2.0 * math.pi * STABILITY_HZ / s.w0, harmonics=H, samples=SAMPLES,
+                           response_dof=s.output_dof, condense=condense, stability=False)
+    p = sol.problem
+    lam = p.f1_ref
+    JX = p.evaluate(sol.X, lam).JX
+    c0, t0 = time.process_time(), time.perf_counter()
+    stable, growth, _ = point_stability(p, JX, p.omega(lam), StabilityOptions())
+    return {"s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0, "status": sol.status.value,
+            "unknowns": int(p.size), "stable": bool(stable), "growth": float(growth),
+            "amplitude_m": float(sol.amplitude_m)}
+
+
+def _relative(a, b):
+    return None if a is None or b is None else abs(a - b) / abs(b)
+
+
+def run_condensed() -> dict:
+    """The rows of condensation onto relative coordinates (module docstring)."""
+    out = {}
+    for H, order in ((1, (True, False)), (3, (False, True))):
+        for cond in order:
+            out[f"H{H}_hb_{'condensed' if cond else 'blocks'}"] = isolated(_branch, H, not cond, False, cond,
+                                                                            label="condensed")
+        a, b = out[f"H{H}_hb_condensed"], out[f"H{H}_hb_blocks"]
+        out[f"H{H}_peak_rel_diff"] = {k: _relative(a.get(k), b.get(k)) for k in ("peak_hz", "peak_m")}
+        out[f"H{H}_cpu_ratio_blocks_over_condensed"] = b["cpu_s"] / a["cpu_s"] if a.get("points") else None
+    st = {c: isolated(_stability_point, 3, c, label="condensed") for c in (True, False)}
+    out["H3_stability_point_condensed"], out["H3_stability_point_full"] = st[True], st[False]
+    out["H3_stability_cpu_ratio"] = st[False]["cpu_s"] / st[True]["cpu_s"] if "growth" in st[True] else None
+    return out
 
 
 def _compare_backbones(a: dict, b: dict) -> float:
@@ -105,6 +158,8 @@ def run(quick: bool) -> dict:
         blk = isolated(_branch, H, True)
         out[f"H{H}_hb_direct"], out[f"H{H}_hb_blocks"] = ref, blk
         out[f"H{H}_hb_blocks_stability"] = isolated(_branch, H, True, True)
+    if not quick:
+        out["condensed"] = run_condensed()
     return out
 
 
@@ -112,4 +167,7 @@ if __name__ == "__main__":
     import json
     import sys
 
-    print(json.dumps(run("--full" not in sys.argv), indent=1))
+    if "--condensed" in sys.argv:
+        print(json.dumps(run_condensed(), indent=1))
+    else:
+        print(json.dumps(run("--full" not in sys.argv), indent=1))

@@ -25,7 +25,7 @@ BAD = {
                 "turning_band_log_q": (float("nan"), "finite"), "fold_window": (0, ">= 1"),
                 "peak_prominence": (1.0, "[0.0, 1.0)"), "jacobian_budget_bytes": (0, ">= 1"),
                 "max_gamma_step": (-0.01, "(0, inf)"), "condense_min_dofs": (0, ">= 1"),
-                "condense_max_fraction": (0.0, "(0.0, 1.0]")},
+                "condense_max_fraction": (0.0, "(0.0, 1.0]"), "condense_relative": (1, "True or False")},
     EPMCOptions: {"ds_start": (0.0, "(0, inf)"), "ds_max": (-1.0, "(0, inf)"), "tol": (0.0, "(0, inf)"),
                   "start_max_iter": (0, ">= 1"), "auto_check_points": (0, ">= 1")},
     QSMAOptions: {"steps_per_decade": (0, ">= 1"), "decades_below": (0, ">= 1"), "substeps": (0, ">= 1"),

@@ -50,7 +50,11 @@ Retained DOFs: every DOF of a contact's tangential selection, DOF 0 (the
 DOF the branch monitor of :mod:`jointdyn.hb.frc` measures) and the
 response DOFs asked for; any other DOF's response is recovered from the
 solution (:meth:`CondensedHBProblem.dof_coefficients` with the parameter
-value, :meth:`CondensedHBProblem.full_coefficients`).
+value, :meth:`CondensedHBProblem.full_coefficients`). Where the contacts and
+pairs act on relative coordinates (a pair's x_a - x_b) that are fewer than
+those DOFs, the problem keeps the coordinates y = S x instead
+(:mod:`jointdyn.hb._coordinates`): everything above holds with the rows of
+the retained DOFs c replaced by S (H_cc = S H S^T, Psi_c = S Psi).
 
 Stability: Hill's method on the full structure. Where its companion matrix
 is small (``StabilityOptions.dense_max_rows``) the full Jacobian is
@@ -75,12 +79,13 @@ from .. import config
 from .._cache import by_identity
 from .._jit import jit
 from ..damping import dense_damping, is_operator
-from ..kinematics import contact_kinematics, selection_matrix
 from ..systems import System, free_modes
+from ._coordinates import Coordinates, retained_coordinates, retained_dofs, static_cholesky
 from .options import HBOptions, hb_options
-from .problem import HBProblem, _linear_blocks, contacts_only, held_by_contacts
+from .problem import HBProblem, _linear_blocks, held_by_contacts
 
-__all__ = ["Receptance", "receptance", "retained_dofs", "CondensedHBProblem", "make_problem", "use_condensed"]
+__all__ = ["Receptance", "receptance", "retained_dofs", "retained_coordinates", "CondensedHBProblem",
+           "make_problem", "use_condensed"]
 
 #: the damping is modal (receptance by the undamped modes) when C = alpha M +
 #: beta K to this fraction of max |C|, or when the off-diagonal entries of
@@ -94,6 +99,10 @@ HB_CONDENSE_STATIC_RTOL = 1e-6
 #: the spectral expansion H of the receptance must satisfy Z(W) H(W) = I at one
 #: frequency to this, relative to max |Z| max |H| (backward error)
 HB_CONDENSE_CHECK_RTOL = 1e-9
+#: condensed onto more than this many coordinates, the blocks H_yy = P diag(g) P^T and their inverses are
+#: formed by BLAS and LAPACK per harmonic (:func:`_blas_blocks`); up to it by one compiled pass over the
+#: distinct entries (:func:`_condensed_blocks`, whose derivative costs O(m^4))
+HB_CONDENSE_BLAS_MIN = 16
 
 #: kinds of spectral expansion of the receptance
 MODAL, STATE_SPACE = "modal", "state-space"
@@ -160,6 +169,17 @@ class Receptance:
         E = np.zeros((self.basis[3].shape[0], idx.size))
         E[idx, np.arange(idx.size)] = 1.0
         return self._coordinates(E).T
+
+    def rows_of(self, coords):
+        """S Psi (m, R) of the coordinates ``coords`` (:class:`~jointdyn.hb._coordinates.Coordinates`,
+        y = S x): the rows of their DOFs for unit rows, else the rows' combinations."""
+        if coords.unit:
+            return self.rows(coords.dofs)
+        if self.basis is None:
+            from scipy.sparse import csr_matrix
+
+            return np.asarray(csr_matrix(coords.S) @ self.vectors)
+        return self._coordinates(np.ascontiguousarray(coords.S.T)).T
 
     def project(self, F):
         """Psi^T F (R,) for a load vector F (n,), real or complex, N."""
@@ -481,65 +501,56 @@ def _check(system: System, rec: Receptance, w2) -> None:
                          f"{err:.3g} (allowed {bound:.3g}); use condense=False")
 
 
-def retained_dofs(system: System, response_dofs=()) -> np.ndarray:
-    """Sorted DOFs kept by a condensed problem: contact selections (tangential
-    and, for normal springs, normal), the DOFs of the interfaces' node pairs, DOF 0 and
-    ``response_dofs``."""
-    kin = contact_kinematics(contacts_only(system))
-    B = np.vstack([selection_matrix(kin, system.ndof), selection_matrix(kin, system.ndof, normal=True)])
-    keep = set(np.flatnonzero(np.any(B != 0.0, axis=0)).tolist()) | {0}
-    for itf in system.interfaces:  # the six DOFs of every node pair
-        keep |= set(itf.pairs[itf.pairs >= 0].tolist())
-    for d in response_dofs:
-        d = int(d)
-        if not 0 <= d < system.ndof:
-            raise ValueError(f"response_dof must be in [0, {system.ndof - 1}], got {d!r}")
-        keep.add(d)
-    return np.array(sorted(keep), dtype=np.int64)
-
-
 def _static_parts(K, c, rec: Receptance | None = None):
-    """(Z0, S0): the static Schur complement Z0 = K_cc - K_co K_oo^-1 K_oc and the static
-    recovery: x = S0(rows) x_c for a static load on the retained DOFs c only.
+    """(Z0, S0): the static Schur complement Z0 = (S K^-1 S^T)^-1 onto the retained coordinates ``c``
+    (a :class:`~jointdyn.hb._coordinates.Coordinates`, or DOFs: their unit rows) and the static recovery:
+    x = S0(rows) y for a static load S^T lambda on them.
 
-    With a receptance ``rec`` whose static factors g(0) are all finite and no
-    smaller than ``HB_CONDENSE_STATIC_RTOL`` of the largest (K positive
-    definite), Z0 = H_cc(0)^-1 from the expansion and S0 is a function
-    ``rows -> H(0)[rows, c] Z0`` (O(n^2) per row, nothing O(n^3)). Otherwise by
-    a Cholesky factorisation of K_oo: S0 is then the array (n, m) (rows c:
-    identity, other rows o: -K_oo^-1 K_oc) indexed by rows; ValueError naming
-    ``condense`` when K_oo is not positive definite (a static load on the other
-    DOFs would have no unique response).
+    With a receptance ``rec`` whose static factors g(0) are all finite and no smaller than
+    ``HB_CONDENSE_STATIC_RTOL`` of the largest (K positive definite), Z0 = H_yy(0)^-1 from the
+    expansion and S0 ``rows -> H(0)[rows] S^T Z0`` (O(n^2) per row). Otherwise by a Cholesky
+    factorisation of K on null(S) (:func:`~jointdyn.hb._coordinates.static_cholesky`, which refuses).
     """
+    coords = c if isinstance(c, Coordinates) else Coordinates.of_dofs(c, K.shape[0])
     if rec is not None:
         g0 = rec.factors(np.zeros(1))[0][0]
         inv = np.abs(1.0 / g0) if np.all(np.isfinite(g0)) and np.all(g0 != 0.0) else None
         if inv is not None and float(inv.min()) > HB_CONDENSE_STATIC_RTOL * float(inv.max()):
-            Pc = rec.rows(c)
+            Pc = rec.rows_of(coords)
             Z0 = np.linalg.inv(((Pc * g0) @ Pc.T).real)
             right = g0[:, None] * (Pc.T @ Z0)
             return Z0, lambda rows: (rec.rows(rows) @ right).real
-    return _static_cholesky(K, c)
+    return static_cholesky(K, coords)
 
 
 def _static_cholesky(K, c):
-    """(Z0, S0) of :func:`_static_parts` by a Cholesky factorisation of K_oo."""
-    from scipy.linalg import LinAlgError, cho_factor, cho_solve
+    """(Z0, S0) of :func:`_static_parts` onto the DOFs ``c`` by a Cholesky factorisation of K_oo."""
+    return static_cholesky(K, Coordinates.of_dofs(c, K.shape[0]))
 
-    n = K.shape[0]
-    o = np.setdiff1d(np.arange(n), c)
-    S0 = np.zeros((n, c.size))
-    S0[c, np.arange(c.size)] = 1.0
-    if o.size == 0:
-        return K[np.ix_(c, c)].copy(), S0.__getitem__
-    try:
-        cf = cho_factor(K[np.ix_(o, o)])
-    except LinAlgError:
-        raise ValueError("condense: K restricted to the DOFs that are not retained must be positive definite "
-                         "(the structure must be held when the contact DOFs are fixed)") from None
-    T0 = -cho_solve(cf, K[np.ix_(o, c)])
-    S0[o] = T0
-    return K[np.ix_(c, c)] + K[np.ix_(c, o)] @ T0, S0.__getitem__
+
+def _coordinate_sum(P, g):
+    """P diag(g) P^T (m, m) complex for P (m, R) real or complex and g (R,) complex."""
+    if np.isrealobj(P):
+        return _real_times(P, g[:, None] * P.T)
+    return (P * g[None, :]) @ P.T
+
+
+def _blas_blocks(rec: Receptance, P, k, w: float, Z0, out) -> None:
+    """What :func:`_condensed_blocks` writes into ``out``, by BLAS and LAPACK per harmonic (many coordinates):
+    the factors g, dg/dw (H, R), Z_red and dZ_red/dw (H, m, m) and their real block matrices."""
+    g, dg, Zk, dZk, Zb, dZb = out
+    gw, dgw = rec.factors(k * w)
+    g[:], dg[:] = gw, dgw * k[:, None]
+    m = Z0.shape[0]
+    Zb[:m, :m] = Z0
+    for h in range(k.size):
+        Z = np.linalg.inv(_coordinate_sum(P, g[h]))
+        Zk[h], dZk[h] = Z, -(Z @ _coordinate_sum(P, dg[h]) @ Z)
+        row = (2 * h + 1) * m
+        for A, B in ((Zk[h], Zb), (dZk[h], dZb)):
+            B[row:row + m, row:row + m] = B[row + m:row + 2 * m, row + m:row + 2 * m] = A.real
+            B[row:row + m, row + m:row + 2 * m] = A.imag
+            B[row + m:row + 2 * m, row:row + m] = -A.imag
 
 
 def _to_complex(v, nh, m):
@@ -558,11 +569,14 @@ def _to_real(x0, xk):
 
 
 class CondensedHBProblem(HBProblem):
-    """Harmonic-balance residual condensed exactly onto the retained DOFs.
+    """Harmonic-balance residual condensed exactly onto the retained coordinates.
 
     Same interface as :class:`~jointdyn.hb.problem.HBProblem` (``evaluate``,
     ``linear_guess``, ``amplitudes``, ...); the unknowns are the harmonics
-    of ``dofs`` (:func:`retained_dofs`) only. See the module docstring.
+    of the coordinates y = S x of ``coordinates``
+    (:func:`~jointdyn.hb._coordinates.retained_coordinates`: the retained DOFs, or relative
+    coordinates) only; ``dofs`` gives the DOF of each unit row, -1 for a relative coordinate. See
+    the module docstring.
 
     Parameters
     ----------
@@ -579,21 +593,26 @@ class CondensedHBProblem(HBProblem):
             raise ValueError("system must be a jointdyn.System")
         self.options = hb_options(options)
         use_condensed(system, True)  # refuses a structure held only through its contacts
-        c = retained_dofs(system, response_dofs)
+        #: the retained coordinates y = S x (:class:`~jointdyn.hb._coordinates.Coordinates`)
+        self.coordinates = retained_coordinates(system, response_dofs, self.options.condense_relative)
         self.receptance = receptance(system)  # first: it also gives system.w0 (_share_w0)
-        self._setup(system, harmonics, samples, parameter, gamma, max_passes, c)
-        self._Z0, self._S0 = _static_parts(system.K, c, self.receptance)
-        self._Psi_c = np.ascontiguousarray(self.receptance.rows(c))
+        self._setup(system, harmonics, samples, parameter, gamma, max_passes, self.coordinates.dofs)
+        self._dof_positions.pop(-1, None)  # -1 marks a relative coordinate, no DOF
+        self._Z0, self._S0 = _static_parts(system.K, self.coordinates, self.receptance)
+        #: S Psi (m, R): the expansion's rows of the coordinates
+        self._Psi_c = np.ascontiguousarray(self.receptance.rows_of(self.coordinates))
         self._a = self.receptance.a.astype(np.complex128)
         self._k = np.arange(1, self.H + 1, dtype=np.float64)
         self._kind = MODAL_CODE if self.receptance.kind == MODAL else STATE_SPACE_CODE
-        #: distinct entries (i <= j) of the symmetric m x m blocks and the products
-        #: Psi_ir Psi_jr (R, pairs) that H_cc = Psi_c diag(g) Psi_c^T sums
-        self._pairs = tuple(np.ascontiguousarray(v, dtype=np.int64) for v in np.triu_indices(c.size))
-        self._Q = np.ascontiguousarray((self._Psi_c[self._pairs[0]] * self._Psi_c[self._pairs[1]]).T,
-                                       dtype=np.complex128)
-        R, m = self._Psi_c.shape[1], c.size
-        self._exp = (self._kind, self._a, self.receptance.b, self._Q, self._k)
+        R, m = self._Psi_c.shape[1], self.n
+        self._pairs = self._exp = None  # many coordinates: _blas_blocks
+        if m <= HB_CONDENSE_BLAS_MIN:
+            #: distinct entries (i <= j) of the symmetric m x m blocks and the products
+            #: Psi_ir Psi_jr (R, pairs) that H_yy = Psi_c diag(g) Psi_c^T sums
+            self._pairs = tuple(np.ascontiguousarray(v, dtype=np.int64) for v in np.triu_indices(m))
+            Q = np.ascontiguousarray((self._Psi_c[self._pairs[0]] * self._Psi_c[self._pairs[1]]).T,
+                                     dtype=np.complex128)
+            self._exp = (self._kind, self._a, self.receptance.b, Q, self._k)
         # workspace of _condensed_blocks (the real block matrices stay zero off their blocks)
         self._work = (np.empty((self.H, R), complex), np.empty((self.H, R), complex),
                       np.empty((self.H, m, m), complex), np.empty((self.H, m, m), complex),
@@ -608,6 +627,19 @@ class CondensedHBProblem(HBProblem):
     def condensed(self) -> bool:
         return True
 
+    def _on_unknowns(self, B):
+        """Rows B (k, ndof) in the retained coordinates (:meth:`Coordinates.express`)."""
+        return self.coordinates.express(B)
+
+    def _pair_positions(self, table):
+        """Per pair of ``table`` (pairs, 6) the positions of its three relative coordinates (side a, side b):
+        of its DOFs among the unknowns, or (j, -1) / (-1, j) where the coordinate is +- unknown j."""
+        pos = np.full(table.shape, -1, dtype=np.int64)
+        for i, row in enumerate(table):
+            for k in range(3):
+                pos[i, k], pos[i, k + 3] = self.coordinates.position(int(row[k]), int(row[k + 3]))
+        return pos
+
     # --- linear part at a frequency -----------------------------------------
     def _linear_at(self, w: float):
         """(Zb, dZb, Zk, dZk, g1, dg1) at w (rad/s), kept for the last w.
@@ -619,7 +651,10 @@ class CondensedHBProblem(HBProblem):
         if self._at_w is not None and self._at_w[0] == w:
             return self._at_w[1]
         ws = self._work
-        _condensed_blocks(self._exp, self._pairs, float(w), self._Z0, ws)
+        if self._exp is None:
+            _blas_blocks(self.receptance, self._Psi_c, self._k, float(w), self._Z0, ws)
+        else:
+            _condensed_blocks(self._exp, self._pairs, float(w), self._Z0, ws)
         g, dg, Zk, dZk, Zb, dZb = ws
         out = (Zb, dZb, Zk, dZk, g[0].copy(), dg[0].copy())  # harmonic 1: k = 1
         self._at_w = (w, out)
@@ -684,8 +719,8 @@ class CondensedHBProblem(HBProblem):
         """Coefficients (nh, len(rows)) of the system DOFs ``rows`` at the condensed X, parameter p.
 
         Per harmonic k >= 1, x = H(k w) (F_k - S^T gamma_k) with the contact
-        forces on the retained DOFs gamma = F_red - Z_red X (so that the
-        retained rows reproduce X); statically x = S0 x_c. Retained rows are
+        forces on the retained coordinates gamma = F_red - Z_red X (so that the
+        coordinates reproduce X); statically x = S0 y. Rows of retained DOFs are
         X itself.
         """
         rows = np.asarray(rows, dtype=np.int64)
@@ -696,10 +731,10 @@ class CondensedHBProblem(HBProblem):
         x0, _ = _to_complex(X, self.nh, self.n)
         _, gk = _to_complex(gamma, self.nh, self.n)
         g, _ = self.receptance.factors(self._k * w)
-        modal = -(gk @ self._Psi_c)  # (H, R): -Psi_c^T gamma_k
+        modal = -(gk @ self._Psi_c)  # (H, R): -(S Psi)^T gamma_k
         modal[0] += self._modal(f)
         out = _to_real(self._S0(rows) @ x0, (g * modal) @ self.receptance.rows(rows).T)
-        kept = np.flatnonzero(np.isin(rows, self.dofs))
+        kept = np.flatnonzero(np.isin(rows, self.dofs[self.dofs >= 0]))
         Xm = X.reshape(self.nh, self.n)
         for j in kept:
             out[:, j] = Xm[:, self.dof_index(int(rows[j]))]
@@ -707,7 +742,7 @@ class CondensedHBProblem(HBProblem):
 
     def dof_coefficients(self, X, dof: int, p=None):
         X = np.asarray(X, dtype=np.float64)
-        if np.any(self.dofs == dof):
+        if dof in self._dof_positions:
             return super().dof_coefficients(X, dof)
         if not 0 <= dof < self.system.ndof:
             raise ValueError(f"dof must be in [0, {self.system.ndof - 1}], got {dof!r}")
@@ -732,16 +767,20 @@ class CondensedHBProblem(HBProblem):
     def full_jacobian(self, JX, w):
         """The full problem's dR/dX (ndof(2H+1) square) from the condensed one at w (rad/s).
 
-        The contact part (:meth:`contact_jacobian`) acts on the retained DOFs only; the
-        linear part is the full A(w) of :func:`~jointdyn.hb.problem._linear_blocks`.
+        The contact part (:meth:`contact_jacobian`) acts on the retained coordinates only
+        (S^T G S per pair of harmonics); the linear part is the full A(w) of
+        :func:`~jointdyn.hb.problem._linear_blocks`.
         """
         n, nh, m = self.system.ndof, self.nh, self.n
         AK, AC, AM = _linear_blocks(self.system, self.H)
         J = AK + w * AC + (w * w) * AM
         G = self.contact_jacobian(JX, w)
-        idx = (np.arange(nh)[:, None] * n + self.dofs[None, :]).ravel()
-        J[np.ix_(idx, idx)] += G.reshape(nh * m, nh * m)
-        return J
+        if self.coordinates.unit:
+            idx = (np.arange(nh)[:, None] * n + self.dofs[None, :]).ravel()
+            J[np.ix_(idx, idx)] += G.reshape(nh * m, nh * m)
+            return J
+        Sb = np.kron(np.eye(nh), self.coordinates.S)  # (nh m, nh n)
+        return J + Sb.T @ G @ Sb
 
     def dense_jacobians(self) -> bool:
         """True: a condensed branch is continued with dense condensed Jacobians at any size."""
@@ -753,8 +792,10 @@ def use_condensed(system: System, condense=None, response_dofs=(), options: HBOp
 
     Automatic: condensed when the system has at least
     ``options.condense_min_dofs`` DOFs, retains at most
-    ``options.condense_max_fraction`` of them (:class:`~jointdyn.hb.options.HBOptions`), and K is positive definite
-    on the DOFs that are not retained. A structure held only through its
+    ``options.condense_max_fraction`` of them (:class:`~jointdyn.hb.options.HBOptions`; its retained DOFs,
+    even where the problem then keeps fewer relative coordinates: the lap joint's 362 coordinates of 733
+    DOFs condensed cost more than the harmonic blocks, docs/performance.md), and K is positive definite
+    on the motions that keep the retained coordinates at zero. A structure held only through its
     contacts (:func:`~jointdyn.hb.problem.held_by_contacts`) is never
     condensed: the receptance and the static Schur complement are those of K,
     which has a rigid-body mode there (ValueError naming ``condense`` when it
@@ -784,11 +825,11 @@ def use_condensed(system: System, condense=None, response_dofs=(), options: HBOp
     opts = hb_options(options)
     if system.ndof < opts.condense_min_dofs:
         return False
-    c = retained_dofs(system, response_dofs)
-    if c.size > opts.condense_max_fraction * system.ndof:
-        return False
+    if retained_dofs(system, response_dofs).size > opts.condense_max_fraction * system.ndof:
+        return False  # the DOFs, not the relative coordinates (docs/performance.md: the lap joint)
     try:
-        _static_parts(system.K, c, receptance(system))
+        _static_parts(system.K, retained_coordinates(system, response_dofs, opts.condense_relative),
+                      receptance(system))
     except ValueError:
         return False
     return True

@@ -1,14 +1,15 @@
 """Hill's method for a condensed harmonic-balance problem, at the cost of the condensed solve.
 
 A condensed problem (:class:`~jointdyn.hb.condense.CondensedHBProblem`)
-solves for the harmonics of the m retained DOFs c only; its stability is
+solves for the harmonics of the m retained coordinates y = S x only (DOFs, or
+relative coordinates: :mod:`jointdyn.hb._coordinates`); its stability is
 that of the full structure, Hill's quadratic problem of n DOFs::
 
     Q(s) = J_X + s D1 + s^2 D2 = Lin(s) + S^T G S,
 
 Lin the linear terms (the full structure's J_X without its contacts, with
-D1 = I (x) C + 2 w nabla (x) M and D2 = I (x) M), S the selection of the
-retained DOFs of every harmonic and G = JX_c - Z_red(w) the contact part of
+D1 = I (x) C + 2 w nabla (x) M and D2 = I (x) M), S the retained
+coordinates' rows for every harmonic and G = JX_c - Z_red(w) the contact part of
 the condensed Jacobian (m (2H+1) square, it couples harmonics).
 Shift-invert Arnoldi (:func:`~jointdyn.hb.hill_arnoldi.shift_invert_exponents`:
 the shifts, ARPACK and Hill's selection of the full method) needs one solve
@@ -25,7 +26,7 @@ Z_q(sigma + i k w) and Z_q(sigma - i k w), with::
 
 the receptance of :func:`~jointdyn.hb.condense.receptance` at a complex
 frequency (Y, lambda_r the damped eigenpairs in modal coordinates, Psi =
-Phi Y). With P = I (x) Phi_c (the rows of the retained DOFs) the solve of
+Phi Y). With P = I (x) Phi_c (Phi_c = S Phi: the coordinates' rows) the solve of
 (Lin + P^T G P) x = r is, by the Woodbury identity::
 
     u = Lin^-1 r,   (I + H_cc G) x_c = P u,   x = u - Lin^-1 P^T G x_c,
@@ -66,13 +67,14 @@ def _modes(problem):
     """(Phi_c (m, n) real, Psi_c (m, R), w_r^2 (n,) or None, c (n,) or None, Ct (n, n) or None, Y (n, R)
     or None, lambda (R,) or None) of a condensed problem (module docstring): modal damping with w_r^2 and
     c, a state-space expansion with Ct, Y and lambda."""
-    rec = problem.receptance
-    Psi_c = np.ascontiguousarray(rec.rows(problem.dofs))
+    rec, coords = problem.receptance, problem.coordinates
+    Psi_c = np.ascontiguousarray(rec.rows_of(coords))
     if rec.modes is None:  # modal: Psi = Phi
         return Psi_c, Psi_c, np.asarray(rec.a, dtype=np.float64), np.asarray(rec.b, dtype=np.float64), None, \
             None, None
     Phi, Ct, Y = rec.modes
-    return (np.ascontiguousarray(Phi[problem.dofs]), Psi_c, None, None, np.asarray(Ct), np.asarray(Y),
+    Phi_c = Phi[coords.dofs] if coords.unit else coords.S @ Phi
+    return (np.ascontiguousarray(Phi_c), Psi_c, None, None, np.asarray(Ct), np.asarray(Y),
             np.asarray(rec.a, dtype=np.complex128))
 
 
@@ -178,7 +180,7 @@ def condensed_hill_exponents(problem, JX, w, options: StabilityOptions | None = 
     Parameters
     ----------
     problem : CondensedHBProblem
-        The condensed problem (its receptance and retained DOFs).
+        The condensed problem (its receptance and retained coordinates).
     JX : ndarray (m(2H+1), m(2H+1))
         Its Jacobian dR/dX at the solution, N/m.
     w : float

@@ -92,7 +92,15 @@ class HBOptions:
         least this many DOFs (default 12; >= 1) ...
     condense_max_fraction : float
         ... whose retained DOFs (contacts, DOF 0, response DOFs) are at most this fraction of all DOFs
-        (default 0.5; in (0, 1]).
+        (default 0.5; in (0, 1]). The DOFs even where the condensed problem keeps fewer relative
+        coordinates (``condense_relative``): on the shipped lap joint (362 coordinates of 733 DOFs) the
+        condensed branch took about twice the CPU seconds of the full problem's harmonic blocks
+        (docs/performance.md), so the automatic choice leaves it to them.
+    condense_relative : bool
+        A condensed problem keeps relative coordinates (a contact's selection row, a node pair's
+        ``x_a - x_b``: three unknowns per pair and harmonic instead of six) where they are fewer than the
+        retained DOFs and independent, else the DOFs (default True; False: always the DOFs;
+        :mod:`jointdyn.hb._coordinates`).
     """
 
     dense_max_unknowns: int = 2000
@@ -115,14 +123,16 @@ class HBOptions:
     max_gamma_step: float = 0.02
     condense_min_dofs: int = 12
     condense_max_fraction: float = 0.5
+    condense_relative: bool = True
 
     def __post_init__(self) -> None:
         ints = {"dense_max_unknowns": 0, "auto_max_harmonics": 1, "auto_max_samples": 4, "start_max_iter": 1,
                 "solve_max_iter": 1, "fold_window": 1, "jacobian_budget_bytes": 1, "condense_min_dofs": 1}
         for name, least in ints.items():
             object.__setattr__(self, name, V.positive_int(name, getattr(self, name), least))
-        if not isinstance(self.block_preconditioner, bool):
-            raise ValueError(f"block_preconditioner must be True or False, got {self.block_preconditioner!r}")
+        for name in ("block_preconditioner", "condense_relative"):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"{name} must be True or False, got {getattr(self, name)!r}")
         for name in ("auto_early_drop", "unbounded_fail_fraction", "saturation_slip_fraction",
                      "condense_max_fraction"):
             object.__setattr__(self, name, V.in_range(name, getattr(self, name), 0.0, 1.0, lo_open=True))

@@ -257,9 +257,9 @@ class HBProblem:
         #: per contact (n0, n1, delta) of its normal load as given in the system (N, N, rad);
         #: (P, kn, 0) for a spring contact (kinematics.ContactKinematics.normal_par)
         self.load_coefficients = kin.normal_par.copy()
-        self.B = list(selection_matrix(kin, self.system.ndof)[:, self.dofs])
+        self.B = list(self._on_unknowns(selection_matrix(kin, self.system.ndof)))
         #: normal rows (g_c = Bn[c] . x over the unknown DOFs), zero for a prescribed load
-        self.Bn = list(selection_matrix(kin, self.system.ndof, normal=True)[:, self.dofs])
+        self.Bn = list(self._on_unknowns(selection_matrix(kin, self.system.ndof, normal=True)))
         self._Bm = np.array(self.B, dtype=np.float64).reshape(nc, self.n)
         self._Bnm = np.array(self.Bn, dtype=np.float64).reshape(nc, self.n)
         #: (P, kn, restart load at a re-contact between samples) per contact, kn = 0 for a prescribed load
@@ -281,16 +281,24 @@ class HBProblem:
         self.has_interfaces = bool(itfs)
         if not itfs:
             return
-        table = np.vstack([itf.pairs for itf in itfs])
+        #: per pair (stacked over the interfaces) the positions of its six DOFs among the unknowns (-1: fixed;
+        #: a condensed problem on relative coordinates: of the pair's coordinates, side a or b by their sign)
+        self.pair_positions = self._pair_positions(np.vstack([itf.pairs for itf in itfs]))
+        #: per pair kt, kn, mu, preload (N/m, N/m, -, N)
+        self.pair_params = np.ascontiguousarray(np.vstack([itf.params for itf in itfs]))
+        self._pair_dirs = pair_directions(self.E, self.restart_at_reference)
+
+    def _on_unknowns(self, B):
+        """Rows B (k, ndof) acting on the system DOFs, as rows acting on the unknowns (k, n)."""
+        return B[:, self.dofs]
+
+    def _pair_positions(self, table):
+        """Positions among the unknowns of the DOFs of the pairs' ``table`` (pairs, 6), -1 kept (fixed)."""
         pos = np.full(table.shape, -1, dtype=np.int64)
         for (i, k), d in np.ndenumerate(table):
             if d >= 0:
                 pos[i, k] = self.dof_index(int(d))
-        #: per pair (stacked over the interfaces) the positions of its six DOFs among the unknowns (-1: fixed)
-        self.pair_positions = pos
-        #: per pair kt, kn, mu, preload (N/m, N/m, -, N)
-        self.pair_params = np.ascontiguousarray(np.vstack([itf.params for itf in itfs]))
-        self._pair_dirs = pair_directions(self.E, self.restart_at_reference)
+        return pos
 
     def _aft_grid(self):
         """(tau, E, P, uniform) of the AFT: the phases the laws are marched at, their synthesis and analysis
@@ -826,7 +834,7 @@ def _problem_at(cls, parameter, H, Ns, max_passes, w, ndof, ncontacts, p, dofs):
     kw = {"harmonics": H, "samples": Ns, "parameter": _FixedFrequency(w), "max_passes": max_passes}
     if dofs is None:
         return cls(system, **kw)
-    q = cls(system, response_dofs=dofs, **kw)
+    q = cls(system, response_dofs=[d for d in dofs if d >= 0], **kw)  # -1: a relative coordinate
     if tuple(int(d) for d in q.dofs) != dofs:
         raise ValueError(f"build({parameter.name} = {p!r}) must keep the contacts on the same DOFs "
                          f"(condensed onto {list(dofs)}, got {q.dofs.tolist()})")
