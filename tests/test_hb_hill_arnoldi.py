@@ -214,3 +214,40 @@ def test_single_solution_decides_a_marginal_growth_by_the_period_map_as_the_bran
     kept = harmonic_balance(s, br.lam[i], harmonics=5, samples=64, guess=br.X[i],
                             stability=StabilityOptions(confirm=opt.rtol))  # an empty band: Hill's label stands
     assert [c for _, c in calls] == [0] and not kept.stable
+
+
+def _chain_point():
+    """One solution of the damper with a chain of three masses (8 exponents) near its fold pair: its Jacobian,
+    M, C, w, H."""
+    s = _damper_with_a_chain(3)
+    sol = harmonic_balance(s, 1.2, harmonics=3, samples=64, stability=False, condense=False)
+    assert sol.status.ok
+    p = sol.problem
+    return p.evaluate(sol.X, p.f1_ref).JX, s.M, s.C, p.omega(p.f1_ref), p.H
+
+
+@pytest.mark.parametrize("k", [12, 3])
+def test_one_real_shift_finds_every_eigenvalue_of_the_band_it_reports(k):
+    """arnoldi_shifts = 1: every eigenvalue of Hill's whole companion matrix (dense LAPACK) in the band it
+    reports between 0 and i w/2 is found; where its disk does not reach i w/2 (few eigenvalues, k = 3) the
+    covering shifts are added and the result is that of their layout."""
+    JX, M, C, w, H = _chain_point()
+    one = hill_arnoldi_exponents(JX, M, C, w, H, StabilityOptions(method="arnoldi", arnoldi_eigenvalues=k,
+                                                                  arnoldi_shifts=1))
+    three = hill_arnoldi_exponents(JX, M, C, w, H, StabilityOptions(method="arnoldi", arnoldi_eigenvalues=k,
+                                                                    arnoldi_shifts=3))
+    _, lam = hill_exponents(JX, M, C, w, H)
+    assert one.band > 0.0
+    inside = lam[(np.abs(lam.real) <= one.band) & (np.abs(lam.imag) <= 0.5 * w)]
+    assert inside.size
+    for z in inside:
+        assert np.min(np.abs(one.exponents - z)) <= EXPONENT_ATOL * w
+    assert abs(one.growth - three.growth) <= EXPONENT_ATOL
+    if k == 3:  # the covering shifts: the very layout of three
+        assert one.band == pytest.approx(three.band, rel=1e-12)
+        assert one.exponents.size == three.exponents.size
+        for z in three.exponents:
+            assert np.min(np.abs(one.exponents - z)) <= EXPONENT_ATOL * w
+    for name, bad in (("arnoldi_shifts", 0), ("arnoldi_cover_shifts", 1)):
+        with pytest.raises(ValueError, match=name):
+            StabilityOptions(**{name: bad})

@@ -82,6 +82,7 @@ from .problem import HBProblem, reference_scales
 from .floquet import companion_rows, confirmed_stability, growths, stability_method
 from .results import HBBranch, HBPeak, PointStatus, sliding_as_a_whole
 from .stability_options import StabilityOptions
+from .stability_schedule import checked_labels
 
 __all__ = ["continued_branch", "solve_point"]
 
@@ -142,7 +143,8 @@ class _Draft:
 
 
 def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBranch:
-    """HBBranch of the continued points: AFT diagnostics and Hill stability of every point.
+    """HBBranch of the continued points: AFT diagnostics of every point and the Hill stability of the points
+    :func:`~jointdyn.hb.stability_schedule.checked_labels` asks for (every point by default).
 
     The evaluations kept by the continuation monitor (``tr.evaluations``:
     parameter value -> (X, evaluation, amplitudes)) are reused where X is
@@ -155,48 +157,73 @@ def _make_branch(tr, status, message, parts: _Parts, peaks, uncovered) -> HBBran
     periodic_error = np.zeros(n)
     force_period = np.zeros(n, dtype=int)
     response0 = np.full((n, 3), np.nan)
-    ws = np.array([problem.omega(v) for v in lam])
-    growth = np.full(n, np.nan)
-    # the Floquet exponents of every point: dense Hill on chunks of points whose Jacobians fit in
-    # HBOptions.jacobian_budget_bytes, or shift-invert Arnoldi point by point (StabilityOptions.method_for)
+    for i in range(n):
+        ev = _kept(tr, X[i], lam[i], jacobian=False)
+        if len(ev) > 2:
+            response0[i] = ev[2]
+        ev = ev[1]
+        passes[i] = int(ev.info[INFO_PASSES])
+        periodic_error[i] = ev.info[INFO_ERROR]
+        force_period[i] = int(ev.info[INFO_PERIOD])
     method = stability_method(problem, tr.stability)
-    dense, need = method == "dense", method != "none"
-    chunk = max(1, min(n, problem.options.jacobian_budget_bytes // (8 * problem.size * problem.size))) if dense else 1
-    JXs = np.empty((chunk, problem.size, problem.size) if dense else (1, 0, 0))
-    lapack = method == "arnoldi" or (dense and companion_rows(problem) > tr.stability.small_eig)
-    with stage_progress(n if need else 0, f"stability ({method})", tr.progress, unit="point") as bar, \
-            (blas_threads() if lapack else contextlib.nullcontext()):
-        for i in range(n):
-            ev = tr.evaluations.get(float(lam[i]))
-            if ev is None or ev[0].tobytes() != X[i].tobytes() or (need and ev[1].JX is None):  # not kept for X
-                ev = (X[i], tr.evaluate(X[i], lam[i], dense),
-                      *(ev[2:] if ev is not None and ev[1].JX is None else ()))
-            if len(ev) > 2:
-                response0[i] = ev[2]
-            ev = ev[1]
-            passes[i] = int(ev.info[INFO_PASSES])
-            periodic_error[i] = ev.info[INFO_ERROR]
-            force_period[i] = int(ev.info[INFO_PERIOD])
-            if method == "arnoldi":
-                growth[i] = growths(problem, (ev.JX,), ws[i:i + 1], tr.stability, method)[0]
-                bar.update(1)
-            elif dense:
-                JXs[i % chunk] = ev.JX if isinstance(ev.JX, np.ndarray) else ev.JX.toarray()  # kept sparse
-                if i % chunk == chunk - 1 or i == n - 1:
-                    lo = i - i % chunk
-                    growth[lo:i + 1] = growths(problem, JXs[:i + 1 - lo], ws[lo:i + 1], tr.stability, method)
-                    bar.update(i + 1 - lo)
-    stable, checked = confirmed_stability(problem, X, lam, growth, tr.stability)
-    counters = {**parts.counters, "monodromy_checks": checked}
+    growth = np.full(n, np.nan)
+    if method == "none":
+        stable, checked, confirmed = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool), 0
+    else:
+        stable, checked, confirmed = _stability(tr, parts, growth, method)
+    counters = {**parts.counters, "monodromy_checks": confirmed}
     # folds need the stability on both sides; without it (no stability asked for) the turning points stand
     fold = (_saddle_nodes(parts.fold, stable, parts.segment, problem.options.fold_window)
-            if np.all(np.isfinite(growth)) else parts.fold)
+            if np.all(np.isfinite(growth[checked])) and (checked.any() or n == 0) else parts.fold)
     return HBBranch(problem=problem, parameter=problem.parameter.name, status=status, message=message, lam=lam,
                     X=X, segment=parts.segment, fold=fold, gap=parts.gap, counters=counters,
                     stable=stable, growth=growth, passes=passes,
                     periodic_error=periodic_error, force_period=force_period, response0=response0,
                     point_status=parts.point_status, peaks=tuple(peaks), uncovered=tuple(uncovered),
-                    response_dof=tr.dof, stability=_STABILITY_NAMES[method])
+                    response_dof=tr.dof, stability=_STABILITY_NAMES[method], stability_checked=checked,
+                    stability_check_every=tr.stability.check_every)
+
+
+def _kept(tr, X, lam, jacobian: bool, dense: bool = False):
+    """(X, evaluation, amplitudes...) at a point of the branch: the continuation monitor's where it kept the
+    very same X (and its Jacobian when ``jacobian``), else evaluated again (dense when ``dense``)."""
+    ev = tr.evaluations.get(float(lam))
+    if ev is None or ev[0].tobytes() != X.tobytes() or (jacobian and ev[1].JX is None):  # not kept for X
+        ev = (X, tr.evaluate(X, lam, dense), *(ev[2:] if ev is not None and ev[1].JX is None else ()))
+    return ev
+
+
+def _stability(tr, parts: _Parts, growth, method: str):
+    """(stable, checked, monodromy checks) of the branch's points; fills ``growth`` (max Re(s) / w) at the
+    checked points. Dense Hill on chunks of points whose Jacobians fit in ``HBOptions.jacobian_budget_bytes``,
+    or shift-invert Arnoldi point by point (``StabilityOptions.method_for``); the points checked are those
+    :func:`~jointdyn.hb.stability_schedule.checked_labels` asks for (``StabilityOptions.check_every``)."""
+    problem, opts = tr.problem, tr.stability
+    lam, X = parts.lam, parts.X
+    n = lam.size
+    ws = np.array([problem.omega(v) for v in lam])
+    dense = method == "dense"
+    chunk = max(1, min(n, problem.options.jacobian_budget_bytes // (8 * problem.size * problem.size))) if dense else 1
+    lapack = method == "arnoldi" or (dense and companion_rows(problem) > opts.small_eig)
+    confirmed = [0]
+
+    def label_of(idx):
+        for lo in range(0, idx.size, chunk):
+            part = idx[lo:lo + chunk]
+            JXs = [_kept(tr, X[i], lam[i], jacobian=True, dense=dense)[1].JX for i in part]
+            if dense:
+                JXs = np.array([J if isinstance(J, np.ndarray) else J.toarray() for J in JXs])  # kept sparse
+            growth[part] = growths(problem, JXs, ws[part], opts, method)
+            bar.update(part.size)
+        ok, m = confirmed_stability(problem, X[idx], lam[idx], growth[idx], opts)
+        confirmed[0] += m
+        return ok
+
+    with stage_progress(n, f"stability ({method})", tr.progress, unit="point") as bar, \
+            (blas_threads() if lapack else contextlib.nullcontext()):
+        stable, checked = checked_labels(parts.segment, parts.gap, parts.fold, opts.check_every, label_of)
+        bar.update(n - int(checked.sum()))  # the points whose label is carried over
+    return stable, checked, confirmed[0]
 
 
 #: the name of each stability method in an HBBranch (and the ``stability`` attribute of its Dataset)

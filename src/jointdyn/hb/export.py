@@ -12,6 +12,7 @@ import numpy as np
 
 from .problem import amplitude_q_meaning, reference_scales
 from .results import HBBranch, PointStatus
+from .stability_schedule import ASSUMPTION
 
 __all__ = ["branch_dataset", "discretisation_attrs", "pair_arrays"]
 
@@ -36,14 +37,20 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
     harmonic: sqrt(a_k^2 + b_k^2), |a_0| for k = 0). Per peak (dim
     ``peak``): ``peak_gamma``, ``peak_<parameter>`` (if not gamma),
     ``peak_amplitude_q``, ``peak_amplitude_m``, ``peak_branch``,
-    ``peak_refined``, ``peak_at_stop`` (:attr:`HBPeak.at_stop`).
+    ``peak_refined``, ``peak_at_stop`` (:attr:`HBPeak.at_stop`),
+    ``stability_checked`` (whether the point's label ``stable`` was
+    computed; False: carried over from the checked points on both sides,
+    growth NaN, ``StabilityOptions.check_every``).
 
     Attributes: ``status`` (:class:`~jointdyn.continuation.ContinuationStatus`;
     ``complete`` only when the range is covered), ``message`` (where and
     why segments stopped), ``uncovered`` (parts of the range without
     points, e.g. ``"1.164-1.185"``; empty when none), ``peaks``,
     ``peak_gamma`` and ``peak_amplitude_q`` (the highest peak, NaN
-    without one), ``folds``, ``unstable_points`` and the counters.
+    without one), ``folds``, ``unstable_points``, ``stability_check_every``,
+    ``stability_checked_points``, ``stability_assumption`` (what a label
+    carried over assumes; empty when every point was checked) and the
+    counters.
     """
     import xarray as xr
 
@@ -71,6 +78,7 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
         "branch": ("point", branch.segment),
         "gap": ("point", branch.gap),
         "growth": ("point", branch.growth),
+        "stability_checked": ("point", branch.stability_checked),
         "aft_passes": ("point", branch.passes),
         "force_period": ("point", branch.force_period),
         "harmonic_amplitude_m": (("point", "harmonic"), harm),
@@ -83,6 +91,8 @@ def branch_dataset(branch: HBBranch, response_dof: int | None = None):
              "amplitude_q": {"long_name": amplitude_q_meaning(p.system), "units": "1"},
              **{v: {"units": "m"} for v in ("amplitude_m", "offset_m", "max_abs_m", "harmonic_amplitude_m",
                                             "peak_amplitude_m")},
+             "stability_checked": {"long_name": "the label stable was computed here (else carried over from the "
+                                                "checked points on both sides)"},
              "point_status": {"flag_meanings": " ".join(s.value for s in PointStatus)},
              "pair_energy_J": {"units": "J", "long_name": "energy dissipated per cycle by each interface pair"},
              "energy_interface_J": {"units": "J", "long_name": "energy dissipated per cycle by all interface pairs"},
@@ -167,7 +177,10 @@ def _branch_attrs(branch: HBBranch, dof: int, ds) -> dict:
         peak_amplitude_q=float(ds.peak_amplitude_q.values[top]) if top is not None else math.nan,
         folds=int(branch.fold.sum()),
         unstable_points=int((~branch.stable).sum()),
-        stability=branch.stability if np.all(np.isfinite(branch.growth)) else "not-computed",
+        stability=branch.stability if _computed(branch) else "not-computed",
+        stability_check_every=int(branch.stability_check_every),
+        stability_checked_points=int(branch.stability_checked.sum()),
+        stability_assumption=ASSUMPTION if _computed(branch) and not branch.stability_checked.all() else "",
         condensed=int(p.condensed),
         unknown_dofs=int(p.n),
         max_aft_passes=int(branch.passes.max()) if branch.passes.size else 0,
@@ -176,6 +189,13 @@ def _branch_attrs(branch: HBBranch, dof: int, ds) -> dict:
         **{f"counter_{k}": int(v) for k, v in branch.counters.items()},
         **discretisation_attrs(branch),
     )
+
+
+def _computed(branch: HBBranch) -> bool:
+    """Whether the branch has its stability: a finite growth at every checked point, and a checked point
+    where it has points."""
+    checked = branch.stability_checked
+    return bool(np.all(np.isfinite(branch.growth[checked])) and (checked.any() or checked.size == 0))
 
 
 def discretisation_attrs(branch: HBBranch) -> dict:

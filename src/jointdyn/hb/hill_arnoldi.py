@@ -34,7 +34,15 @@ r_j of the farthest of them is among those found (Arnoldi converged), so
 the union of the disks covers the band ``|Re s| <= d`` along the strip with
 ``d = sqrt(min_j r_j^2 - h^2)``, h the farthest a point of the axis between
 0 and i w/2 lies from a shift (0 when the disks do not overlap: the band is
-not covered). A shift that falls on an eigenvalue (Q exactly singular) is
+not covered). ``arnoldi_shifts = 1`` (an option) is the one real shift
+sigma = 0 (a real Q(0) = J_X, whose LU costs about a quarter of a complex
+one's): its disk covers the strip when the farthest of its eigenvalues lies
+beyond w/2 (h = w/2, d = sqrt(r_0^2 - w^2/4)), as on a structure whose
+exponents near the axis are few (a reduced model: the exponents of a mode
+above (H + 1/2) w have no member near the axis); where it does not (band 0:
+exponents crowd the strip), the shifts j = 1..m of the layout of
+``arnoldi_cover_shifts`` = m + 1 shifts are added to it, and the band is that
+of all of them. A shift that falls on an eigenvalue (Q exactly singular) is
 moved by 1e-3 w. Hill's selection is applied to what was found: the
 conjugates added, copies found from two shifts counted once, and where more
 than 2n were found the 2n with the smallest |Im s| (the dense method's
@@ -202,7 +210,8 @@ def hill_arnoldi_exponents(JX, M, C, w, H, options: StabilityOptions | None = No
     H : int
         Number of harmonics.
     options : StabilityOptions, optional
-        ``arnoldi_shifts``, ``arnoldi_eigenvalues``, ``arnoldi_tol``, ``arnoldi_maxiter``.
+        ``arnoldi_shifts``, ``arnoldi_cover_shifts``, ``arnoldi_eigenvalues``, ``arnoldi_tol``,
+        ``arnoldi_maxiter``.
 
     Returns
     -------
@@ -235,13 +244,19 @@ def shift_invert_exponents(operator, n: int, H: int, w: float, opt: StabilityOpt
     k = min(opt.arnoldi_eigenvalues, 2 * N - 2)
     if k < 1:
         raise ValueError(f"Hill's companion matrix has {2 * N} rows: too few for Arnoldi (at least 3)")
-    m = opt.arnoldi_shifts - 1
     found, radii, ys = [], [], []
-    for j in range(m + 1):
-        y, lam = _nearest(operator, N, 0.5 * w * j / m, w, k, opt)
+
+    def at(y):
+        y, lam = _nearest(operator, N, y, w, k, opt)
         found.append(lam)
         ys.append(y)
         radii.append(float(np.max(np.abs(lam - complex(0.0, y)))))
+
+    for y in _layout(opt.arnoldi_shifts, w):
+        at(y)
+    if opt.arnoldi_shifts == 1 and _band(ys, radii, w) == 0.0:  # one disk short of i w/2: the covering shifts
+        for y in _layout(opt.arnoldi_cover_shifts, w)[1:]:
+            at(y)
     lam = np.concatenate(found)
     lam = np.concatenate((lam, lam.conj()))
     sel = _dedupe(lam, w, 1e-8)
@@ -249,12 +264,23 @@ def shift_invert_exponents(operator, n: int, H: int, w: float, opt: StabilityOpt
         key = np.round(np.abs(sel.imag) / w, 8)
         sel = sel[np.argsort(key, kind="stable")[: 2 * n]]
         sel = sel[np.argsort(-sel.real, kind="stable")]
+    band = _band(ys, radii, w)
+    growth = float(sel[0].real) / w if sel.size else math.nan
+    return ArnoldiExponents(exponents=sel, band=band, growth=growth)
+
+
+def _layout(count: int, w: float) -> list:
+    """Imaginary parts (rad/s) of ``count`` shifts evenly from 0 to w/2 (0 alone for one)."""
+    return [0.5 * w * j / (count - 1) for j in range(count)] if count > 1 else [0.0]
+
+
+def _band(ys, radii, w: float) -> float:
+    """Half-width d (1/s) of the band about the axis, between 0 and i w/2, that the disks of radii ``radii``
+    about the shifts i ``ys`` (ascending) cover (module docstring); 0 where they do not cover the axis."""
     # every point of the axis between 0 and i w/2 lies within h of a shift
     h = max(ys[0], 0.5 * w - ys[-1], *(0.5 * (b - a) for a, b in zip(ys, ys[1:])))
     r2 = min(radii) ** 2 - h * h
-    band = math.sqrt(r2) if r2 > 0.0 else 0.0
-    growth = float(sel[0].real) / w if sel.size else math.nan
-    return ArnoldiExponents(exponents=sel, band=band, growth=growth)
+    return math.sqrt(r2) if r2 > 0.0 else 0.0
 
 
 def hill_arnoldi_growth(JXs, M, C, ws, H, options: StabilityOptions | None = None) -> np.ndarray:

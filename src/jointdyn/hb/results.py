@@ -180,6 +180,14 @@ class HBBranch:
         companion matrix), ``hill-arnoldi`` (the exponents nearest the
         imaginary axis by shift-invert Arnoldi) or ``not-computed``
         (asked for no stability: growth NaN, no point stable).
+    stability_checked : ndarray of bool (points,)
+        Where the label ``stable`` was computed
+        (``StabilityOptions.check_every``,
+        :mod:`jointdyn.hb.stability_schedule`); elsewhere it is carried over
+        from the checked points on both sides, which agree, and ``growth``
+        is NaN. None when built: the points with a finite growth.
+    stability_check_every : int
+        ``StabilityOptions.check_every`` of the branch (1: every point).
     """
 
     problem: HBProblem
@@ -204,6 +212,12 @@ class HBBranch:
     response_dof: int
     discretisation: DiscretisationCheck | None = None
     stability: str = "hill"
+    stability_checked: np.ndarray | None = None
+    stability_check_every: int = 1
+
+    def __post_init__(self) -> None:
+        if self.stability_checked is None:
+            object.__setattr__(self, "stability_checked", np.isfinite(np.asarray(self.growth, dtype=float)))
 
     def gamma(self):
         """gamma = w / w0 per point."""

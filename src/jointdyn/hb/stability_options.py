@@ -37,8 +37,22 @@ class StabilityOptions:
         (0.094 against 0.028 s), 12x at 1722 and 42x at 4410 rows.
     arnoldi_shifts : int
         Shifts on the imaginary axis between 0 and i w/2, both included
-        (>= 2); more shifts cover a wider band about the axis with the same
-        eigenvalues per shift.
+        (>= 1, default 3: 0, i w/4, i w/2); more shifts cover a wider band
+        about the axis with the same eigenvalues per shift. 1: the real
+        shift 0 alone (a real LU, about a quarter of a complex one's), with
+        the shifts of ``arnoldi_cover_shifts`` added where its disk does not
+        reach i w/2 (:mod:`jointdyn.hb.hill_arnoldi`). On the lap joint at
+        H = 3 (5131 rows, one BLAS thread, load about 8-11) one shift took
+        3.5-5.0 s of CPU per point against 35-38 s for three, with the same
+        exponents (docs/performance.md). Not the default: on the tests'
+        condensed models one shift misses an exponent outside the strip
+        that dense Hill's selection keeps (an undamped model) and two shifts
+        (0, i w/2) give growths off dense Hill's by more than 1e-6 on a
+        condensed branch (docs/harmonic-balance.md).
+    arnoldi_cover_shifts : int
+        Shifts between 0 and i w/2 (>= 2) of the layout used where one real
+        shift does not cover the strip (3: 0, i w/4, i w/2; the shift 0 is
+        the one already made).
     arnoldi_eigenvalues : int
         Eigenvalues computed nearest each shift (>= 1).
     arnoldi_sparse_density : float
@@ -71,11 +85,25 @@ class StabilityOptions:
         as one stack and solved by one LAPACK call per parity block (the
         loop over the points in C), larger ones one point at a time (the
         stack's memory grows as points x rows^2); >= 0.
+    check_every : int
+        The points of a branch whose exponents are computed
+        (:mod:`jointdyn.hb.stability_schedule`): 1 (default) every point;
+        k > 1 every k-th point of each stretch of joined points, its ends,
+        both sides of every turning point, and, where two checked
+        neighbours disagree in label, the points between them by bisection
+        until the change lies between adjacent points; the other points
+        carry the label of their checked neighbours (``stability_checked``
+        False, growth NaN). It assumes no exponent crosses the imaginary
+        axis and back between two checked points: an unstable stretch
+        shorter than k points between two stable checked points is missed.
+        A single solution (:func:`~jointdyn.hb.frc.harmonic_balance`) is
+        always checked; >= 1.
     """
 
     method: str = "auto"
     dense_max_rows: int = 500
     arnoldi_shifts: int = 3
+    arnoldi_cover_shifts: int = 3
     arnoldi_eigenvalues: int = 12
     arnoldi_sparse_density: float = 0.1
     arnoldi_tol: float = 1e-13
@@ -84,11 +112,13 @@ class StabilityOptions:
     rtol: float = 1e-6
     confirm: float = 1e-4
     small_eig: int = 200
+    check_every: int = 1
 
     def __post_init__(self) -> None:
         V.choice("method", self.method, STABILITY_METHODS)
         V.positive_int("dense_max_rows", self.dense_max_rows, 0)
-        V.positive_int("arnoldi_shifts", self.arnoldi_shifts, 2)
+        V.positive_int("arnoldi_shifts", self.arnoldi_shifts, 1)
+        V.positive_int("arnoldi_cover_shifts", self.arnoldi_cover_shifts, 2)
         V.positive_int("arnoldi_eigenvalues", self.arnoldi_eigenvalues)
         V.in_range("arnoldi_sparse_density", self.arnoldi_sparse_density, 0.0, 1.0, lo_open=True)
         V.positive("arnoldi_tol", self.arnoldi_tol)
@@ -97,6 +127,7 @@ class StabilityOptions:
         V.positive("rtol", self.rtol)
         V.nonnegative("confirm", self.confirm)
         V.positive_int("small_eig", self.small_eig, 0)
+        V.positive_int("check_every", self.check_every)
 
     def method_for(self, rows: int) -> str:
         """The method used for a companion matrix of ``rows`` rows: ``dense``, ``arnoldi`` or ``none``."""
