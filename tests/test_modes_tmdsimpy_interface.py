@@ -47,10 +47,11 @@ def test_the_script_model_is_the_benchmark_chain():
     (itf,) = s.interfaces
     np.testing.assert_array_equal(itf.preload, m["P"])
     for name in ("kt", "kn", "mu"):
-        np.testing.assert_array_equal(getattr(itf, name), np.full(NODES, m[name]))
+        np.testing.assert_array_equal(np.broadcast_to(getattr(itf, name), (NODES,)), m[name])
     pairs = np.full((NODES, 6), -1)
     pairs[:, :3] = 3 * np.arange(NODES)[:, None] + np.arange(3)  # (t1, t2, n) of node i against ground
     np.testing.assert_array_equal(itf.pairs, pairs)
+    np.testing.assert_array_equal(m["pairs"], pairs)
     assert s.output_dof == m["output_dof"] == 0
 
 

@@ -1,4 +1,4 @@
-"""tmdsimpy's EPMC backbone of the node-pair chain, for the side-by-side of docs/performance.md.
+"""tmdsimpy's EPMC backbone of the node-pair chain or the shipped lap joint, for the side-by-side of docs/performance.md.
 
 The model is the chain of ``benchmarks/bench_hb_interface_chain.py`` (``chain(nodes)``),
 restated here in plain numpy (:func:`chain_model`; tests/test_modes_tmdsimpy_interface.py
@@ -44,10 +44,15 @@ with a message, status 0, where they are not. How tmdsimpy is set up:
   log-amplitudes of a tmdsimpy result by the same natural continuation, times it, and gives the
   largest differences in DOF 0's amplitude, frequency and damping ratio.
 
+``--model lap`` takes the shipped lap joint instead (:func:`lap_model`: the System of
+``benchmarks/bench_hb_scale.py``, 733 DOFs dense, 120 two-sided pairs, each a tmdsimpy element on its
+relative coordinates x_a - x_b, the span 2e-6..2e-3 m at the output DOF); jointdyn's side then
+assembles its harmonic-block Jacobians as one matrix for the bordered Newton.
+
 Run (prints JSON, ``--out`` writes it)::
 
     PYTHONPATH=/path/to/tmdsimpy-checkout python docs/scripts/tmdsimpy_chain_epmc.py \\
-        --nodes 16 --harmonics 5 --samples 128 --out tmdsimpy_chain16.json
+        --model chain16 --harmonics 5 --samples 128 --out tmdsimpy_chain16.json
     python docs/scripts/tmdsimpy_chain_epmc.py --jointdyn tmdsimpy_chain16.json
 """
 
@@ -70,7 +75,9 @@ KT, KN, MU = 2e4, 5e4, 0.5
 
 
 def chain_model(nodes: int) -> dict:
-    """M, C, K (kg, N s/m, N/m), preloads P (N), pair stiffnesses and mu of the chain (module docstring)."""
+    """M, C, K (kg, N s/m, N/m), preloads P (N), per-pair stiffnesses and mu, the pairs' DOFs (jointdyn's
+    ``a_t1, a_t2, a_n, b_t1, b_t2, b_n``, -1 for ground), the output DOF and the amplitude span (m, at the
+    output DOF on the linear mode: 0.01..10 fy / kt of the patch) of the chain (module docstring)."""
     n = 3 * nodes
     K = np.zeros((n, n))
     for i in range(nodes - 1):
@@ -82,15 +89,62 @@ def chain_model(nodes: int) -> dict:
             K[b, a] -= kd
     K[np.arange(n), np.arange(n)] += np.tile([1e3, 4e3, 1e3], nodes)
     P = 10.0 * (0.2 + np.exp(-((np.arange(nodes) - nodes / 2) / (nodes / 4)) ** 2))
-    return {"M": 0.1 * np.eye(n), "C": 1e-4 * K, "K": K, "P": P, "kt": KT, "kn": KN, "mu": MU, "output_dof": 0}
+    pairs = np.column_stack((3 * np.arange(nodes)[:, None] + np.arange(3), np.full((nodes, 3), -1)))
+    a_ref = MU * P.sum() / (KT * nodes)  # fy / kt of the patch, m
+    return {"name": f"chain{nodes}", "M": 0.1 * np.eye(n), "C": 1e-4 * K, "K": K, "P": P,
+            "kt": np.full(nodes, KT), "kn": np.full(nodes, KN), "mu": np.full(nodes, MU), "pairs": pairs,
+            "output_dof": 0, "span_m": (0.01 * a_ref, 10.0 * a_ref)}
+
+
+#: the lap joint's span at its output DOF, m: ``benchmarks/bench_hb_scale.py``'s AMPLITUDE_M
+LAP_SPAN_M = (2e-6, 2e-3)
+
+
+def lap_model() -> dict:
+    """The shipped lap joint as ``benchmarks/bench_hb_scale.py`` measures it (jointdyn's
+    ``figures.lap.lap_joint_system``: 733 DOFs dense, modal damping of the stuck modes, 120 two-sided
+    pairs), in the form of :func:`chain_model` (needs jointdyn)."""
+    from jointdyn.damping import dense_damping
+    from jointdyn.figures import lap
+
+    s, lj = lap.lap_joint_system(lap.LAP_FORCE_N, lap.LAP_ZETA)
+    itf = s.interfaces[0]
+    npairs = itf.pairs.shape[0]
+    per = lambda v: np.broadcast_to(np.asarray(v, dtype=float), (npairs,)).copy()  # noqa: E731
+    return {"name": "lap", "M": np.asarray(s.M), "C": np.asarray(dense_damping(s.C)), "K": np.asarray(s.K),
+            "P": per(itf.preload), "kt": per(itf.kt), "kn": per(itf.kn), "mu": per(itf.mu),
+            "pairs": np.asarray(itf.pairs), "output_dof": int(s.output_dof), "span_m": LAP_SPAN_M}
+
+
+def model(name: str) -> dict:
+    """:func:`chain_model` for ``chainN`` (N nodes), :func:`lap_model` for ``lap``."""
+    if name == "lap":
+        return lap_model()
+    if name.startswith("chain") and name[5:].isdigit():
+        return chain_model(int(name[5:]))
+    raise ValueError(f"--model must be lap or chainN (N nodes), got {name!r}")
+
+
+def _selection(pair, n: int) -> np.ndarray:
+    """The 3 x n selection of a pair's relative (t1, t2, n) displacement: x[a] - x[b] (-1: ground)."""
+    Q = np.zeros((3, n))
+    for k in range(3):
+        if pair[k] >= 0:
+            Q[k, pair[k]] += 1.0
+        if pair[3 + k] >= 0:
+            Q[k, pair[3 + k]] -= 1.0
+    return Q
 
 
 def _stuck_mode(m: dict):
     """(omega rad/s, mass-normalised shape with a positive output DOF) of the stuck linear first mode."""
     from scipy.linalg import eigh
 
-    nodes = m["P"].size
-    Ks = m["K"] + np.diag(np.tile([m["kt"], m["kt"], m["kn"]], nodes))
+    n = m["M"].shape[0]
+    Ks = m["K"].copy()
+    for i, pair in enumerate(m["pairs"]):
+        Q = _selection(pair, n)
+        Ks += Q.T @ np.diag([m["kt"][i], m["kt"][i], m["kn"][i]]) @ Q
     lam, vec = eigh(Ks, m["M"], subset_by_index=[0, 0])
     phi = vec[:, 0] / math.sqrt(vec[:, 0] @ m["M"] @ vec[:, 0])
     return math.sqrt(lam[0]), phi * np.sign(phi[m["output_dof"]])
@@ -102,11 +156,10 @@ def _system(m: dict):
 
     n = m["M"].shape[0]
     vib = VibrationSystem(m["M"], m["K"], C=m["C"])
-    for i, p in enumerate(m["P"]):
-        Q = np.zeros((3, n))
-        Q[np.arange(3), 3 * i + np.arange(3)] = 1.0
-        vib.add_nl_force(ElasticDryFriction3D(Q, Q.T.copy(), m["kt"], m["kn"], m["mu"], u0=0.0,
-                                              meso_gap=-p / m["kn"]))
+    for i, (pair, p) in enumerate(zip(m["pairs"], m["P"])):
+        Q = _selection(pair, n)
+        vib.add_nl_force(ElasticDryFriction3D(Q, Q.T.copy(), m["kt"][i], m["kn"][i], m["mu"][i], u0=0.0,
+                                              meso_gap=-p / m["kn"][i]))
     return vib
 
 
@@ -128,24 +181,25 @@ CONTINUATION_CONFIG = {"DynamicCtoP": True, "TargetNfev": 4, "MaxSteps": 400, "d
                        "backtrackStop": 0.05}
 
 
-def _setup(nodes: int, H: int, Nt: int) -> dict:
-    """tmdsimpy's EPMC residual of the chain, its starting point and the amplitude span (log10 of its
-    mass-normalised modal amplitude: 0.01..10 fy / kt at DOF 0 on the linear mode, and 0.15 more)."""
+def _setup(name: str, H: int, Nt: int) -> dict:
+    """tmdsimpy's EPMC residual of the model, its starting point and the amplitude span (log10 of its
+    mass-normalised modal amplitude: the model's ``span_m`` at its output DOF on the linear mode, and 0.15
+    more)."""
     import tmdsimpy.utils.harmonic as hutils
 
-    m = chain_model(nodes)
+    m = model(name)
     n, dof = m["M"].shape[0], m["output_dof"]
     h = np.arange(H + 1)
     Nhc = hutils.Nhc(h)
     vib = _system(m)
     w0, phi = _stuck_mode(m)
-    a_ref = m["mu"] * m["P"].sum() / (m["kt"] * nodes)  # fy / kt of the patch, m
     Fl = np.zeros(n * Nhc)
-    Fl[2:n:3] = m["P"]  # static forces on the normal DOFs: balance the preloads
+    for pair, p in zip(m["pairs"], m["P"]):  # static forces on the normal DOFs: balance the preloads
+        Fl[:n] += p * _selection(pair, n)[2]
     Fl[2 * n + dof] = 1.0  # phase: sine of DOF 0's first harmonic = 0
     Uwxa0 = np.zeros(n * Nhc + 3)
     Uwxa0[n:2 * n] = phi
-    la0 = math.log10(0.01 * a_ref / phi[dof])
+    la0 = math.log10(m["span_m"][0] / phi[dof])
     Uwxa0[-3:] = w0, float(phi @ m["C"] @ phi), la0
     count = [0]
 
@@ -158,8 +212,8 @@ def _setup(nodes: int, H: int, Nt: int) -> dict:
     CtoP = hutils.harmonic_wise_conditioning(Uwxa0, n, h, delta=1e-3)
     CtoP[:n] = hutils.harmonic_wise_conditioning(Uwxa0, n, h, delta=1e-5)[:n]
     CtoP[-3:-1] = np.abs(Uwxa0[-3:-1])
-    return {"n": n, "dof": dof, "res": res, "count": count, "Uwxa0": Uwxa0, "CtoP": CtoP, "a_ref": a_ref,
-            "w0": w0, "la0": la0, "la1": math.log10(10.0 * a_ref / phi[dof]) + 0.15}
+    return {"n": n, "dof": dof, "res": res, "count": count, "Uwxa0": Uwxa0, "CtoP": CtoP, "span_m": m["span_m"],
+            "w0": w0, "la0": la0, "la1": math.log10(m["span_m"][1] / phi[dof]) + 0.15}
 
 
 def _amplitude_row(Uwxa, R, n: int, dof: int) -> list:
@@ -171,12 +225,12 @@ def _amplitude_row(Uwxa, R, n: int, dof: int) -> list:
             float(np.max(np.abs(np.asarray(R)[:-2])))]
 
 
-def run(nodes: int, H: int, Nt: int, points: int = 40) -> dict:
-    """tmdsimpy's EPMC backbone of the chain at ``points`` equally spaced values of its log-amplitude
+def run(name: str, H: int, Nt: int, points: int = 40) -> dict:
+    """tmdsimpy's EPMC backbone of the model at ``points`` equally spaced values of its log-amplitude
     over the span of :func:`_setup`, up to the first one where Newton finds no solution (module docstring)."""
     from tmdsimpy.jax.solvers import NonlinearSolverOMP
 
-    S = _setup(nodes, H, Nt)
+    S = _setup(name, H, Nt)
     n, dof, res, CtoP = S["n"], S["dof"], S["res"], S["CtoP"][:-1]
     t = time.perf_counter()
     res(S["Uwxa0"])  # compiles the JAX code
@@ -219,20 +273,20 @@ def run(nodes: int, H: int, Nt: int, points: int = 40) -> dict:
     wall, cpu = time.perf_counter() - t, time.process_time() - tc
     evaluations = S["count"][0]
     rows = [_amplitude_row(X, res(X, False)[0], n, dof) for X in sols]
-    return {"nodes": nodes, "harmonics": H, "samples": Nt, "wall_s": wall, "cpu_s": cpu, "compile_s": compile_s,
+    return {"model": name, "harmonics": H, "samples": Nt, "wall_s": wall, "cpu_s": cpu, "compile_s": compile_s,
             "residual_evaluations": evaluations, "points": len(rows), "solves": len(path) - 1, "halvings": halvings,
             "wall_s_to_last_point": last[0], "cpu_s_to_last_point": last[1], "no_solution_from_la": stopped,
-            "la_range": [S["la0"], S["la1"]], "a_ref_m": S["a_ref"],
+            "la_range": [S["la0"], S["la1"]], "span_m": list(S["span_m"]),
             "omega_stuck_rad_s": S["w0"], "backbone": rows}
 
 
-def run_continuation(nodes: int, H: int, Nt: int) -> dict:
+def run_continuation(name: str, H: int, Nt: int) -> dict:
     """tmdsimpy's ``Continuation`` with its EPMC example's recipe over the same span: the points it
     reports (log-amplitude, omega), until it ends or leaves the span."""
     from tmdsimpy.continuation import Continuation
     from tmdsimpy.jax.solvers import NonlinearSolverOMP
 
-    S = _setup(nodes, H, Nt)
+    S = _setup(name, H, Nt)
     CtoP = S["CtoP"].copy()
     CtoP[-1] = abs(S["la1"] - S["la0"])
     trail = []
@@ -262,6 +316,7 @@ def _jointdyn_at_modal_amplitude(problem):
     def residual(z, la):
         v, lam = z[:-1], float(z[-1])
         Rs, Jv, Jlam = problem.residual(v, lam)
+        Jv = Jv.toarray() if hasattr(Jv, "toarray") else Jv  # harmonic blocks (a reduced model): as one matrix
         Y = problem.unpack(v, lam)[0] / 10.0 ** lam
         m2 = float(Y[n:2 * n] @ M @ Y[n:2 * n] + Y[2 * n:3 * n] @ M @ Y[2 * n:3 * n])
         g = np.zeros(z.size)
@@ -275,19 +330,29 @@ def _jointdyn_at_modal_amplitude(problem):
     return residual
 
 
+def jointdyn_system(name: str):
+    """jointdyn's System of the model :func:`model` restates: the benchmark's ``chain(N)`` or the lap joint."""
+    if name == "lap":
+        from jointdyn.figures import lap
+
+        return lap.lap_joint_system(lap.LAP_FORCE_N, lap.LAP_ZETA)[0]
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+    from bench_hb_interface_chain import chain
+
+    return chain(int(model(name)["P"].size))
+
+
 def run_jointdyn(reference: dict) -> dict:
     """jointdyn's EPMC (:class:`jointdyn.modes.EPMCProblem` bordered by the modal amplitude, solved by
     :func:`jointdyn.continuation.newton`) of the benchmark's ``chain(nodes)`` at the log-amplitudes of
     a tmdsimpy run, by the same natural continuation (secant predictor, a step halved where Newton
     fails or the frequency jumps), timed after a first solve that loads or compiles the kernels."""
-    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-    from bench_hb_interface_chain import chain
-
     from jointdyn.continuation import newton
     from jointdyn.modes import EPMCProblem
     from jointdyn.modes import EPMCOptions
 
-    p = EPMCProblem(chain(reference["nodes"]), harmonics=reference["harmonics"], samples=reference["samples"])
+    p = EPMCProblem(jointdyn_system(reference["model"]), harmonics=reference["harmonics"],
+                    samples=reference["samples"])
     residual = _jointdyn_at_modal_amplitude(p)
     las = [r[0] for r in reference["backbone"]]
     v0 = p.linear_guess()
@@ -352,7 +417,7 @@ def _provenance(commit: str | None) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--nodes", type=int, default=16)
+    ap.add_argument("--model", default="chain16", help="chainN (N nodes) or lap (the shipped lap joint)")
     ap.add_argument("--harmonics", type=int, default=5)
     ap.add_argument("--samples", type=int, default=128)
     ap.add_argument("--points", type=int, default=40)
@@ -374,9 +439,9 @@ def main(argv=None) -> int:
         except ImportError as exc:
             print(f"tmdsimpy side by side skipped: {exc}")
             return 0
-        out = run(args.nodes, args.harmonics, args.samples, args.points)
+        out = run(args.model, args.harmonics, args.samples, args.points)
         if args.continuation:
-            out.update(run_continuation(args.nodes, args.harmonics, args.samples))
+            out.update(run_continuation(args.model, args.harmonics, args.samples))
         out["provenance"] = _provenance(args.tmdsimpy_commit)
     text = json.dumps(out)
     print(text)
