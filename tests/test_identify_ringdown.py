@@ -194,8 +194,9 @@ def test_iwan_decay_through_macroslip_fits_the_whole_model_to_the_windows():
     assert "through macroslip" in fit.message and fit.status.value in ("identified", "partly-identified")
     true = {"k": 4e5, "kt": 1e5, "fy_N": 20.0, "zeta": 0.002}
     determined = [n for n in true if fit.parameters[n] is not None]
-    # k from the slipping frequency; kt, fy (intervals of +-4 to +-7 %) and zeta (+-40 %) are named
-    # not determined by the rule that a determined interval lies within +-3 %
+    # k from the slipping frequency; kt, fy (intervals of about -6 to +4 and -7 to +5 %) and zeta
+    # (-60 to +50 %) are named not determined by the rule that a determined interval lies within
+    # +-3 %
     assert "k" in determined, fit.message
     for n in determined:
         assert abs(fit.parameters[n] / true[n] - 1.0) < 0.03, (n, fit.parameters[n])
@@ -205,8 +206,8 @@ def test_iwan_decay_through_macroslip_fits_the_whole_model_to_the_windows():
     bb = epmc(system, (0.3 * b.amplitude_m.min(), 1.5 * b.amplitude_m.max()), harmonics=3, progress=False)
     la, at = np.log(bb.amplitude_m), np.log(b.amplitude_m)
     assert np.max(np.abs(fit.fitted["omega_rad_s"] / np.interp(at, la, bb.omega_rad_s) - 1.0)) < 0.005
-    # the damping ratio over the range the fit reports (its 95 % interval within +-5 %: here 0.95
-    # down to 0.48 slip displacements, the first and the last five windows trimmed)
+    # the damping ratio over the range the fit reports (its 95 % interval within +-5 %: here from
+    # the top window, 1.98 slip displacements, down to 0.40, the last windows trimmed)
     rng = fit.damping_range
     inside = np.array(rng["determined"], bool)
     assert rng["points"] == inside.sum() >= 3 and rng["trimmed_top"] + rng["trimmed_bottom"] > 0
@@ -349,3 +350,55 @@ def test_law_decay_rate_is_the_microslip_one_below_slip_and_the_stuck_one_above(
     stiff = jd.make_law("iwan", kt=1e5, mu=1e6, n_ref=100.0)
     w, D, rate = law_rates(stiff, k, zeta, m, np.array([1e-4]))
     np.testing.assert_allclose(rate, zeta * math.sqrt((k + 1e5) / m), rtol=1e-6)
+
+
+def test_law_turning_points_against_the_viscous_and_the_coulomb_oscillator():
+    """The half-cycle work balance of jointdyn.identify._lawdecay.law_turning_points against
+    closed forms: with no joint force left to dissipate (fy huge) the free decay of a viscous
+    oscillator, ln A falling by pi zeta / sqrt(1 - zeta^2) per half-cycle (the balance takes
+    the viscous work at omega_0: off by about (pi zeta)^2 / 6 of that); a Jenkins joint much
+    stiffer than k (kt = 1e4 k, no viscous damping) is Coulomb friction, the half travel falling
+    by 2 fy / k per half-cycle (less 4 fy^2 / (k kt 2 S) from the stuck stretches)."""
+    from jointdyn.identify._lawdecay import law_turning_points
+
+    m, k, zeta = 2.0, 4e5, 0.002
+    lin = jd.make_law("iwan", kt=1e5, mu=1e6, n_ref=100.0)
+    t, lna = law_turning_points(lin, k, zeta, m, math.log(1e-3), math.log(1e-3) - 0.2)
+    np.testing.assert_allclose(-np.diff(lna), math.pi * zeta / math.sqrt(1.0 - zeta * zeta), rtol=1e-4)
+    np.testing.assert_allclose(np.diff(t), math.pi / math.sqrt((k + 1e5) / m), rtol=1e-6)
+    fy = 20.0
+    coulomb = jd.make_law("jenkins", kt=1e4 * k, mu=0.2, n_ref=100.0)
+    _, lna = law_turning_points(coulomb, k, 0.0, m, math.log(1e-3), math.log(0.5e-3))
+    S = np.exp(lna)
+    np.testing.assert_allclose(-np.diff(S), 2.0 * fy / k, rtol=2e-3)
+
+
+def test_law_decay_matches_the_falls_of_a_simulated_decay_through_macroslip():
+    """The decay model of a ring-down through macroslip (jointdyn.identify._lawdecay) against
+    jointdyn's own time integration: the Iwan SDOF released from 5 slip displacements, no noise,
+    its windows from backbone_from_ringdown, and the model with the true parameters started
+    from each window's ln A. The falls of ln A from window to window match within 0.001 (at
+    most 0.0004 measured) but the first, whose window lies at the start of the band-pass filter
+    (its ln A 0.0026 low against the unfiltered record's: within 0.003). The model averaged
+    over a period (-d ln A/dt of the energy balance, integrated in t, each window taken as the
+    envelope at its centre) misses them by up to 0.0056, at 1.3 to 2 slip displacements, where
+    the fall per period peaks and bends within a window."""
+    from jointdyn.identify._lawdecay import law_decay_steps, law_rates
+    from jointdyn.identify.backbone import modal_law
+
+    system, law = _sdof("iwan")
+    t, x = _decay(system, law, [5.0 * law.x_slip], 0, math.sqrt(5e5 / 2.0), 150, 64, noise=0.0)
+    win = backbone_from_ringdown(t, x, "x", band=(300.0, 750.0)).windows
+    assert math.exp(win["lna"][0]) > 1.9 * law.x_slip and win["lna"].size >= 8
+    true = modal_law("iwan", None)({"k": 4e5, "kt": 1e5, "fy": 20.0, "zeta": 0.002})
+    measured = np.diff(win["lna"])
+    fall, _ = law_decay_steps(true, 4e5, 0.002, 2.0, win)
+    err = np.abs(fall - measured)
+    assert err[0] < 0.003 and np.max(err[1:]) < 0.001, err
+    # the period-averaged model: d t = -d ln A / rate by quadrature, read a window spacing later
+    lev = np.linspace(win["lna"][0] + 0.05, win["lna"][-1] - 0.5, 600)
+    rate = law_rates(true, 4e5, 0.002, 2.0, np.exp(lev))[2]
+    tl = np.concatenate(([0.0], np.cumsum(0.5 * (1.0 / rate[1:] + 1.0 / rate[:-1]) * -np.diff(lev))))
+    start = np.interp(-win["lna"][:-1], -lev, tl)
+    averaged = np.interp(start + np.diff(win["t"]), tl, lev) - win["lna"][:-1]
+    assert np.max(np.abs(averaged - measured)[1:]) > 0.004

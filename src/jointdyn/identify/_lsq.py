@@ -105,7 +105,7 @@ def _weak(params, u, jac, fun):
 
 
 def solve(fun, params: list, *, diff_step=None, profile: bool = False, level: float = FIT_LEVEL,
-          starts=()) -> Solution:
+          starts=(), noise_known: bool = False) -> Solution:
     """Minimise ``sum(fun(values)^2)`` over the parameters (``fun`` takes a dict of
     values by name and returns the residual vector) with scipy's trust-region
     least squares within the bounds; then the standard errors from the Jacobian at the
@@ -117,7 +117,8 @@ def solve(fun, params: list, *, diff_step=None, profile: bool = False, level: fl
     (:mod:`._profile`); a lower sum of squares met on a profile (the optimiser stopped in
     a local minimum) restarts least squares from there, once. ``starts``: further start
     points (dicts of values by name, the others from ``params``); least squares begins at
-    the one of lowest sum of squares."""
+    the one of lowest sum of squares. ``noise_known``: ``fun`` is whitened by a measured noise,
+    so the profile intervals take the residual variance as at least 1 (:func:`._profile.profile_intervals`)."""
     from ._profile import Interval, profile_intervals
 
     def values(u):
@@ -138,7 +139,7 @@ def solve(fun, params: list, *, diff_step=None, profile: bool = False, level: fl
     for attempt in range(2 if profile else 0):
         cov0 = covariance(np.asarray(res.jac, float), res.fun, np.ones(len(params), bool), FIT_XTOL)
         se_u = np.sqrt(np.abs(np.diag(cov0)))
-        bounds, best = profile_intervals(resid, params, res.x, se_u, res.fun.size, level)
+        bounds, best = profile_intervals(resid, params, res.x, se_u, res.fun.size, level, noise_known)
         ssr0 = float(res.fun @ res.fun)
         if attempt == 0 and best[0] < ssr0 * (1.0 - 1e-6):
             res = _least_squares(resid, best[1], lb, ub, diff_step)

@@ -160,7 +160,8 @@ class _Profiler:
         return c
 
 
-def profile_intervals(resid, params, u_opt, se_unit, m: int, level: float = FIT_LEVEL) -> tuple:
+def profile_intervals(resid, params, u_opt, se_unit, m: int, level: float = FIT_LEVEL,
+                      noise_known: bool = False) -> tuple:
     """Profile-likelihood intervals of every parameter.
 
     Parameters
@@ -178,6 +179,10 @@ def profile_intervals(resid, params, u_opt, se_unit, m: int, level: float = FIT_
         Number of residuals.
     level : float
         Confidence level (0, 1).
+    noise_known : bool
+        The residuals are whitened by a measured noise: the residual variance is taken as at
+        least 1 (a residual smaller than that noise, by chance over few residuals, does not
+        narrow the intervals; a larger one widens them).
 
     Returns
     -------
@@ -188,7 +193,7 @@ def profile_intervals(resid, params, u_opt, se_unit, m: int, level: float = FIT_
     """
     r0 = resid(np.asarray(u_opt, float))
     ssr0 = float(r0 @ r0)
-    rise = threshold(ssr0, m, len(params), level)
+    rise = threshold(max(ssr0, float(m - len(params))) if noise_known else ssr0, m, len(params), level)
     prof = _Profiler(resid, params, u_opt, ssr0, rise)
     out = []
     for i, p in enumerate(params):

@@ -57,8 +57,8 @@ RINGDOWN_FIT_MAX_SPAN = 1.2
 RINGDOWN_FIT_BAR_SPAN = 1.06
 #: the fitted model's damping ratio is reported as determined by a ring-down (``damping_range``)
 #: at the amplitudes where its 95 % interval lies within this fraction of it on each side (-):
-#: the accuracy asked of a ring-down's damping ratio. At the noisy bottom of a decay and at its
-#: fast-falling top the windows fix it less well; there the backbone is trimmed and says so.
+#: the accuracy asked of a ring-down's damping ratio. At the noisy bottom of a decay the windows
+#: fix it less well; there the backbone is trimmed and says so.
 RINGDOWN_DAMPING_RTOL = 0.05
 #: relative step of the forward differences of the damping range's Jacobians (-)
 RINGDOWN_RANGE_STEP = 1e-5
@@ -127,7 +127,7 @@ def damping_range(fun, values: dict, params, A, damping_of, bound: float = RINGD
     the residual variance where the fit leaves more than the noise; ``damping_of(values, A)``
     gives the damping ratios. The kept range is the longest run of consecutive points whose
     interval's half-width is at most ``bound`` of the value: the noise of the windows at the
-    bottom of a decay (and the averaging error of its fast-falling top) set where it ends, not a
+    bottom of a decay (and at its top, where few windows fall fast) sets where it ends, not a
     fixed count of windows.
 
     Returns
