@@ -132,6 +132,9 @@ def _closing(kt, mu, n0, n1, a1, a2, w1, w2):  # pragma: no cover - compiled
     return 1.0, f * t1, f * t2, n0, t1, t2, r, 0.0, 1.0
 
 
+#: the smallest positive normal double: below it a sum of squares is subnormal
+_NORMAL_MIN = 2.2250738585072014e-308
+
 @jit(inline="always")
 def _exit(kt, mu, v1, v2, s, nd, Ta1, Ta2, Na, proj):  # pragma: no cover - compiled
     """First sigma >= 0 where the stuck trial ``Ta + kt v sigma`` leaves the disc of radius
@@ -198,7 +201,10 @@ def _pair(kt, kn, mu, P, a1, a2, g0, u1, u2, g, w1, w2):  # pragma: no cover - c
     L, Ta1, Ta2, Na, T01, T02, r0, reclose, proj = _closing(kt, mu, n0, n1, a1, a2, w1, w2)
     v1 = u1 - a1
     v2 = u2 - a2
-    s = math.sqrt(v1 * v1 + v2 * v2)
+    s2 = v1 * v1 + v2 * v2
+    # hypot where the squares are subnormal (a step below about 1e-154 m: sqrt of their sum loses up to
+    # half the digits there); the sum of squares elsewhere, exact to rounding and cheaper on this path
+    s = math.sqrt(s2) if s2 >= _NORMAL_MIN else math.hypot(v1, v2)
     nd = n1 - n0
     sig = _exit(kt, mu, v1, v2, s, nd, Ta1, Ta2, Na, proj)
     if not sig < L:  # stuck to the end
